@@ -1,0 +1,3 @@
+from rotframe.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,54 @@
+"""Exceptions raised by rotframe.
+
+Every error a user can cause is a :class:`RotframeError`. The ones that mean
+"your input was wrong" are also :class:`ValueError`, so code that already
+catches ``ValueError`` keeps working; the command line turns them into exit
+code 2 with one line of text. :class:`IntegrationError` is a numerical failure
+(exit code 3) and carries the simulated time that was reached.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "RotframeError",
+    "NotARotationError",
+    "GimbalLockError",
+    "ScenarioError",
+    "IntegrationError",
+]
+
+
+class RotframeError(Exception):
+    """Base class of every error rotframe raises on purpose."""
+
+
+class NotARotationError(RotframeError, ValueError):
+    """A matrix that should be a proper rotation is not (not orthogonal, or det != +1)."""
+
+
+class GimbalLockError(RotframeError, ValueError):
+    """Euler angles or their rates are not unique at a singular middle angle."""
+
+
+class ScenarioError(RotframeError, ValueError):
+    """A scenario file, parameter or command-line value is invalid.
+
+    The message names the file or key, the offending value and what is allowed.
+    """
+
+
+class IntegrationError(RotframeError):
+    """The integration failed (non-finite state, step-size collapse).
+
+    Attributes
+    ----------
+    t_reached : float
+        Simulated time (s) of the last good state.
+    partial : object or None
+        What was computed up to ``t_reached`` (a trajectory), so that nothing is lost.
+    """
+
+    def __init__(self, message: str, t_reached: float = float("nan"), partial=None):
+        super().__init__(message)
+        self.t_reached = t_reached
+        self.partial = partial

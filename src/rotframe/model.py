@@ -1,0 +1,234 @@
+"""What a particle scene is: its force terms and their constants.
+
+A :class:`ParticleModel` lists the terms a scene includes, and nothing else is
+computed (a term that is absent costs one branch in the compiled kernel). It
+is constant during a run; the state (positions and velocities) lives apart, in
+the arrays the integrators advance, as MuJoCo keeps ``mjModel`` apart from
+``mjData``.
+
+All values are SI floats in the rotating frame's axes; units are converted at
+the edge (:mod:`rotframe.scenario`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["OmegaSchedule", "ParticleModel", "TERMS"]
+
+#: Force terms a particle scene can name.
+TERMS = (
+    "gravity",
+    "altitude-gravity",
+    "central-gravity",
+    "coriolis",
+    "centrifugal",
+    "euler",
+    "linear-drag",
+    "quadratic-drag",
+    "pendulum",
+    "spring",
+)
+
+
+@dataclass(frozen=True)
+class OmegaSchedule:
+    """Rotation of the frame: a fixed unit axis times a magnitude w(t).
+
+    w(t) is piecewise linear through the nodes ``(times, values)`` and held
+    constant outside them; a single node is a constant rate. Its integral
+    (the angle turned) and derivative (for the Euler force) are then exact.
+
+    Parameters
+    ----------
+    axis : (3,) array_like
+        Direction of omega in the rotating frame's axes (normalised here).
+    times, values : (K,) array_like
+        Node times (s, increasing) and rates (rad/s).
+    """
+
+    axis: np.ndarray
+    times: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def constant(cls, omega_vector):
+        """A constant angular velocity vector (rad/s), rotating-frame axes."""
+        w = np.asarray(omega_vector, dtype=float)
+        norm = float(np.linalg.norm(w))
+        axis = w / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
+        return cls(axis, np.zeros(1), np.array([norm]))
+
+    @classmethod
+    def ramp(cls, axis, omega0, alpha, duration):
+        """w(t) = omega0 + alpha t on [0, duration] about a fixed axis."""
+        duration = float(duration)
+        if alpha == 0.0 or duration <= 0.0:
+            return cls.constant(np.asarray(axis, float) / np.linalg.norm(axis) * omega0)
+        return cls.table(axis, [0.0, duration], [omega0, omega0 + alpha * duration])
+
+    @classmethod
+    def table(cls, axis, times, values):
+        """Piecewise-linear w(t) through the given nodes."""
+        axis = np.asarray(axis, dtype=float)
+        times = np.asarray(times, dtype=float)
+        values = np.asarray(values, dtype=float)
+        if times.ndim != 1 or times.shape != values.shape or times.size == 0:
+            raise ScenarioError("omega table: times and values must be 1-D arrays of one length")
+        if np.any(np.diff(times) <= 0):
+            raise ScenarioError("omega table: times must increase strictly")
+        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(values))):
+            raise ScenarioError("omega table: times and values must be finite")
+        return cls(axis / np.linalg.norm(axis), times, values)
+
+    @classmethod
+    def from_callable(cls, axis, func, t_end, nodes=4097):
+        """Sample a callable w(t) (rad/s) on ``nodes`` points of [0, t_end].
+
+        The compiled kernels cannot call Python, so a callable is tabulated;
+        the piecewise-linear interpolant has error O((t_end / nodes)^2 w'').
+        """
+        times = np.linspace(0.0, float(t_end), int(nodes))
+        values = np.array([float(func(t)) for t in times])
+        return cls.table(axis, times, values)
+
+    @property
+    def is_constant(self) -> bool:
+        return self.values.size == 1 or bool(np.all(self.values == self.values[0]))
+
+    def cumulative(self) -> np.ndarray:
+        """Integral of w from the first node to each node (rad)."""
+        dt = np.diff(self.times)
+        seg = 0.5 * dt * (self.values[1:] + self.values[:-1])
+        return np.concatenate([[0.0], np.cumsum(seg)])
+
+    def vector(self, t=0.0) -> np.ndarray:
+        """omega(t) as a vector (rad/s)."""
+        return self.axis * float(np.interp(t, self.times, self.values))
+
+    def angle(self, t):
+        """Angle turned since the first node, exact for the schedule (rad); vectorised."""
+        from rotframe.kernels import omega_angle
+
+        wint = self.cumulative()
+        return np.array([omega_angle(float(x), self.times, self.values, wint) for x in np.atleast_1d(t)])
+
+
+@dataclass(frozen=True)
+class ParticleModel:
+    """The force terms of a particle scene and their constants (SI).
+
+    Parameters
+    ----------
+    terms : tuple of str
+        Names from :data:`TERMS`. Only these are computed.
+    omega : OmegaSchedule
+        Rotation of the frame (used by coriolis, centrifugal and euler).
+    g : (3,) array
+        Uniform gravity vector (m/s^2) for ``gravity``. If the frame is the
+        Earth's and ``g`` is the effective gravity, the centrifugal term is
+        already inside it: do not name ``centrifugal`` too.
+    g0, radius, gm : float
+        For ``altitude-gravity`` (g0 (R/(R+z))^2, down) and ``central-gravity``
+        (-GM (r - c)/|r - c|^3 with the centre c = (0, 0, -R)).
+    k_linear, k_quadratic : float
+        Drag: a = -k_linear v (1/s) and a = -k_quadratic |v| v (1/m).
+    pendulum_length : float
+        String length L (m) for ``pendulum``; the bob stays on the sphere
+        |r - pivot| = L.
+    pivot : (3,) array
+        Suspension point (m).
+    spring : float
+        w0^2 (1/s^2) of a horizontal restoring force a = -w0^2 (x, y, 0), the
+        linearised (small-angle) pendulum, for ``spring``.
+    """
+
+    terms: tuple
+    omega: OmegaSchedule = field(default_factory=lambda: OmegaSchedule.constant([0.0, 0.0, 0.0]))
+    g: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    g0: float = 0.0
+    radius: float = 0.0
+    gm: float = 0.0
+    k_linear: float = 0.0
+    k_quadratic: float = 0.0
+    pendulum_length: float = 0.0
+    pivot: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    spring: float = 0.0
+
+    def __post_init__(self):
+        unknown = [t for t in self.terms if t not in TERMS]
+        if unknown:
+            raise ScenarioError(f"model: unknown term {unknown[0]!r}; allowed: {', '.join(TERMS)}")
+        gravities = [t for t in self.terms if t.endswith("gravity")]
+        if len(gravities) > 1:
+            raise ScenarioError(f"model: name one gravity term, not {gravities}")
+        if "pendulum" in self.terms and not self.pendulum_length > 0:
+            raise ScenarioError("model: pendulum needs a positive length")
+
+    def has(self, term: str) -> bool:
+        return term in self.terms
+
+    @property
+    def is_linear(self) -> bool:
+        """True when r'' is linear in (r, v) with constant coefficients.
+
+        Then the exact propagator (matrix exponential) applies.
+        """
+        nonlinear = {"altitude-gravity", "central-gravity", "quadratic-drag", "pendulum"}
+        if nonlinear & set(self.terms):
+            return False
+        uses_omega = {"coriolis", "centrifugal", "euler"} & set(self.terms)
+        return not uses_omega or self.omega.is_constant
+
+    def pack(self) -> np.ndarray:
+        """The flat parameter vector of :mod:`rotframe.kernels`."""
+        from rotframe import kernels as k
+
+        P = np.zeros(k.N_PARAMS)
+        P[k.I_AXIS : k.I_AXIS + 3] = self.omega.axis
+        P[k.I_CORIOLIS] = float(self.has("coriolis"))
+        P[k.I_CENTRIFUGAL] = float(self.has("centrifugal"))
+        P[k.I_EULER] = float(self.has("euler") and not self.omega.is_constant)
+        P[k.I_KLIN] = self.k_linear if self.has("linear-drag") else 0.0
+        P[k.I_KQUAD] = self.k_quadratic if self.has("quadratic-drag") else 0.0
+        if self.has("gravity"):
+            P[k.I_GMODE] = 0.0
+            P[k.I_G : k.I_G + 3] = self.g
+        elif self.has("altitude-gravity"):
+            P[k.I_GMODE] = 1.0
+        elif self.has("central-gravity"):
+            P[k.I_GMODE] = 2.0
+        else:
+            P[k.I_GMODE] = -1.0
+        P[k.I_GM] = self.gm
+        P[k.I_R] = self.radius
+        P[k.I_G0] = self.g0
+        if self.has("pendulum"):
+            P[k.I_PLEN] = self.pendulum_length
+            P[k.I_PIVOT : k.I_PIVOT + 3] = self.pivot
+        if self.has("spring"):
+            P[k.I_SPRING] = self.spring
+        return P
+
+    def linear_matrices(self):
+        """(K, C, b) with r'' = K r + C v + b, for a linear model (see :attr:`is_linear`)."""
+        w = self.omega.vector(0.0)
+        W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+        K = np.zeros((3, 3))
+        C = np.zeros((3, 3))
+        b = np.zeros(3)
+        if self.has("gravity"):
+            b = np.asarray(self.g, dtype=float).copy()
+        if self.has("coriolis"):
+            C -= 2.0 * W
+        if self.has("centrifugal"):
+            K -= W @ W
+        if self.has("linear-drag"):
+            C -= self.k_linear * np.eye(3)
+        if self.has("spring"):
+            K -= self.spring * np.diag([1.0, 1.0, 0.0])
+        return K, C, b

@@ -1,0 +1,187 @@
+"""Recordings of runs in rerun's ``.rrd`` format (layout fixed in DESIGN.md).
+
+* Timeline ``sim_time`` (a duration, integer nanoseconds rounded here, since
+  ``TimeColumn(duration=float seconds)`` would truncate).
+* Particles: ``world/<name>`` Points3D per sample, ``world/<name>/trail`` the path
+  as a static line strip. Rigid bodies: ``world/<name>`` Transform3D per
+  sample with the body axes as static Arrows3D below it.
+* Diagnostics: ``diagnostics/<quantity>`` Scalars. Summary: static
+  TextDocument at ``scenario``. A blueprint opens a 3D view beside the time series.
+* Bulk data goes by columns (``send_columns``); nothing is logged step by step.
+  Positions are float32 in rerun, so scenes log them in a local frame (ENU, body).
+* Files are deterministic (fixed recording id, no ``log_time``) and written to a
+  temporary name, then renamed: an earlier complete recording is only ever
+  replaced by a complete one. An interrupted or failed run is finalised as
+  ``<name>.partial.rrd``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["Recording", "default_path", "decimate"]
+
+
+def default_path(scenario_name: str) -> Path:
+    """``recordings/<scenario>.rrd`` in the working directory."""
+    return Path("recordings") / f"{scenario_name}.rrd"
+
+
+def partial_path(path: Path) -> Path:
+    """``x.rrd`` -> ``x.partial.rrd``."""
+    path = Path(path)
+    return path.with_name(path.stem + ".partial.rrd")
+
+
+def decimate(n: int, max_samples: int) -> np.ndarray:
+    """Indices of at most ``max_samples`` evenly spread samples of ``n``, first and last kept."""
+    if n <= max_samples:
+        return np.arange(n)
+    return np.unique(np.linspace(0, n - 1, max_samples).round().astype(np.int64))
+
+
+def _time_column(times):
+    import rerun as rr
+
+    ns = np.round(np.asarray(times, dtype=np.float64) * 1e9).astype(np.int64)
+    return rr.TimeColumn("sim_time", duration=ns.astype("timedelta64[ns]"))
+
+
+class Recording:
+    """One run's recording; use as a context manager or call :meth:`finish`.
+
+    Parameters
+    ----------
+    path : path-like
+        Final name (``.rrd``). Data goes to ``<path>.tmp`` until :meth:`finish`.
+    application_id : str
+        Shown in the viewer (the scenario name).
+    """
+
+    def __init__(self, path, application_id: str):
+        import rerun as rr
+
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.tmp = self.path.with_name(self.path.name + ".tmp")
+        self.rec = rr.RecordingStream(application_id, recording_id=f"rotframe-{application_id}",
+                                      send_properties=False)
+        self.rec.set_log_time_enabled(False)
+        self.rec.set_log_tick_enabled(False)
+        self.rec.save(str(self.tmp))
+        self._done = False
+
+    # -- logging -------------------------------------------------------------
+
+    def points(self, entity, times, positions, radius=None, color=None, trail=True):
+        """Points per sample at ``entity``; ``positions`` (n, 3) or (n, N, 3), m."""
+        import rerun as rr
+
+        pos = np.asarray(positions, dtype=np.float64)
+        if pos.ndim == 2:
+            pos = pos[:, None, :]
+        n, count, _ = pos.shape
+        flat = pos.reshape(n * count, 3).astype(np.float32)
+        cols = rr.Points3D.columns(positions=flat).partition(np.full(n, count))
+        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=cols)
+        static = {}
+        if radius is not None:
+            static["radii"] = [float(radius)]
+        if color is not None:
+            static["colors"] = [color]
+        if static:
+            self.rec.log(entity, rr.Points3D.from_fields(**static), static=True)
+        if trail:
+            strips = [pos[:, k, :].astype(np.float32) for k in range(count)]
+            self.rec.log(f"{entity}/trail", rr.LineStrips3D(strips, colors=color), static=True)
+
+    def line(self, entity, points, color=None):
+        """A static polyline (m)."""
+        import rerun as rr
+
+        self.rec.log(entity, rr.LineStrips3D([np.asarray(points, dtype=np.float32)], colors=color), static=True)
+
+    def segments(self, entity, times, starts, ends, color=None):
+        """A moving arrow per sample from ``starts`` to ``ends`` (n, 3)."""
+        import rerun as rr
+
+        starts = np.asarray(starts, dtype=np.float32)
+        vectors = (np.asarray(ends, dtype=np.float64) - starts).astype(np.float32)
+        cols = rr.Arrows3D.columns(origins=starts, vectors=vectors)
+        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=cols)
+        if color is not None:
+            self.rec.log(entity, rr.Arrows3D.from_fields(colors=[color]), static=True)
+
+    def body(self, entity, times, quaternions_xyzw, translation=None, axis_length=1.0):
+        """A rigid body: Transform3D per sample (scalar-last quaternions, body -> space)."""
+        import rerun as rr
+
+        q = np.asarray(quaternions_xyzw, dtype=np.float64)
+        kwargs = {"quaternion": q.astype(np.float32)}
+        if translation is not None:
+            kwargs["translation"] = np.asarray(translation, dtype=np.float32)
+        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Transform3D.columns(**kwargs))
+        L = float(axis_length)
+        self.rec.log(f"{entity}/axes", rr.Arrows3D(
+            vectors=[[L, 0, 0], [0, L, 0], [0, 0, L]],
+            colors=[[230, 60, 60], [60, 200, 60], [60, 90, 230]], labels=["e1", "e2", "e3"]), static=True)
+
+    def scalars(self, entity, times, values):
+        """A time series at ``entity`` (``diagnostics/<quantity>``)."""
+        import rerun as rr
+
+        vals = np.asarray(values, dtype=np.float64)
+        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Scalars.columns(scalars=vals))
+
+    def exact_values(self, entity, **arrays):
+        """Static float64 arrays (exact state that tests may read back) via AnyValues."""
+        import rerun as rr
+
+        self.rec.log(entity, rr.AnyValues(**{k: np.asarray(v, dtype=np.float64).ravel() for k, v in arrays.items()}),
+                     static=True)
+
+    def text(self, entity, markdown: str):
+        import rerun as rr
+
+        self.rec.log(entity, rr.TextDocument(markdown, media_type=rr.MediaType.MARKDOWN), static=True)
+
+    def blueprint(self, series=("diagnostics",)):
+        """3D view of ``world`` beside the time series and the summary text."""
+        import rerun.blueprint as rrb
+
+        views = [rrb.TimeSeriesView(origin=f"/{s}", name=s) for s in series]
+        bp = rrb.Blueprint(
+            rrb.Horizontal(
+                rrb.Spatial3DView(origin="/world", name="world"),
+                rrb.Vertical(*views, rrb.TextDocumentView(origin="/scenario", name="summary")),
+                column_shares=[3, 2],
+            ),
+            collapse_panels=True,
+        )
+        self.rec.send_blueprint(bp)
+
+    # -- finishing -----------------------------------------------------------
+
+    def finish(self, complete: bool = True) -> Path:
+        """Flush, write the footer and move the file to its final or partial name."""
+        if self._done:
+            return self.final
+        self.rec.flush()
+        self.rec.disconnect()
+        self.final = self.path if complete else partial_path(self.path)
+        os.replace(self.tmp, self.final)
+        self._done = True
+        return self.final
+
+    def abandon(self):
+        """Drop the temporary file (nothing useful was logged)."""
+        if not self._done:
+            self.rec.disconnect()
+            try:
+                self.tmp.unlink()
+            except FileNotFoundError:
+                pass
+            self._done = True

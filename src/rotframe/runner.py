@@ -1,0 +1,124 @@
+"""Run a scenario: values in, summary and result out (no printing, no recording).
+
+The command line (:mod:`rotframe.cli`) and the Python convenience function
+:func:`run` share this path; recording is downstream of a finished or
+interrupted run (:func:`record_result`).
+"""
+
+from __future__ import annotations
+
+import time
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["run", "simulate", "summarize", "record_result"]
+
+
+def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
+    """Load, simulate and analyse a scenario; returns ``(summary, result)``.
+
+    Parameters
+    ----------
+    name_or_path : str
+        Scenario name in ``scenarios/`` or a path to a ``.toml`` file.
+    sets : dict, optional
+        Parameter overrides ``{key: value}`` as on the command line.
+    method : str, optional
+        Integrator; default from the scenario's ``[run]`` or the scene.
+    terms : list of str, optional
+        Model terms replacing the scenario's ``model`` list.
+    """
+    from rotframe import scenario as sc
+
+    scn = sc.load(name_or_path)
+    values = scn.with_values(sets or {})
+    t0 = time.perf_counter()
+    result = simulate(scn, values, method=method, terms=terms, progress=progress)
+    simulate_s = time.perf_counter() - t0
+    summary = summarize(scn, values, result, {"simulate_s": simulate_s})
+    return summary, result
+
+
+def simulate(scn, values, *, method=None, terms=None, progress=None):
+    """Run the scene of ``scn`` with resolved ``values``; returns a SceneResult."""
+    from rotframe import scenes
+
+    scene = scenes.get(scn.scene)
+    run_settings = dict(values["run"])
+    method = method or run_settings.get("method")
+    allowed = getattr(scene, "METHODS", None)
+    if method is not None and allowed is not None and method not in allowed:
+        raise ScenarioError(f"--method {method!r} does not apply to {scn.name!r}; allowed: {', '.join(allowed)}")
+    params = {k: v for k, v in values.items() if k != "run"}
+    terms = list(scn.model if terms is None else terms)
+    return scene.simulate(params, terms, method, run_settings, progress)
+
+
+def summarize(scn, values, result, timing):
+    """The run summary (the JSON contract of DESIGN.md)."""
+    from rotframe import scenes
+
+    scene = scenes.get(scn.scene)
+    params = {k: v for k, v in values.items() if k != "run"}
+    analysis = scene.analyse(params, result)
+    summary = {
+        "scenario": scn.name,
+        "params": params,
+        "model": list(result.terms),
+        "method": result.method,
+        "steps": int(result.steps),
+        "metrics": analysis["metrics"],
+        "theory": analysis.get("theory", {}),
+        "diagnostics": analysis.get("diagnostics", {}),
+        "timing": dict(timing),
+        "recording": None,
+    }
+    if analysis.get("notes"):
+        summary["notes"] = analysis["notes"]
+    if not result.complete:
+        summary["complete"] = False
+        summary["t_reached_s"] = float(result.trajectory.t_reached)
+    return summary
+
+
+def summarize_minimal(scn, values, result, timing):
+    """A summary without metrics, for a partial run whose analysis is not possible."""
+    params = {k: v for k, v in values.items() if k != "run"}
+    return {"scenario": scn.name, "params": params, "model": list(result.terms), "method": result.method,
+            "steps": int(result.steps), "metrics": {}, "theory": {}, "diagnostics": {},
+            "timing": dict(timing), "recording": None, "complete": False,
+            "t_reached_s": float(result.trajectory.t_reached)}
+
+
+def record_result(scn, values, result, summary, path, complete=True):
+    """Write the recording; returns the final path (``.partial.rrd`` if not complete)."""
+    from rotframe import scenes
+    from rotframe.record import Recording
+
+    scene = scenes.get(scn.scene)
+    params = {k: v for k, v in values.items() if k != "run"}
+    rec = Recording(path, scn.name)
+    try:
+        scene.record(rec, params, result)
+        rec.text("scenario", summary_markdown(scn, summary))
+        rec.blueprint()
+    except BaseException:
+        rec.finish(complete=False)
+        raise
+    return rec.finish(complete=complete)
+
+
+def summary_markdown(scn, summary) -> str:
+    """The summary as Markdown for the recording's TextDocument."""
+    lines = [f"# {scn.title or scn.name}", "", scn.description, "", "## Parameters", ""]
+    for key, value in summary["params"].items():
+        unit = scn.parameters[key].unit if key in scn.parameters else ""
+        lines.append(f"- **{key}** = {value} {unit}")
+    lines += ["", f"Model: {', '.join(summary['model'])}; method: {summary['method']}; steps: {summary['steps']}",
+              "", "## Metrics (simulated / theory)", ""]
+    for key, value in summary["metrics"].items():
+        theory = summary["theory"].get(key)
+        lines.append(f"- **{key}** = {value:.6g}" + (f" / {theory:.6g}" if isinstance(theory, float) else ""))
+    lines += ["", "## Diagnostics", ""]
+    lines += [f"- {k} = {v:.3g}" for k, v in summary["diagnostics"].items() if isinstance(v, float)]
+    return "\n".join(lines)

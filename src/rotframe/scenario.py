@@ -1,0 +1,373 @@
+"""Scenario files: TOML in ``scenarios/``, loaded, validated and resolved to SI.
+
+A scenario file is meant to be read by a physicist who never saw the code::
+
+    name = "tower-drop"
+    title = "Reich's drop, Freiberg 1831"
+    description = "..."
+    scene = "tower-drop"            # which rotframe scene builds the model
+    model = ["gravity", "coriolis"] # the terms the scene includes by default
+
+    [parameters.height]
+    default = 158.5
+    unit = "m"
+    min = 0
+    doc = "drop height above the ground"
+
+    [run]
+    method = "exact"    # default integrator (``rotframe run --method`` overrides)
+    step = 1e-3         # s, fixed-step methods
+    rtol = 1e-10        # adaptive methods
+    samples = 2000      # samples recorded
+
+Values on the command line (``--set KEY=VALUE``) and in the file are numbers in
+the parameter's documented unit (SI; angles in degrees), astropy quantity
+strings of the right dimension (``"520 ft"``, ``"50d54m"``, ``"48d50m46s N"``)
+or, for vectors, comma-separated numbers. Every value is checked: unknown keys
+get a did-you-mean, wrong dimensions and impossible values are refused with a
+:class:`~rotframe.errors.ScenarioError` naming the file, key, value and what is
+allowed. This module imports astropy only when a string has to be parsed, so
+listing scenarios stays instant.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS"]
+
+_TOP_KEYS = ("name", "title", "description", "scene", "model", "optional_terms", "parameters", "run", "record")
+_PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusive_max", "shape", "choices", "type")
+#: Settings under ``[run]`` that ``--set`` may change too.
+RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
+_RECORD_KEYS = ("samples", "magnify", "trail")
+
+
+def scenario_dir() -> Path:
+    """The ``scenarios/`` folder: ``$ROTFRAME_SCENARIOS``, else the repository's, else the package's."""
+    import os
+
+    env = os.environ.get("ROTFRAME_SCENARIOS")
+    if env:
+        return Path(env)
+    here = Path(__file__).resolve()
+    for base in (here.parents[2], here.parent):
+        if (base / "scenarios").is_dir():
+            return base / "scenarios"
+    return here.parents[2] / "scenarios"
+
+
+def names() -> list[str]:
+    """Names of the scenarios in :func:`scenario_dir`, sorted."""
+    return sorted(p.stem for p in scenario_dir().glob("*.toml"))
+
+
+def find(name_or_path: str) -> Path:
+    """Resolve a scenario name (inside ``scenarios/``) or a path to a ``.toml`` file.
+
+    A bare name may not escape ``scenarios/``: ``../x`` or ``a/b`` are refused;
+    a path must end in ``.toml`` and exist.
+    """
+    text = str(name_or_path)
+    if text.endswith(".toml"):
+        path = Path(text)
+        if not path.is_file():
+            raise ScenarioError(f"scenario file {text!r} does not exist")
+        return path
+    valid = names()
+    if "/" in text or "\\" in text or text.startswith(".") or not text:
+        raise ScenarioError(f"scenario {text!r}: not a scenario name; use one of {', '.join(valid)} "
+                            "or a path ending in .toml")
+    path = scenario_dir() / f"{text}.toml"
+    if not path.is_file():
+        raise ScenarioError(f"unknown scenario {text!r}{_did_you_mean(text, valid)}; available: {', '.join(valid)}")
+    return path
+
+
+@dataclass
+class Parameter:
+    """One scenario parameter: default, unit, bounds and documentation."""
+
+    name: str
+    default: object
+    unit: str = ""
+    doc: str = ""
+    min: float | None = None
+    max: float | None = None
+    exclusive_min: bool = False
+    exclusive_max: bool = False
+    shape: int = 0  # 0 scalar, 3 vector
+    choices: tuple = ()
+    type: str = "float"  # float, int, bool, str, vector
+
+    def describe(self) -> str:
+        bounds = []
+        if self.min is not None:
+            bounds.append((">" if self.exclusive_min else ">=") + f" {self.min:g}")
+        if self.max is not None:
+            bounds.append(("<" if self.exclusive_max else "<=") + f" {self.max:g}")
+        if self.choices:
+            bounds.append("one of " + ", ".join(map(str, self.choices)))
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{_fmt(self.default)}{unit}" + (f" ({', '.join(bounds)})" if bounds else "")
+
+
+@dataclass
+class Scenario:
+    """A loaded, validated scenario: what the scene is, not where it is."""
+
+    name: str
+    path: Path
+    title: str
+    description: str
+    scene: str
+    model: list
+    optional_terms: list
+    parameters: dict
+    run: dict
+    record: dict
+    values: dict = field(default_factory=dict)
+
+    def with_values(self, sets: dict | None = None) -> dict:
+        """Parameter values (documented units) after applying ``--set`` overrides.
+
+        Run settings (:data:`RUN_KEYS`) may be set the same way; they are
+        returned under the key ``"run"``.
+        """
+        values = {k: p.default for k, p in self.parameters.items()}
+        run = dict(self.run)
+        for key, raw in (sets or {}).items():
+            if key in self.parameters:
+                values[key] = parse_value(self.parameters[key], raw, source="--set")
+            elif key in RUN_KEYS:
+                run[key] = _parse_run_value(key, raw, source="--set")
+            else:
+                allowed = list(self.parameters) + list(RUN_KEYS)
+                raise ScenarioError(f"--set: unknown key {key!r} for scenario {self.name!r}"
+                                    f"{_did_you_mean(key, allowed)}; allowed: {', '.join(allowed)}")
+        values["run"] = run
+        return values
+
+
+def load(name_or_path: str) -> Scenario:
+    """Load and validate a scenario by name or path."""
+    path = find(name_or_path)
+    src = path.name
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{src}: not valid TOML: {exc}") from None
+    _check_keys(data, _TOP_KEYS, src, "top level")
+    for required in ("scene", "parameters"):
+        if required not in data:
+            raise ScenarioError(f"{src}: missing {required!r}")
+    from rotframe.scenes import SCENES
+
+    scene = data["scene"]
+    if scene not in SCENES:
+        raise ScenarioError(f"{src}: scene {scene!r} unknown{_did_you_mean(scene, list(SCENES))}; "
+                            f"available: {', '.join(SCENES)}")
+    params = {}
+    for key, spec in data["parameters"].items():
+        if not isinstance(spec, dict):
+            spec = {"default": spec}
+        _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
+        if "default" not in spec:
+            raise ScenarioError(f"{src}: parameters.{key} has no default")
+        p = Parameter(name=key, default=None, unit=spec.get("unit", ""), doc=spec.get("doc", ""),
+                      min=spec.get("min"), max=spec.get("max"),
+                      exclusive_min=bool(spec.get("exclusive_min", False)),
+                      exclusive_max=bool(spec.get("exclusive_max", False)),
+                      shape=int(spec.get("shape", 0)), choices=tuple(spec.get("choices", ())),
+                      type=spec.get("type", _infer_type(spec)))
+        p.default = parse_value(p, spec["default"], source=src)
+        params[key] = p
+    clash = set(params) & set(RUN_KEYS)
+    if clash:
+        raise ScenarioError(f"{src}: parameter names {sorted(clash)} are reserved for [run]")
+    run = {"method": None, "step": None, "rtol": 1e-10, "samples": 2000}
+    for key, raw in data.get("run", {}).items():
+        if key not in RUN_KEYS:
+            raise ScenarioError(f"{src}: unknown key 'run.{key}'{_did_you_mean(key, list(RUN_KEYS))}; "
+                                f"allowed: {', '.join(RUN_KEYS)}")
+        run[key] = _parse_run_value(key, raw, source=src)
+    record = data.get("record", {})
+    _check_keys(record, _RECORD_KEYS, src, "record")
+    model = list(data.get("model", []))
+    from rotframe.model import TERMS
+
+    for term in model + list(data.get("optional_terms", [])):
+        if term not in TERMS:
+            raise ScenarioError(f"{src}: model term {term!r} unknown{_did_you_mean(term, list(TERMS))}; "
+                                f"allowed: {', '.join(TERMS)}")
+    return Scenario(name=data.get("name", path.stem), path=path, title=data.get("title", ""),
+                    description=data.get("description", "").strip(), scene=scene, model=model,
+                    optional_terms=list(data.get("optional_terms", [])), parameters=params, run=run,
+                    record=record)
+
+
+# ---------------------------------------------------------------------------
+# values
+# ---------------------------------------------------------------------------
+
+
+def parse_value(p: Parameter, raw, source: str = ""):
+    """Parse and check one value for parameter ``p``; returns it in ``p.unit``."""
+    where = f"{source}: " if source else ""
+    if p.type == "bool":
+        if isinstance(raw, bool):
+            return raw
+        text = str(raw).strip().lower()
+        if text in ("true", "1", "yes", "on"):
+            return True
+        if text in ("false", "0", "no", "off"):
+            return False
+        raise ScenarioError(f"{where}{p.name} = {raw!r}: expected true or false")
+    if p.type == "str":
+        value = str(raw)
+        if p.choices and value not in p.choices:
+            raise ScenarioError(f"{where}{p.name} = {value!r}: allowed {', '.join(map(str, p.choices))}"
+                                f"{_did_you_mean(value, list(map(str, p.choices)))}")
+        return value
+    if p.type == "vector":
+        items = raw if isinstance(raw, (list, tuple)) else str(raw).split(",")
+        try:
+            vec = [_to_float(p, x, where) for x in items]
+        except ScenarioError:
+            raise
+        if p.shape and len(vec) != p.shape:
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected {p.shape} comma-separated numbers "
+                                f"in {p.unit or 'the documented unit'}")
+        return vec
+    value = _to_float(p, raw, where)
+    if p.type == "int":
+        if value != int(value):
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a whole number")
+        value = int(value)
+    _check_bounds(p, value, raw, where)
+    return value
+
+
+def _to_float(p: Parameter, raw, where: str) -> float:
+    if isinstance(raw, bool):
+        raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a number in {p.unit or 'the documented unit'}")
+    if isinstance(raw, (int, float)):
+        value = float(raw)
+    elif isinstance(raw, str):
+        value = _parse_quantity(p, raw.strip(), where)
+    else:
+        raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a number or a quantity string")
+    if not math.isfinite(value):
+        raise ScenarioError(f"{where}{p.name} = {raw!r}: must be a finite number")
+    return value
+
+
+def _parse_quantity(p: Parameter, text: str, where: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    unit = p.unit or ""
+    import astropy.units as u
+
+    try:
+        if unit in ("deg", "rad"):
+            from astropy.coordinates import Angle
+
+            sign = 1.0
+            stripped = text
+            if text[-1:].upper() in ("N", "S", "E", "W") and not text[-2:].lower().endswith("rad"):
+                sign = -1.0 if text[-1].upper() in ("S", "W") else 1.0
+                stripped = text[:-1].strip()
+            return sign * float(Angle(stripped).to_value(unit))
+        q = u.Quantity(text)
+        target = u.Unit(unit) if unit else u.dimensionless_unscaled
+        return float(q.to_value(target))
+    except (u.UnitConversionError, u.UnitTypeError) as exc:
+        raise ScenarioError(f"{where}{p.name} = {text!r}: wrong dimension; expected a value in "
+                            f"{unit or 'no unit'} ({_first_line(exc)})") from None
+    except (ValueError, TypeError) as exc:
+        raise ScenarioError(f"{where}{p.name} = {text!r}: not a number or quantity; expected e.g. "
+                            f"'{_fmt(p.default)} {unit}'. ({_first_line(exc)})") from None
+
+
+def _check_bounds(p: Parameter, value: float, raw, where: str):
+    bad = None
+    if p.min is not None and (value < p.min or (p.exclusive_min and value == p.min)):
+        bad = ("> " if p.exclusive_min else ">= ") + f"{p.min:g}"
+    if p.max is not None and (value > p.max or (p.exclusive_max and value == p.max)):
+        bad = ("< " if p.exclusive_max else "<= ") + f"{p.max:g}"
+    if bad:
+        unit = f" {p.unit}" if p.unit else ""
+        shown = raw if isinstance(raw, str) else f"{value:g}"
+        raise ScenarioError(f"{where}{p.name} = {shown}: out of range; allowed {bad}{unit}")
+
+
+def _parse_run_value(key, raw, source):
+    kind = RUN_KEYS[key]
+    where = f"{source}: " if source else ""
+    if kind is str:
+        from rotframe.integrators import METHODS
+
+        if str(raw) not in METHODS:
+            raise ScenarioError(f"{where}method = {raw!r}: allowed {', '.join(METHODS)}"
+                                f"{_did_you_mean(str(raw), list(METHODS))}")
+        return str(raw)
+    p = Parameter(name=key, default=raw, unit="s" if key == "step" else "", min=0.0, exclusive_min=True)
+    value = _to_float(p, raw, where)
+    _check_bounds(p, value, raw, where)
+    if kind is int:
+        if value != int(value):
+            raise ScenarioError(f"{where}{key} = {raw!r}: expected a whole number")
+        return int(value)
+    return value
+
+
+# ---------------------------------------------------------------------------
+# helpers
+# ---------------------------------------------------------------------------
+
+
+def _infer_type(spec) -> str:
+    d = spec.get("default")
+    if spec.get("shape"):
+        return "vector"
+    if isinstance(d, bool):
+        return "bool"
+    if isinstance(d, list):
+        return "vector"
+    if isinstance(d, str) and spec.get("choices"):
+        return "str"
+    if isinstance(d, int) and not spec.get("unit"):
+        return "int"
+    return "float"
+
+
+def _check_keys(data: dict, allowed, src: str, where: str):
+    for key in data:
+        if key not in allowed:
+            raise ScenarioError(f"{src}: unknown key {key!r} in {where}{_did_you_mean(key, list(allowed))}; "
+                                f"allowed: {', '.join(allowed)}")
+
+
+def _did_you_mean(word: str, options) -> str:
+    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _first_line(exc) -> str:
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
+def _fmt(value) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, list):
+        return ",".join(_fmt(v) for v in value)
+    return str(value)
