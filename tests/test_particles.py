@@ -1,0 +1,149 @@
+"""Particle core: every method against the inertial-line oracle, orders, conservation, events."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rotframe.integrators import Event, integrate_particles
+from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.scenes.turntable import inertial_line
+
+Z = np.array([0.0, 0.0, 1.0])
+R0 = np.array([2.0, 0.0, 0.0])
+V0 = np.array([-1.0, 0.3, 0.0])
+
+
+def _turntable(alpha, method, step, duration=4.0):
+    omega = OmegaSchedule.ramp(Z, 1.0, alpha, duration)
+    terms = ("coriolis", "centrifugal") + (("euler",) if alpha else ())
+    model = ParticleModel(terms, omega=omega)
+    traj = integrate_particles(model, R0, V0, duration, method=method, step=step, rtol=1e-12, samples=40)
+    oracle = inertial_line(omega, R0, V0, traj.times)
+    return np.max(np.linalg.norm(traj.r[:, 0] - oracle, axis=1))
+
+
+# (method, step, tolerance on the max position error in metres, order)
+# Over 4 s the puck travels about 4 m and the table turns ~0.9 times; a second-order
+# method at |omega| h = 1e-4 errs by ~(omega h)^2 x distance x turns ~ 1e-7 m.
+CASES = [
+    ("splitting", 1e-4, 1e-6, 2),
+    ("splitting4", 1e-3, 1e-9, 4),
+    ("rk4", 1e-3, 1e-10, 4),
+    ("dop853", None, 1e-10, None),
+]
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.2])
+@pytest.mark.parametrize("method,step,tol,order", CASES)
+def test_every_method_reproduces_the_inertial_line(method, step, tol, order, alpha):
+    assert _turntable(alpha, method, step) < tol
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.2])
+@pytest.mark.parametrize("method,step,tol,order", [c for c in CASES if c[3]])
+def test_observed_order_of_convergence(method, step, tol, order, alpha):
+    h = step * 20
+    e1 = _turntable(alpha, method, h)
+    e2 = _turntable(alpha, method, h / 2)
+    observed = np.log2(e1 / e2)
+    assert abs(observed - order) < 0.3, observed
+
+
+def test_exact_propagator_matches_inertial_line_for_constant_spin():
+    omega = OmegaSchedule.constant([0.0, 0.0, 1.0])
+    model = ParticleModel(("coriolis", "centrifugal"), omega=omega)
+    assert model.is_linear
+    traj = integrate_particles(model, R0, V0, 10.0, method="exact", samples=500)
+    oracle = inertial_line(omega, R0, V0, traj.times)
+    assert np.max(np.linalg.norm(traj.r[:, 0] - oracle, axis=1)) < 1e-12
+
+
+def test_splitting_keeps_speed_under_pure_coriolis_and_rk4_does_not():
+    omega = OmegaSchedule.constant([0.3, -0.2, 1.0])
+    model = ParticleModel(("coriolis",), omega=omega)
+    v0 = np.array([1.0, 2.0, -0.5])
+    n_steps = 10**6
+    h = 0.05  # |2 omega| h ~ 0.1 rad per step
+    speeds = {}
+    for method in ("splitting", "rk4"):
+        traj = integrate_particles(model, [0, 0, 0], v0, n_steps * h, method=method, step=h, samples=100)
+        speeds[method] = np.abs(np.linalg.norm(traj.v[:, 0], axis=1) / np.linalg.norm(v0) - 1).max()
+    # round-off only: at most one ulp per step (N eps = 2.2e-10), against RK4's truncation loss
+    assert speeds["splitting"] < n_steps * np.finfo(float).eps
+    assert speeds["rk4"] > 1e-6  # RK4 damps the rotation: |v| decays like (1 - (wh)^6/72) per step
+
+
+def test_ground_event_is_located_to_round_off():
+    lat = np.radians(50.9)
+    om = 7.292115e-5 * np.array([0.0, np.cos(lat), np.sin(lat)])
+    model = ParticleModel(("gravity", "coriolis", "quadratic-drag"), omega=OmegaSchedule.constant(om),
+                          g=np.array([0, 0, -9.81]), k_quadratic=1e-3)
+    ev = Event("ground", "r", 2, 0.0, -1, True)
+    for method in ("splitting", "rk4", "dop853"):
+        traj = integrate_particles(model, [0, 0, 100.0], [0, 0, 0], 20.0, method=method, step=1e-3,
+                                   samples=50, events=[ev])
+        (t_hit,), state = traj.event_times["ground"][0], traj.event_states["ground"][0]
+        assert abs(state[0, 2]) < 1e-12
+        assert 4.0 < t_hit < 6.0
+        # the particle stops at the impact
+        assert np.allclose(traj.r[-1, 0], state[0, :3])
+
+
+def test_drag_fall_agrees_with_solve_ivp_reference():
+    k2 = 2e-3
+    g = np.array([0.0, 0.0, -9.81])
+    om = np.array([0.0, 5e-5, 5e-5])
+
+    def rhs(t, y):
+        v = y[3:]
+        a = g - 2 * np.cross(om, v) - k2 * np.linalg.norm(v) * v
+        return np.concatenate([v, a])
+
+    ref = solve_ivp(rhs, (0, 3.0), [0, 0, 100, 3, 1, 10], method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
+    model = ParticleModel(("gravity", "coriolis", "quadratic-drag"), omega=OmegaSchedule.constant(om), g=g,
+                          k_quadratic=k2)
+    for method, step, tol in [("splitting4", 1e-3, 1e-9), ("dop853", None, 1e-9), ("splitting", 1e-4, 1e-6)]:
+        traj = integrate_particles(model, [0, 0, 100], [3, 1, 10], 3.0, method=method, step=step, rtol=1e-12,
+                                   samples=10)
+        state = np.concatenate([traj.r[-1, 0], traj.v[-1, 0]])
+        assert np.max(np.abs(state - ref)) < tol, method
+
+
+def test_pendulum_splitting_keeps_the_string_length():
+    L = 10.0
+    model = ParticleModel(("gravity", "coriolis", "pendulum"),
+                          omega=OmegaSchedule.constant([0, 4e-5, 6e-5]), g=np.array([0, 0, -9.81]),
+                          pendulum_length=L, pivot=np.array([0.0, 0.0, L]))
+    r0 = np.array([L * np.sin(0.3), 0.0, L - L * np.cos(0.3)])
+    traj = integrate_particles(model, r0, [0, 0, 0], 200.0, method="splitting", step=1e-2, samples=200)
+    length = np.linalg.norm(traj.r[:, 0] - model.pivot, axis=1)
+    assert np.max(np.abs(length - L)) < 1e-12
+    radial_v = np.einsum("ij,ij->i", traj.r[:, 0] - model.pivot, traj.v[:, 0]) / L
+    assert np.max(np.abs(radial_v)) < 1e-12
+
+
+def test_ensemble_equals_separate_runs():
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0, 1e-4, 1e-4]),
+                          g=np.array([0, 0, -9.81]))
+    r0 = np.array([[0, 0, 10.0], [1, 2, 30.0], [0, 0, 5.0]])
+    v0 = np.array([[1, 0, 0], [0, 3, 1.0], [0, 0, 0]])
+    ens = integrate_particles(model, r0, v0, 2.0, method="splitting", step=1e-3, samples=20)
+    for p in range(3):
+        one = integrate_particles(model, r0[p], v0[p], 2.0, method="splitting", step=1e-3, samples=20)
+        assert np.array_equal(ens.r[:, p], one.r[:, 0])
+
+
+def test_dop853_tableau_is_consistent():
+    from rotframe._dop853 import coefficients
+
+    A, B, C, E3, E5 = coefficients()
+    assert np.allclose(A.sum(axis=1), C, atol=1e-14)
+    assert abs(B.sum() - 1) < 1e-14
+
+
+def test_exact_method_refuses_nonlinear_models():
+    from rotframe.errors import ScenarioError
+
+    model = ParticleModel(("gravity", "quadratic-drag"), g=np.array([0, 0, -9.81]), k_quadratic=1e-3)
+    with pytest.raises(ScenarioError, match="linear"):
+        integrate_particles(model, [0, 0, 1], [0, 0, 0], 1.0, method="exact")
