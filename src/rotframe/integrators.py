@@ -68,7 +68,8 @@ class Event:
     """A zero crossing located to round-off on the method's own trajectory.
 
     ``kind`` "r" or "v": the event function is ``r[component] - value`` or
-    ``v[component] - value``; ``direction`` +1 rising, -1 falling, 0 both;
+    ``v[component] - value``; "altitude": height above the sphere of the
+    model's ``radius`` centred at (0, 0, -radius), minus ``value`` (curved ground); ``direction`` +1 rising, -1 falling, 0 both;
     a ``terminal`` event stops that particle (ground impact).
     """
 
@@ -80,7 +81,8 @@ class Event:
     terminal: bool = False
 
     def row(self):
-        return [0.0 if self.kind == "r" else 1.0, float(self.component), float(self.value),
+        kind = {"r": 0.0, "v": 1.0, "altitude": 2.0}[self.kind]
+        return [kind, float(self.component), float(self.value),
                 float(self.direction), float(self.terminal)]
 
 

@@ -30,6 +30,7 @@ Layout of ``P`` (see ``pack`` in :mod:`rotframe.model`)::
     15:18 pendulum pivot (m)
     18    g0 for the altitude model (m/s^2)
     19    horizontal spring w0^2 (1/s^2): a += -w0^2 (x, y, 0), the small-angle pendulum
+    20    density scale height H (m) of the drag: k -> k exp(-z / H); 0 for uniform air
 
 The rotation-rate magnitude table is ``wt`` (node times, increasing) and
 ``wv`` (values, rad/s); outside the table the end values are held. ``wint``
@@ -44,11 +45,12 @@ from numba import njit
 
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
-I_KLIN, I_KQUAD, I_GMODE, I_GM, I_R, I_PLEN, I_PIVOT, I_G0, I_SPRING = 9, 10, 11, 12, 13, 14, 15, 18, 19
-N_PARAMS = 20
+I_KLIN, I_KQUAD, I_GMODE, I_GM, I_R, I_PLEN, I_PIVOT, I_G0, I_SPRING, I_SCALE_H = 9, 10, 11, 12, 13, 14, 15, 18, 19, 20
+N_PARAMS = 21
 
 # Event description: (kind, component, value, direction, terminal)
-#   kind 0: position component r[c] - value, kind 1: velocity component v[c] - value
+#   kind 0: position component r[c] - value, kind 1: velocity component v[c] - value,
+#   kind 2: altitude above the sphere of radius R about (0, 0, -R), minus value (curved ground)
 #   direction: +1 rising only, -1 falling only, 0 both. terminal: 1 stops that particle.
 N_EVENT_FIELDS = 5
 
@@ -170,6 +172,9 @@ def acceleration(r, v, t, P, wt, wv, out):
     k1 = P[I_KLIN]
     k2 = P[I_KQUAD]
     if k1 != 0.0 or k2 != 0.0:
+        air = _air(r, P)
+        k1 *= air
+        k2 *= air
         speed = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
         k = k1 + k2 * speed
         out[0] -= k * v[0]
@@ -211,8 +216,17 @@ def _rotate(v, ax, ay, az, c, s):
 
 
 @njit(cache=True)
+def _air(r, P):
+    """Relative air density exp(-z / H) at r, or 1 for uniform air (H = 0)."""
+    H = P[I_SCALE_H]
+    if H > 0.0:
+        return np.exp(-r[2] / H)
+    return 1.0
+
+
+@njit(cache=True)
 def _drag_flow(v, k1, k2, h):
-    """Exact flow of v' = -(k1 + k2 |v|) v over h (direction kept, speed decays)."""
+    """Exact flow of v' = -(k1 + k2 |v|) v over h at fixed position (direction kept, speed decays)."""
     if k1 == 0.0 and k2 == 0.0:
         return
     speed = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
@@ -251,8 +265,9 @@ def step_splitting(r, v, t, h, P, wt, wv, wint, a):
     for i in range(3):
         r[i] += hh * v[i]
     _position_acceleration(r, t + hh, P, wt, wv, a)
-    k1 = P[I_KLIN]
-    k2 = P[I_KQUAD]
+    air = _air(r, P)
+    k1 = P[I_KLIN] * air
+    k2 = P[I_KQUAD] * air
     for i in range(3):
         v[i] += hh * a[i]
     _drag_flow(v, k1, k2, hh)
@@ -291,8 +306,9 @@ def step_sphere(r, v, t, h, P, wt, wv, wint, a):
     a[0] -= an * nx
     a[1] -= an * ny
     a[2] -= an * nz
-    k1 = P[I_KLIN]
-    k2 = P[I_KQUAD]
+    air = _air(r, P)
+    k1 = P[I_KLIN] * air
+    k2 = P[I_KQUAD] * air
     for i in range(3):
         v[i] += hh * a[i]
     _drag_flow(v, k1, k2, hh)
@@ -402,11 +418,15 @@ def select_step(method, r, v, t, h, P, wt, wv, wint, a):
 
 
 @njit(cache=True)
-def _event_value(ev, r, v):
+def _event_value(ev, r, v, P):
     c = int(ev[1])
     if ev[0] == 0.0:
         return r[c] - ev[2]
-    return v[c] - ev[2]
+    if ev[0] == 1.0:
+        return v[c] - ev[2]
+    R = P[I_R]
+    dz = r[2] + R
+    return np.sqrt(r[0] * r[0] + r[1] * r[1] + dz * dz) - R - ev[2]
 
 
 @njit(cache=True)
@@ -476,7 +496,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         t = t0
         k_step = 0
         for e in range(n_ev):
-            g_old[e] = _event_value(events[e], ri, vi)
+            g_old[e] = _event_value(events[e], ri, vi, P)
         for s in range(n_samples):
             if is_alive:
                 for _ in range(steps_per_sample):
@@ -489,7 +509,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                     t_new = t0 + k_step * h
                     stop = False
                     for e in range(n_ev):
-                        g_new = _event_value(events[e], ri, vi)
+                        g_new = _event_value(events[e], ri, vi, P)
                         if _crossed(events[e], g_old[e], g_new):
                             tau = _locate(method, events[e], rs, vs, t, h, P, wt, wv, wint, a, rt, vt)
                             k = ev_count[p]
@@ -536,7 +556,7 @@ def _locate(method, ev, rs, vs, t, h, P, wt, wv, wint, a, rt, vt):
     """
     lo = 0.0
     hi = h
-    g_lo = _event_value(ev, rs, vs)
+    g_lo = _event_value(ev, rs, vs, P)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
@@ -544,7 +564,7 @@ def _locate(method, ev, rs, vs, t, h, P, wt, wv, wint, a, rt, vt):
         rt[:] = rs
         vt[:] = vs
         select_step(method, rt, vt, t, mid, P, wt, wv, wint, a)
-        g_mid = _event_value(ev, rt, vt)
+        g_mid = _event_value(ev, rt, vt, P)
         if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
             lo = mid
             g_lo = g_mid
@@ -647,7 +667,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         _deriv(t, y, P, wt, wv, f0)
         nf = 1
         for e in range(n_ev):
-            g_old[e] = _event_value(events[e], y[0:3], y[3:6])
+            g_old[e] = _event_value(events[e], y[0:3], y[3:6], P)
         k_out = 0
         while k_out < n_out and sample_times[k_out] <= t:
             out_r[k_out, p] = y[0:3]
@@ -686,7 +706,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             stop = False
             t_stop = t_new
             for e in range(n_ev):
-                g_new = _event_value(events[e], y_new[0:3], y_new[3:6])
+                g_new = _event_value(events[e], y_new[0:3], y_new[3:6], P)
                 if _crossed(events[e], g_old[e], g_new):
                     lo = 0.0
                     hi = h_used
@@ -696,7 +716,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                         if mid <= lo or mid >= hi:
                             break
                         _dop853_step(t, y, f0, mid, P, wt, wv, A, B, C, Kt, yt)
-                        g_mid = _event_value(events[e], yt[0:3], yt[3:6])
+                        g_mid = _event_value(events[e], yt[0:3], yt[3:6], P)
                         if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
                             lo = mid
                             g_lo = g_mid

@@ -32,6 +32,7 @@ TERMS = (
     "quadratic-drag",
     "pendulum",
     "spring",
+    "curvature",
 )
 
 
@@ -142,6 +143,9 @@ class ParticleModel:
         |r - pivot| = L.
     pivot : (3,) array
         Suspension point (m).
+    scale_height : float
+        Density scale height H (m) of the drag: the drag coefficients are
+        multiplied by exp(-z / H) (an isothermal atmosphere); 0 for uniform air.
     spring : float
         w0^2 (1/s^2) of a horizontal restoring force a = -w0^2 (x, y, 0), the
         linearised (small-angle) pendulum, for ``spring``.
@@ -158,6 +162,7 @@ class ParticleModel:
     pendulum_length: float = 0.0
     pivot: np.ndarray = field(default_factory=lambda: np.zeros(3))
     spring: float = 0.0
+    scale_height: float = 0.0
 
     def __post_init__(self):
         unknown = [t for t in self.terms if t not in TERMS]
@@ -178,7 +183,9 @@ class ParticleModel:
 
         Then the exact propagator (matrix exponential) applies.
         """
-        nonlinear = {"altitude-gravity", "central-gravity", "quadratic-drag", "pendulum"}
+        nonlinear = {"altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature"}
+        if self.scale_height > 0 and "linear-drag" in self.terms:
+            return False
         if nonlinear & set(self.terms):
             return False
         uses_omega = {"coriolis", "centrifugal", "euler"} & set(self.terms)
@@ -212,6 +219,7 @@ class ParticleModel:
             P[k.I_PIVOT : k.I_PIVOT + 3] = self.pivot
         if self.has("spring"):
             P[k.I_SPRING] = self.spring
+        P[k.I_SCALE_H] = self.scale_height
         return P
 
     def linear_matrices(self):
@@ -232,3 +240,37 @@ class ParticleModel:
         if self.has("spring"):
             K -= self.spring * np.diag([1.0, 1.0, 0.0])
         return K, C, b
+
+
+def term_accelerations(model: ParticleModel, times, r, v) -> dict:
+    """Size of each force term's acceleration along a path (m/s^2), for audits.
+
+    Evaluates every term the model *could* have (whether or not it is on) at
+    the samples ``r, v`` of shape (n, 3): gravity variants are reported as
+    their difference from uniform gravity, since that is what switching them
+    on changes. Returns ``{term: (n,) array}``.
+    """
+    r = np.asarray(r, dtype=float)
+    v = np.asarray(v, dtype=float)
+    t = np.asarray(times, dtype=float)
+    axis = model.omega.axis
+    w = np.interp(t, model.omega.times, model.omega.values)[:, None] * axis
+    out = {"coriolis": np.linalg.norm(2 * np.cross(w, v), axis=1),
+           "centrifugal": np.linalg.norm(np.cross(w, np.cross(w, r)), axis=1)}
+    speed = np.linalg.norm(v, axis=1)
+    air = np.exp(-r[:, 2] / model.scale_height) if model.scale_height > 0 else 1.0
+    out["quadratic-drag"] = model.k_quadratic * air * speed**2
+    out["linear-drag"] = model.k_linear * air * speed
+    g_uniform = np.asarray(model.g, dtype=float)
+    if model.radius > 0:
+        c = np.array([0.0, 0.0, -model.radius])
+        d = r - c
+        dist = np.linalg.norm(d, axis=1)[:, None]
+        if model.gm > 0:
+            g_central = -model.gm * d / dist**3
+            out["central-gravity"] = np.linalg.norm(g_central - g_uniform, axis=1)
+        if model.g0 > 0:
+            g_alt = np.zeros_like(r)
+            g_alt[:, 2] = -model.g0 * (model.radius / (model.radius + r[:, 2])) ** 2
+            out["altitude-gravity"] = np.linalg.norm(g_alt - g_uniform, axis=1)
+    return out

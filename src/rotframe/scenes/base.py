@@ -56,3 +56,40 @@ def rel_drift(series) -> float:
     x = np.asarray(series, dtype=float)
     scale = abs(x[0]) if x[0] != 0 else 1.0
     return float(np.max(np.abs(x - x[0])) / scale)
+
+
+def until_event(traj, name, particle=0):
+    """(times, r, v) of one particle up to and including its first ``name`` event.
+
+    Samples after the event are dropped and the exact event state appended, so
+    that metrics and recordings end where the motion ended.
+    """
+    times = traj.event_times.get(name, [np.array([])])[particle]
+    if len(times) == 0:
+        return traj.times, traj.r[:, particle], traj.v[:, particle]
+    t_ev = float(times[0])
+    state = traj.event_states[name][particle][0]
+    keep = traj.times < t_ev
+    return (np.append(traj.times[keep], t_ev), np.vstack([traj.r[keep, particle], state[:3]]),
+            np.vstack([traj.v[keep, particle], state[3:]]))
+
+
+def earth_model_constants(latitude_deg, g_model="wgs84"):
+    """(Omega, omega_enu, g) for a site: rotation vector in ENU and effective gravity (m/s^2).
+
+    ``g_model`` "wgs84": Somigliana normal gravity at the latitude (effective
+    gravity, centrifugal included); "standard": astropy's g0 = 9.80665 m/s^2.
+    """
+    from rotframe import earth
+
+    lat = np.radians(latitude_deg)
+    g = float(earth.normal_gravity(lat)) if g_model == "wgs84" else earth.G0
+    return earth.OMEGA_EARTH, earth.omega_enu(lat), g
+
+
+def energy_in_rotating_frame(r, v, g, omega=None, centrifugal=False):
+    """Jacobi energy per unit mass 1/2 |v|^2 + g z [- 1/2 |omega x r|^2]: conserved without drag."""
+    e = 0.5 * np.sum(v * v, axis=1) + g * r[:, 2]
+    if centrifugal and omega is not None:
+        e -= 0.5 * np.sum(np.cross(omega, r) ** 2, axis=1)
+    return e
