@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from rotframe import analytic
+from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import default_method
 from rotframe.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import SceneResult, earth_model_constants, energy_in_rotating_frame, rel_drift, run_particles

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from rotframe import analytic
+from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import default_method
 from rotframe.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import SceneResult, earth_model_constants, rel_drift, run_particles

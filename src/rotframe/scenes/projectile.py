@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from rotframe import analytic
+from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import Event
 from rotframe.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import SceneResult, earth_model_constants, run_particles, until_event
