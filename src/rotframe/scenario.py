@@ -47,6 +47,8 @@ _PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusi
 #: Settings under ``[run]`` that ``--set`` may change too.
 RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
 _RECORD_KEYS = ("samples", "magnify", "trail")
+#: Model terms of rigid-body scenes (particle terms are in rotframe.model.TERMS).
+RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
 
 def scenario_dir() -> Path:
@@ -202,10 +204,11 @@ def load(name_or_path: str) -> Scenario:
     model = list(data.get("model", []))
     from rotframe.model import TERMS
 
+    known = TERMS + RIGID_TERMS
     for term in model + list(data.get("optional_terms", [])):
-        if term not in TERMS:
+        if term not in known:
             raise ScenarioError(f"{src}: model term {term!r} unknown{_did_you_mean(term, list(TERMS))}; "
-                                f"allowed: {', '.join(TERMS)}")
+                                f"allowed: {', '.join(known)}")
     return Scenario(name=data.get("name", path.stem), path=path, title=data.get("title", ""),
                     description=data.get("description", "").strip(), scene=scene, model=model,
                     optional_terms=list(data.get("optional_terms", [])), parameters=params, run=run,
