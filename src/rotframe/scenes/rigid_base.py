@@ -1,0 +1,201 @@
+"""What the rigid-body scenes share: a trajectory type and a chunked, interruptible run."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.integrators import RunInterrupted
+
+#: Methods of the free body; ``exact`` is the elliptic-function flow.
+FREE_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
+#: Methods of the heavy top.
+HEAVY_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
+
+
+@dataclass
+class BodyTrajectory:
+    """Samples of a rigid body: angular momentum in body axes and attitude.
+
+    ``L`` (n, 3) kg m^2/s in body axes; ``q`` (n, 4) scalar-last quaternions,
+    body -> space; ``times`` (n,) s.
+    """
+
+    times: np.ndarray
+    L: np.ndarray
+    q: np.ndarray
+    method: str
+    steps: int = 0
+    complete: bool = True
+    t_reached: float = math.nan
+    extras: dict = field(default_factory=dict)
+
+
+def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
+    """Integrate a free body, or a heavy symmetric top (``top = (mass, length, g)``), by a named method.
+
+    Fixed-step methods use ``run["step"]`` and keep ``run["samples"]`` samples;
+    the work is done in chunks so that progress shows, Ctrl-C interrupts and a
+    non-finite state stops the run with everything before it kept.
+    """
+    from rotframe import rigid
+
+    samples = max(1, int(run.get("samples") or 2000))
+    times = np.linspace(0.0, duration, samples + 1)
+    if method == "exact":
+        if top is not None:
+            raise ScenarioError("method 'exact' is the free body's flow; the heavy top has gravity")
+        t0 = time.perf_counter()
+        L, q = rigid.free_body_exact(inertia, L0, q0, times[:1])
+        compile_s = time.perf_counter() - t0
+        out_L = np.empty((samples + 1, 3))
+        out_q = np.empty((samples + 1, 4))
+        done = 0
+        try:
+            for start in range(0, samples + 1, 4096):
+                stop = min(samples + 1, start + 4096)
+                out_L[start:stop], out_q[start:stop] = rigid.free_body_exact(inertia, L0, q0, times[start:stop])
+                done = stop
+                if progress:
+                    progress(stop / (samples + 1))
+        except KeyboardInterrupt:
+            raise RunInterrupted(_truncate(BodyTrajectory(times, out_L, out_q, method, 1), done)) from None
+        traj = BodyTrajectory(times, out_L, out_q, method, 1, True, duration)
+        traj.extras["compile_s"] = compile_s
+        return _check_finite(traj)
+    step = float(run.get("step") or duration / samples / 20)
+    dt_sample = duration / samples
+    sps = max(1, math.ceil(dt_sample / step - 1e-9))
+    h = dt_sample / sps
+    stepper = _stepper(method, inertia, top)
+    t0 = time.perf_counter()
+    stepper(L0, q0, h, 1, 1)  # load or compile the kernel
+    compile_s = time.perf_counter() - t0
+    out_L = np.empty((samples + 1, 3))
+    out_q = np.empty((samples + 1, 4))
+    out_L[0], out_q[0] = L0, q0
+    chunk = max(1, int(2e6 // sps))
+    done = 0
+    L, q = np.asarray(L0, float), np.asarray(q0, float)
+    try:
+        while done < samples:
+            m = min(chunk, samples - done)
+            try:
+                Ls, qs, _ = stepper(L, q, h, m * sps, sps)
+            except IntegrationError as exc:
+                # the kernel keeps the finite samples of this chunk in exc.partial = (L, q, times)
+                Ls, qs = exc.partial[0], exc.partial[1]
+                k = len(Ls) - 1
+                out_L[done + 1:done + 1 + k] = Ls[1:]
+                out_q[done + 1:done + 1 + k] = qs[1:]
+                good = done + 1 + k
+                partial = _truncate(BodyTrajectory(times, out_L, out_q, method, (done + k) * sps), good)
+                raise IntegrationError(f"non-finite state after t = {times[good - 1]:.6g} s (method {method}); "
+                                       "reduce the step", t_reached=float(times[good - 1]), partial=partial) from None
+            out_L[done + 1:done + 1 + m] = Ls[1:]
+            out_q[done + 1:done + 1 + m] = qs[1:]
+            L, q = Ls[-1], qs[-1]
+            done += m
+            if progress:
+                progress(done / samples)
+    except KeyboardInterrupt:
+        raise RunInterrupted(_truncate(BodyTrajectory(times, out_L, out_q, method, done * sps), done + 1)) from None
+    traj = BodyTrajectory(times, out_L, out_q, method, samples * sps, True, duration)
+    traj.extras.update(compile_s=compile_s, step=h)
+    return traj
+
+
+def _stepper(method, inertia, top):
+    from rotframe import rigid
+
+    i1, i2, i3 = inertia
+    mgl = 0.0 if top is None else top[0] * top[1] * top[2]
+    if method == "rk4":
+        return lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)
+    order = {"": 2, "4": 4, "6": 6}
+    for prefix in ("lie-poisson", "splitting"):
+        if method.startswith(prefix) and method[len(prefix):] in order:
+            k = order[method[len(prefix):]]
+            if top is not None:
+                mass, length, g = top
+                return lambda L, q, h, n, every: rigid.heavy_top_splitting(
+                    i1, i3, mass, length, g, L, q, h, n, order=k, sample_every=every)
+            return lambda L, q, h, n, every: rigid.lie_poisson(inertia, L, q, h, n, order=k, sample_every=every)
+    raise ScenarioError(f"method {method!r} unknown for a rigid body")
+
+
+def _truncate(traj, n):
+    n = max(1, n)
+    return BodyTrajectory(traj.times[:n], traj.L[:n], traj.q[:n], traj.method, traj.steps, False,
+                          float(traj.times[n - 1]), traj.extras)
+
+
+def _check_finite(traj):
+    ok = np.all(np.isfinite(traj.L), axis=1) & np.all(np.isfinite(traj.q), axis=1)
+    if not ok.all():
+        bad = int(np.argmin(ok))
+        raise IntegrationError(f"non-finite state after t = {traj.times[max(bad - 1, 0)]:.6g} s",
+                               t_reached=float(traj.times[max(bad - 1, 0)]), partial=_truncate(traj, bad))
+    return traj
+
+
+def guarded(finish, func, *args, **kwargs):
+    """Run ``func``; wrap its (partial) trajectory with ``finish`` even when it fails."""
+    try:
+        traj = func(*args, **kwargs)
+    except (IntegrationError, RunInterrupted) as exc:
+        exc.partial = finish(exc.partial) if exc.partial is not None else None
+        raise
+    return finish(traj)
+
+
+def initial_attitude_zxz(phi, theta, psi):
+    """Quaternion (x, y, z, w), body -> space, of ZXZ Euler angles (Goldstein's convention, rad)."""
+    from scipy.spatial.transform import Rotation
+
+    from rotframe import frames
+
+    A = frames.euler_to_dcm([phi, theta, psi], seq="ZXZ")  # space -> body
+    return Rotation.from_matrix(A.T).as_quat()
+
+
+def invariant_drifts(inertia, traj):
+    """Relative drifts of the energy and |L| along a free-body trajectory."""
+    from rotframe import rigid
+    from rotframe.scenes.base import rel_drift
+
+    E = rigid.energy(inertia, traj.L)
+    M = np.linalg.norm(traj.L, axis=1)
+    return rel_drift(E), rel_drift(M), E, M
+
+
+def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0):
+    """Body transform, its axes, a box of the same principal moments, L in space, the polhode."""
+    import rerun as rr
+
+    from rotframe import rigid
+    from rotframe.record import decimate
+
+    idx = decimate(len(traj.times), 5000)
+    t = traj.times[idx]
+    rec.body(f"world/{name}", t, traj.q[idx], axis_length=axis_length)
+    I = np.asarray(inertia, float)
+    # a box with these principal moments: I1 = m (b^2 + c^2) / 12, ...
+    s = 6.0 / mass * (np.array([I[1] + I[2] - I[0], I[0] + I[2] - I[1], I[0] + I[1] - I[2]]))
+    half = 0.5 * np.sqrt(np.clip(s, 1e-12 * s.max(), None))
+    half *= axis_length * 0.6 / half.max()
+    rec.rec.log(f"world/{name}/shape", rr.Boxes3D(half_sizes=[half], colors=[[200, 170, 90, 160]]), static=True)
+    Ls = rigid.angular_momentum_space(traj.q[idx], traj.L[idx])
+    unit = Ls[0] / max(np.linalg.norm(Ls[0]), 1e-300)
+    rec.rec.log("world/angular_momentum", rr.Arrows3D(vectors=[1.5 * axis_length * unit], colors=[[250, 250, 250]],
+                                                      labels=["L (fixed in space)"]), static=True)
+    Lb = traj.L[idx] / np.maximum(np.linalg.norm(traj.L[idx], axis=1), 1e-300)[:, None]
+    rec.line(f"world/{name}/polhode", 1.2 * axis_length * Lb, color=[250, 200, 60])
+    rec.scalars("diagnostics/omega_body/1", t, traj.L[idx, 0] / I[0] if I[0] else 0 * t)
+    rec.scalars("diagnostics/omega_body/2", t, traj.L[idx, 1] / I[1] if I[1] else 0 * t)
+    rec.scalars("diagnostics/omega_body/3", t, traj.L[idx, 2] / I[2] if I[2] else 0 * t)
+    return idx

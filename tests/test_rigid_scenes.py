@@ -1,0 +1,104 @@
+"""The rigid-body scenarios end to end: metrics against theory, recordings, degenerate bodies."""
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rotframe import runner
+
+
+def run(name, method=None, **sets):
+    return runner.run(name, {k: str(v) for k, v in sets.items()}, method=method)
+
+
+@pytest.mark.parametrize("eps,period", [(1e-2, 39.1), (1e-4, 71.0), (1e-6, 102.9)])
+def test_flip_interval_follows_the_ln_one_over_eps_law(eps, period):
+    # PHYSICS.md: for I = (1, 2, 3), w0 = (eps, 1, eps) the period of w is 39.1, 71.0, 102.9 s
+    s, _ = run("dzhanibekov", omega=f"{eps},1,{eps}", duration=4 * period)
+    assert s["metrics"]["flip_interval_s"] == pytest.approx(period / 2, abs=0.06)
+    assert s["metrics"]["flip_interval_s"] == pytest.approx(s["theory"]["flip_interval_s"], rel=1e-6)
+
+
+@pytest.mark.parametrize("method,step,tol", [("exact", None, 1e-14), ("lie-poisson", 1e-2, 1e-13),
+                                             ("lie-poisson4", 1e-2, 1e-13), ("rk4", 1e-2, 1e-6)])
+def test_every_free_body_method_flips_at_the_elliptic_interval(method, step, tol):
+    sets = {"step": step} if step else {}
+    s, _ = run("dzhanibekov", method=method, **sets)
+    assert s["metrics"]["flip_interval_s"] == pytest.approx(s["theory"]["flip_interval_s"], rel=1e-4)
+    assert s["metrics"]["momentum_rel_drift"] < tol
+
+
+def test_dzhanibekov_recording_shows_the_flips(tmp_path):
+    from rerun.chunk import RrdReader
+
+    out = tmp_path / "dz.rrd"
+    res = subprocess.run([sys.executable, "-m", "rotframe", "run", "dzhanibekov", "--out", str(out)],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    omega2, transforms = [], 0
+    for chunk in RrdReader(str(out)).stream():
+        rb = chunk.to_record_batch()
+        if chunk.entity_path == "/diagnostics/omega_body/2":
+            col = rb.column("Scalars:scalars").to_pylist()
+            omega2.extend(v[0] for v in col)
+        if chunk.entity_path == "/world/body" and not chunk.is_static:
+            transforms += chunk.num_rows
+    signs = np.sign(np.array(omega2))
+    assert np.count_nonzero(signs[1:] != signs[:-1]) >= 8  # 200 s at a 19.6 s flip interval
+    assert transforms > 100
+
+
+def test_earth_free_top_gives_the_euler_period():
+    s, _ = run("free-top")
+    assert s["diagnostics"]["body_precession_period_sidereal_days"] == pytest.approx(304.5, abs=0.5)
+    assert s["metrics"]["space_precession_rate_rad_s"] == pytest.approx(s["theory"]["space_precession_rate_rad_s"],
+                                                                        rel=1e-9)
+
+
+def test_free_top_symmetric_precession_rate():
+    s, _ = run("free-top", i1=2.0, i3=3.0, omega3=5.0, omega_perp=0.5, duration=20)
+    k = 5.0 * (3.0 - 2.0) / 2.0
+    assert s["metrics"]["body_precession_period_s"] == pytest.approx(2 * math.pi / k, rel=1e-9)
+
+
+def test_heavy_top_turning_angles_match_the_cubic():
+    for method in ("splitting", "splitting4"):
+        s, _ = run("heavy-top", method=method, duration=2)
+        assert s["metrics"]["theta_max_deg"] == pytest.approx(s["theory"]["theta_max_deg"], abs=1e-3)
+        assert s["metrics"]["theta_min_deg"] == pytest.approx(s["theory"]["theta_min_deg"], abs=1e-3)
+        assert s["metrics"]["nutation_period_s"] == pytest.approx(s["theory"]["nutation_period_s"], rel=1e-3)
+
+
+@pytest.mark.parametrize("factor,stays_up", [(1.2, True), (0.8, False)])
+def test_sleeping_top_threshold_from_both_sides(factor, stays_up):
+    i1, i3, m, l, g = 1.9e-4, 2.5e-5, 0.1, 0.04, 9.81
+    critical = math.sqrt(4 * m * g * l * i1) / i3  # I3^2 w3^2 = 4 I1 m g l
+    s, _ = run("heavy-top", theta0=0, wobble=1e-4, psidot0=factor * critical, duration=3)
+    assert s["diagnostics"]["sleeping_top_stable"] is stays_up
+    if stays_up:
+        assert s["metrics"]["theta_max_deg"] < 0.01
+    else:
+        assert s["metrics"]["theta_max_deg"] > 30
+
+
+@pytest.mark.parametrize("sets", [{"i1": 2, "i2": 2, "i3": 2},           # sphere
+                                  {"i1": 1, "i2": 1, "i3": 2},           # symmetric
+                                  {"i1": 1, "i2": 1, "i3": 0, "omega": "0.3,1,0"}])  # thin rod
+def test_degenerate_bodies_run_without_nan(sets):
+    for method in ("exact", "lie-poisson"):
+        s, result = run("dzhanibekov", method=method, **sets, duration=20)
+        assert np.all(np.isfinite(result.trajectory.L)) and np.all(np.isfinite(result.trajectory.q))
+
+
+@pytest.mark.parametrize("args", [["dzhanibekov", "--set", "i3=5"],        # triangle inequality
+                                  ["dzhanibekov", "--set", "omega=1,2"],    # not three numbers
+                                  ["dzhanibekov", "--set", "i1=-1"],
+                                  ["heavy-top", "--method", "lie-poisson"]])
+def test_impossible_bodies_exit_2(tmp_path, args):
+    res = subprocess.run([sys.executable, "-m", "rotframe", "run", *args, "--no-record"], cwd=tmp_path,
+                         capture_output=True, text=True)
+    assert res.returncode == 2, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
