@@ -38,7 +38,7 @@ def test_separatrix_exact_flow_and_splitting_hold_rk4_drifts(eps):
     L, q, _ = rigid.lie_poisson(inertia, L0, q0, h, n, order=4, sample_every=50)
     M = np.linalg.norm(L, axis=1)
     turns = n * 3 * 5  # order 4: three order-2 steps of five exact turns each
-    assert np.max(np.abs(M / M[0] - 1)) < 3 * EPS * math.sqrt(turns)  # round-off only
+    assert np.max(np.abs(M / M[0] - 1)) < 10 * EPS * math.sqrt(turns)  # round-off only
     E = rigid.energy(inertia, L)
     assert np.max(np.abs(E / E[0] - 1)) < 1e-8
     # RK4 at the same step keeps neither invariant to round-off (expected to drift)
