@@ -102,3 +102,20 @@ def test_impossible_bodies_exit_2(tmp_path, args):
                          capture_output=True, text=True)
     assert res.returncode == 2, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_kinetic_energy_equals_the_seed_euler_angle_formula_along_a_heavy_top_run():
+    # T = I1/2 (phidot^2 sin^2 theta + thetadot^2) + I3/2 (phidot cos theta + psidot)^2 (the lecture),
+    # with the angles read from the quaternions and the rates from omega via rotframe.frames
+    from rotframe import frames, rigid
+    from rotframe.scenes.heavy_top import euler_angles
+
+    s, result = run("heavy-top", duration=0.5)
+    traj = result.trajectory
+    inertia = result.extras["inertia"]
+    angles = euler_angles(traj.q[::50], "ZXZ")
+    omega = traj.L[::50] / inertia
+    rates = frames.omega_to_euler_rates(angles, omega, seq="ZXZ", frame="body")
+    T_seed = rigid.symmetric_top_euler_energy(inertia[0], inertia[2], *angles.T, *rates.T)
+    T_body = rigid.energy(inertia, traj.L[::50])
+    assert np.allclose(T_seed, T_body, rtol=1e-12)

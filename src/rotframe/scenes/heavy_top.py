@@ -55,6 +55,22 @@ def tilt(traj):
     return np.arccos(np.clip(e3[:, 2], -1.0, 1.0))
 
 
+def euler_angles(q, seq="ZXZ"):
+    """Euler angles (rad, any of the twelve sequences) of body -> space quaternions, as an output.
+
+    The direction-cosine matrix of :mod:`rotframe.frames` maps space to body, the
+    transpose of the quaternion's matrix. Where the angles are not unique (the
+    sleeping top at theta = 0) the third angle is set to 0 (``on_gimbal_lock="mask"``).
+    """
+    from scipy.spatial.transform import Rotation
+
+    from rotframe import frames
+
+    A = np.swapaxes(Rotation.from_quat(q).as_matrix(), -1, -2)
+    angles, _ = frames.dcm_to_euler(frames.orthonormalize(A), seq=seq, on_gimbal_lock="mask")
+    return np.unwrap(angles, axis=0)
+
+
 def analyse(values, result):
     from rotframe import rigid
 
@@ -94,6 +110,9 @@ def record(rec, values, result):
     idx = record_body(rec, traj, result.extras["inertia"], axis_length=values["length"] * 1.5, mass=values["mass"])
     theta = tilt(traj)
     rec.scalars("diagnostics/theta_deg", traj.times[idx], np.degrees(theta[idx]))
+    angles = euler_angles(traj.q[idx], "ZXZ")
+    for k, name in enumerate(("phi", "theta", "psi")):
+        rec.scalars(f"diagnostics/euler_zxz/{name}_deg", traj.times[idx], np.degrees(angles[:, k]))
     tip = rigid.body_to_space(traj.q[idx], np.array([0.0, 0.0, 1.5 * values["length"]]))
     rec.line("world/tip_path", tip, color=[60, 200, 120])
     E = rigid.energy(result.extras["inertia"], traj.L) + values["mass"] * values["g"] * values["length"] * np.cos(theta)
