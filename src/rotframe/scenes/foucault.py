@@ -109,6 +109,13 @@ def analyse(values, result):
     theory = {"precession_rate_deg_per_hour": math.degrees(theory_rate) * 3600,
               "period_s": float(analytic.pendulum_period(values["length"], g, amplitude))}
     diagnostics = {"simulated_hours": float(traj.times[-1] / 3600)}
+    if not values["small_angle"]:
+        # released from rest in the rotating frame the swing is an ellipse of minor axis
+        # b = a Omega sin(lat) / w0, whose Airy precession runs against the Foucault turn
+        w0 = math.sqrt(g / values["length"])
+        b = values["amplitude"] * theory_rate / w0
+        airy = analytic.airy_precession(values["length"], g, values["amplitude"], b)
+        diagnostics["airy_corrected_rate_deg_per_hour"] = math.degrees(theory_rate - airy) * 3600
     if model.has("pendulum"):
         diagnostics["constraint_drift_m"] = float(np.max(np.abs(np.linalg.norm(r - model.pivot, axis=1)
                                                                 - values["length"])))
