@@ -130,3 +130,12 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
     assert "partial" in err and "simulated time" in err
     rows, _, _ = read_rrd(partial)["/world/puck"]
     assert rows >= 1
+
+
+def test_quantity_strings_convert(tmp_path):
+    res = rotframe("run", "tower-drop", "--set", "height=520 ft", "--set", "latitude=50d53m", "--json", "--no-record",
+                   cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    params = json.loads(res.stdout)["params"]
+    assert params["height"] == pytest.approx(520 * 0.3048)
+    assert params["latitude"] == pytest.approx(50 + 53 / 60)

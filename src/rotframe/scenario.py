@@ -278,7 +278,13 @@ def _parse_quantity(p: Parameter, text: str, where: str) -> float:
         pass
     unit = p.unit or ""
     import astropy.units as u
+    from astropy.units import imperial
 
+    with imperial.enable():  # "520 ft", "4 inch", "30 mi/h", only for this parse
+        return _parse_quantity_enabled(p, text, where, unit, u)
+
+
+def _parse_quantity_enabled(p: Parameter, text: str, where: str, unit: str, u) -> float:
     try:
         if unit in ("deg", "rad"):
             from astropy.coordinates import Angle
@@ -365,7 +371,9 @@ def _did_you_mean(word: str, options) -> str:
 
 
 def _first_line(exc) -> str:
-    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    """The first sentence of an exception's message (astropy's run to several lines of advice)."""
+    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return text.split(". ")[0].rstrip(".")
 
 
 def _fmt(value) -> str:
