@@ -1,14 +1,12 @@
 """The command line as a user meets it: exit codes, one-line errors, JSON, recordings."""
 
 import json
-import os
 import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]

@@ -609,11 +609,11 @@ def table(rows, speed) -> str:
 
 
 def main(args) -> int:
-    progress = None
-    if not args.json and sys.stderr.isatty():
-        def progress(row):
-            sys.stderr.write(f"\r  {row['scenario']:<12} {row['method']:<24}")
-            sys.stderr.flush()
+    def show(row):
+        sys.stderr.write(f"\r  {row['scenario']:<12} {row['method']:<24}")
+        sys.stderr.flush()
+
+    progress = show if not args.json and sys.stderr.isatty() else None
     rows = run_bench(args.names, quick=args.quick, progress=progress)
     if progress:
         sys.stderr.write("\n")

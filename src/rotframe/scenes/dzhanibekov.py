@@ -12,8 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from rotframe.errors import ScenarioError
-from rotframe.scenes.base import SceneResult
-from rotframe.scenes.rigid_base import (FREE_METHODS, guarded, integrate_body, invariant_drifts, record_body)
+from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
 
 METHODS = FREE_METHODS
 
@@ -30,13 +29,7 @@ def build(values):
 
 
 def simulate(values, terms, method, run, progress):
-    inertia, L0, q0 = build(values)
-    method = method or run.get("method") or "exact"
-
-    def finish(traj):
-        return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia})
-
-    return guarded(finish, integrate_body, method, inertia, L0, q0, values["duration"], run, progress)
+    return simulate_free_body(build(values), values["duration"], method, run, progress)
 
 
 def flip_times(times, w):

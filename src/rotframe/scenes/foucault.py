@@ -25,7 +25,7 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import default_method
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, earth_model_constants, energy_in_rotating_frame, rel_drift, run_particles
+from rotframe.scenes.base import SceneResult, earth_model_constants, energy_in_rotating_frame, run_particles
 
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 SAMPLES_PER_PERIOD = 32
@@ -132,7 +132,7 @@ def record(rec, values, result):
 
     traj = result.trajectory
     idx = decimate(len(traj.times), int(values.get("record_samples", 20000)))
-    t, r, v = traj.times[idx], traj.r[idx, 0], traj.v[idx, 0]
+    t, r = traj.times[idx], traj.r[idx, 0]
     L = values["length"]
     rec.points("world/bob", t, r, radius=0.15, color=[230, 90, 40], trail=False)
     rec.line("world/path", r, color=[230, 90, 40, 80])

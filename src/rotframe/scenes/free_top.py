@@ -15,8 +15,7 @@ import math
 
 import numpy as np
 
-from rotframe.scenes.base import SceneResult
-from rotframe.scenes.rigid_base import FREE_METHODS, guarded, integrate_body, invariant_drifts, record_body
+from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
 
 METHODS = FREE_METHODS
 
@@ -31,13 +30,7 @@ def build(values):
 
 
 def simulate(values, terms, method, run, progress):
-    inertia, L0, q0 = build(values)
-    method = method or run.get("method") or "exact"
-
-    def finish(traj):
-        return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia})
-
-    return guarded(finish, integrate_body, method, inertia, L0, q0, values["duration"], run, progress)
+    return simulate_free_body(build(values), values["duration"], method, run, progress)
 
 
 def measured_rates(traj, inertia):

@@ -14,7 +14,6 @@ import math
 
 import numpy as np
 
-from rotframe.errors import ScenarioError
 from rotframe.scenes.base import SceneResult
 from rotframe.scenes.rigid_base import HEAVY_METHODS, guarded, initial_attitude_zxz, integrate_body
 

@@ -27,8 +27,6 @@ METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 
 
 def build(values, terms):
-    from rotframe import earth
-
     Omega, w, g = earth_model_constants(values["latitude"])
     terms = list(terms)
     if values["drag"] > 0 and "quadratic-drag" not in terms:

@@ -109,6 +109,19 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     return traj
 
 
+def simulate_free_body(body, duration, method, run, progress):
+    """Run a free body ``body = (inertia, L0, q0)``; the default method is the exact flow."""
+    from rotframe.scenes.base import SceneResult
+
+    inertia, L0, q0 = body
+    method = method or run.get("method") or "exact"
+
+    def finish(traj):
+        return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia})
+
+    return guarded(finish, integrate_body, method, inertia, L0, q0, duration, run, progress)
+
+
 def _stepper(method, inertia, top):
     from rotframe import rigid
 

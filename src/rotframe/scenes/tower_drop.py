@@ -27,8 +27,6 @@ GROUND = Event("ground", "r", 2, 0.0, -1, True)
 
 def build(values, terms):
     """(model, r0, v0, duration) for the parameters; drag > 0 adds quadratic drag."""
-    from rotframe import earth
-
     Omega, w, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
     terms = list(terms)
     if values["drag"] > 0 and "quadratic-drag" not in terms:
