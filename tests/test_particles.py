@@ -147,3 +147,15 @@ def test_exact_method_refuses_nonlinear_models():
     model = ParticleModel(("gravity", "quadratic-drag"), g=np.array([0, 0, -9.81]), k_quadratic=1e-3)
     with pytest.raises(ScenarioError, match="linear"):
         integrate_particles(model, [0, 0, 1], [0, 0, 0], 1.0, method="exact")
+
+
+def test_omega_as_table_or_callable_matches_the_ramp():
+    duration = 4.0
+    ramp = OmegaSchedule.ramp(Z, 1.0, 0.2, duration)
+    table = OmegaSchedule.table(Z, [0.0, 1.0, 4.0], [1.0, 1.2, 1.8])
+    func = OmegaSchedule.from_callable(Z, lambda t: 1.0 + 0.2 * t, duration)
+    for omega in (table, func):
+        model = ParticleModel(("coriolis", "centrifugal", "euler"), omega=omega)
+        traj = integrate_particles(model, R0, V0, duration, method="splitting4", step=1e-3, samples=40)
+        oracle = inertial_line(ramp, R0, V0, traj.times)
+        assert np.max(np.linalg.norm(traj.r[:, 0] - oracle, axis=1)) < 1e-9
