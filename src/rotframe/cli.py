@@ -34,15 +34,16 @@ def main(argv=None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_OK
-    from rotframe.errors import ScenarioError, RotframeError
+    from rotframe.errors import IntegrationError, RotframeError
 
     try:
         return args.func(args)
-    except (ScenarioError, RotframeError, ValueError) as exc:
-        if isinstance(exc, RotframeError) or isinstance(exc, ScenarioError):
-            _error(str(exc))
-            return EXIT_INPUT
-        raise
+    except IntegrationError as exc:
+        _error(f"numerical failure: {exc}")
+        return EXIT_NUMERICAL
+    except RotframeError as exc:
+        _error(str(exc))
+        return EXIT_INPUT
 
 
 def _parser():
@@ -169,27 +170,18 @@ def cmd_show(args) -> int:
 
 
 def cmd_run(args) -> int:
-    from rotframe import runner, scenario as sc
+    from rotframe import runner, scenario as sc, scenes
     from rotframe.errors import IntegrationError
     from rotframe.integrators import RunInterrupted
 
     sets = _parse_sets(args.sets)
     scn = sc.load(args.name)
     values = scn.with_values(sets)
-    if args.method is not None:
-        from rotframe.integrators import METHODS
-        from rotframe import scenes
-
-        allowed = getattr(scenes.get(scn.scene), "METHODS", None) or list(METHODS)
-        if args.method not in allowed:
-            raise _input_error(f"--method {args.method!r}: allowed for {scn.name}: {', '.join(allowed)}")
     out = None if args.no_record else (args.out or str(_default_recording(scn.name)))
     if out is not None:
         _check_writable(out)
     _install_sigterm()
     progress = _Progress(enabled=sys.stderr.isatty() and not args.json)
-    from rotframe import scenes
-
     scenes.get(scn.scene)  # import the scene (and astropy, numba) before the clock starts
     t0 = time.perf_counter()
     status = EXIT_OK

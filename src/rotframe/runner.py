@@ -48,7 +48,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
     method = method or run_settings.get("method")
     allowed = getattr(scene, "METHODS", None)
     if method is not None and allowed is not None and method not in allowed:
-        raise ScenarioError(f"--method {method!r} does not apply to {scn.name!r}; allowed: {', '.join(allowed)}")
+        raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}")
     params = {k: v for k, v in values.items() if k != "run"}
     terms = list(scn.model if terms is None else terms)
     return scene.simulate(params, terms, method, run_settings, progress)
