@@ -333,17 +333,14 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
 
     expm is evaluated directly at every 64th sample and the samples between
     are reached by powers of the one-interval propagator, so round-off stays
-    at a few tens of ulps however long the run.
+    at a few tens of ulps however long the run. Events are located on the exact
+    flow for all particles at once (:func:`rotframe.linear.locate_crossings`).
     """
     from scipy.linalg import expm
-    from scipy.optimize import brentq
 
-    K, C, b = model.linear_matrices()
-    M = np.zeros((7, 7))
-    M[0:3, 3:6] = np.eye(3)
-    M[3:6, 0:3] = K
-    M[3:6, 3:6] = C
-    M[3:6, 6] = b
+    from rotframe.linear import flow_matrix, locate_crossings
+
+    M = flow_matrix(model)
     n = r0.shape[0]
     s0 = np.concatenate([r0, v0, np.ones((n, 1))], axis=1).T  # (7, N)
     dt = duration / samples
@@ -365,35 +362,28 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)
     if not np.all(np.isfinite(out)):
         raise IntegrationError("exact propagator produced a non-finite state", t_reached=0.0, partial=traj)
-
-    def state_at(t, p):
-        return expm(M * t) @ s0[:, p]
-
     for ev in events:
+        if ev.kind not in ("r", "v"):
+            raise ScenarioError(f"event {ev.name!r}: kind {ev.kind!r} needs a nonlinear model, not 'exact'")
         col = ev.component + (0 if ev.kind == "r" else 3)
-        traj.event_times[ev.name] = []
-        traj.event_states[ev.name] = []
-        for p in range(n):
-            g = out[:, col, p] - ev.value
-            found_t, found_s = [], []
-            for k in range(samples):
-                g0, g1 = g[k], g[k + 1]
-                rising = g0 < 0.0 <= g1
-                falling = g0 > 0.0 >= g1
-                if (ev.direction > 0 and rising) or (ev.direction < 0 and falling) or (
-                        ev.direction == 0 and (rising or falling)):
-                    if g1 == 0.0:
-                        tc = times[k + 1]
-                    else:
-                        tc = brentq(lambda t: state_at(t, p)[col] - ev.value, times[k], times[k + 1],
-                                    xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-                    sc = state_at(tc, p)
-                    found_t.append(tc)
-                    found_s.append(sc[:6])
-                    if ev.terminal:
-                        traj.r[k + 1:, p] = sc[0:3]
-                        traj.v[k + 1:, p] = sc[3:6]
-                        break
-            traj.event_times[ev.name].append(np.array(found_t))
-            traj.event_states[ev.name].append(np.array(found_s).reshape(-1, 6))
+        g = out[:, col, :] - ev.value  # (samples + 1, N)
+        rising = (g[:-1] < 0.0) & (g[1:] >= 0.0)
+        falling = (g[:-1] > 0.0) & (g[1:] <= 0.0)
+        crossed = rising if ev.direction > 0 else falling if ev.direction < 0 else rising | falling
+        if ev.terminal:  # only each particle's first crossing counts
+            has = crossed.any(axis=0)
+            first = np.argmax(crossed, axis=0)
+            crossed = np.zeros_like(crossed)
+            crossed[first[has], np.nonzero(has)[0]] = True
+        k, p = np.nonzero(crossed)
+        tau, state = locate_crossings(M, out[k, :, p].T, np.full(len(k), dt), g[k, p], g[k + 1, p], col,
+                                      ev.value, times[k])
+        order = np.argsort(p, kind="stable")  # group the crossings by particle, in time order
+        splits = np.cumsum(np.bincount(p, minlength=n))[:-1]
+        traj.event_times[ev.name] = np.split((times[k] + tau)[order], splits)
+        traj.event_states[ev.name] = np.split(state[:6].T[order], splits)
+        if ev.terminal:  # a stopped particle keeps its event state in the later samples
+            after = np.arange(samples + 1)[:, None] > k[None, :]  # (samples + 1, crossings)
+            traj.r[:, p] = np.where(after[:, :, None], state[0:3].T[None], traj.r[:, p])
+            traj.v[:, p] = np.where(after[:, :, None], state[3:6].T[None], traj.v[:, p])
     return traj

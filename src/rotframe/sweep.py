@@ -422,11 +422,9 @@ def run_batch(task: BatchTask) -> BatchOutput:
 def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=()) -> EnsembleRun:
     """Integrate an ensemble to a terminal event in one vectorised call of the compiled core.
 
-    For scenes' ``simulate_ensemble``. Kernel methods locate the event inside the
-    kernel. ``exact`` integrates the samples without events and then locates every
-    particle's first crossing at once, by safeguarded Newton iteration on the exact
-    linear flow from the sample before it (the exact propagator's own event search
-    runs particle by particle). Paths for ``keep`` come from the same call when the
+    For scenes' ``simulate_ensemble``. The integrator locates the event for every
+    particle (the kernels inside the compiled loop; ``exact`` for all particles at
+    once on the exact flow). Paths for ``keep`` come from the same call when the
     ensemble is small, else from a second call on those particles only.
 
     Parameters
@@ -455,7 +453,7 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=()) 
         traj = _integrate(model, r0, v0, duration, event, method, run, samples)
         sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, path_samples) if keep else None
         sub_index = list(range(len(keep)))
-    t_event, state = _linear_crossings(model, traj, event) if exact else _first_events(traj, event)
+    t_event, state = _first_events(traj, event)
     paths = {k: _path_until(sub, j, t_event[k], state[k]) for k, j in zip(keep, sub_index)}
     return EnsembleRun(t_event, state, paths, traj.method)
 
@@ -1140,9 +1138,8 @@ def _decimated(times, pos):
 def _integrate(model, r0, v0, duration, event, method, run, samples):
     from rotframe.integrators import integrate_particles
 
-    events = [] if method == "exact" else [event]
     return integrate_particles(model, r0, v0, duration, method=method, step=run.get("step"),
-                               rtol=run.get("rtol") or 1e-10, samples=int(samples), events=events)
+                               rtol=run.get("rtol") or 1e-10, samples=int(samples), events=[event])
 
 
 def _first_events(traj, event):
@@ -1155,96 +1152,6 @@ def _first_events(traj, event):
             t_event[p] = times[0]
             state[p] = states[0]
     return t_event, state
-
-
-def _linear_crossings(model, traj, event):
-    """First crossing of ``event`` per particle on the exact flow of a linear model (vectorised)."""
-    M = _flow_matrix(model)
-    g = _event_values(event, traj.r, traj.v)
-    crossed = _crossed(g[:-1], g[1:], event.direction)
-    state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
-    t_event = np.full(g.shape[1], math.nan)
-    idx = np.nonzero(crossed.any(axis=0))[0]
-    if len(idx) == 0:
-        return t_event, state
-    k = np.argmax(crossed, axis=0)[idx]
-    s_k = np.concatenate([traj.r[k, idx], traj.v[k, idx], np.ones((len(idx), 1))], axis=1).T.copy()
-    t_k = traj.times[k]
-    tau = _newton_crossing(M, s_k, traj.times[k + 1] - t_k, g[k, idx], g[k + 1, idx], event, t_k)
-    t_event[idx] = t_k + tau
-    state[idx] = _propagate(M, s_k, tau)[:6].T
-    return t_event, state
-
-
-def _flow_matrix(model):
-    """M of s' = M s, s = (r, v, 1), for a linear model."""
-    K, C, b = model.linear_matrices()
-    M = np.zeros((7, 7))
-    M[0:3, 3:6] = np.eye(3)
-    M[3:6, 0:3] = K
-    M[3:6, 3:6] = C
-    M[3:6, 6] = b
-    return M
-
-
-def _event_values(event, r, v):
-    if event.kind == "r":
-        return r[..., event.component] - event.value
-    if event.kind == "v":
-        return v[..., event.component] - event.value
-    raise ScenarioError(f"event {event.name!r}: kind {event.kind!r} is not supported by the exact ensemble")
-
-
-def _crossed(g0, g1, direction):
-    rising = (g0 < 0.0) & (g1 >= 0.0)
-    falling = (g0 > 0.0) & (g1 <= 0.0)
-    return rising if direction > 0 else falling if direction < 0 else rising | falling
-
-
-def _newton_crossing(M, s_k, dt, g_lo, g_hi, event, t_k, max_iter=100):
-    """tau in (0, dt] where the event function vanishes: Newton on the exact flow, kept in a bracket.
-
-    ``s_k`` (7, m) are the states at the start of each particle's bracket.
-    """
-    col = event.component + (0 if event.kind == "r" else 3)
-    lo, hi = np.zeros_like(dt), dt.copy()
-    tau = dt * g_lo / (g_lo - g_hi)
-    for _ in range(max_iter):
-        s = _propagate(M, s_k, tau)
-        g = s[col] - event.value
-        dg = M[col] @ s
-        same = ((g < 0.0) == (g_lo < 0.0)) & (g != 0.0)
-        lo, g_lo, hi = np.where(same, tau, lo), np.where(same, g, g_lo), np.where(same, hi, tau)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            newton = tau - g / dg
-        converged = (g == 0.0) | (np.abs(newton - tau) <= 4 * np.finfo(float).eps * (t_k + tau))
-        if np.all(converged):
-            return np.where(g == 0.0, tau, newton)
-        bad = ~np.isfinite(newton) | (newton < lo) | (newton > hi)
-        tau = np.where(converged, tau, np.where(bad, 0.5 * (lo + hi), newton))
-    return tau
-
-
-def _propagate(M, s, tau):
-    """exp(M tau_j) s_j for every column j of ``s`` (7, m): Taylor series, to round-off.
-
-    Sub-steps keep ||A h|| <= 1 for the linear block A; the number of terms is
-    fixed by the remainder bound, so no convergence test is needed per term.
-    """
-    rho_total = float(np.max(np.sum(np.abs(M[:6, :6]), axis=0))) * float(np.max(np.abs(tau), initial=0.0))
-    n_sub = max(1, int(math.ceil(rho_total)))
-    rho, bound, terms = rho_total / n_sub, 1.0, 0
-    while bound > 1e-20 or terms < 4:
-        terms += 1
-        bound *= max(rho, 0.5) / terms
-    h = tau / n_sub
-    for _ in range(n_sub):
-        acc, term = s.copy(), s
-        for k in range(1, terms + 4):
-            term = (M @ term) * (h / k)
-            acc += term
-        s = acc
-    return s
 
 
 def _path_until(traj, j, t_event, state):
