@@ -406,21 +406,23 @@ def _row(p, method, setting, wall, error, nfev, inv, compile_s=None):
     return row
 
 
-def speedups(rows):
+def speedups(rows, max_error=1e-2):
     """Per (scenario, horizon): speed ratio of the best rotframe method over the fastest scipy method.
 
-    At each final error reached by a rotframe row, the scipy time for the same
-    error is interpolated (log-log) on the lower envelope of all scipy rows;
-    the ratio is reported at the rotframe row that maximises it within the
-    error range scipy covers, with the error where it holds.
+    For each rotframe row, the fastest scipy row whose final error is at least
+    as small is found; the ratio of their wall times is reported at the
+    rotframe row that maximises it, with the error where it holds. Rows with
+    error above ``max_error`` are not accuracy and are left out, and so are rows
+    with zero error (a method compared with itself as the reference).
     """
     out = {}
     keys = {(r["scenario"], r["horizon"]) for r in rows if "horizon" in r}
     for key in sorted(keys):
-        mine = [r for r in rows if (r["scenario"], r.get("horizon")) == key and not r["method"].startswith("scipy")
-                and np.isfinite(r["error"]) and r["error"] > 0]
-        theirs = [r for r in rows if (r["scenario"], r.get("horizon")) == key and r["method"].startswith("scipy")
-                  and np.isfinite(r["error"]) and r["error"] > 0]
+        def usable(r):
+            return (r["scenario"], r.get("horizon")) == key and np.isfinite(r["error"]) and 0 < r["error"] <= max_error
+
+        mine = [r for r in rows if usable(r) and not r["method"].startswith("scipy")]
+        theirs = [r for r in rows if usable(r) and r["method"].startswith("scipy")]
         if not mine or not theirs:
             continue
         best = None
@@ -642,6 +644,10 @@ def table(rows, speed) -> str:
     return "\n".join(lines)
 
 
+def _json_rows(rows):
+    return [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()} for r in rows]
+
+
 def main(args) -> int:
     def show(row):
         sys.stderr.write(f"\r  {row['scenario']:<12} {row['method']:<24}")
@@ -653,9 +659,13 @@ def main(args) -> int:
         sys.stderr.write("\n")
     speed = speedups(rows)
     plots = plot(rows, args.plots) if getattr(args, "plots", None) else []
+    if plots:  # keep the numbers beside the pictures
+        with open(os.path.join(args.plots, "bench.json"), "w") as f:
+            json.dump(_json_rows(rows), f, indent=0)
+        with open(os.path.join(args.plots, "bench.txt"), "w") as f:
+            f.write(table(rows, speed) + "\n")
     if args.json:
-        print(json.dumps([{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
-                          for r in rows]))
+        print(json.dumps(_json_rows(rows)))
     else:
         print(table(rows, speed))
         for p in plots:
