@@ -42,11 +42,10 @@ from rotframe.errors import ScenarioError
 
 __all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS"]
 
-_TOP_KEYS = ("name", "title", "description", "scene", "model", "optional_terms", "parameters", "run", "record")
+_TOP_KEYS = ("name", "title", "description", "scene", "model", "optional_terms", "parameters", "run")
 _PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusive_max", "shape", "choices", "type")
 #: Settings under ``[run]`` that ``--set`` may change too.
 RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
-_RECORD_KEYS = ("samples", "magnify", "trail")
 #: Model terms of rigid-body scenes (particle terms are in rotframe.model.TERMS).
 RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
@@ -133,7 +132,6 @@ class Scenario:
     optional_terms: list
     parameters: dict
     run: dict
-    record: dict
     values: dict = field(default_factory=dict)
 
     def with_values(self, sets: dict | None = None) -> dict:
@@ -199,8 +197,6 @@ def load(name_or_path: str) -> Scenario:
             raise ScenarioError(f"{src}: unknown key 'run.{key}'{_did_you_mean(key, list(RUN_KEYS))}; "
                                 f"allowed: {', '.join(RUN_KEYS)}")
         run[key] = _parse_run_value(key, raw, source=src)
-    record = data.get("record", {})
-    _check_keys(record, _RECORD_KEYS, src, "record")
     model = list(data.get("model", []))
     from rotframe.model import TERMS
 
@@ -211,8 +207,7 @@ def load(name_or_path: str) -> Scenario:
                                 f"allowed: {', '.join(known)}")
     return Scenario(name=data.get("name", path.stem), path=path, title=data.get("title", ""),
                     description=data.get("description", "").strip(), scene=scene, model=model,
-                    optional_terms=list(data.get("optional_terms", [])), parameters=params, run=run,
-                    record=record)
+                    optional_terms=list(data.get("optional_terms", [])), parameters=params, run=run)
 
 
 # ---------------------------------------------------------------------------
