@@ -115,6 +115,9 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
     rec_dir = tmp_path / "recordings"
     rec_dir.mkdir()
     (rec_dir / "turntable.rrd").write_bytes(b"earlier")
+    # compile the kernels first, so that the signal arrives while the run integrates
+    assert rotframe("run", "turntable", "--set", "duration=0.1", "--method", "splitting", "--no-record",
+                    cwd=tmp_path).returncode == 0
     proc = subprocess.Popen([sys.executable, "-m", "rotframe", "run", "turntable", "--set", "duration=4000",
                              "--set", "step=1e-5", "--method", "splitting"], cwd=tmp_path,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -271,22 +271,22 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
     chunk = max(1, int(4e6 // max(cost, 1)))
-    # a call with no samples loads (or compiles) the kernel, once per process: timed apart, as compile_s
-    t_load = time.perf_counter()
-    if info.kind in _LOADED:
-        pass
-    elif info.kind == "fixed":
-        kernels.run_fixed(info.code, r[:0], v[:0], alive[:0], 0.0, h, sps, 0, P, wt, wv, wint, ev_tab,
-                          out_r[:0], out_v[:0], *_EventBuffers(0, 1).args())
-    else:
-        kernels.run_dop853(r[:0], v[:0], alive[:0], 0.0, times[1:2], P, wt, wv, float(rtol), atol, 1.0,
-                           A, B, C, E3, E5, ev_tab, out_r[:0], out_v[:0], *_EventBuffers(0, 1).args(), h_state[:0])
-    _LOADED.add(info.kind)
-    compile_s = time.perf_counter() - t_load
     done = 0
     nfev = 0
     steps = 0
     try:
+        # a call with no samples loads (or compiles) the kernel, once per process: timed apart, as compile_s
+        t_load = time.perf_counter()
+        if info.kind in _LOADED:
+            pass
+        elif info.kind == "fixed":
+            kernels.run_fixed(info.code, r[:0], v[:0], alive[:0], 0.0, h, sps, 0, P, wt, wv, wint, ev_tab,
+                              out_r[:0], out_v[:0], *_EventBuffers(0, 1).args())
+        else:
+            kernels.run_dop853(r[:0], v[:0], alive[:0], 0.0, times[1:2], P, wt, wv, float(rtol), atol, 1.0, A, B,
+                               C, E3, E5, ev_tab, out_r[:0], out_v[:0], *_EventBuffers(0, 1).args(), h_state[:0])
+        _LOADED.add(info.kind)
+        compile_s = time.perf_counter() - t_load
         while done < samples:
             m = min(chunk, samples - done)
             t0 = times[done]
