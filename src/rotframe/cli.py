@@ -108,7 +108,9 @@ def _parser():
     q.add_argument("path", metavar="PATH")
     q.set_defaults(func=cmd_view)
 
-    q = sub.add_parser("section", help="properties of a cross-section (area, centroid, principal axes)")
+    q = sub.add_parser("section", help="properties of a cross-section (area, centroid, principal axes)",
+                       description="SHAPE is rectangle, circle, tube, i-beam, angle, channel or polygon; "
+                                   "'rotframe section shapes' lists each shape's parameters and defaults.")
     q.add_argument("shape", metavar="SHAPE")
     q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
     q.add_argument("--png", metavar="PATH", default=None, help="write a drawing of the section")
@@ -253,8 +255,11 @@ def cmd_view(args) -> int:
 
 
 def cmd_section(args) -> int:
-    from rotframe.section_cli import run_section
+    from rotframe.section_cli import run_section, shapes_help
 
+    if args.shape == "shapes":
+        print(shapes_help())
+        return EXIT_OK
     return run_section(args.shape, args.sets, args.png, args.json)
 
 
