@@ -201,3 +201,21 @@ def test_latitude_strings_parse():
     assert s["params"]["latitude"] == pytest.approx(48 + 50 / 60 + 46 / 3600)
     s = run("tower-drop", latitude="33d52m S")
     assert s["params"]["latitude"] == pytest.approx(-(33 + 52 / 60))
+
+
+def test_audit_shows_what_each_optional_term_changes(tmp_path):
+    import json
+
+    def audit(name):
+        res = subprocess.run([sys.executable, "-m", "rotframe", "run", name, "--audit", "--json", "--no-record"],
+                             cwd=tmp_path, capture_output=True, text=True)
+        assert res.returncode == 0, res.stderr
+        return json.loads(res.stdout)["audit"]["terms"]
+
+    tower = audit("tower-drop")
+    assert tower["centrifugal"]["switched"] == "on"
+    assert tower["centrifugal"]["peak_acceleration_m_s2"] < 1e-5
+    assert abs(tower["centrifugal"]["metrics"]["east_deflection_m"]["relative"]) < 1e-6
+    gun = audit("projectile")
+    assert abs(gun["curvature"]["metrics"]["range_m"]["relative"]) > 1e-2
+    assert gun["central-gravity"]["peak_acceleration_m_s2"] > 0.1
