@@ -133,7 +133,7 @@ def _turntable(quick):
 
 def _tower_drop(quick):
     from rotframe import earth
-    from rotframe.integrators import Event, integrate_particles
+    from rotframe.integrators import integrate_particles
     from rotframe.model import OmegaSchedule, ParticleModel
 
     lat = math.radians(50 + 53 / 60)
@@ -163,7 +163,6 @@ def _tower_drop(quick):
             return Y[-1], 0, energy(traj.times, Y)
         return base(method, setting)
 
-    del Event
     return [Problem("tower-drop", "5 s fall", T, np.concatenate([r0, v0]), rhs,
                     lambda y: float(np.linalg.norm(y[:3] - y_exact[:3])),
                     "analytic (exact propagator): final position error (m)", energy, runs, run)]
