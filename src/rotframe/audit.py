@@ -17,11 +17,10 @@ from rotframe.model import term_accelerations
 __all__ = ["audit"]
 
 
-def audit(scn, values, base_summary, method=None):
-    """Toggle each optional term; returns ``{"terms": {...}, "text": table}``."""
+def audit(scn, values, base_result, base_summary, method=None):
+    """Toggle each optional term of the finished run ``base_result``; returns ``{"terms": ..., "text": table}``."""
     from rotframe import runner
 
-    base_result = runner.simulate(scn, values, method=method)
     model = base_result.extras.get("model")
     traj = base_result.trajectory
     peaks = {}
@@ -32,12 +31,7 @@ def audit(scn, values, base_summary, method=None):
     for term in scn.optional_terms:
         terms = list(base_result.terms)
         switched = "off" if term in terms else "on"
-        if switched == "off":
-            terms = [t for t in terms if t != term]
-        else:
-            # a gravity variant replaces uniform gravity rather than adding to it
-            keep = [t for t in terms if not (term.endswith("gravity") and t.endswith("gravity"))]
-            terms = keep + [term]
+        terms = [t for t in terms if t != term] if switched == "off" else terms + [term]
         result = runner.simulate(scn, values, method=method, terms=terms)
         summary = runner.summarize(scn, values, result, {})
         changes = {}

@@ -223,7 +223,7 @@ def cmd_run(args) -> int:
     if args.audit and status == EXIT_OK:
         from rotframe.audit import audit
 
-        summary["audit"] = audit(scn, values, summary, method=args.method)
+        summary["audit"] = audit(scn, values, result, summary, method=args.method)
     if args.json:
         print(json.dumps(_jsonable(summary)))
     else:

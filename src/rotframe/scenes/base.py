@@ -74,6 +74,19 @@ def until_event(traj, name, particle=0):
             np.vstack([traj.v[keep, particle], state[3:]]))
 
 
+def resolve_terms(terms, drag=0.0):
+    """The model terms a scene runs with, after two rules shared by the Earth scenes.
+
+    The ``drag`` parameter decides whether ``quadratic-drag`` is on (a term with a
+    zero coefficient is work for nothing); a gravity variant (``altitude-gravity``,
+    ``central-gravity``) replaces uniform ``gravity`` rather than adding to it.
+    """
+    terms = [t for t in terms if t != "quadratic-drag"] + (["quadratic-drag"] if drag > 0 else [])
+    if any(t in ("altitude-gravity", "central-gravity") for t in terms):
+        terms = [t for t in terms if t != "gravity"]
+    return tuple(terms)
+
+
 def earth_model_constants(latitude_deg, g_model="wgs84"):
     """(Omega, omega_enu, g) for a site: rotation vector in ENU and effective gravity (m/s^2).
 

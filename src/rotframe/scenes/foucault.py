@@ -47,11 +47,11 @@ def build(values, terms):
                               omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                               pendulum_length=L, pivot=np.array([0.0, 0.0, L]))
         r0 = np.array([a, 0.0, L - math.sqrt(L * L - a * a)])
-    return model, r0, np.zeros(3), g
+    return model, r0, np.zeros(3), g, Omega
 
 
 def simulate(values, terms, method, run, progress):
-    model, r0, v0, g = build(values, terms)
+    model, r0, v0, g, Omega = build(values, terms)
     T = values["duration"]
     period = 2 * math.pi * math.sqrt(values["length"] / g)
     samples = max(int(run.get("samples") or 0), int(SAMPLES_PER_PERIOD * T / period))
@@ -60,7 +60,7 @@ def simulate(values, terms, method, run, progress):
 
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g})
+                           extras={"model": model, "g": g, "Omega": Omega})
 
     return run_particles(model, r0, v0, T, method, run, progress, finish)
 
@@ -101,7 +101,7 @@ def analyse(values, result):
     model = result.extras["model"]
     r, v = traj.r[:, 0], traj.v[:, 0]
     rate, period = measured_rates(traj.times, r, v, values["length"], g)
-    Omega, _, _ = earth_model_constants(values["latitude"])
+    Omega = result.extras["Omega"]
     lat = math.radians(values["latitude"])
     theory_rate = analytic.foucault_precession_rate(lat, Omega)
     amplitude = 0.0 if values["small_angle"] else values["amplitude"]

@@ -21,23 +21,17 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import Event
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, earth_model_constants, run_particles, until_event
+from rotframe.scenes.base import SceneResult, earth_model_constants, resolve_terms, run_particles, until_event
 
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 
 
 def build(values, terms):
     Omega, w, g = earth_model_constants(values["latitude"])
-    terms = list(terms)
-    if values["drag"] > 0 and "quadratic-drag" not in terms:
-        terms.append("quadratic-drag")
-    if values["drag"] == 0 and "quadratic-drag" in terms:
-        terms.remove("quadratic-drag")
-    if "central-gravity" in terms and "gravity" in terms:
-        terms.remove("gravity")
+    terms = resolve_terms(terms, values["drag"])
     R = earth.R_EARTH
     # GM chosen so that central gravity equals the effective g at the gun (same g at the start)
-    model = ParticleModel(tuple(terms), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
+    model = ParticleModel(terms, omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                           k_quadratic=values["drag"], scale_height=values["scale_height"], radius=R,
                           gm=g * R * R, g0=g)
     az, el = math.radians(values["azimuth"]), math.radians(values["elevation"])

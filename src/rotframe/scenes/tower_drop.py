@@ -19,7 +19,7 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.integrators import Event, default_method
 from rotframe.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, energy_in_rotating_frame, rel_drift,
-                                  run_particles, until_event)
+                                  resolve_terms, run_particles, until_event)
 
 METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
@@ -28,12 +28,7 @@ GROUND = Event("ground", "r", 2, 0.0, -1, True)
 def build(values, terms):
     """(model, r0, v0, duration) for the parameters; drag > 0 adds quadratic drag."""
     Omega, w, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
-    terms = list(terms)
-    if values["drag"] > 0 and "quadratic-drag" not in terms:
-        terms.append("quadratic-drag")
-    if values["drag"] == 0 and "quadratic-drag" in terms:
-        terms.remove("quadratic-drag")
-    model = ParticleModel(tuple(terms), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
+    model = ParticleModel(resolve_terms(terms, values["drag"]), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                           k_quadratic=values["drag"], g0=g, radius=earth.R_EARTH, gm=earth.GM_EARTH)
     h = values["height"]
     t_vac = math.sqrt(2 * h / g)
