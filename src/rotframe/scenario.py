@@ -81,6 +81,11 @@ def find(name_or_path: str) -> Path:
         if not path.is_file():
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
+    from rotframe.scenes import SCENARIO_FILES, load_plugins
+
+    load_plugins()
+    if text in SCENARIO_FILES:  # registered with rotframe.register_scene
+        return SCENARIO_FILES[text]
     valid = names()
     if "/" in text or "\\" in text or text.startswith(".") or not text:
         raise ScenarioError(f"scenario {text!r}: not a scenario name; use one of {', '.join(valid)} "
@@ -167,8 +172,9 @@ def load(name_or_path: str) -> Scenario:
     for required in ("scene", "parameters"):
         if required not in data:
             raise ScenarioError(f"{src}: missing {required!r}")
-    from rotframe.scenes import SCENES
+    from rotframe.scenes import SCENES, load_plugins
 
+    load_plugins()
     scene = data["scene"]
     if scene not in SCENES:
         raise ScenarioError(f"{src}: scene {scene!r} unknown{_did_you_mean(scene, list(SCENES))}; "
