@@ -192,8 +192,8 @@ def resolve_values(scn, params: Mapping[str, Any]) -> dict:
             run_settings[key] = sc._parse_run_value(key, _plain(raw, unit, key, scn.name), source=scn.name)
         else:
             allowed = list(scn.parameters) + [k for k in sc.RUN_KEYS if k != "method"]
-            hint = " (the method is run()'s second argument)" if key == "method" else sc._did_you_mean(key, allowed)
-            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{hint}; allowed: {', '.join(allowed)}")
+            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{sc._did_you_mean(key, allowed)}; "
+                                f"allowed: {', '.join(allowed)}")
     values["run"] = run_settings
     return values
 
