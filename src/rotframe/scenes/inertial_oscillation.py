@@ -70,5 +70,8 @@ def analyse(values, result):
 def record(rec, values, result):
     traj = result.trajectory
     rec.points("world/puck", traj.times, traj.r[:, 0] / 1000.0, radius=0.5, color=[230, 90, 40])
+    lat = math.radians(values["latitude"])
+    omega = result.extras["Omega"] * np.array([0.0, math.cos(lat), math.sin(lat)])
+    rec.frame_axes("world/frame", max(float(np.max(np.abs(traj.r[:, 0]))) / 1000.0, 1.0) / 2, omega=omega)
     rec.scalars("diagnostics/speed_rel_error", traj.times,
                 np.linalg.norm(traj.v[:, 0], axis=1) / values["speed"] - 1 if values["speed"] else 0 * traj.times)
