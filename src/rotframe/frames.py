@@ -47,6 +47,7 @@ leading axes and computes in float64.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from rotframe.errors import GimbalLockError, NotARotationError, RotframeError
@@ -85,7 +86,7 @@ class _InputError(RotframeError, ValueError):
 # --------------------------------------------------------------------------- public
 
 
-def direction_cosines(v):
+def direction_cosines(v: ArrayLike) -> np.ndarray:
     """Direction cosines ``(alpha, beta, gamma)`` of a vector.
 
     Parameters
@@ -116,7 +117,7 @@ def direction_cosines(v):
     return u / np.linalg.norm(u, axis=-1, keepdims=True)
 
 
-def elemental(axis, angle, degrees=False):
+def elemental(axis: int | str, angle: ArrayLike, degrees: bool = False) -> np.ndarray:
     """Passive rotation matrix about one coordinate axis (the seed's ``D``, ``C``, ``B``).
 
     Parameters
@@ -140,7 +141,7 @@ def elemental(axis, angle, degrees=False):
     return _passive(_axis_index(axis), angle)
 
 
-def euler_to_dcm(angles, seq="ZXZ", degrees=False):
+def euler_to_dcm(angles: ArrayLike, seq: str = "ZXZ", degrees: bool = False) -> np.ndarray:
     """Direction-cosine matrix ``A`` (space -> body components) from Euler angles.
 
     Parameters
@@ -167,14 +168,14 @@ def euler_to_dcm(angles, seq="ZXZ", degrees=False):
 
 
 def dcm_to_euler(
-    A,
-    seq="ZXZ",
-    degrees=False,
+    A: ArrayLike,
+    seq: str = "ZXZ",
+    degrees: bool = False,
     *,
-    on_gimbal_lock="raise",
-    gimbal_atol=GIMBAL_ATOL,
-    atol=1e-9,
-):
+    on_gimbal_lock: str = "raise",
+    gimbal_atol: float = GIMBAL_ATOL,
+    atol: float = 1e-9,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Euler angles of a direction-cosine matrix ``A`` (space -> body components).
 
     Parameters
@@ -239,7 +240,7 @@ def dcm_to_euler(
     return (ang, locked) if on_gimbal_lock == "mask" else ang
 
 
-def check_rotation(A, atol=1e-9):
+def check_rotation(A: ArrayLike, atol: float = 1e-9) -> np.ndarray:
     """Check that ``A`` is a proper rotation matrix and return it as float64.
 
     Parameters
@@ -287,7 +288,7 @@ def check_rotation(A, atol=1e-9):
     return A
 
 
-def orthonormalize(A):
+def orthonormalize(A: ArrayLike) -> np.ndarray:
     """Nearest proper rotation matrix to ``A`` (in the Frobenius norm).
 
     Polar decomposition by SVD: with ``A = U S V^T``, the result is
@@ -327,7 +328,13 @@ def orthonormalize(A):
     return U @ Vt
 
 
-def euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body", degrees=False):
+def euler_rates_to_omega(
+    angles: ArrayLike,
+    rates: ArrayLike,
+    seq: str = "ZXZ",
+    frame: str = "body",
+    degrees: bool = False,
+) -> np.ndarray:
     """Angular velocity from Euler angles and their time derivatives.
 
     Parameters
@@ -361,8 +368,14 @@ def euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body", degrees=False):
 
 
 def omega_to_euler_rates(
-    angles, omega, seq="ZXZ", frame="body", degrees=False, *, gimbal_atol=GIMBAL_ATOL
-):
+    angles: ArrayLike,
+    omega: ArrayLike,
+    seq: str = "ZXZ",
+    frame: str = "body",
+    degrees: bool = False,
+    *,
+    gimbal_atol: float = GIMBAL_ATOL,
+) -> np.ndarray:
     """Euler-angle rates from an angular velocity (inverse of :func:`euler_rates_to_omega`).
 
     Parameters
@@ -409,7 +422,7 @@ def omega_to_euler_rates(
     return np.linalg.solve(J, omega)[..., 0]
 
 
-def space_derivative(d_body, omega, vec):
+def space_derivative(d_body: ArrayLike, omega: ArrayLike, vec: ArrayLike) -> np.ndarray:
     """Transport theorem: rate of change of a vector seen from space.
 
     ``(d vec/dt)_space = (d vec/dt)_rot + omega x vec``.
@@ -438,7 +451,12 @@ def space_derivative(d_body, omega, vec):
     return d_body + np.cross(omega, vec)
 
 
-def fictitious_accelerations(r, v, omega, omega_dot=None):
+def fictitious_accelerations(
+    r: ArrayLike,
+    v: ArrayLike,
+    omega: ArrayLike,
+    omega_dot: ArrayLike | None = None,
+) -> dict[str, np.ndarray]:
     """Coriolis, centrifugal and Euler accelerations in a rotating frame.
 
     In the rotating frame ``a_rot = F/m + coriolis + centrifugal + euler``.
@@ -478,7 +496,7 @@ def fictitious_accelerations(r, v, omega, omega_dot=None):
     }
 
 
-def from_scipy(rotation):
+def from_scipy(rotation: Rotation) -> np.ndarray:
     """Direction-cosine matrix ``A`` (space -> body) of a scipy ``Rotation``.
 
     scipy's ``as_matrix()`` is active (body -> space components), so ``A`` is its
@@ -502,7 +520,7 @@ def from_scipy(rotation):
     return np.swapaxes(rotation.as_matrix(), -1, -2)
 
 
-def to_scipy(A, atol=1e-9):
+def to_scipy(A: ArrayLike, atol: float = 1e-9) -> Rotation:
     """scipy ``Rotation`` of a direction-cosine matrix ``A`` (space -> body).
 
     Parameters
