@@ -301,7 +301,7 @@ def combine(parts: Iterable) -> tuple[float, np.ndarray, np.ndarray]:
 # ---------------------------------------------------------------------------
 
 
-def principal_moments(tensor: ArrayLike, *, rtol: float = RTOL) -> np.ndarray:
+def principal_moments(tensor: ArrayLike, *, rtol: float = RTOL) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments and axes of a physical inertia tensor.
 
     The tensor is validated (:func:`check_tensor`: finite, symmetric, positive

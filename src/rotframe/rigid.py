@@ -613,7 +613,7 @@ def symmetric_top_euler_energy(
     phidot: ArrayLike,
     thetadot: ArrayLike,
     psidot: ArrayLike,
-) -> np.ndarray:
+) -> np.ndarray | float:
     """Kinetic energy (J) of a symmetric top from ZXZ Euler angles and rates.
 
     ``T = I1/2 (phidot^2 sin^2 theta + thetadot^2) + I3/2 (phidot cos theta + psidot)^2``

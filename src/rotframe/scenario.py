@@ -178,7 +178,8 @@ def load(name_or_path: str) -> Scenario:
     scene = data["scene"]
     if scene not in SCENES:
         raise ScenarioError(f"{src}: scene {scene!r} unknown{_did_you_mean(scene, list(SCENES))}; "
-                            f"available: {', '.join(SCENES)}")
+                            f"available: {', '.join(SCENES)} (a scene of your own: rotframe.register_scene, "
+                            "and ROTFRAME_PLUGINS=module for the command line)")
     params = {}
     for key, spec in data["parameters"].items():
         if not isinstance(spec, dict):

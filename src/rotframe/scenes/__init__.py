@@ -34,6 +34,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import os
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -106,6 +107,7 @@ def load_plugins() -> None:
                 if spec is None or not path.is_file():
                     raise ImportError(f"no file {item}")
                 module = importlib.util.module_from_spec(spec)
+                sys.modules[spec.name] = module  # so that the plugin can name itself (sys.modules[__name__])
                 spec.loader.exec_module(module)
             else:
                 importlib.import_module(item)
