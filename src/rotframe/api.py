@@ -26,8 +26,8 @@ Examples
 True
 >>> scn = rotframe.load("tower-drop")
 >>> p = scn.parameters["height"]
->>> (p.unit, p.default, p.min)
-('m', 158.5, 0.0)
+>>> p.unit, p.default, p.min, p.doc
+('m', 158.5, 0, 'drop height above the ground')
 >>> r = rotframe.run("tower-drop", height="520 ft", latitude=50.9)
 >>> round(r.metrics["east_deflection_m"] * 1000, 1)   # mm east of the foot
 27.6
@@ -94,7 +94,7 @@ def load(name_or_path: str | Path):
     >>> scn.scene, scn.parameters["latitude"].unit
     ('foucault', 'deg')
     >>> print(scn.parameters["length"].describe())
-    67 m (> 0 m)
+    67 m (> 0)
     """
     from rotframe import scenario as sc
 

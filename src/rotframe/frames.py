@@ -159,6 +159,14 @@ def euler_to_dcm(angles: ArrayLike, seq: str = "ZXZ", degrees: bool = False) -> 
     ndarray, shape (..., 3, 3)
         ``A`` with ``x_body = A @ x_space``. For ``"ZXZ"`` this is the seed's
         ``A = B C D``. Equals ``Rotation.from_euler(seq, angles).as_matrix().T``.
+    Examples
+    --------
+    A rotation of the axes by 90 deg about z: the space x axis has body components (0, -1, 0).
+
+    >>> import numpy as np
+    >>> A = euler_to_dcm([90, 0, 0], seq="ZXZ", degrees=True)
+    >>> np.round(A @ [1.0, 0.0, 0.0], 12) + 0.0
+    array([ 0., -1.,  0.])
     """
     axes, extrinsic = _parse_sequence(seq)
     a = _angles(angles, "euler_to_dcm", "angles", degrees)
@@ -214,6 +222,12 @@ def dcm_to_euler(
         ``A`` is not a proper rotation within ``atol``.
     GimbalLockError
         With ``on_gimbal_lock="raise"``, where the angles are not unique.
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = euler_to_dcm([0.3, 1.1, -0.4], seq="ZXZ")
+    >>> np.round(dcm_to_euler(A, seq="ZXZ"), 12)
+    array([ 0.3,  1.1, -0.4])
     """
     axes, extrinsic = _parse_sequence(seq)
     if on_gimbal_lock not in ("raise", "mask"):
@@ -260,6 +274,13 @@ def check_rotation(A: ArrayLike, atol: float = 1e-9) -> np.ndarray:
     NotARotationError
         Naming the defect: wrong shape, non-finite entries, not orthogonal
         (``max |A^T A - I|`` and ``det A`` are reported), or a reflection (det = -1).
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_rotation(np.diag([1.0, 1.0, -1.0]))
+    Traceback (most recent call last):
+    ...
+    rotframe.errors.NotARotationError: ...
     """
     A = _matrices(A, "check_rotation")
     finite = np.isfinite(A).all(axis=(-1, -2))
@@ -360,6 +381,14 @@ def euler_rates_to_omega(
         ``w1 = phi' sin(theta) sin(psi) + theta' cos(psi)``,
         ``w2 = phi' sin(theta) cos(psi) - theta' sin(psi)``,
         ``w3 = phi' cos(theta) + psi'``.
+    Examples
+    --------
+    Aerospace yaw-pitch-roll (intrinsic ZYX): body rates (p, q, r) from the Euler rates.
+
+    >>> import numpy as np
+    >>> w = euler_rates_to_omega([30, 10, 5], [2, 0, 1], seq="ZYX", frame="body", degrees=True)
+    >>> np.round(w, 6)                           # deg/s, since degrees=True
+    array([0.652704, 0.171663, 1.962121])
     """
     J, _ = _rate_matrix(angles, seq, frame, degrees, "euler_rates_to_omega")
     rates = _vectors(rates, "euler_rates_to_omega", "rates")
@@ -478,6 +507,15 @@ def fictitious_accelerations(
     dict of ndarray, shape (..., 3)
         ``"coriolis"``: ``-2 omega x v``; ``"centrifugal"``: ``-omega x (omega x r)``;
         ``"euler"``: ``-omega_dot x r`` (zeros when ``omega_dot`` is None).
+    Examples
+    --------
+    A puck moving north at 10 m/s at latitude 45 deg (ENU axes):
+
+    >>> import numpy as np
+    >>> omega = 7.292115e-5 * np.array([0.0, np.cos(np.pi / 4), np.sin(np.pi / 4)])
+    >>> a = fictitious_accelerations(r=[0, 0, 0], v=[0, 10, 0], omega=omega)
+    >>> np.round(a["coriolis"] * 1e3, 4) + 0.0  # mm/s^2: 2 Omega sin(45 deg) 10 m/s, east (to the right)
+    array([1.0313, 0.    , 0.    ])
     """
     r = _vectors(r, "fictitious_accelerations", "r")
     v = _vectors(v, "fictitious_accelerations", "v")

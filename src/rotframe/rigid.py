@@ -725,6 +725,10 @@ def sleeping_top_threshold(i1: float, i3: float, mass: float, length: float, g: 
     -------
     float
         Critical ``omega3`` (rad/s); 0 when ``m g l <= 0`` (hanging top).
+    Examples
+    --------
+    >>> round(sleeping_top_threshold(1.9e-4, 2.5e-5, 0.1, 0.04, 9.81), 2)   # sqrt(4 I1 m g l) / I3, rad/s
+    218.44
     """
     mgl = _heavy_top_mgl(mass, length, g)
     return math.sqrt(4.0 * max(mgl, 0.0) * i1) / i3

@@ -13,7 +13,7 @@ Examples
 'deg/h'
 >>> quantity_unit("energy_rel_drift")
 ''
->>> quantity_unit("flips") is None
+>>> quantity_unit("sleeping_top_stable") is None
 True
 """
 
