@@ -521,6 +521,8 @@ def register_scene(name: str, scene: Any, scenario: str | Path | None = None) ->
         A scenario file whose ``scene`` is ``name``; ``rotframe.run(name)`` and
         ``rotframe run NAME`` then find it by ``name``.
 
+    Notes
+    -----
     To make the command line see a scene, put the module that calls
     ``register_scene`` in ``ROTFRAME_PLUGINS`` (comma-separated module names or
     ``.py`` paths), e.g. ``ROTFRAME_PLUGINS=examples/my_scene.py rotframe run my-scene``.

@@ -463,10 +463,8 @@ def space_derivative(d_body: ArrayLike, omega: ArrayLike, vec: ArrayLike) -> np.
     omega : array_like, shape (..., 3)
         Angular velocity of the rotating frame relative to space.
     vec : array_like, shape (..., 3)
-        The vector.
-
-    All three must have components in the same axes (usually the body axes); the
-    result has components in those axes too.
+        The vector. All three must have components in the same axes (usually the
+        body axes); the result has components in those axes too.
 
     Returns
     -------
@@ -499,8 +497,7 @@ def fictitious_accelerations(
         Angular velocity of the frame relative to inertial space.
     omega_dot : array_like, shape (..., 3), optional
         Its time derivative (the same seen from either frame); None means constant.
-
-    All components in the same axes (usually the rotating axes); so are the results.
+        All components in the same axes (usually the rotating axes); so are the results.
 
     Returns
     -------
