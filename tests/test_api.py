@@ -43,7 +43,7 @@ def test_scenarios_and_load():
     scn = rotframe.load("foucault")
     p = scn.parameters["length"]
     assert (p.name, p.unit, p.default) == ("length", "m", 67.0)
-    assert p.min == 0 and p.exclusive_min and p.doc
+    assert p.bounds == (0, None) and p.exclusive_min and p.doc
 
 
 def test_acceptance_command():
@@ -223,3 +223,47 @@ def test_png(tmp_path):
     r = rotframe.run("foucault", duration=60)
     r.plot(tmp_path / "f.png")
     assert (tmp_path / "f.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_cli_version_and_help_for_every_option(capsys):
+    import argparse
+
+    from rotframe import cli
+
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--version"])
+    assert info.value.code == 0 and capsys.readouterr().out.strip() == f"rotframe {rotframe.__version__}"
+    parser = cli._parser()
+    missing = []
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                missing += [f"{name} {a.dest}" for a in sub._actions
+                            if not isinstance(a, argparse._HelpAction) and not a.help]
+    assert not missing, missing
+
+
+def test_cli_export_and_png(tmp_path, capsys):
+    from rotframe import cli
+
+    assert cli.main(["run", "heavy-top", "--set", "duration=0.2", "--no-record", "--json",
+                     "--export", str(tmp_path / "h.npz"), "--png", str(tmp_path / "h.png")]) == 0
+    summary = json.loads(capsys.readouterr().out)  # stdout is still one JSON object
+    data = np.load(tmp_path / "h.npz")
+    assert data["L"].shape == (len(data["times"]), 3) and data["q"].shape == (len(data["times"]), 4)
+    assert summary["export"] == str(tmp_path / "h.npz") and (tmp_path / "h.png").stat().st_size > 0
+    assert cli.main(["run", "heavy-top", "--export", str(tmp_path / "h.txt")]) == 2
+    assert "--export" in capsys.readouterr().err
+
+
+def test_view_without_a_display(tmp_path, monkeypatch, capsys):
+    from rotframe import cli
+
+    path = rotframe.run("tower-drop").record(tmp_path / "t.rrd")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert cli.main(["view", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert len(captured.err.strip().splitlines()) == 1 and "--web" in captured.err
+    assert "/world/body" in captured.out

@@ -26,8 +26,8 @@ Examples
 True
 >>> scn = rotframe.load("tower-drop")
 >>> p = scn.parameters["height"]
->>> p.unit, p.default, p.min, p.doc
-('m', 158.5, 0, 'drop height above the ground')
+>>> p.unit, p.default, p.bounds, p.doc
+('m', 158.5, (0, None), 'drop height above the ground')
 >>> r = rotframe.run("tower-drop", height="520 ft", latitude=50.9)
 >>> round(r.metrics["east_deflection_m"] * 1000, 1)   # mm east of the foot
 27.6
@@ -76,7 +76,7 @@ def load(name_or_path: str | Path):
     """Load and check a scenario; returns a :class:`rotframe.scenario.Scenario`.
 
     Its ``parameters`` map each name to a :class:`rotframe.scenario.Parameter`
-    with ``unit``, ``default`` (in that unit), the bounds ``min`` and ``max``
+    with ``name``, ``unit``, ``default`` (in that unit), ``bounds`` = ``(min, max)``
     (``exclusive_min``/``exclusive_max`` say whether they are allowed),
     ``choices`` and ``doc``. ``scenario.run`` holds the run settings
     (``method``, ``step``, ``rtol``, ``samples``), ``scenario.model`` the force
@@ -132,6 +132,8 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     rotframe.errors.IntegrationError
         Numerical failure; ``exc.partial`` holds a :class:`Result` of what was
         computed up to ``exc.t_reached``.
+    rotframe.integrators.RunInterrupted
+        Ctrl-C during the run; ``exc.partial`` holds a :class:`Result` of what was computed.
 
     Examples
     --------
@@ -419,9 +421,9 @@ class Result:
                 from rerun.notebook import Viewer
 
                 stream = rr.RecordingStream(self.scenario.name, recording_id=f"rotframe-{self.scenario.name}")
-                stream.log_file_from_path(rrd)
-                viewer = Viewer(recording=stream)
+                viewer = Viewer(recording=stream)  # the viewer first: it receives what is logged after it
                 viewer.display()
+                stream.log_file_from_path(rrd)  # rerun's own loader reads the .rrd back
                 return None
             except ImportError:
                 print('the notebook viewer needs the notebook extra: python -m pip install "rotframe[notebook]"; '

@@ -123,6 +123,11 @@ class Parameter:
         unit = f" {self.unit}" if self.unit else ""
         return f"{_fmt(self.default)}{unit}" + (f" ({', '.join(bounds)})" if bounds else "")
 
+    @property
+    def bounds(self) -> tuple:
+        """``(min, max)`` in :attr:`unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
+        return (self.min, self.max)
+
 
 @dataclass
 class Scenario:
