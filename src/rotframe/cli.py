@@ -93,7 +93,7 @@ def _parser():
     q.set_defaults(func=cmd_bench)
 
     q = sub.add_parser("sweep", help="run a scenario over a grid or Monte Carlo samples of parameters")
-    q.add_argument("name", metavar="NAME|FILE.toml")
+    q.add_argument("name", metavar="NAME|FILE.toml", help="a scenario name ('rotframe list') or a path to a .toml file")
     q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="fix a parameter for every run, as in 'run'")
     q.add_argument("--grid", action="append", default=[], metavar="KEY=START:STOP:N",
