@@ -267,3 +267,18 @@ def test_view_without_a_display(tmp_path, monkeypatch, capsys):
     captured = capsys.readouterr()
     assert len(captured.err.strip().splitlines()) == 1 and "--web" in captured.err
     assert "/world/body" in captured.out
+
+
+def test_ensemble_sweep_rows_carry_the_theory_of_single_runs(tmp_path, monkeypatch):
+    """A tower-drop sweep runs as one ensemble; its rows have the theory columns a single run has."""
+    from rotframe import sweep
+
+    monkeypatch.chdir(tmp_path)
+    spec = sweep.parse_spec("tower-drop", grid=["height=20:300:3", "latitude=-60:60:2"])
+    res = sweep.run_sweep(spec, plots=False, recording=False)
+    assert res.path == "ensemble"
+    table = res.table.to_pydict()
+    for i in range(res.rows):
+        single = rotframe.run("tower-drop", height=table["height"][i], latitude=table["latitude"][i])
+        for key, value in single.theory.items():
+            assert table["theory_" + key][i] == pytest.approx(value, rel=1e-14), key

@@ -145,3 +145,17 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
         for k in keep:
             tracks[members[k]] = ens.paths[k]
     return metrics
+
+
+def ensemble_theory(values):
+    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
+
+    Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
+    (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
+    t = sqrt(2 h / g).
+    """
+    Omega, _, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
+    lat = math.radians(values["latitude"])
+    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(values["height"], lat, g, Omega)),
+            "north_deflection_m": float(analytic.drop_north_deflection_second_order(values["height"], lat, g, Omega)),
+            "fall_time_s": math.sqrt(2 * values["height"] / g)}
