@@ -53,6 +53,10 @@ def _parser():
                     "viewer, benchmark methods.",
         epilog="Examples: rotframe list | rotframe show foucault | rotframe run foucault --set latitude=0 | "
                "rotframe run tower-drop --json --no-record")
+    from rotframe import __version__
+
+    p.add_argument("--version", action="version", version=f"rotframe {__version__}",
+                   help="print the version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
     q = sub.add_parser("list", help="list the scenarios")
@@ -60,11 +64,11 @@ def _parser():
     q.set_defaults(func=cmd_list)
 
     q = sub.add_parser("show", help="show a scenario's description, parameters and defaults")
-    q.add_argument("name", metavar="NAME")
+    q.add_argument("name", metavar="NAME", help="a scenario name ('rotframe list') or a path to a .toml file")
     q.set_defaults(func=cmd_show)
 
     q = sub.add_parser("run", help="run a scenario and record it")
-    q.add_argument("name", metavar="NAME|FILE.toml")
+    q.add_argument("name", metavar="NAME|FILE.toml", help="a scenario name ('rotframe list') or a path to a .toml file")
     q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="change a parameter: a number in its documented unit (SI, angles in degrees), a quantity "
                         "string such as '520 ft' or '50d54m', or comma-separated numbers for vectors")
@@ -75,17 +79,21 @@ def _parser():
     q.add_argument("--json", action="store_true", help="print one JSON object on stdout and nothing else")
     q.add_argument("--audit", action="store_true",
                    help="also rerun with each optional model term toggled and report what each term changes")
+    q.add_argument("--export", metavar="FILE", default=None,
+                   help="also write the trajectory to FILE: .npz (arrays), .csv or .parquet (a table, one row per "
+                        "sample and particle; SI units in the column names)")
+    q.add_argument("--png", metavar="FILE", default=None, help="also write a picture of the run (PNG, matplotlib)")
     q.set_defaults(func=cmd_run)
 
     q = sub.add_parser("bench", help="speed against error for every method")
-    q.add_argument("names", nargs="*", metavar="NAME")
-    q.add_argument("--json", action="store_true")
+    q.add_argument("names", nargs="*", metavar="NAME", help="problems to run (default: all)")
+    q.add_argument("--json", action="store_true", help="print a JSON list of rows on stdout and nothing else")
     q.add_argument("--quick", action="store_true", help="a short ladder, for a smoke test")
     q.add_argument("--plots", metavar="DIR", default=None, help="write work-precision PNGs to DIR")
     q.set_defaults(func=cmd_bench)
 
     q = sub.add_parser("sweep", help="run a scenario over a grid or Monte Carlo samples of parameters")
-    q.add_argument("name", metavar="NAME|FILE.toml")
+    q.add_argument("name", metavar="NAME|FILE.toml", help="a scenario name ('rotframe list') or a path to a .toml file")
     q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="fix a parameter for every run, as in 'run'")
     q.add_argument("--grid", action="append", default=[], metavar="KEY=START:STOP:N",
@@ -93,28 +101,38 @@ def _parser():
     q.add_argument("--log-grid", action="append", default=[], metavar="KEY=START:STOP:N",
                    help="N logarithmically spaced values from START to STOP (inclusive, both > 0)")
     q.add_argument("--samples", type=int, default=None, metavar="N", help="Monte Carlo samples")
-    q.add_argument("--vary", action="append", default=[], metavar="KEY=normal(MEAN,SD)|uniform(LO,HI)")
-    q.add_argument("--seed", type=int, default=0, metavar="S")
-    q.add_argument("--method", metavar="M")
+    q.add_argument("--vary", action="append", default=[], metavar="KEY=normal(MEAN,SD)|uniform(LO,HI)",
+                   help="draw KEY from a distribution for each Monte Carlo sample (with --samples)")
+    q.add_argument("--seed", type=int, default=0, metavar="S", help="random seed of the Monte Carlo samples")
+    q.add_argument("--method", metavar="M", help="integrator (see 'rotframe show NAME')")
     g = q.add_mutually_exclusive_group()
     g.add_argument("--workers", type=int, default=None, metavar="N", help="a LocalCluster of N processes")
     g.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786")
-    q.add_argument("--out", metavar="PATH.parquet", default=None)
+    q.add_argument("--out", metavar="PATH.parquet", default=None,
+                   help="result table (default sweeps/<name>.parquet; plots and a recording go beside it)")
     q.add_argument("--resume", action="store_true", help="compute only the rows missing from --out")
-    q.add_argument("--json", action="store_true")
+    q.add_argument("--json", action="store_true", help="print the result as JSON on stdout and nothing else")
     q.set_defaults(func=cmd_sweep)
 
-    q = sub.add_parser("view", help="open a recording in the rerun viewer")
-    q.add_argument("path", metavar="PATH")
+    q = sub.add_parser("view", help="open a recording in the rerun viewer",
+                       description="Open a recording in the rerun viewer. Without a display (no DISPLAY or "
+                                   "WAYLAND_DISPLAY) it prints a text summary instead and says how to use --web.")
+    q.add_argument("path", metavar="PATH", help="a .rrd recording")
+    g = q.add_mutually_exclusive_group()
+    g.add_argument("--web", action="store_true",
+                   help="serve rerun's web viewer instead of opening a window (open the printed URL in a browser)")
+    g.add_argument("--summary", action="store_true",
+                   help="print a text summary of the recording (entities, samples, time range, the run summary)")
     q.set_defaults(func=cmd_view)
 
     q = sub.add_parser("section", help="properties of a cross-section (area, centroid, principal axes)",
                        description="SHAPE is rectangle, circle, tube, i-beam, angle, channel or polygon; "
                                    "'rotframe section shapes' lists each shape's parameters and defaults.")
-    q.add_argument("shape", metavar="SHAPE")
-    q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE")
+    q.add_argument("shape", metavar="SHAPE", help="a shape name, or 'shapes' to list them")
+    q.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="a dimension of the shape: metres, or a quantity string such as '4 inch'")
     q.add_argument("--png", metavar="PATH", default=None, help="write a drawing of the section")
-    q.add_argument("--json", action="store_true")
+    q.add_argument("--json", action="store_true", help="print one JSON object on stdout and nothing else")
     q.set_defaults(func=cmd_section)
     return p
 
@@ -182,6 +200,7 @@ def cmd_run(args) -> int:
     out = None if args.no_record else (args.out or str(_default_recording(scn.name)))
     if out is not None:
         _check_writable(out)
+    _check_outputs(args)
     _install_sigterm()
     progress = _Progress(enabled=sys.stderr.isatty() and not args.json)
     scenes.get(scn.scene)  # import the scene (and astropy, numba) before the clock starts
@@ -220,6 +239,8 @@ def cmd_run(args) -> int:
     compile_s = float(getattr(result.trajectory, "extras", {}).get("compile_s", 0.0))
     summary["timing"].update({"compile_s": compile_s, "simulate_s": simulate_s - compile_s,
                               "record_s": record_s, "total_s": time.perf_counter() - _T_START})
+    summary["units"] = _units(scn, summary)
+    _write_outputs(args, scn, values, result, summary)
     if args.audit and status == EXIT_OK:
         from rotframe.audit import audit
 
@@ -251,7 +272,28 @@ def cmd_view(args) -> int:
 
     if not os.path.isfile(args.path):
         raise _input_error(f"view: no recording at {args.path!r}")
+    if args.summary:
+        from rotframe.recording_summary import describe
+
+        print(describe(args.path))
+        return EXIT_OK
+    if args.web:
+        return subprocess.call([sys.executable, "-m", "rerun", "--web-viewer", args.path])
+    if not _has_display():
+        from rotframe.recording_summary import describe
+
+        print(f"rotframe: view: no display here (DISPLAY and WAYLAND_DISPLAY are unset), so a text summary "
+              f"follows; 'rotframe view {args.path} --web' serves rerun's web viewer to a browser", file=sys.stderr)
+        print(describe(args.path))
+        return EXIT_OK
     return subprocess.call([sys.executable, "-m", "rerun", args.path])
+
+
+def _has_display() -> bool:
+    """True where a window can open: macOS and Windows, or X11/Wayland with a display set."""
+    if sys.platform in ("darwin", "win32"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
 def cmd_section(args) -> int:
@@ -306,6 +348,40 @@ def _check_writable(out):
         raise _input_error(f"--out {out!r}: folder {folder!r} is not writable")
     if os.path.exists(folder) and not os.path.isdir(folder):
         raise _input_error(f"--out {out!r}: {folder!r} is not a folder")
+
+
+def _check_outputs(args):
+    """Refuse a bad --export or --png path before the run starts."""
+    from rotframe.export import FORMATS
+
+    export, png = getattr(args, "export", None), getattr(args, "png", None)
+    if export is not None and os.path.splitext(export)[1].lower() not in FORMATS:
+        raise _input_error(f"--export {export!r}: the file must end in {', '.join(FORMATS)}")
+    if png is not None and not png.lower().endswith(".png"):
+        raise _input_error(f"--png {png!r}: the file must end in .png")
+
+
+def _units(scn, summary):
+    from rotframe.units import summary_units
+
+    return summary_units(scn.parameters, summary)
+
+
+def _write_outputs(args, scn, values, result, summary):
+    """--export and --png: the trajectory and a picture, from the same Result the Python API gives."""
+    if not (getattr(args, "export", None) or getattr(args, "png", None)):
+        return
+    from rotframe.api import Result
+
+    res = Result(scn, values, result, summary)
+    if args.export:
+        summary["export"] = str(res.export(args.export))
+    if args.png:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        res.plot(args.png)
+        summary["png"] = args.png
 
 
 def _input_error(message):

@@ -47,6 +47,7 @@ leading axes and computes in float64.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from rotframe.errors import GimbalLockError, NotARotationError, RotframeError
@@ -85,7 +86,7 @@ class _InputError(RotframeError, ValueError):
 # --------------------------------------------------------------------------- public
 
 
-def direction_cosines(v):
+def direction_cosines(v: ArrayLike) -> np.ndarray:
     """Direction cosines ``(alpha, beta, gamma)`` of a vector.
 
     Parameters
@@ -116,7 +117,7 @@ def direction_cosines(v):
     return u / np.linalg.norm(u, axis=-1, keepdims=True)
 
 
-def elemental(axis, angle, degrees=False):
+def elemental(axis: int | str, angle: ArrayLike, degrees: bool = False) -> np.ndarray:
     """Passive rotation matrix about one coordinate axis (the seed's ``D``, ``C``, ``B``).
 
     Parameters
@@ -140,7 +141,7 @@ def elemental(axis, angle, degrees=False):
     return _passive(_axis_index(axis), angle)
 
 
-def euler_to_dcm(angles, seq="ZXZ", degrees=False):
+def euler_to_dcm(angles: ArrayLike, seq: str = "ZXZ", degrees: bool = False) -> np.ndarray:
     """Direction-cosine matrix ``A`` (space -> body components) from Euler angles.
 
     Parameters
@@ -158,6 +159,14 @@ def euler_to_dcm(angles, seq="ZXZ", degrees=False):
     ndarray, shape (..., 3, 3)
         ``A`` with ``x_body = A @ x_space``. For ``"ZXZ"`` this is the seed's
         ``A = B C D``. Equals ``Rotation.from_euler(seq, angles).as_matrix().T``.
+    Examples
+    --------
+    A rotation of the axes by 90 deg about z: the space x axis has body components (0, -1, 0).
+
+    >>> import numpy as np
+    >>> A = euler_to_dcm([90, 0, 0], seq="ZXZ", degrees=True)
+    >>> np.round(A @ [1.0, 0.0, 0.0], 12) + 0.0
+    array([ 0., -1.,  0.])
     """
     axes, extrinsic = _parse_sequence(seq)
     a = _angles(angles, "euler_to_dcm", "angles", degrees)
@@ -167,14 +176,14 @@ def euler_to_dcm(angles, seq="ZXZ", degrees=False):
 
 
 def dcm_to_euler(
-    A,
-    seq="ZXZ",
-    degrees=False,
+    A: ArrayLike,
+    seq: str = "ZXZ",
+    degrees: bool = False,
     *,
-    on_gimbal_lock="raise",
-    gimbal_atol=GIMBAL_ATOL,
-    atol=1e-9,
-):
+    on_gimbal_lock: str = "raise",
+    gimbal_atol: float = GIMBAL_ATOL,
+    atol: float = 1e-9,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Euler angles of a direction-cosine matrix ``A`` (space -> body components).
 
     Parameters
@@ -213,6 +222,12 @@ def dcm_to_euler(
         ``A`` is not a proper rotation within ``atol``.
     GimbalLockError
         With ``on_gimbal_lock="raise"``, where the angles are not unique.
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = euler_to_dcm([0.3, 1.1, -0.4], seq="ZXZ")
+    >>> np.round(dcm_to_euler(A, seq="ZXZ"), 12)
+    array([ 0.3,  1.1, -0.4])
     """
     axes, extrinsic = _parse_sequence(seq)
     if on_gimbal_lock not in ("raise", "mask"):
@@ -239,7 +254,7 @@ def dcm_to_euler(
     return (ang, locked) if on_gimbal_lock == "mask" else ang
 
 
-def check_rotation(A, atol=1e-9):
+def check_rotation(A: ArrayLike, atol: float = 1e-9) -> np.ndarray:
     """Check that ``A`` is a proper rotation matrix and return it as float64.
 
     Parameters
@@ -259,6 +274,13 @@ def check_rotation(A, atol=1e-9):
     NotARotationError
         Naming the defect: wrong shape, non-finite entries, not orthogonal
         (``max |A^T A - I|`` and ``det A`` are reported), or a reflection (det = -1).
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_rotation(np.diag([1.0, 1.0, -1.0]))
+    Traceback (most recent call last):
+    ...
+    rotframe.errors.NotARotationError: ...
     """
     A = _matrices(A, "check_rotation")
     finite = np.isfinite(A).all(axis=(-1, -2))
@@ -287,7 +309,7 @@ def check_rotation(A, atol=1e-9):
     return A
 
 
-def orthonormalize(A):
+def orthonormalize(A: ArrayLike) -> np.ndarray:
     """Nearest proper rotation matrix to ``A`` (in the Frobenius norm).
 
     Polar decomposition by SVD: with ``A = U S V^T``, the result is
@@ -327,7 +349,13 @@ def orthonormalize(A):
     return U @ Vt
 
 
-def euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body", degrees=False):
+def euler_rates_to_omega(
+    angles: ArrayLike,
+    rates: ArrayLike,
+    seq: str = "ZXZ",
+    frame: str = "body",
+    degrees: bool = False,
+) -> np.ndarray:
     """Angular velocity from Euler angles and their time derivatives.
 
     Parameters
@@ -353,6 +381,14 @@ def euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body", degrees=False):
         ``w1 = phi' sin(theta) sin(psi) + theta' cos(psi)``,
         ``w2 = phi' sin(theta) cos(psi) - theta' sin(psi)``,
         ``w3 = phi' cos(theta) + psi'``.
+    Examples
+    --------
+    Aerospace yaw-pitch-roll (intrinsic ZYX): body rates (p, q, r) from the Euler rates.
+
+    >>> import numpy as np
+    >>> w = euler_rates_to_omega([30, 10, 5], [2, 0, 1], seq="ZYX", frame="body", degrees=True)
+    >>> np.round(w, 6)                           # deg/s, since degrees=True
+    array([0.652704, 0.171663, 1.962121])
     """
     J, _ = _rate_matrix(angles, seq, frame, degrees, "euler_rates_to_omega")
     rates = _vectors(rates, "euler_rates_to_omega", "rates")
@@ -361,8 +397,14 @@ def euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body", degrees=False):
 
 
 def omega_to_euler_rates(
-    angles, omega, seq="ZXZ", frame="body", degrees=False, *, gimbal_atol=GIMBAL_ATOL
-):
+    angles: ArrayLike,
+    omega: ArrayLike,
+    seq: str = "ZXZ",
+    frame: str = "body",
+    degrees: bool = False,
+    *,
+    gimbal_atol: float = GIMBAL_ATOL,
+) -> np.ndarray:
     """Euler-angle rates from an angular velocity (inverse of :func:`euler_rates_to_omega`).
 
     Parameters
@@ -409,7 +451,7 @@ def omega_to_euler_rates(
     return np.linalg.solve(J, omega)[..., 0]
 
 
-def space_derivative(d_body, omega, vec):
+def space_derivative(d_body: ArrayLike, omega: ArrayLike, vec: ArrayLike) -> np.ndarray:
     """Transport theorem: rate of change of a vector seen from space.
 
     ``(d vec/dt)_space = (d vec/dt)_rot + omega x vec``.
@@ -421,10 +463,8 @@ def space_derivative(d_body, omega, vec):
     omega : array_like, shape (..., 3)
         Angular velocity of the rotating frame relative to space.
     vec : array_like, shape (..., 3)
-        The vector.
-
-    All three must have components in the same axes (usually the body axes); the
-    result has components in those axes too.
+        The vector. All three must have components in the same axes (usually the
+        body axes); the result has components in those axes too.
 
     Returns
     -------
@@ -438,7 +478,12 @@ def space_derivative(d_body, omega, vec):
     return d_body + np.cross(omega, vec)
 
 
-def fictitious_accelerations(r, v, omega, omega_dot=None):
+def fictitious_accelerations(
+    r: ArrayLike,
+    v: ArrayLike,
+    omega: ArrayLike,
+    omega_dot: ArrayLike | None = None,
+) -> dict[str, np.ndarray]:
     """Coriolis, centrifugal and Euler accelerations in a rotating frame.
 
     In the rotating frame ``a_rot = F/m + coriolis + centrifugal + euler``.
@@ -452,14 +497,22 @@ def fictitious_accelerations(r, v, omega, omega_dot=None):
         Angular velocity of the frame relative to inertial space.
     omega_dot : array_like, shape (..., 3), optional
         Its time derivative (the same seen from either frame); None means constant.
-
-    All components in the same axes (usually the rotating axes); so are the results.
+        All components in the same axes (usually the rotating axes); so are the results.
 
     Returns
     -------
     dict of ndarray, shape (..., 3)
         ``"coriolis"``: ``-2 omega x v``; ``"centrifugal"``: ``-omega x (omega x r)``;
         ``"euler"``: ``-omega_dot x r`` (zeros when ``omega_dot`` is None).
+    Examples
+    --------
+    A puck moving north at 10 m/s at latitude 45 deg (ENU axes):
+
+    >>> import numpy as np
+    >>> omega = 7.292115e-5 * np.array([0.0, np.cos(np.pi / 4), np.sin(np.pi / 4)])
+    >>> a = fictitious_accelerations(r=[0, 0, 0], v=[0, 10, 0], omega=omega)
+    >>> np.round(a["coriolis"] * 1e3, 4) + 0.0  # mm/s^2: 2 Omega sin(45 deg) 10 m/s, east (to the right)
+    array([1.0313, 0.    , 0.    ])
     """
     r = _vectors(r, "fictitious_accelerations", "r")
     v = _vectors(v, "fictitious_accelerations", "v")
@@ -478,7 +531,7 @@ def fictitious_accelerations(r, v, omega, omega_dot=None):
     }
 
 
-def from_scipy(rotation):
+def from_scipy(rotation: Rotation) -> np.ndarray:
     """Direction-cosine matrix ``A`` (space -> body) of a scipy ``Rotation``.
 
     scipy's ``as_matrix()`` is active (body -> space components), so ``A`` is its
@@ -502,7 +555,7 @@ def from_scipy(rotation):
     return np.swapaxes(rotation.as_matrix(), -1, -2)
 
 
-def to_scipy(A, atol=1e-9):
+def to_scipy(A: ArrayLike, atol: float = 1e-9) -> Rotation:
     """scipy ``Rotation`` of a direction-cosine matrix ``A`` (space -> body).
 
     Parameters

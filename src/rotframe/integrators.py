@@ -38,10 +38,18 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+
+if TYPE_CHECKING:  # names used only in annotations
+    from collections.abc import Callable, Sequence
+
+    from numpy.typing import ArrayLike
+
+    from rotframe.model import ParticleModel
 
 __all__ = ["METHODS", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
 
@@ -113,7 +121,7 @@ class Trajectory:
     event_states: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
 
-    def truncated(self, n: int) -> "Trajectory":
+    def truncated(self, n: int) -> Trajectory:
         return Trajectory(self.times[:n], self.r[:n], self.v[:n], self.method, self.steps, self.nfev,
                           False, float(self.times[n - 1]) if n else math.nan,
                           self.event_times, self.event_states, self.extras)
@@ -131,13 +139,15 @@ class RunInterrupted(Exception):
         self.reason = reason
 
 
-def default_method(model) -> str:
+def default_method(model: ParticleModel) -> str:
     """``exact`` for linear constant-coefficient models, else ``splitting``."""
     return "exact" if model.is_linear else "splitting"
 
 
-def integrate_particles(model, r0, v0, duration, *, method=None, step=None, rtol=1e-10, atol=None,
-                        samples=1000, events=(), progress=None, max_events=64):
+def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,
+                        method: str | None = None, step: float | None = None, rtol: float = 1e-10,
+                        atol: float | None = None, samples: int = 1000, events: Sequence[Event] = (),
+                        progress: Callable[[float], object] | None = None, max_events: int = 64) -> Trajectory:
     """Integrate an ensemble of particles in a rotating frame.
 
     Parameters

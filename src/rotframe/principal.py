@@ -25,13 +25,14 @@ Conventions
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rotframe.errors import RotframeError
 
 __all__ = ["principal_axes"]
 
 
-def principal_axes(tensor, *, rtol: float = 1e-10):
+def principal_axes(tensor: ArrayLike, *, rtol: float = 1e-10) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments and axes of a symmetric 2x2 or 3x3 tensor.
 
     Parameters

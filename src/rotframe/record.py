@@ -3,10 +3,15 @@
 * Timeline ``sim_time`` (a duration, integer nanoseconds rounded here, since
   ``TimeColumn(duration=float seconds)`` would truncate).
 * Particles: ``world/<name>`` Points3D per sample, ``world/<name>/trail`` the path
-  as a static line strip. Rigid bodies: ``world/<name>`` Transform3D per
+  up to the current time (a line strip that grows with time, the most recent
+  samples at full resolution). Rigid bodies: ``world/<name>`` Transform3D per
   sample with the body axes as static Arrows3D below it.
-* Diagnostics: ``diagnostics/<quantity>`` Scalars. Summary: static
-  TextDocument at ``scenario``. A blueprint opens a 3D view beside the time series.
+* Diagnostics: ``diagnostics/<quantity>`` Scalars; the closed-form theory of a
+  measured series beside it at ``diagnostics/<quantity>/theory``. Summary:
+  static TextDocument at ``scenario``. ``world`` is z-up, right-handed (ENU:
+  x east, y north, z up). A blueprint opens a 3D view beside one time-series
+  view per kind of quantity (angles, lengths, errors and drifts, ...), so that
+  numbers of different sizes do not share an axis.
 * Bulk data goes by columns (``send_columns``); nothing is logged step by step.
   Positions are float32 in rerun, so scenes log them in a local frame (ENU, body).
 * Files are deterministic (fixed recording id, no ``log_time``) and written to a
@@ -22,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Recording", "default_path", "decimate"]
+__all__ = ["Recording", "default_path", "decimate", "series_kind"]
 
 
 def default_path(scenario_name: str) -> Path:
@@ -41,6 +46,32 @@ def decimate(n: int, max_samples: int) -> np.ndarray:
     if n <= max_samples:
         return np.arange(n)
     return np.unique(np.linspace(0, n - 1, max_samples).round().astype(np.int64))
+
+
+def series_kind(entity: str) -> str:
+    """The time-series view a series goes to, from its name: errors and drifts together, else by unit.
+
+    >>> series_kind("diagnostics/energy_rel_error")
+    'errors and drifts (relative)'
+    >>> series_kind("diagnostics/swing_angle_deg")
+    'angles (deg)'
+    >>> series_kind("diagnostics/omega_body/2")
+    'omega_body'
+    """
+    from rotframe.units import quantity_unit
+
+    name = entity.rstrip("/").rsplit("/", 1)[-1]
+    if "rel_error" in name or "rel_drift" in name:
+        return "errors and drifts (relative)"
+    if "error" in name or "drift" in name:
+        return f"errors ({quantity_unit(name) or 'absolute'})"
+    unit = quantity_unit(name)
+    if unit == "deg":
+        return "angles (deg)"
+    if unit:
+        return f"{name.rsplit('_', 1)[0].replace('_', ' ')} ({unit})" if unit not in ("m", "mm", "km") else f"lengths ({unit})"
+    parent = entity.rstrip("/").rsplit("/", 1)
+    return parent[0].rsplit("/", 1)[-1] if len(parent) > 1 and name.isdigit() else name
 
 
 def _time_column(times):
@@ -73,6 +104,7 @@ class Recording:
         self.rec.set_log_tick_enabled(False)
         self.rec.save(str(self.tmp))
         self._done = False
+        self._series: list[tuple[str, str]] = []  # (entity, kind) of the scalar series, for the blueprint
 
     # -- logging -------------------------------------------------------------
 
@@ -95,8 +127,32 @@ class Recording:
         if static:
             self.rec.log(entity, rr.Points3D.from_fields(**static), static=True)
         if trail:
-            strips = [pos[:, k, :].astype(np.float32) for k in range(count)]
-            self.rec.log(f"{entity}/trail", rr.LineStrips3D(strips, colors=color), static=True)
+            self.trail(f"{entity}/trail", times, pos, color=color)
+
+    def trail(self, entity, times, positions, frames=400, window=600, color=None):
+        """The path up to each time: a line strip per frame that grows with time.
+
+        ``positions`` (n, 3) or (n, N, 3). At most ``frames`` frames are logged,
+        each with the last ``window`` samples at full resolution (the whole
+        path while it is shorter), so the trail of a long run is its recent
+        part rather than a blur of the whole.
+        """
+        import rerun as rr
+
+        pos = np.asarray(positions, dtype=np.float64)
+        if pos.ndim == 2:
+            pos = pos[:, None, :]
+        n, count, _ = pos.shape
+        keys = decimate(n, frames)
+        strips = []
+        for k in keys:
+            lo = max(0, int(k) + 1 - window)
+            for j in range(count):
+                strips.append(pos[lo:k + 1, j, :].astype(np.float32))
+        cols = rr.LineStrips3D.columns(strips=strips).partition(np.full(len(keys), count))
+        self.rec.send_columns(entity, indexes=[_time_column(np.asarray(times)[keys])], columns=cols)
+        if color is not None:
+            self.rec.log(entity, rr.LineStrips3D.from_fields(colors=[color]), static=True)
 
     def line(self, entity, points, color=None):
         """A static polyline (m)."""
@@ -129,12 +185,52 @@ class Recording:
             vectors=[[L, 0, 0], [0, L, 0], [0, 0, L]],
             colors=[[230, 60, 60], [60, 200, 60], [60, 90, 230]], labels=["e1", "e2", "e3"]), static=True)
 
-    def scalars(self, entity, times, values):
-        """A time series at ``entity`` (``diagnostics/<quantity>``)."""
+    def scalars(self, entity, times, values, kind=None, label=None):
+        """A time series at ``entity`` (``diagnostics/<quantity>``).
+
+        ``kind`` names the time-series view it goes to (default: from the name,
+        see :func:`series_kind`); ``label`` is its name in the plot legend.
+        """
         import rerun as rr
 
         vals = np.asarray(values, dtype=np.float64)
         self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Scalars.columns(scalars=vals))
+        if label is not None:
+            self.rec.log(entity, rr.SeriesLines(names=[label]), static=True)
+        self._series.append((entity, kind or series_kind(entity)))
+
+    def reference(self, entity, times, values, label="theory", name="theory"):
+        """The closed-form value of the series at ``entity``, logged beside it at ``<entity>/<name>``.
+
+        Drawn grey and thin, in the same view as the measured series.
+        """
+        import rerun as rr
+
+        vals = np.asarray(values, dtype=np.float64)
+        if vals.ndim == 0:
+            vals = np.full(len(times), float(vals))
+        path = f"{entity}/{name}"
+        self.rec.send_columns(path, indexes=[_time_column(times)], columns=rr.Scalars.columns(scalars=vals))
+        self.rec.log(path, rr.SeriesLines(colors=[[150, 150, 150]], widths=[1.0], names=[label]), static=True)
+
+    def frame_axes(self, entity, length, labels=("E", "N", "U"), omega=None):
+        """Static axes of the frame the scene is seen in (labelled), and its rotation vector if given.
+
+        ``omega`` (3,) rad/s in that frame: drawn as an arrow of length
+        ``length`` along it, labelled with its size.
+        """
+        import rerun as rr
+
+        L = float(length)
+        self.rec.log(entity, rr.Arrows3D(vectors=[[L, 0, 0], [0, L, 0], [0, 0, L]], labels=list(labels),
+                                         colors=[[200, 80, 80], [80, 180, 80], [80, 110, 220]]), static=True)
+        if omega is not None:
+            w = np.asarray(omega, dtype=np.float64)
+            norm = float(np.linalg.norm(w))
+            if norm > 0:
+                self.rec.log(f"{entity}/omega", rr.Arrows3D(vectors=[(1.2 * L * w / norm).astype(np.float32)],
+                                                            colors=[[250, 200, 40]],
+                                                            labels=[f"omega ({norm:.4g} rad/s)"]), static=True)
 
     def exact_values(self, entity, **arrays):
         """Static float64 arrays (exact state that tests may read back) via AnyValues."""
@@ -149,10 +245,24 @@ class Recording:
         self.rec.log(entity, rr.TextDocument(markdown, media_type=rr.MediaType.MARKDOWN), static=True)
 
     def blueprint(self, series=("diagnostics",)):
-        """3D view of ``world`` beside the time series and the summary text."""
+        """3D view of ``world`` beside one time-series view per kind of quantity and the summary text.
+
+        Also declares ``world`` right-handed and z-up (ENU) for the viewer.
+        The kinds are those given to (or inferred by) :meth:`scalars`; with no
+        series logged through it, one view per root in ``series``.
+        """
+        import rerun as rr
         import rerun.blueprint as rrb
 
-        views = [rrb.TimeSeriesView(origin=f"/{s}", name=s) for s in series]
+        self.rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        groups: dict[str, list[str]] = {}
+        for entity, kind in self._series:
+            groups.setdefault(kind, []).append(entity)
+        if groups:
+            views = [rrb.TimeSeriesView(origin="/", name=kind, contents=[f"+ /{e.strip('/')}/**" for e in entities])
+                     for kind, entities in groups.items()]
+        else:
+            views = [rrb.TimeSeriesView(origin=f"/{s}", name=s) for s in series]
         bp = rrb.Blueprint(
             rrb.Horizontal(
                 rrb.Spatial3DView(origin="/world", name="world"),
@@ -164,6 +274,7 @@ class Recording:
         self.rec.send_blueprint(bp)
 
     # -- finishing -----------------------------------------------------------
+
 
     def finish(self, complete: bool = True) -> Path:
         """Flush, write the footer and move the file to its final or partial name."""

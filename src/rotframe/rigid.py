@@ -57,9 +57,12 @@ References
 
 from __future__ import annotations
 
+from typing import Callable, Iterable
+
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike
 from numba import njit
 from scipy import special
 from scipy.spatial.transform import Rotation
@@ -96,7 +99,12 @@ class InvalidStateError(RotframeError, ValueError):
 # ===========================================================================
 
 
-def free_body_exact(inertia, L0_body, q0, times):
+def free_body_exact(
+    inertia: ArrayLike,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    times: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray]:
     """Exact motion of the torque-free rigid body.
 
     Angular momentum (Landau & Lifshitz par. 37, in the notation of
@@ -177,7 +185,7 @@ def free_body_exact(inertia, L0_body, q0, times):
     return _free_asymmetric(frame, L0, q0, t)
 
 
-def elliptic_period(inertia, L0_body):
+def elliptic_period(inertia: ArrayLike, L0_body: ArrayLike) -> float:
     """Period (s) of the body angular velocity ``omega(t)`` of the free body.
 
     Asymmetric body: ``4 K(m) / lambda`` (Landau & Lifshitz par. 37; ``sn`` and
@@ -219,8 +227,17 @@ def elliptic_period(inertia, L0_body):
 # ===========================================================================
 
 
-def lie_poisson(inertia, L0_body, q0, h, n_steps, order=2, torque=None, torque_frame="body",
-                sample_every=1):
+def lie_poisson(
+    inertia: ArrayLike,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    h: float,
+    n_steps: int,
+    order: int = 2,
+    torque: Callable | ArrayLike | None = None,
+    torque_frame: str = "body",
+    sample_every: int = 1,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Free (or constantly torqued) rigid body by Lie-Poisson splitting.
 
     ``H = sum L_i^2 / (2 I_i)``; the flow of each term is exact: ``L_body``
@@ -274,7 +291,17 @@ def lie_poisson(inertia, L0_body, q0, h, n_steps, order=2, torque=None, torque_f
                           L0, q0, h, n_steps, order, sample_every)
 
 
-def torqued_splitting(inertia, L0_body, q0, h, n_steps, torque, torque_frame="body", order=2, sample_every=1):
+def torqued_splitting(
+    inertia: ArrayLike,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    h: float,
+    n_steps: int,
+    torque: Callable | ArrayLike | None,
+    torque_frame: str = "body",
+    order: int = 2,
+    sample_every: int = 1,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rigid body under a torque that depends on time and state, by Strang splitting.
 
     ``torque(t, L_body, q) -> (3,)`` (N m) in body or space axes. Each step of
@@ -343,8 +370,19 @@ def _conjugate(q):
     return np.array([-q[0], -q[1], -q[2], q[3]])
 
 
-def heavy_top_splitting(i1, i3, mass, length, g, L0_body, q0, h, n_steps, order=2,
-                        sample_every=1):
+def heavy_top_splitting(
+    i1: float,
+    i3: float,
+    mass: float,
+    length: float,
+    g: float,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    h: float,
+    n_steps: int,
+    order: int = 2,
+    sample_every: int = 1,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Heavy symmetric top about a fixed point by Strang splitting.
 
     ``H = |L|^2/(2 I1) + (1/I3 - 1/I1) L3^2/2 + m g l (e3 . z)``. Kick
@@ -395,7 +433,14 @@ def heavy_top_splitting(i1, i3, mass, length, g, L0_body, q0, h, n_steps, order=
 # ===========================================================================
 
 
-def rigid_rhs(t, y, inertia, mgl=0.0, torque=None, torque_frame="body"):
+def rigid_rhs(
+    t: float,
+    y: ArrayLike,
+    inertia: ArrayLike,
+    mgl: float = 0.0,
+    torque: Callable | ArrayLike | None = None,
+    torque_frame: str = "body",
+) -> np.ndarray:
     """Right-hand side of the rigid body in quaternion form, for ``solve_ivp``.
 
     ``dL/dt = L x omega + N_body`` (Euler's equations in principal axes),
@@ -429,8 +474,17 @@ def rigid_rhs(t, y, inertia, mgl=0.0, torque=None, torque_frame="body"):
     return _rhs(np.asarray(y, dtype=np.float64), inv_i, float(mgl), torque_body, torque_space)
 
 
-def rigid_rk4(inertia, L0_body, q0, h, n_steps, mgl=0.0, torque=None, torque_frame="body",
-              sample_every=1):
+def rigid_rk4(
+    inertia: ArrayLike,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    h: float,
+    n_steps: int,
+    mgl: float = 0.0,
+    torque: Callable | ArrayLike | None = None,
+    torque_frame: str = "body",
+    sample_every: int = 1,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Classical fixed-step RK4 on :func:`rigid_rhs` (compiled), for comparison.
 
     RK4 keeps none of the invariants: ``|L|``, the energy and ``|q|`` drift like
@@ -468,7 +522,7 @@ def rigid_rk4(inertia, L0_body, q0, h, n_steps, mgl=0.0, torque=None, torque_fra
 # ===========================================================================
 
 
-def energy(inertia, L_body):
+def energy(inertia: ArrayLike, L_body: ArrayLike) -> np.ndarray:
     """Kinetic energy ``sum L_i^2 / (2 I_i)`` (J) from body angular momentum.
 
     Parameters
@@ -487,7 +541,7 @@ def energy(inertia, L_body):
     return 0.5 * np.sum(L * omega_body(inertia, L), axis=-1)
 
 
-def omega_body(inertia, L):
+def omega_body(inertia: ArrayLike, L: ArrayLike) -> np.ndarray:
     """Body angular velocity ``omega = L / I`` (rad/s).
 
     A zero moment gives a zero component (its ``L`` component must be zero).
@@ -510,7 +564,7 @@ def omega_body(inertia, L):
     return L * inv_i
 
 
-def body_to_space(q, vec):
+def body_to_space(q: ArrayLike, vec: ArrayLike) -> np.ndarray:
     """Rotate body components to space components: ``R(q) @ vec``.
 
     Parameters
@@ -533,7 +587,7 @@ def body_to_space(q, vec):
     return v + w * t + np.cross(u, t)
 
 
-def angular_momentum_space(q, L_body):
+def angular_momentum_space(q: ArrayLike, L_body: ArrayLike) -> np.ndarray:
     """Angular momentum in space axes, ``R(q) @ L_body`` (kg m^2/s).
 
     Parameters
@@ -550,7 +604,16 @@ def angular_momentum_space(q, L_body):
     return body_to_space(q, L_body)
 
 
-def symmetric_top_euler_energy(i1, i3, phi, theta, psi, phidot, thetadot, psidot):
+def symmetric_top_euler_energy(
+    i1: float,
+    i3: float,
+    phi: ArrayLike,
+    theta: ArrayLike,
+    psi: ArrayLike,
+    phidot: ArrayLike,
+    thetadot: ArrayLike,
+    psidot: ArrayLike,
+) -> np.ndarray | float:
     """Kinetic energy (J) of a symmetric top from ZXZ Euler angles and rates.
 
     ``T = I1/2 (phidot^2 sin^2 theta + thetadot^2) + I3/2 (phidot cos theta + psidot)^2``
@@ -575,7 +638,17 @@ def symmetric_top_euler_energy(i1, i3, phi, theta, psi, phidot, thetadot, psidot
     return 0.5 * i1 * (phidot**2 * s**2 + thetadot**2) + 0.5 * i3 * (phidot * c + psidot) ** 2
 
 
-def heavy_top_turning_points(i1, i3, mass, length, g, theta0, thetadot0, phidot0, psidot0):
+def heavy_top_turning_points(
+    i1: float,
+    i3: float,
+    mass: float,
+    length: float,
+    g: float,
+    theta0: float,
+    thetadot0: float,
+    phidot0: float,
+    psidot0: float,
+) -> tuple[float, ...]:
     """Nutation limits and period of the heavy symmetric top (Goldstein 5.7).
 
     With ``u = cos theta``, ``udot^2 = f(u) = (1 - u^2)(alpha - beta u) - (b - a u)^2``,
@@ -635,7 +708,7 @@ def heavy_top_turning_points(i1, i3, mass, length, g, theta0, thetadot0, phidot0
     return th1, th2, period
 
 
-def sleeping_top_threshold(i1, i3, mass, length, g):
+def sleeping_top_threshold(i1: float, i3: float, mass: float, length: float, g: float) -> float:
     """Critical spin (rad/s) above which the upright heavy top is stable.
 
     ``omega3_c = sqrt(4 m g l I1) / I3`` (Goldstein 5.7: stable when
@@ -652,12 +725,16 @@ def sleeping_top_threshold(i1, i3, mass, length, g):
     -------
     float
         Critical ``omega3`` (rad/s); 0 when ``m g l <= 0`` (hanging top).
+    Examples
+    --------
+    >>> round(sleeping_top_threshold(1.9e-4, 2.5e-5, 0.1, 0.04, 9.81), 2)   # sqrt(4 I1 m g l) / I3, rad/s
+    218.44
     """
     mgl = _heavy_top_mgl(mass, length, g)
     return math.sqrt(4.0 * max(mgl, 0.0) * i1) / i3
 
 
-def free_symmetric_precession(i1, i3, omega3):
+def free_symmetric_precession(i1: float, i3: float, omega3: float) -> float:
     """Body-frame precession rate of the free symmetric top (rad/s).
 
     ``k = omega3 (I3 - I1) / I1``: ``(omega1, omega2)`` turns about body axis 3 at

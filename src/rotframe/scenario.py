@@ -81,6 +81,11 @@ def find(name_or_path: str) -> Path:
         if not path.is_file():
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
+    from rotframe.scenes import SCENARIO_FILES, load_plugins
+
+    load_plugins()
+    if text in SCENARIO_FILES:  # registered with rotframe.register_scene
+        return SCENARIO_FILES[text]
     valid = names()
     if "/" in text or "\\" in text or text.startswith(".") or not text:
         raise ScenarioError(f"scenario {text!r}: not a scenario name; use one of {', '.join(valid)} "
@@ -117,6 +122,11 @@ class Parameter:
             bounds.append("one of " + ", ".join(map(str, self.choices)))
         unit = f" {self.unit}" if self.unit else ""
         return f"{_fmt(self.default)}{unit}" + (f" ({', '.join(bounds)})" if bounds else "")
+
+    @property
+    def bounds(self) -> tuple:
+        """``(min, max)`` in :attr:`unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
+        return (self.min, self.max)
 
 
 @dataclass
@@ -167,12 +177,14 @@ def load(name_or_path: str) -> Scenario:
     for required in ("scene", "parameters"):
         if required not in data:
             raise ScenarioError(f"{src}: missing {required!r}")
-    from rotframe.scenes import SCENES
+    from rotframe.scenes import SCENES, load_plugins
 
+    load_plugins()
     scene = data["scene"]
     if scene not in SCENES:
         raise ScenarioError(f"{src}: scene {scene!r} unknown{_did_you_mean(scene, list(SCENES))}; "
-                            f"available: {', '.join(SCENES)}")
+                            f"available: {', '.join(SCENES)} (a scene of your own: rotframe.register_scene, "
+                            "and ROTFRAME_PLUGINS=module for the command line)")
     params = {}
     for key, spec in data["parameters"].items():
         if not isinstance(spec, dict):

@@ -1039,8 +1039,11 @@ def _ensemble_batch(task, scn, scene, base):
     run = dict(base["run"], samples=min(int(base["run"].get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
     metrics = scene.simulate_ensemble(values_list, list(scn.model), task.method, run, tracks=tracks) \
         if values_list else []
+    theory = getattr(scene, "ensemble_theory", None)  # the theory columns single runs have
     for j, i in enumerate(where):
         rows[i]["metrics"] = {k: _float(v) for k, v in metrics[j].items()}
+        if theory is not None:
+            rows[i]["theory"] = {k: _float(v) for k, v in theory(values_list[j]).items()}
     out_tracks = {int(task.rows[where[j]]): _decimated(*tr) for j, tr in tracks.items() if tr is not None}
     seconds = [(time.perf_counter() - t0) / max(len(rows), 1)] * len(rows)
     return BatchOutput(task.index, rows, out_tracks, seconds)

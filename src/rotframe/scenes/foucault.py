@@ -128,20 +128,26 @@ def analyse(values, result):
 
 
 def record(rec, values, result):
+    """The bob with a trail that grows with time, the swing plane and its angle beside Omega sin(lat) t,
+    the local frame with Earth's rotation vector, the string's length error."""
     from rotframe.record import decimate
 
     traj = result.trajectory
     idx = decimate(len(traj.times), int(values.get("record_samples", 20000)))
     t, r = traj.times[idx], traj.r[idx, 0]
     L = values["length"]
-    rec.points("world/bob", t, r, radius=0.15, color=[230, 90, 40], trail=False)
-    rec.line("world/path", r, color=[230, 90, 40, 80])
+    rec.points("world/bob", t, r, radius=0.15, color=[230, 90, 40])
     g = result.extras["g"]
     angle = swing_angle(traj.r[:, 0], traj.v[:, 0], math.sqrt(g / L))[idx]
     a = values["amplitude"]
     d = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=1) * a
     rec.segments("world/swing_plane", t, -d, d, color=[40, 160, 230])
     rec.line("world/string_at_rest", [[0, 0, 0], [0, 0, L]], color=[150, 150, 150])
-    rec.scalars("diagnostics/swing_angle_deg", t, np.degrees(angle))
-    if result.extras["model"].has("pendulum"):
+    model = result.extras["model"]
+    rec.frame_axes("world/frame", a, omega=model.omega.vector() if not values["small_angle"] else None)
+    rec.scalars("diagnostics/swing_angle_deg", t, np.degrees(angle), label="swing plane (measured)")
+    rate = analytic.foucault_precession_rate(math.radians(values["latitude"]), result.extras["Omega"])
+    rec.reference("diagnostics/swing_angle_deg", t, np.degrees(angle[0] - rate * t),
+                  label="-Omega sin(lat) t (clockwise in the north)")
+    if model.has("pendulum"):
         rec.scalars("diagnostics/constraint_error_m", t, np.linalg.norm(r - [0, 0, L], axis=1) - L)

@@ -102,17 +102,44 @@ def analyse(values, result):
 
 
 def record(rec, values, result):
+    """The top, L in space per sample (its horizontal part turns under the gravity torque), theta and its
+    turning-angle theory, the Euler angles, the energy error; each kind in its own time-series view."""
     from rotframe import rigid
     from rotframe.scenes.rigid_base import record_body
 
     traj = result.trajectory
-    idx = record_body(rec, traj, result.extras["inertia"], axis_length=values["length"] * 1.5, mass=values["mass"])
+    idx = record_body(rec, traj, result.extras["inertia"], axis_length=values["length"] * 1.5, mass=values["mass"],
+                      L_label="L in space (its vertical part is conserved; the horizontal part turns "
+                              "with the gravity torque)")
+    t = traj.times[idx]
     theta = tilt(traj)
-    rec.scalars("diagnostics/theta_deg", traj.times[idx], np.degrees(theta[idx]))
+    rec.scalars("diagnostics/theta_deg", t, np.degrees(theta[idx]), kind="tilt theta (deg)", label="theta (simulated)")
+    theory = analyse_theory(values)
+    if theory is not None:
+        rec.reference("diagnostics/theta_deg", t, math.degrees(theory[0]), label="theta_min (Goldstein cubic)",
+                      name="theory_min")
+        rec.reference("diagnostics/theta_deg", t, math.degrees(theory[1]), label="theta_max (Goldstein cubic)",
+                      name="theory_max")
     angles = euler_angles(traj.q[idx], "ZXZ")
     for k, name in enumerate(("phi", "theta", "psi")):
-        rec.scalars(f"diagnostics/euler_zxz/{name}_deg", traj.times[idx], np.degrees(angles[:, k]))
+        kind = "Euler angle theta (deg)" if name == "theta" else f"Euler angle {name} (deg, unwrapped)"
+        rec.scalars(f"diagnostics/euler_zxz/{name}_deg", t, np.degrees(angles[:, k]), kind=kind)
     tip = rigid.body_to_space(traj.q[idx], np.array([0.0, 0.0, 1.5 * values["length"]]))
-    rec.line("world/tip_path", tip, color=[60, 200, 120])
+    rec.trail("world/tip_path", t, tip, color=[60, 200, 120])
+    rec.frame_axes("world/frame", values["length"], labels=("x", "y", "z (up)"))
     E = rigid.energy(result.extras["inertia"], traj.L) + values["mass"] * values["g"] * values["length"] * np.cos(theta)
-    rec.scalars("diagnostics/energy_rel_error", traj.times[idx], (E[idx] - E[0]) / abs(E[0]))
+    rec.scalars("diagnostics/energy_rel_error", t, (E[idx] - E[0]) / abs(E[0]))
+
+
+def analyse_theory(values):
+    """(theta_min, theta_max, period) from Goldstein's cubic, or None where it has no bracket."""
+    from rotframe import rigid
+
+    if not (values["theta0"] > 0 or values["wobble"] != 0):
+        return None
+    args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])
+    try:
+        return rigid.heavy_top_turning_points(*args, math.radians(values["theta0"]), values["wobble"],
+                                              values["phidot0"], values["psidot0"])
+    except Exception:  # the cubic has no bracket (e.g. exactly steady precession)
+        return None

@@ -70,5 +70,14 @@ def analyse(values, result):
 def record(rec, values, result):
     traj = result.trajectory
     rec.points("world/puck", traj.times, traj.r[:, 0] / 1000.0, radius=0.5, color=[230, 90, 40])
+    f = 2 * result.extras["Omega"] * math.sin(math.radians(values["latitude"]))
+    omega = np.array([0.0, 0.0, f / 2])  # the f-plane: only the vertical part of Omega acts
+    rec.frame_axes("world/frame", max(float(np.max(np.abs(traj.r[:, 0]))) / 1000.0, 1.0) / 2, omega=omega)
     rec.scalars("diagnostics/speed_rel_error", traj.times,
                 np.linalg.norm(traj.v[:, 0], axis=1) / values["speed"] - 1 if values["speed"] else 0 * traj.times)
+    v = traj.v[:, 0]
+    if values["speed"]:
+        direction = np.degrees(np.unwrap(np.arctan2(v[:, 1], v[:, 0])))
+        rec.scalars("diagnostics/velocity_direction_deg", traj.times, direction, label="direction of v (from east)")
+        rec.reference("diagnostics/velocity_direction_deg", traj.times, direction[0] - np.degrees(f * traj.times),
+                      label="turns at -2 Omega sin(lat) (clockwise in the north)")

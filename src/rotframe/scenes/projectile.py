@@ -98,6 +98,7 @@ def record(rec, values, result):
     traj = result.trajectory
     times, r, v = until_event(traj, "ground")
     rec.points("world/shell", times, r / 1000.0, radius=0.5, color=[230, 90, 40])
+    rec.frame_axes("world/frame", 20.0, omega=result.extras["model"].omega.vector())  # km
     rng, lateral = ground_track(values, r, result.extras["model"])
     rec.scalars("diagnostics/altitude_km", times, r[:, 2] / 1000.0)
     rec.scalars("diagnostics/lateral_deflection_m", times, lateral)

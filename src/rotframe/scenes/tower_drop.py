@@ -87,10 +87,17 @@ def record(rec, values, result):
     shown[:, :2] *= magnify
     rec.points("world/deflection_magnified", times, shown, radius=0.5, color=[40, 160, 230])
     rec.line("world/tower", [[0, 0, 0], [0, 0, h]], color=[150, 150, 150])
-    rec.scalars("diagnostics/east_deflection_mm", times, 1e3 * r[:, 0])
-    rec.scalars("diagnostics/north_deflection_mm", times, 1e3 * r[:, 1])
+    model = result.extras["model"]
+    w = model.omega.vector()
+    rec.frame_axes("world/frame", h / 5, omega=w)
+    rec.scalars("diagnostics/east_deflection_mm", times, 1e3 * r[:, 0], label="east (simulated)")
+    # first order in Omega: x(t) = (1/3) Omega g t^3 cos(lat), the vertical component of g only
+    Omega, g = float(np.linalg.norm(w)), result.extras["g"]
+    rec.reference("diagnostics/east_deflection_mm", times,
+                  1e3 * Omega * g * times ** 3 * math.cos(math.radians(values["latitude"])) / 3,
+                  label="(1/3) Omega g t^3 cos(lat)")
+    rec.scalars("diagnostics/north_deflection_mm", times, 1e3 * r[:, 1], label="north (simulated)")
     if values["drag"] == 0:
-        model = result.extras["model"]
         e = energy_in_rotating_frame(r, v, result.extras["g"], model.omega.vector(), model.has("centrifugal"))
         rec.scalars("diagnostics/energy_rel_error", times, (e - e[0]) / abs(e[0]))
     rec.exact_values("world/body/landing", state=np.concatenate([r[-1], v[-1]]), time=[times[-1]])
@@ -138,3 +145,17 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
         for k in keep:
             tracks[members[k]] = ens.paths[k]
     return metrics
+
+
+def ensemble_theory(values):
+    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
+
+    Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
+    (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
+    t = sqrt(2 h / g).
+    """
+    Omega, _, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
+    lat = math.radians(values["latitude"])
+    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(values["height"], lat, g, Omega)),
+            "north_deflection_m": float(analytic.drop_north_deflection_second_order(values["height"], lat, g, Omega)),
+            "fall_time_s": math.sqrt(2 * values["height"] / g)}

@@ -79,6 +79,25 @@ def record(rec, values, result):
     phi = np.linspace(0, 2 * np.pi, 181)
     R = values["table_radius"]
     rec.line("world/turntable", np.stack([R * np.cos(phi), R * np.sin(phi), 0 * phi], axis=1), color=[120, 120, 200])
+    rec.frame_axes("world/frame", 0.5 * R, labels=("x (turntable)", "y (turntable)", "z (spin axis)"))
+    _record_inertial_axes(rec, traj.times, result.extras["omega"], 0.8 * R)
     err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
     rec.scalars("diagnostics/position_error_m", traj.times, err)
     rec.scalars("diagnostics/inertial_speed_rel_error", traj.times, _inertial_speed(result) / _inertial_speed(result)[0] - 1)
+
+
+def _record_inertial_axes(rec, times, omega, length):
+    """The inertial (lab) axes as seen from the turntable: they turn by -theta(t) about z."""
+    import rerun as rr
+
+    from rotframe.record import decimate
+
+    idx = decimate(len(times), 2000)
+    half = -0.5 * np.asarray(omega.angle(times[idx]), dtype=float).reshape(-1)
+    quat = np.stack([0 * half, 0 * half, np.sin(half), np.cos(half)], axis=1).astype(np.float32)
+    rec.rec.send_columns("world/inertial_axes", indexes=[rr.TimeColumn(
+        "sim_time", duration=np.round(times[idx] * 1e9).astype(np.int64).astype("timedelta64[ns]"))],
+        columns=rr.Transform3D.columns(quaternion=quat))
+    rec.rec.log("world/inertial_axes/arrows", rr.Arrows3D(
+        vectors=[[length, 0, 0], [0, length, 0]], colors=[[120, 120, 120], [120, 120, 120]],
+        labels=["X (inertial)", "Y (inertial)"]), static=True)

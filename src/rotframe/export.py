@@ -1,0 +1,81 @@
+"""Write a run's trajectory to a file: ``.npz``, ``.csv`` or ``.parquet``.
+
+* ``.npz`` (numpy): the arrays in their natural shapes (``times`` (n,);
+  ``r``, ``v`` (n, N, 3) for particles; ``L`` (n, 3), ``q`` (n, 4) for bodies),
+  plus ``units`` and ``summary`` as JSON strings.
+* ``.csv``: the long table of :meth:`rotframe.api.TrajectoryArrays.columns`
+  (one row per sample and particle), units in the column names, a header
+  line starting with ``#`` giving the scenario and frame.
+* ``.parquet`` (needs pyarrow, the ``export`` extra): the same table, with the
+  units and the summary in the file's metadata.
+
+Read back with ``numpy.load``, ``numpy.genfromtxt(..., names=True)`` or
+``pyarrow.parquet.read_table``/``pandas.read_parquet``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Mapping
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["FORMATS", "write_trajectory"]
+
+FORMATS = (".npz", ".csv", ".parquet")
+
+
+def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None = None) -> Path:
+    """Write ``traj`` (a :class:`rotframe.api.TrajectoryArrays`) to ``path``; the suffix picks the format.
+
+    Parameters
+    ----------
+    traj : TrajectoryArrays
+        The samples.
+    path : path-like
+        Ends in ``.npz``, ``.csv`` or ``.parquet``. Written to a temporary name
+        and renamed, so an existing file is only replaced by a complete one.
+    summary : mapping, optional
+        The run summary (JSON-ready) to store beside the arrays.
+    """
+    import os
+
+    import numpy as np
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise ScenarioError(f"--export {str(path)!r}: the file must end in {', '.join(FORMATS)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp" + suffix)
+    units = dict(traj.units)
+    meta = {"scenario": (summary or {}).get("scenario", ""), "frame": traj.frame, "units": units}
+    if suffix == ".npz":
+        arrays = {"times": traj.times}
+        for name in ("r", "v", "L", "q"):
+            value = getattr(traj, name)
+            if value is not None:
+                arrays[name] = value
+        np.savez(tmp, **arrays, units=json.dumps(units), frame=traj.frame,
+                 summary=json.dumps(dict(summary or {})))
+    else:
+        cols = traj.columns()
+        if suffix == ".csv":
+            names = list(cols)
+            table = np.column_stack([np.asarray(cols[k], dtype=float) for k in names])
+            fmt = ["%d" if k == "particle" else "%.17g" for k in names]
+            header = f"{json.dumps(meta)}\n" + ",".join(names)
+            np.savetxt(tmp, table, delimiter=",", fmt=fmt, header=header, comments="# ")
+        else:
+            try:
+                import pyarrow as pa
+                import pyarrow.parquet as pq
+            except ImportError:
+                raise ScenarioError(f"--export {str(path)!r}: parquet needs pyarrow "
+                                    '(python -m pip install "rotframe[export]"); .npz and .csv need nothing') from None
+            table = pa.table({k: np.asarray(v) for k, v in cols.items()})
+            table = table.replace_schema_metadata({"rotframe": json.dumps(dict(meta, summary=dict(summary or {})))})
+            pq.write_table(table, tmp)
+    os.replace(tmp, path)
+    return path
