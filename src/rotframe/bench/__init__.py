@@ -401,7 +401,7 @@ def planned_units(p, quick, peers_ok):
     return n
 
 
-SCIPY_METHODS_QUICK = ("DOP853",)
+SCIPY_METHODS_QUICK = SCIPY_METHODS  # every baseline, at one tolerance
 
 
 def _scipy_rtols(p, quick):
@@ -475,8 +475,9 @@ def run_problem(p, progress=None, plan=None):
 
 
 def _scipy_ladder(p, name, rhs_fn, method, rtols, scale, plan, emit, solve_ivp, compile_s=None):
+    budget = min(p.scipy_budget_s, 3.0) if plan.quick else p.scipy_budget_s
     for rtol in rtols:
-        rhs = _with_deadline(rhs_fn, p.scipy_budget_s)
+        rhs = _with_deadline(rhs_fn, budget)
         atol = p.atol if scale is None else rtol * scale
 
         def solve():
@@ -488,7 +489,7 @@ def _scipy_ladder(p, name, rhs_fn, method, rtols, scale, plan, emit, solve_ivp, 
             sol = solve()
         except _OverBudget:
             row = _row(p, name, rtol, time.perf_counter() - t0, math.nan, rhs.calls, None, family="peer")
-            row["note"] = f"stopped after {p.scipy_budget_s:g} s (over the budget)"
+            row["note"] = f"stopped after {budget:g} s (over the budget)"
             emit(row)
             break  # tighter tolerances would take longer still
         first = time.perf_counter() - t0
@@ -498,7 +499,7 @@ def _scipy_ladder(p, name, rhs_fn, method, rtols, scale, plan, emit, solve_ivp, 
         emit(_row(p, name, rtol, wall, p.error(sol.y[:, -1]) if ok else math.nan, sol.nfev, inv,
                   compile_s=compile_s, family="peer"))
         compile_s = None
-        if first > p.scipy_budget_s / 3:
+        if first > budget / 3:
             break  # the next, tighter tolerance would exceed the budget
 
 
@@ -792,9 +793,9 @@ def record_rows(n=10**6):
 def run_bench(names=None, quick=False, progress=None, on_row=None):
     """All rows for the named benchmarks (default: every problem, ensemble, sweep, start-up, recording).
 
-    ``quick``: short ladders, three repeats, plain scipy DOP853 only (no numba or
-    diffrax peers), no sweep or start-up (they start processes); every problem
-    still runs once. ``progress(done, total, label)`` is called after each
+    ``quick``: short ladders, three repeats, plain scipy at one tolerance (no
+    numba or diffrax peers), no sweep or start-up (they start processes); every
+    problem still runs once. ``progress(done, total, label)`` is called after each
     timed unit; ``on_row(row)`` with each row. Summary rows (``kind``
     "summary", one per problem and error level) close the list.
     """
@@ -810,7 +811,8 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
     if not quick and not peers_ok:
         notes.append(why)
     if quick:
-        notes.append("quick: plain scipy DOP853 only (no numba or diffrax peers), short ladders, 3 repeats")
+        notes.append("quick: plain scipy at rtol 1e-6 only (no numba or diffrax peers), short ladders, 3 repeats, "
+                     "no sweep or start-up")
     extras = [n for n in EXTRAS if (not names and not (quick and n in ("sweep", "startup"))) or n in names]
     plan.total = sum(planned_units(p, quick, peers_ok) for p in probs) + len(extras)
     for p in probs:
