@@ -92,3 +92,12 @@ def test_diffrax_peer_solves_a_rotation_when_installed():
     y, nfev = run(1e-12)
     angle = -2 * 0.5 * 2.0
     assert np.allclose(y[3:5], [math.cos(angle), math.sin(angle)], atol=1e-9) and nfev > 0
+
+
+def test_levels_below_the_reference_accuracy_are_not_claimed():
+    rows = [_row("dop853", 1e-3, 1e-10, "rotframe"), _row("diffrax-Dopri8", 1e-1, 1e-10, "peer")]
+    for r in rows:
+        r["reference_error"] = 3e-9
+    summ = {r["level"]: r for r in level_summary(rows)}
+    assert summ[1e-6]["ratio"] == pytest.approx(100.0)
+    assert summ[1e-9]["ratio"] is None and "not measurable" in summ[1e-9]["note"]
