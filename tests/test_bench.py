@@ -20,7 +20,13 @@ def test_bench_quick_json_rows_follow_the_contract(tmp_path):
     assert {"exact", "splitting", "rk4", "dop853"} <= methods
     exact = [r for r in rows if r["method"] == "exact"][0]
     assert exact["error"] < 1e-9 and exact["error_kind"].startswith("analytic")
-    assert all(r["wall_s"] > 0 for r in rows)
+    timed = [r for r in rows if r.get("kind") is None]
+    assert all(r["wall_s"] > 0 for r in timed)
+    # one summary row per error level, with the fastest peer and the ratio
+    summary = [r for r in rows if r.get("kind") == "summary"]
+    assert [r["level"] for r in summary] == [1e-3, 1e-6, 1e-9]
+    assert all(r["peer"].startswith("scipy") and r["ratio"] > 0 for r in summary)
+    assert any(r.get("kind") == "environment" for r in rows)
     speed = speedups(rows)
     assert all(math.isfinite(s["speedup"]) for s in speed.values())
 

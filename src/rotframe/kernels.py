@@ -70,7 +70,7 @@ N_EVENT_FIELDS = 5
 # Every kernel: cached on disk; a division by zero gives inf or nan (caught as a
 # non-finite state) instead of raising, which also lets numba drop the reference counting
 # of arrays passed to small functions that it inlines.
-_jit = njit(cache=True, error_model="numpy")
+_jit = njit(cache=True, error_model="numpy", nogil=True)  # nogil: ensembles run blocks on threads
 
 # Force evaluations per step of each method code (0 splitting, 1 splitting4, 2 rk4).
 _NFEV = (1, 3, 4)

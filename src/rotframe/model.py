@@ -102,10 +102,18 @@ class OmegaSchedule:
         return self.values.size == 1 or bool(np.all(self.values == self.values[0]))
 
     def cumulative(self) -> np.ndarray:
-        """Integral of w from the first node to each node (rad)."""
-        dt = np.diff(self.times)
-        seg = 0.5 * dt * (self.values[1:] + self.values[:-1])
-        return np.concatenate([[0.0], np.cumsum(seg)])
+        """Integral of w from the first node to each node (rad).
+
+        Computed once per schedule (the schedule is frozen) and returned as a
+        copy: a run's per-call overhead stays a few microseconds.
+        """
+        cached = self.__dict__.get("_cumulative")
+        if cached is None:
+            dt = np.diff(self.times)
+            seg = 0.5 * dt * (self.values[1:] + self.values[:-1])
+            cached = np.concatenate([[0.0], np.cumsum(seg)])
+            object.__setattr__(self, "_cumulative", cached)
+        return cached.copy()
 
     def vector(self, t=0.0) -> np.ndarray:
         """omega(t) as a vector (rad/s)."""
@@ -192,7 +200,14 @@ class ParticleModel:
         return not uses_omega or self.omega.is_constant
 
     def pack(self) -> np.ndarray:
-        """The flat parameter vector of :mod:`rotframe.kernels`."""
+        """The flat parameter vector of :mod:`rotframe.kernels` (made once per model, returned as a copy)."""
+        cached = self.__dict__.get("_packed")
+        if cached is None:
+            cached = self._pack()
+            object.__setattr__(self, "_packed", cached)
+        return cached.copy()
+
+    def _pack(self) -> np.ndarray:
         from rotframe import kernels as k
 
         P = np.zeros(k.N_PARAMS)

@@ -45,6 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rotframe.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (moved; kept importable)
 from rotframe.errors import RotframeError, ScenarioError
 
 __all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "EnsembleRun", "parse_spec",
@@ -52,7 +53,7 @@ __all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "Ense
 
 #: at most this many trajectories and samples per trajectory in the recording
 MAX_TRACKS = 2000
-MAX_TRACK_SAMPLES = 500
+MAX_TRACK_SAMPLES = 500  # the same as rotframe.ensemble.MAX_TRACK_SAMPLES
 #: wall time of one batch of runs (s): long enough that task overhead stays small, short enough to lose little
 MIN_BATCH_S = 0.2
 MAX_BATCH_S = 30.0
@@ -62,8 +63,6 @@ ENSEMBLE_BATCH = 1 << 17
 MIN_ENSEMBLE_BATCH = 4096
 #: Dask retries of a task whose worker failed
 RETRIES = 3
-#: particle-samples held at once by :func:`integrate_ensemble` (13 floats each)
-PATH_BUDGET = 2_000_000
 _DISTRIBUTIONS = {"normal": ("MEAN", "SD"), "uniform": ("LO", "HI")}
 _META_KEY = b"rotframe.sweep"
 
@@ -176,27 +175,6 @@ class SweepInterrupted(KeyboardInterrupt):
     def __init__(self, saved: int, total: int, parts: str):
         super().__init__(f"{saved} of {total} rows saved")
         self.saved, self.total, self.parts = saved, total, parts
-
-
-@dataclass
-class EnsembleRun:
-    """What :func:`integrate_ensemble` returns.
-
-    Attributes
-    ----------
-    t_event : (N,) array
-        Time (s) of each particle's first event; NaN where it had none.
-    state : (N, 6) array
-        (r, v) at the event, or at the end of the run where there was none.
-    paths : dict
-        Index -> (times (n,), positions (n, 3)) up to the event, for the indices asked for.
-    method : str
-    """
-
-    t_event: np.ndarray
-    state: np.ndarray
-    paths: dict
-    method: str
 
 
 def main(args) -> int:
@@ -417,58 +395,6 @@ def run_batch(task: BatchTask) -> BatchOutput:
         return _runs_batch(task, scn, base)
     except RunInterrupted:  # Ctrl-C inside an integration: the sweep stops, the batch is not written
         raise KeyboardInterrupt from None
-
-
-def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=()) -> EnsembleRun:
-    """Integrate an ensemble to a terminal event in one vectorised call of the compiled core.
-
-    For scenes' ``simulate_ensemble``. The integrator locates the event for every
-    particle (the kernels inside the compiled loop; ``exact`` for all particles at
-    once on the exact flow). Paths for ``keep`` come from the same call when the
-    ensemble is small, else from a second call on those particles only.
-
-    Parameters
-    ----------
-    model : ParticleModel
-    r0, v0 : (N, 3) arrays
-    duration : float
-        Long enough for every particle to reach the event.
-    event : rotframe.integrators.Event
-        Terminal event (kinds ``r`` and ``v`` with ``exact``).
-    method : str
-    run : dict
-        Run settings (``step``, ``rtol``, ``samples``: at most :data:`MAX_TRACK_SAMPLES` are kept in paths).
-    keep : sequence of int
-        Particles whose paths are wanted.
-    """
-    n = len(r0)
-    keep = list(keep)
-    path_samples = max(2, min(int(run.get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
-    exact = method == "exact"
-    if n * (path_samples + 1) <= PATH_BUDGET:
-        traj = _integrate(model, r0, v0, duration, event, method, run, max(path_samples, 16))
-        sub, sub_index = traj, keep
-    else:
-        samples = int(np.clip(PATH_BUDGET // n, 16, path_samples)) if exact else 1
-        traj = _integrate(model, r0, v0, duration, event, method, run, samples)
-        sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, path_samples) if keep else None
-        sub_index = list(range(len(keep)))
-    t_event, state = _first_events(traj, event)
-    paths = {k: _path_until(sub, j, t_event[k], state[k]) for k, j in zip(keep, sub_index)}
-    return EnsembleRun(t_event, state, paths, traj.method)
-
-
-def group_points(values_list, varying) -> list:
-    """Indices of ``values_list`` grouped by every value except the keys in ``varying``.
-
-    Points of one group share the model and differ only in initial conditions, so a scene
-    can integrate each group as one ensemble.
-    """
-    groups = {}
-    for i, values in enumerate(values_list):
-        key = tuple(sorted((k, repr(v)) for k, v in values.items() if k not in varying))
-        groups.setdefault(key, []).append(i)
-    return list(groups.values())
 
 
 def write_plots(table, spec: SweepSpec, stem) -> list:
@@ -1136,34 +1062,6 @@ def _decimated(times, pos):
 # ---------------------------------------------------------------------------
 # ensembles
 # ---------------------------------------------------------------------------
-
-
-def _integrate(model, r0, v0, duration, event, method, run, samples):
-    from rotframe.integrators import integrate_particles
-
-    return integrate_particles(model, r0, v0, duration, method=method, step=run.get("step"),
-                               rtol=run.get("rtol") or 1e-10, samples=int(samples), events=[event])
-
-
-def _first_events(traj, event):
-    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none."""
-    n = traj.r.shape[1]
-    state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
-    t_event = np.full(n, math.nan)
-    for p, (times, states) in enumerate(zip(traj.event_times[event.name], traj.event_states[event.name])):
-        if len(times):
-            t_event[p] = times[0]
-            state[p] = states[0]
-    return t_event, state
-
-
-def _path_until(traj, j, t_event, state):
-    """Samples of particle j before its event, then the event state; positions only."""
-    times = traj.times
-    if not np.isfinite(t_event):
-        return times, traj.r[:, j]
-    keep = times < t_event
-    return np.append(times[keep], t_event), np.vstack([traj.r[keep, j], state[None, :3]])
 
 
 # ---------------------------------------------------------------------------

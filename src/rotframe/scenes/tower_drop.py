@@ -109,7 +109,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model: each such group is one
     ``integrate_particles`` call with one particle per point and the ground event
-    (:func:`rotframe.sweep.integrate_ensemble`). The metrics are those of
+    (:func:`rotframe.ensemble.integrate_ensemble`). The metrics are those of
     :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
@@ -128,7 +128,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     list of dict
         ``analyse(...)["metrics"]`` per point, in order.
     """
-    from rotframe.sweep import group_points, integrate_ensemble
+    from rotframe.ensemble import group_points, integrate_ensemble
 
     metrics = [None] * len(values_list)
     for members in group_points(values_list, varying=("height", "magnify")):

@@ -1,0 +1,216 @@
+"""Ensembles of particles to a terminal event, on every core.
+
+A scene's ``simulate_ensemble`` integrates many particles that share one model
+(for example drops from different heights) in vectorised calls of the compiled
+core. The particles are cut into fixed blocks of :data:`BLOCK` particles, and
+the blocks run on a pool of threads (the compiled kernels release the GIL).
+The cut does not depend on the number of threads, and every particle is
+integrated on its own inside a block, so the results are bitwise identical
+for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``).
+
+``threads=None`` means every core (``os.cpu_count()``), or the default set by
+:func:`set_default_threads` (the CLI's ``--threads``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "set_default_threads", "resolve_threads",
+           "BLOCK", "MAX_TRACK_SAMPLES", "PATH_BUDGET"]
+
+#: at most this many samples per kept path
+MAX_TRACK_SAMPLES = 500
+#: particle-samples held at once by :func:`integrate_ensemble` (13 floats each)
+PATH_BUDGET = 2_000_000
+#: particles per block; fixed, so that the cut never depends on the number of threads
+BLOCK = 4096
+
+_default_threads = None
+
+
+def set_default_threads(threads):
+    """Threads used where ``threads=None`` is passed (None: every core)."""
+    global _default_threads
+    if threads is not None and int(threads) < 1:
+        from rotframe.errors import ScenarioError
+
+        raise ScenarioError(f"threads: {threads}; must be >= 1")
+    _default_threads = None if threads is None else int(threads)
+
+
+def resolve_threads(threads=None) -> int:
+    """The number of threads for ``threads`` (None: the default, else every core)."""
+    if threads is None:
+        threads = _default_threads
+    if threads is None:
+        threads = os.cpu_count() or 1
+    threads = int(threads)
+    if threads < 1:
+        from rotframe.errors import ScenarioError
+
+        raise ScenarioError(f"threads: {threads}; must be >= 1")
+    return threads
+
+
+@dataclass
+class EnsembleRun:
+    """What :func:`integrate_ensemble` returns.
+
+    Attributes
+    ----------
+    t_event : (N,) array
+        Time (s) of each particle's first event; NaN where it had none.
+    state : (N, 6) array
+        (r, v) at the event, or at the end of the run where there was none.
+    paths : dict
+        Index -> (times (n,), positions (n, 3)) up to the event, for the indices asked for.
+    method : str
+    """
+
+    t_event: np.ndarray
+    state: np.ndarray
+    paths: dict
+    method: str
+
+
+def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), threads=None) -> EnsembleRun:
+    """Integrate an ensemble to a terminal event in vectorised calls of the compiled core, on every core.
+
+    The integrator locates the event for every particle (the kernels inside the
+    compiled loop; ``exact`` for all particles at once on the exact flow).
+    Paths for ``keep`` come from the same call when the ensemble is small, else
+    from a second call on those particles only.
+
+    Parameters
+    ----------
+    model : ParticleModel
+    r0, v0 : (N, 3) arrays
+    duration : float
+        Long enough for every particle to reach the event.
+    event : rotframe.integrators.Event
+        Terminal event (kinds ``r`` and ``v`` with ``exact``).
+    method : str
+    run : dict
+        Run settings (``step``, ``rtol``, ``samples``: at most :data:`MAX_TRACK_SAMPLES` are kept in paths).
+    keep : sequence of int
+        Particles whose paths are wanted.
+    threads : int, optional
+        Threads for the compiled methods (None: :func:`resolve_threads`). The
+        result does not depend on it. ``exact`` runs in one vectorised call.
+    """
+    r0 = np.asarray(r0, dtype=np.float64)
+    v0 = np.asarray(v0, dtype=np.float64)
+    n = len(r0)
+    keep = list(keep)
+    path_samples = max(2, min(int(run.get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
+    exact = method == "exact"
+    # one absolute tolerance for the whole ensemble (dop853), whatever the blocks
+    atol = run.get("atol")
+    if method == "dop853" and not atol and n:
+        scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
+        atol = float(run.get("rtol") or 1e-10) * scale
+    run = dict(run, atol=atol)
+    if n * (path_samples + 1) <= PATH_BUDGET:
+        t_event, state, traj = _integrate_blocks(model, r0, v0, duration, event, method, run,
+                                                 max(path_samples, 16), threads)
+        sub, sub_index = traj, keep
+    else:
+        samples = int(np.clip(PATH_BUDGET // n, 16, path_samples)) if exact else 1
+        t_event, state, traj = _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads)
+        sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, path_samples) if keep else None
+        sub_index = list(range(len(keep)))
+    paths = {k: _path_until(sub, j, t_event[k], state[k]) for k, j in zip(keep, sub_index)}
+    return EnsembleRun(t_event, state, paths, method)
+
+
+def group_points(values_list, varying) -> list:
+    """Indices of ``values_list`` grouped by every value except the keys in ``varying``.
+
+    Points of one group share the model and differ only in initial conditions, so a scene
+    can integrate each group as one ensemble.
+    """
+    groups = {}
+    for i, values in enumerate(values_list):
+        key = tuple(sorted((k, repr(v)) for k, v in values.items() if k not in varying))
+        groups.setdefault(key, []).append(i)
+    return list(groups.values())
+
+
+# ---------------------------------------------------------------------------
+
+
+class _Merged:
+    """Positions of every particle over the common sample times (what paths need)."""
+
+    def __init__(self, times, r):
+        self.times, self.r = times, r
+
+
+def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads):
+    """(t_event, state, trajectory-like) of the whole ensemble, block by block on a thread pool."""
+    n = len(r0)
+    if method == "exact" or n <= BLOCK:
+        traj = _integrate(model, r0, v0, duration, event, method, run, samples)
+        t_event, state = _first_events(traj, event)
+        return t_event, state, traj
+    bounds = [(lo, min(n, lo + BLOCK)) for lo in range(0, n, BLOCK)]
+
+    def one(b):
+        lo, hi = b
+        traj = _integrate(model, r0[lo:hi], v0[lo:hi], duration, event, method, run, samples)
+        t_event, state = _first_events(traj, event)
+        return t_event, state, traj.times, traj.r
+
+    workers = min(resolve_threads(threads), len(bounds))
+    if workers == 1:
+        parts = [one(b) for b in bounds]
+    else:
+        from concurrent.futures import ThreadPoolExecutor
+
+        # compile (or load) the kernel once in this thread, so that the pool does not wait on the compiler
+        _integrate(model, r0[:1], v0[:1], duration, event, method, run, 1)
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            parts = list(pool.map(one, bounds))  # in block order; the first failure is raised
+    t_event = np.concatenate([p[0] for p in parts])
+    state = np.concatenate([p[1] for p in parts])
+    r = np.concatenate([p[3] for p in parts], axis=1)
+    return t_event, state, _Merged(parts[0][2], r)
+
+
+def _integrate(model, r0, v0, duration, event, method, run, samples):
+    from rotframe.integrators import integrate_particles
+
+    kw = {}
+    if run.get("atol"):
+        kw["atol"] = run["atol"]
+    # a terminal event stops the particle: one record per particle is enough
+    max_events = 1 if event.terminal else 64
+    return integrate_particles(model, r0, v0, duration, method=method, step=run.get("step"),
+                               rtol=run.get("rtol") or 1e-10, samples=int(samples), events=[event],
+                               max_events=max_events, **kw)
+
+
+def _first_events(traj, event):
+    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none."""
+    n = traj.r.shape[1]
+    state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
+    t_event = np.full(n, math.nan)
+    for p, (times, states) in enumerate(zip(traj.event_times[event.name], traj.event_states[event.name])):
+        if len(times):
+            t_event[p] = times[0]
+            state[p] = states[0]
+    return t_event, state
+
+
+def _path_until(traj, j, t_event, state):
+    """Samples of particle j before its event, then the event state; positions only."""
+    times = traj.times
+    if not np.isfinite(t_event):
+        return times, traj.r[:, j]
+    keep = times < t_event
+    return np.append(times[keep], t_event), np.vstack([traj.r[keep, j], state[None, :3]])

@@ -1,0 +1,103 @@
+"""The bench's summary per problem and error level, and its peers' right-hand sides (no timing asserted).
+
+The summary is checked on hand-made rows (what it must pick is known); the peers'
+right-hand sides against rotframe.rigid.rigid_rhs and the particle equations
+written out here with np.cross (a third, plain writing of the same formulas).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rotframe import rigid
+from rotframe.bench import level_summary, peers
+
+
+def _row(method, wall, error, family, scenario="p", horizon="h"):
+    return {"scenario": scenario, "method": method, "setting": 1e-6, "wall_s": wall, "error": error,
+            "error_kind": "k", "nfev": 1, "horizon": horizon, "family": family}
+
+
+def test_summary_picks_the_fastest_run_at_each_level():
+    rows = [_row("dop853", 1e-4, 5e-4, "rotframe"), _row("dop853", 3e-4, 5e-7, "rotframe"),
+            _row("rk4", 2e-4, 2e-10, "rotframe"),
+            _row("diffrax-Tsit5", 2e-3, 8e-4, "peer"), _row("scipy-DOP853", 1e-3, 9e-7, "peer"),
+            _row("diffrax-Dopri8", 5e-3, 1e-8, "peer")]
+    rows[-1]["compile_s"] = 2.5
+    summ = {r["level"]: r for r in level_summary(rows)}
+    assert summ[1e-3]["rotframe_method"] == "dop853" and summ[1e-3]["wall_s"] == 1e-4
+    assert summ[1e-3]["peer"] == "scipy-DOP853" and summ[1e-3]["ratio"] == pytest.approx(10.0)
+    assert summ[1e-6]["wall_s"] == 2e-4 and summ[1e-6]["ratio"] == pytest.approx(5.0)  # rk4 is faster there
+    assert "below the 10x goal by a factor 2.0" in summ[1e-6]["note"]
+    assert summ[1e-9]["peer"] is None and summ[1e-9]["ratio"] is None
+    assert "no peer run reached this error (smallest 1.0e-08)" in summ[1e-9]["note"]
+    for r in summ.values():  # the row contract of bench --json
+        assert {"scenario", "method", "setting", "wall_s", "error", "error_kind", "nfev"} <= set(r)
+
+
+def test_summary_ignores_zero_error_except_for_exact():
+    rows = [_row("splitting", 1e-6, 0.0, "rotframe"), _row("exact", 1e-3, 0.0, "rotframe"),
+            _row("scipy-RK45", 1e-2, 1e-10, "peer")]
+    summ = level_summary(rows)
+    assert all(r["rotframe_method"] == "exact" for r in summ)
+
+
+def test_peer_rigid_rhs_match_rotframe():
+    rng = np.random.default_rng(0)
+    inertia = np.array([1.9e-4, 1.9e-4, 2.5e-5])
+    spec = {"kind": "rigid", "inertia": tuple(inertia), "mgl": 0.04}
+    f, g = peers.python_rhs(spec), peers.numba_rhs(spec)
+    for _ in range(5):
+        y = rng.normal(size=7)
+        ref = rigid.rigid_rhs(0.0, y, inertia, mgl=0.04)
+        assert np.allclose(f(0.0, y), ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
+        assert np.allclose(g(0.0, y), ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("spec", [
+    {"kind": "particle", "w": (0.0, 4.6e-5, 5.7e-5), "g": (0.0, 0.0, -9.81), "ramp": None, "pendulum": None},
+    {"kind": "particle", "w": (0.0, 4.6e-5, 5.7e-5), "g": (0.0, 0.0, -9.81), "ramp": None,
+     "pendulum": (67.0, (0.0, 0.0, 67.0))},
+    {"kind": "particle", "w": (0.0, 0.0, 0.0), "g": (0.0, 0.0, 0.0), "ramp": (1.0, 0.2), "pendulum": None}])
+def test_peer_particle_rhs_match_the_equations(spec):
+    rng = np.random.default_rng(1)
+    f, g = peers.python_rhs(spec), peers.numba_rhs(spec)
+    for _ in range(5):
+        t, y = rng.uniform(0, 4), rng.normal(size=6) * 10
+        r, v = y[:3], y[3:]
+        if spec["ramp"]:
+            w = np.array([0.0, 0.0, spec["ramp"][0] + spec["ramp"][1] * t])
+            wd = np.array([0.0, 0.0, spec["ramp"][1]])
+            a = -2 * np.cross(w, v) - np.cross(w, np.cross(w, r)) - np.cross(wd, r)
+        else:
+            a = np.array(spec["g"]) - 2 * np.cross(spec["w"], v)
+            if spec["pendulum"]:
+                L, pivot = spec["pendulum"]
+                n = (r - np.array(pivot)) / L
+                a = a - (a @ n + v @ v / L) * n
+        ref = np.concatenate([v, a])
+        assert np.allclose(f(t, y), ref, rtol=1e-13, atol=1e-12)
+        assert np.allclose(g(t, y), ref, rtol=1e-13, atol=1e-12)
+
+
+def test_diffrax_peer_solves_a_rotation_when_installed():
+    ok, why = peers.diffrax_available()
+    if not ok:
+        pytest.skip(why)
+    # pure Coriolis, no gravity: the velocity turns at 2|w| exactly, |v| is constant
+    spec = {"kind": "particle", "w": (0.0, 0.0, 0.5), "g": (0.0, 0.0, 0.0), "ramp": None, "pendulum": None}
+    y0 = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    run, _ = peers.diffrax_solver(spec, "Dopri8", 2.0, y0, peers.atol_scale(spec, y0))
+    y, nfev = run(1e-12)
+    angle = -2 * 0.5 * 2.0
+    assert np.allclose(y[3:5], [math.cos(angle), math.sin(angle)], atol=1e-9) and nfev > 0
+
+
+def test_levels_below_the_reference_accuracy_are_not_claimed():
+    rows = [_row("dop853", 1e-3, 1e-10, "rotframe"), _row("diffrax-Dopri8", 1e-1, 1e-10, "peer")]
+    for r in rows:
+        r["reference_error"] = 3e-9
+    summ = {r["level"]: r for r in level_summary(rows)}
+    assert summ[1e-6]["ratio"] == pytest.approx(100.0)
+    assert summ[1e-9]["ratio"] is None and "not measurable" in summ[1e-9]["note"]

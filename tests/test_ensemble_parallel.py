@@ -1,0 +1,87 @@
+"""Ensembles on several threads give bitwise the same result as on one (rotframe.ensemble).
+
+The particles are cut into fixed blocks whatever the number of threads, and
+each particle is integrated on its own, so equality is exact (no tolerance).
+The blocked run is also compared with one unblocked ``integrate_particles``
+call: with one sample per run the kernel sees the same inputs, so it too is
+equal bitwise; a small block size keeps the test cheap.
+"""
+
+import numpy as np
+import pytest
+
+from rotframe import ensemble
+from rotframe.integrators import Event, integrate_particles
+from rotframe.model import OmegaSchedule, ParticleModel
+
+GROUND = Event("ground", "r", 2, 0.0, -1, True)
+
+
+def _model():
+    w = np.array([0.0, 4.6e-5, 5.7e-5])
+    return ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -9.81]))
+
+
+def _start(n, seed=3):
+    rng = np.random.default_rng(seed)
+    r0 = np.zeros((n, 3))
+    r0[:, 2] = rng.uniform(10.0, 200.0, n)
+    v0 = rng.normal(scale=2.0, size=(n, 3))
+    return r0, v0
+
+
+def _same(a, b):
+    return np.array_equal(a, b, equal_nan=True)
+
+
+@pytest.mark.parametrize("method,run", [("splitting", {"step": 1e-2, "samples": 1}),
+                                        ("dop853", {"rtol": 1e-8, "samples": 1})])
+def test_threads_do_not_change_the_result(monkeypatch, method, run):
+    monkeypatch.setattr(ensemble, "BLOCK", 64)
+    monkeypatch.setattr(ensemble, "PATH_BUDGET", 100)  # the large-ensemble branch: one sample per particle
+    r0, v0 = _start(300)
+    model = _model()
+    runs = [ensemble.integrate_ensemble(model, r0, v0, 10.0, GROUND, method=method, run=run, keep=[0, 150],
+                                        threads=t) for t in (1, 2, 3)]
+    for other in runs[1:]:
+        assert _same(runs[0].t_event, other.t_event)
+        assert _same(runs[0].state, other.state)
+        for k in (0, 150):
+            assert _same(runs[0].paths[k][1], other.paths[k][1])
+    assert np.isfinite(runs[0].t_event).all()  # every particle landed within 10 s
+
+
+def test_blocked_equals_one_unblocked_call(monkeypatch):
+    monkeypatch.setattr(ensemble, "BLOCK", 50)
+    monkeypatch.setattr(ensemble, "PATH_BUDGET", 100)
+    r0, v0 = _start(170, seed=5)
+    model = _model()
+    ens = ensemble.integrate_ensemble(model, r0, v0, 10.0, GROUND, method="splitting", run={"step": 1e-2},
+                                      threads=2)
+    traj = integrate_particles(model, r0, v0, 10.0, method="splitting", step=1e-2, samples=1, events=[GROUND])
+    t_ref = np.array([t[0] for t in traj.event_times["ground"]])
+    assert _same(ens.t_event, t_ref)
+    assert _same(ens.state, np.array([s[0] for s in traj.event_states["ground"]]))
+
+
+def test_small_ensemble_with_paths_is_thread_independent(monkeypatch):
+    monkeypatch.setattr(ensemble, "BLOCK", 40)
+    r0, v0 = _start(100, seed=7)
+    model = _model()
+    a = ensemble.integrate_ensemble(model, r0, v0, 10.0, GROUND, method="rk4", run={"step": 1e-2, "samples": 50},
+                                    keep=[3, 99], threads=1)
+    b = ensemble.integrate_ensemble(model, r0, v0, 10.0, GROUND, method="rk4", run={"step": 1e-2, "samples": 50},
+                                    keep=[3, 99], threads=2)
+    assert _same(a.t_event, b.t_event) and _same(a.state, b.state)
+    for k in (3, 99):
+        assert _same(a.paths[k][0], b.paths[k][0]) and _same(a.paths[k][1], b.paths[k][1])
+        assert a.paths[k][0][-1] == a.t_event[k]  # the path ends at the landing
+
+
+def test_thread_count_validation():
+    from rotframe.errors import ScenarioError
+
+    assert ensemble.resolve_threads(2) == 2
+    assert ensemble.resolve_threads(None) >= 1
+    with pytest.raises(ScenarioError, match="threads"):
+        ensemble.set_default_threads(0)
