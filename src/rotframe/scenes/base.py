@@ -208,6 +208,21 @@ def unresolved_note(metric, what, period, duration, per_period=SAMPLES_PER_PERIO
             f"set duration <= {bound * period / per_period:.4g} s")
 
 
+def method_rel_error(traj, time_scale):
+    """A bound on the relative error of a run's metrics from its method, for a motion of ``time_scale`` s.
+
+    ``exact`` and the adaptive ``dop853`` (rtol <= 1e-10 in the scenes): 1e-9,
+    round-off and tolerance. Fixed-step methods: 10 (h / T)^p with p = 2 for
+    ``splitting`` and 4 for ``splitting4`` and ``rk4`` (their global error over a
+    motion of time scale T), a factor 10 of margin over the leading term.
+    """
+    h = traj.extras.get("step") or 0.0
+    order = {"splitting": 2, "splitting4": 4, "rk4": 4}.get(traj.method)
+    if order is None or not h or not time_scale > 0:
+        return 1e-9
+    return 1e-9 + 10.0 * (h / time_scale) ** order
+
+
 def reject_subnormal(values):
     """ScenarioError for a nonzero parameter below the smallest normal float64 (2.2e-308).
 

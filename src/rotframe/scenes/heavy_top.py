@@ -150,7 +150,7 @@ def analyse(values, result):
                       "nutation_period_s": float(tp[2]) if len(tp) > 2 else math.nan}
             if tp[1] - tp[0] <= NUTATION_FLOOR:
                 theory["nutation_period_s"] = math.nan
-                notes.append(f"theory: theta stays at {math.degrees(tp[0]):.6g} deg (steady motion; the period of "
+                notes.append(f"theory: theta stays at {math.degrees(tp[0]):.6g} deg (steady to the resolution of the cubic; the period of "
                              f"small nods about it would be {tp[2]:.6g} s)")
             # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin;
             # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
