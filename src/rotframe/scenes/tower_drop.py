@@ -104,8 +104,8 @@ def analyse(values, result):
     if e is not None:
         diagnostics["energy_rel_drift"] = rel_drift(e)
     else:
-        notes.append("theory is the vacuum closed form; with drag the body falls longer and deflects less far east "
-                     "than the vacuum formula says for the same fall time (no energy invariant either)")
+        notes.append("theory is the vacuum closed form, indicative only with drag: the body falls longer, and the "
+                     "air both prolongs the Coriolis push and damps the eastward drift (no energy invariant either)")
     if model.has("altitude-gravity") or model.has("central-gravity"):
         notes.append("theory assumes uniform gravity; weaker gravity aloft changes every value by up to a "
                      f"relative h / R = {values['height'] / earth.R_EARTH:.2g}")
