@@ -186,9 +186,9 @@ def samples_for(duration, shortest_period, requested, per_period=SAMPLES_PER_PER
     """Samples that resolve ``shortest_period`` over ``duration``, and whether the bound allowed it.
 
     Returns ``(samples, resolved)``: ``samples = max(requested, per_period *
-    duration / shortest_period)``, capped at ``max(requested, bound)``;
-    ``resolved`` is False when the cap left fewer than ``per_period`` samples per
-    period (metrics of that motion must then be reported as null with a note).
+    duration / shortest_period)`` when that is at most ``bound``; otherwise
+    ``(requested, False)``: the samples cannot resolve the motion, and its
+    metrics must be reported as null with a note.
     A non-positive or infinite period needs no resolution.
     """
     requested = max(1, int(requested))
@@ -197,8 +197,9 @@ def samples_for(duration, shortest_period, requested, per_period=SAMPLES_PER_PER
     need = math.ceil(per_period * duration / shortest_period)
     if need <= requested:
         return requested, True
-    cap = max(requested, int(bound))
-    return min(need, cap), need <= cap
+    if need > max(requested, int(bound)):
+        return requested, False  # the metrics will be null: no point in paying for samples that cannot help
+    return need, True
 
 
 def unresolved_note(metric, what, period, duration, per_period=SAMPLES_PER_PERIOD, bound=MAX_SAMPLES):
