@@ -95,7 +95,8 @@ def analyse(values, result):
                          "are infinite (null)" if lat == 0 else
                          f"the velocity turns by less than {TURN_FLOOR:g} rad in the run, below round-off: period "
                          "and radius not measured (lengthen duration)")
-            metrics = {"period_s": math.nan, "radius_m": math.nan}
+            if lat != 0:  # on the equator infinity is the answer; elsewhere the run could not tell
+                metrics = {"period_s": math.nan, "radius_m": math.nan}
     theory_vals = {"period_s": float(theory.period), "radius_m": float(theory.radius)}
     exact = "exact: 2 pi / |f| and speed / |f|, f = 2 Omega sin(latitude), of the same f-plane model"
     theory_notes = {"period_s": exact, "radius_m": exact}
