@@ -274,3 +274,24 @@ def test_every_null_metric_comes_with_a_note(name, sets):
     s = run(name, **sets)
     assert any(null(v) for v in s["metrics"].values())
     assert s.get("notes")
+
+
+# --- extreme but allowed inputs ----------------------------------------------------------------
+
+
+def test_inertial_circle_of_a_nearly_still_puck_keeps_its_radius():
+    # speed 1e-300: the positions (~1e-296 m) square to zero in float64 unless the fit is scaled
+    s = run("inertial-oscillation", speed=1e-300)
+    assert s["metrics"]["radius_m"] == pytest.approx(1e-300 / (2 * OMEGA * math.sin(math.radians(45))), rel=1e-9)
+
+
+def test_full_pendulum_swing_at_round_off_of_the_string_is_null_with_a_note():
+    s = run("foucault", amplitude=1e-200)
+    assert null(s["metrics"]["precession_rate_deg_per_hour"]) and "small_angle" in notes(s)
+    assert s["warnings"] == []
+
+
+def test_heavy_top_run_shorter_than_a_nutation_does_not_report_turning_points():
+    s = run("heavy-top", duration=1e-3)
+    assert null(s["metrics"]["theta_max_deg"]) and "shorter than one nutation period" in notes(s)
+    assert s["warnings"] == []

@@ -78,7 +78,9 @@ def swing_angle(r, v, w0):
     Major axis of A = v v^T + w0^2 x x^T in the horizontal plane; defined
     modulo pi, unwrapped by doubling.
     """
-    x, y, vx, vy = r[:, 0], r[:, 1], v[:, 0], v[:, 1]
+    # in units of the swing's size (the angle does not depend on them): squares of a tiny swing do not underflow
+    scale = max(float(np.max(np.abs(r[:, :2]))), float(np.max(np.abs(v[:, :2]))) / w0) or 1.0
+    x, y, vx, vy = r[:, 0] / scale, r[:, 1] / scale, v[:, 0] / scale, v[:, 1] / scale
     axx = vx * vx + w0 * w0 * x * x
     ayy = vy * vy + w0 * w0 * y * y
     axy = vx * vy + w0 * w0 * x * y
@@ -99,7 +101,8 @@ def measured_rates(times, r, v, length, g, with_error=False):
         spread = float(np.sum((times - times.mean()) ** 2))
         slope_error = math.sqrt(float(np.sum(resid**2)) / max(len(times) - 2, 1) / spread) if spread > 0 else math.inf
     # period from the maxima of the horizontal distance: x.v changes sign from + to -
-    rho = r[:, 0] * v[:, 0] + r[:, 1] * v[:, 1]
+    scale = max(float(np.max(np.abs(r[:, :2]))), float(np.max(np.abs(v[:, :2]))) / w0) or 1.0
+    rho = (r[:, 0] / scale) * (v[:, 0] / scale) + (r[:, 1] / scale) * (v[:, 1] / scale)
     k = np.nonzero((rho[:-1] > 0) & (rho[1:] <= 0))[0]
     if len(k) >= 3:
         tc = times[k] + (times[k + 1] - times[k]) * rho[k] / (rho[k] - rho[k + 1])
@@ -151,6 +154,11 @@ def analyse(values, result):
         metrics["period_s"] = math.nan
         notes.append(unresolved_note("period_s", "swing", T_swing, duration, per_period=SAMPLES_PER_PERIOD,
                                      bound=MAX_SAMPLES) + " (the precession rate needs no such resolution)")
+    if not values["small_angle"] and a < 1e4 * np.finfo(float).eps * L:
+        # the string is kept to round-off of its length, eps L: a swing not far above that is noise
+        metrics = {"precession_rate_deg_per_hour": math.nan, "period_s": math.nan}
+        notes.append(f"amplitude {a:.3g} m is within 1e4 round-offs of the string length ({L:g} m): the full "
+                     "pendulum cannot resolve the swing; use small_angle = true")
     if duration < 2 * T_swing:
         metrics["precession_rate_deg_per_hour"] = math.nan
         notes.append(f"precession not measured: the run is shorter than two swings ({2 * T_swing:.4g} s)")

@@ -137,6 +137,11 @@ def analyse(values, result):
                "nutation_period_s": period}
     if not result.extras.get("resolved", True):  # extremes of unresolved samples are not the motion's
         metrics.update(theta_min_deg=math.nan, theta_max_deg=math.nan)
+    T_nut = result.extras.get("nutation_period", math.inf)
+    if amplitude > floor and math.isfinite(T_nut) and float(traj.times[-1]) < T_nut:
+        metrics.update(theta_min_deg=math.nan, theta_max_deg=math.nan)
+        notes.append(f"the run is shorter than one nutation period ({T_nut:.4g} s): theta has not reached both "
+                     "turning points, so theta_min_deg and theta_max_deg are null")
     theory, tolerance = {}, {}
     exact = "exact: roots of Goldstein's cubic f(u) of the same top"
     theory_notes = {"theta_min_deg": exact, "theta_max_deg": exact,

@@ -65,11 +65,13 @@ def measured(times, r, v):
     if turned < 0.5 * math.pi:
         radius = float(np.mean(np.linalg.norm(v, axis=1))) / abs(rate)
     else:
-        # algebraic circle fit x^2 + y^2 + D x + E y + F = 0
-        x, y = r[:, 0], r[:, 1]
+        # algebraic circle fit x^2 + y^2 + D x + E y + F = 0, in units of the path's extent so that
+        # squares neither underflow nor overflow whatever the speed
+        scale = float(np.max(np.abs(r[:, :2]))) or 1.0
+        x, y = r[:, 0] / scale, r[:, 1] / scale
         M = np.stack([x, y, np.ones_like(x)], axis=1)
         D, E, F = np.linalg.lstsq(M, -(x * x + y * y), rcond=None)[0]
-        radius = math.sqrt(max(D * D / 4 + E * E / 4 - F, 0.0))
+        radius = scale * math.sqrt(max(D * D / 4 + E * E / 4 - F, 0.0))
     return 2 * math.pi / abs(rate), radius, math.copysign(1.0, rate)
 
 
