@@ -65,8 +65,6 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
     relative 1e-9 covers round-off of the exact flow; fixed-step methods add
     (lambda h)^2 relative (order 2, factor 10 of margin).
     """
-    from rotframe import rigid
-
     dt = float(traj.times[1] - traj.times[0])
     w = traj.L / np.where(inertia > 0, inertia, np.inf)
     dL = np.cross(traj.L, w)[:, mid]
