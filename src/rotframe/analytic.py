@@ -25,6 +25,7 @@ __all__ = [
     "ProjectileFlat",
     "drop_east_deflection_first_order",
     "drop_north_deflection_second_order",
+    "drop_north_deflection_centrifugal_second_order",
     "linear_rotating_propagator",
     "drop_exact_linear",
     "foucault_precession_rate",
@@ -111,6 +112,26 @@ def drop_north_deflection_second_order(height, latitude, g, omega):
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
     d = -(omega**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 6.0
+    return float(d) if np.ndim(d) == 0 else d
+
+
+def drop_north_deflection_centrifugal_second_order(height, latitude, g, omega):
+    """Northward deflection from the variation of the centrifugal force along the fall, m.
+
+    With effective gravity ``g`` measured at the foot, the explicit centrifugal term
+    adds only its change with height: at r = (0, 0, z) in ENU,
+    ``-w x (w x r) = Omega^2 z (0, -sin(lat) cos(lat), cos^2(lat))``. Along the
+    zeroth-order fall ``z = h - g t^2 / 2``, ``y'' = -Omega^2 sin cos (h - g t^2 / 2)``,
+    so ``y = -Omega^2 sin cos (h t^2 / 2 - g t^4 / 24)``; at ``h = g T^2 / 2``:
+
+    ``d_north = -(5/24) Omega^2 g T^4 sin(lat) cos(lat)``,
+
+    5/4 of the Coriolis part (:func:`drop_north_deflection_second_order`), in the
+    same (equatorward) sense. Second order in Omega; the neglected terms are of
+    relative order Omega T. Parameters as in :func:`drop_east_deflection_first_order`.
+    """
+    t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
+    d = -5.0 * (omega**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 24.0
     return float(d) if np.ndim(d) == 0 else d
 
 

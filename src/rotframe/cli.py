@@ -407,6 +407,7 @@ def _jsonable(obj):
 
 
 def _format_summary(scn, s) -> str:
+    """The run summary as a text table; each theory is named and each warning has its own line."""
     lines = [f"{scn.name}: {scn.title}"]
     params = ", ".join(f"{k}={_short(v)}{(' ' + scn.parameters[k].unit) if k in scn.parameters and scn.parameters[k].unit else ''}"
                        for k, v in s["params"].items())
@@ -416,15 +417,23 @@ def _format_summary(scn, s) -> str:
     lines.append("  metric                          simulated        theory    rel. diff")
     for key, value in s["metrics"].items():
         theory = s["theory"].get(key)
-        if isinstance(theory, (int, float)) and isinstance(value, (int, float)):
+        shown = _short(value) if _is_number(value) else "null"
+        if _is_number(theory) and _is_number(value):
             diff = abs(value - theory) / abs(theory) if theory else abs(value - theory)
             lines.append(f"  {key:<30} {value:>11.6g}  {theory:>12.6g}  {diff:>10.2g}")
+        elif _is_number(theory):
+            lines.append(f"  {key:<30} {shown:>11}  {theory:>12.6g}")
         else:
-            lines.append(f"  {key:<30} {_short(value):>11}")
+            lines.append(f"  {key:<30} {shown:>11}")
     for key, value in s["diagnostics"].items():
-        lines.append(f"  {key:<30} {_short(value):>11}")
+        lines.append(f"  {key:<30} {_short(value) if value is not None else 'null':>11}")
+    for key, what in s.get("theory_notes", {}).items():
+        if key in s["theory"]:
+            lines.append(f"  theory of {key}: {what}")
     for note in s.get("notes", []):
         lines.append(f"  note: {note}")
+    for warning in s.get("warnings", []):
+        lines.append(f"  warning: {warning}")
     if "audit" in s:
         lines.append(s["audit"]["text"])
     t = s["timing"]
@@ -432,6 +441,11 @@ def _format_summary(scn, s) -> str:
                  f"compiling kernels), record {t['record_s']:.3f} s, total {t['total_s']:.3f} s")
     lines.append(f"  recording   {s['recording'] or '(none)'}")
     return "\n".join(lines)
+
+
+def _is_number(v) -> bool:
+    """A finite int or float (not a bool): what the table prints as a number."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def _short(v):

@@ -1003,8 +1003,14 @@ def _bracketing_roots(coeffs, v0):
     ``f`` at its midpoint is the allowed region. Clipped to ``[0, 2]``.
     """
     dcoeffs = np.polyder(coeffs)
+    # a leading coefficient whose term is below round-off on [0, 2] (a top of negligible weight) would put
+    # the companion matrix at a scale that ruins the other roots: leave it to the Newton polish below
+    lead = np.asarray(coeffs, dtype=float)
+    while len(lead) > 2 and abs(lead[0]) * 2.0 ** (len(lead) - 1) <= 1e-17 * float(
+            np.sum(np.abs(lead[1:]) * 2.0 ** np.arange(len(lead) - 2, -1, -1))):
+        lead = lead[1:]
     roots = []
-    for r in np.sort(np.roots(coeffs).real):
+    for r in np.sort(np.roots(lead).real):
         for _ in range(4):
             d = np.polyval(dcoeffs, r)
             trial = r - np.polyval(coeffs, r) / d if d != 0.0 else r

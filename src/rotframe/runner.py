@@ -55,12 +55,23 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
 
 
 def summarize(scn, values, result, timing):
-    """The run summary (the JSON contract of DESIGN.md)."""
+    """The run summary (the JSON contract of DESIGN.md).
+
+    Besides the contract's keys it always has ``warnings`` (a list of strings,
+    empty on a clean run) and ``theory_notes`` ({metric: what its theory value is:
+    "exact ..." or an approximation with its assumptions and accuracy}). A warning
+    is raised for every metric that differs from its theory by more than the
+    scene's stated tolerance (``tolerance`` in the scene's analysis: the method's
+    accuracy for an exact theory, the approximation's accuracy otherwise; a metric
+    with no tolerance is compared with an indicative theory only), plus the
+    scene's own warnings.
+    """
     from rotframe import scenes
 
     scene = scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}
     analysis = scene.analyse(params, result)
+    theory = analysis.get("theory", {})
     summary = {
         "scenario": scn.name,
         "params": params,
@@ -68,8 +79,11 @@ def summarize(scn, values, result, timing):
         "method": result.method,
         "steps": int(result.steps),
         "metrics": analysis["metrics"],
-        "theory": analysis.get("theory", {}),
+        "theory": theory,
+        "theory_notes": dict(analysis.get("theory_notes", {})),
         "diagnostics": analysis.get("diagnostics", {}),
+        "warnings": list(analysis.get("warnings", [])) + theory_warnings(
+            analysis["metrics"], theory, analysis.get("tolerance", {}), analysis.get("theory_notes", {})),
         "timing": dict(timing),
         "recording": None,
     }
@@ -81,11 +95,37 @@ def summarize(scn, values, result, timing):
     return summary
 
 
+def theory_warnings(metrics, theory, tolerance, notes=None):
+    """Warnings for metrics farther from their theory than the stated tolerance allows.
+
+    ``tolerance`` maps a metric to the largest absolute difference |simulated -
+    theory| that the method's accuracy and the theory's stated accuracy allow
+    together. A metric with no tolerance, or with a missing (null) value on either
+    side, is not compared.
+    """
+    import math
+
+    notes = notes or {}
+    out = []
+    for key, tol in tolerance.items():
+        value, ref = metrics.get(key), theory.get(key)
+        if tol is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                                  for x in (value, ref)):
+            continue
+        diff = abs(value - ref)
+        if diff > tol:
+            what = notes.get(key, "theory")
+            out.append(f"{key}: simulated {value:.6g} differs from theory {ref:.6g} ({what}) by {diff:.3g}, "
+                       f"more than the stated accuracy {tol:.3g}")
+    return out
+
+
 def summarize_minimal(scn, values, result, timing):
     """A summary without metrics, for a partial run whose analysis is not possible."""
     params = {k: v for k, v in values.items() if k != "run"}
     return {"scenario": scn.name, "params": params, "model": list(result.terms), "method": result.method,
-            "steps": int(result.steps), "metrics": {}, "theory": {}, "diagnostics": {},
+            "steps": int(result.steps), "metrics": {}, "theory": {}, "theory_notes": {}, "diagnostics": {},
+            "warnings": ["the run stopped early and could not be analysed"],
             "timing": dict(timing), "recording": None, "complete": False,
             "t_reached_s": float(result.trajectory.t_reached)}
 

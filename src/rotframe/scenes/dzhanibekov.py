@@ -9,9 +9,12 @@ half the period 4 K(m) / lambda; energy and |L| are conserved.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from rotframe.errors import ScenarioError
+from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note
 from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
 
 METHODS = FREE_METHODS
@@ -28,8 +31,21 @@ def build(values):
     return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
 
 
+#: Samples per period of omega(t): omega_mid changes sign twice a period, so 32 per flip.
+SAMPLES_PER_OMEGA_PERIOD = 64
+
+
 def simulate(values, terms, method, run, progress):
-    return simulate_free_body(build(values), values["duration"], method, run, progress)
+    from rotframe import rigid
+
+    reject_subnormal(values)
+    body = build(values)
+    period = rigid.elliptic_period(body[0], body[1])
+    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000,
+                                    per_period=SAMPLES_PER_OMEGA_PERIOD)
+    result = simulate_free_body(body, values["duration"], method, dict(run, samples=samples), progress)
+    result.extras.update(resolved=resolved, omega_period=period)
+    return result
 
 
 def flip_times(times, w):
@@ -38,18 +54,62 @@ def flip_times(times, w):
     return times[k] + (times[k + 1] - times[k]) * w[k] / (w[k] - w[k + 1])
 
 
+def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
+    """Largest error (s) of the mean flip interval measured from the samples.
+
+    Each sign change is placed by linear interpolation; omega_mid has an
+    inflection there (d^2 omega_mid / dt^2 = 0 where omega_mid = 0, from Euler's
+    equations), so the error is O(dt^3 lambda^2) with lambda = max |dL_mid/dt| /
+    max |L_mid|, the steepness of the flip; taken at dt^3 lambda^2 per crossing.
+    The interval is (last - first) / (n - 1), so two crossing errors count. A
+    relative 1e-9 covers round-off of the exact flow; fixed-step methods add
+    (lambda h)^2 relative (order 2, factor 10 of margin).
+    """
+    dt = float(traj.times[1] - traj.times[0])
+    w = traj.L / np.where(inertia > 0, inertia, np.inf)
+    dL = np.cross(traj.L, w)[:, mid]
+    lam = float(np.max(np.abs(dL)) / max(np.max(np.abs(traj.L[:, mid])), 1e-300))
+    tol = 2 * dt**3 * lam**2 / n_intervals + 1e-9 * interval
+    h = traj.extras.get("step")
+    if method != "exact" and h:
+        tol += 10.0 * interval * (lam * h) ** 2
+    return tol
+
+
 def analyse(values, result):
     from rotframe import rigid
 
     traj, inertia = result.trajectory, result.extras["inertia"]
     mid = int(np.argsort(inertia)[1])
-    flips = flip_times(traj.times, traj.L[:, mid])
-    interval = float(np.mean(np.diff(flips))) if len(flips) >= 2 else float("nan")
     e_drift, m_drift, _, _ = invariant_drifts(inertia, traj)
     period = rigid.elliptic_period(inertia, traj.L[0])
-    notes = [] if len(flips) >= 2 else ["fewer than two flips in the simulated time: lengthen duration"]
+    notes, tolerance = [], {}
+    exact = "exact: conserved by the free body"
+    theory_notes = {"flip_interval_s": "exact: half the period 4 K(m) / lambda of omega(t) of the same free body "
+                                       "(Jacobi elliptic functions)",
+                    "energy_rel_drift": exact, "momentum_rel_drift": exact}
+    interval = math.nan
+    if not result.extras.get("resolved", True):
+        notes.append(unresolved_note("flip_interval_s", "omega", period, float(traj.times[-1]),
+                                     per_period=SAMPLES_PER_OMEGA_PERIOD))
+        flips = np.array([])
+    else:
+        flips = flip_times(traj.times, traj.L[:, mid])
+        if len(flips) >= 2:
+            interval = float((flips[-1] - flips[0]) / (len(flips) - 1))
+            tolerance["flip_interval_s"] = _flip_tolerance(traj, inertia, mid, len(flips) - 1, interval, traj.method)
+        else:
+            notes.append("fewer than two flips in the simulated time: lengthen duration")
+    if len(set(inertia.tolist())) < 3:
+        notes.append("two principal moments are equal: there is no intermediate axis; flip_interval_s is the "
+                     "interval between sign changes of omega about the axis of the middle moment as sorted")
+    elif abs(traj.L[0, mid]) < 0.5 * np.linalg.norm(traj.L[0]):
+        notes.append("the body starts far from its intermediate axis: omega changes sign about that axis as the "
+                     "body wobbles about a stable one; it does not turn over")
+    theory = {"flip_interval_s": period / 2 if math.isfinite(period) else math.nan,
+              "energy_rel_drift": 0.0, "momentum_rel_drift": 0.0}
     return {"metrics": {"flip_interval_s": interval, "energy_rel_drift": e_drift, "momentum_rel_drift": m_drift},
-            "theory": {"flip_interval_s": period / 2, "energy_rel_drift": 0.0, "momentum_rel_drift": 0.0},
+            "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
             "diagnostics": {"flips": len(flips), "omega_period_s": period}, "notes": notes}
 
 

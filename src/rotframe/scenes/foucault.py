@@ -25,10 +25,13 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import default_method
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, earth_model_constants, energy_in_rotating_frame, run_particles
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
+                                  potential_energy, reject_subnormal, run_particles, unresolved_note)
 
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 SAMPLES_PER_PERIOD = 32
+#: Samples kept at most (memory: 48 bytes each); beyond, the period is not measured.
+MAX_SAMPLES = 2_000_000
 
 
 def build(values, terms):
@@ -51,16 +54,21 @@ def build(values, terms):
 
 
 def simulate(values, terms, method, run, progress):
+    reject_subnormal(values)
     model, r0, v0, g, Omega = build(values, terms)
     T = values["duration"]
     period = 2 * math.pi * math.sqrt(values["length"] / g)
-    samples = max(int(run.get("samples") or 0), int(SAMPLES_PER_PERIOD * T / period))
+    need = int(SAMPLES_PER_PERIOD * T / period)
+    resolved = need <= MAX_SAMPLES
+    samples = max(int(run.get("samples") or 0), min(need, MAX_SAMPLES))
     run = dict(run, samples=samples)
-    method = method or default_method(model)
+    # unless a method is named: the linearised (small-angle) model by its exact propagator, the full
+    # pendulum by dop853, the cheapest for its stated accuracy in `rotframe bench foucault`
+    method = method or ("dop853" if model.has("pendulum") else default_method(model))
 
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g, "Omega": Omega})
+                           extras={"model": model, "g": g, "Omega": Omega, "resolved": resolved})
 
     return run_particles(model, r0, v0, T, method, run, progress, finish)
 
@@ -71,20 +79,31 @@ def swing_angle(r, v, w0):
     Major axis of A = v v^T + w0^2 x x^T in the horizontal plane; defined
     modulo pi, unwrapped by doubling.
     """
-    x, y, vx, vy = r[:, 0], r[:, 1], v[:, 0], v[:, 1]
+    # in units of the swing's size (the angle does not depend on them): squares of a tiny swing do not underflow
+    scale = max(float(np.max(np.abs(r[:, :2]))), float(np.max(np.abs(v[:, :2]))) / w0) or 1.0
+    x, y, vx, vy = r[:, 0] / scale, r[:, 1] / scale, v[:, 0] / scale, v[:, 1] / scale
     axx = vx * vx + w0 * w0 * x * x
     ayy = vy * vy + w0 * w0 * y * y
     axy = vx * vy + w0 * w0 * x * y
     return 0.5 * np.unwrap(np.arctan2(2 * axy, axx - ayy))
 
 
-def measured_rates(times, r, v, length, g):
-    """(precession rate in rad/s, clockwise positive; period in s) from the motion."""
+def measured_rates(times, r, v, length, g, with_error=False):
+    """(precession rate in rad/s, clockwise positive; period in s) from the motion.
+
+    With ``with_error`` a third value is the standard error (rad/s) of the fitted
+    rate, from the scatter of the swing angle about the fitted line.
+    """
     w0 = math.sqrt(g / length)
     angle = swing_angle(r, v, w0)
     slope = np.polyfit(times, angle, 1)[0]
+    if with_error:
+        resid = angle - np.polyval(np.polyfit(times, angle, 1), times)
+        spread = float(np.sum((times - times.mean()) ** 2))
+        slope_error = math.sqrt(float(np.sum(resid**2)) / max(len(times) - 2, 1) / spread) if spread > 0 else math.inf
     # period from the maxima of the horizontal distance: x.v changes sign from + to -
-    rho = r[:, 0] * v[:, 0] + r[:, 1] * v[:, 1]
+    scale = max(float(np.max(np.abs(r[:, :2]))), float(np.max(np.abs(v[:, :2]))) / w0) or 1.0
+    rho = (r[:, 0] / scale) * (v[:, 0] / scale) + (r[:, 1] / scale) * (v[:, 1] / scale)
     k = np.nonzero((rho[:-1] > 0) & (rho[1:] <= 0))[0]
     if len(k) >= 3:
         tc = times[k] + (times[k + 1] - times[k]) * rho[k] / (rho[k] - rho[k + 1])
@@ -92,7 +111,7 @@ def measured_rates(times, r, v, length, g):
         period = 2 * half_period
     else:
         period = math.nan
-    return -slope, period
+    return (-slope, period, slope_error) if with_error else (-slope, period)
 
 
 def analyse(values, result):
@@ -100,31 +119,74 @@ def analyse(values, result):
     g = result.extras["g"]
     model = result.extras["model"]
     r, v = traj.r[:, 0], traj.v[:, 0]
-    rate, period = measured_rates(traj.times, r, v, values["length"], g)
+    L, a = values["length"], values["amplitude"]
+    rate, period, rate_error = measured_rates(traj.times, r, v, L, g, with_error=True)
     Omega = result.extras["Omega"]
     lat = math.radians(values["latitude"])
-    theory_rate = analytic.foucault_precession_rate(lat, Omega)
-    amplitude = 0.0 if values["small_angle"] else values["amplitude"]
-    metrics = {"precession_rate_deg_per_hour": math.degrees(rate) * 3600, "period_s": period}
-    theory = {"precession_rate_deg_per_hour": math.degrees(theory_rate) * 3600,
-              "period_s": float(analytic.pendulum_period(values["length"], g, amplitude))}
-    diagnostics = {"simulated_hours": float(traj.times[-1] / 3600)}
-    if not values["small_angle"]:
+    foucault_rate = analytic.foucault_precession_rate(lat, Omega)
+    w0 = math.sqrt(g / L)
+    T_swing = 2 * math.pi / w0
+    duration = float(traj.times[-1])
+    notes, warnings = [], []
+    per_hour = math.degrees(1.0) * 3600
+    if values["small_angle"]:
+        theory_rate, airy = foucault_rate, 0.0
+        rate_label = "exact for the linearised model: Omega sin(latitude)"
+        period_theory = float(analytic.pendulum_period(L, g, 0.0))
+        period_label = "small amplitude 2 pi sqrt(L / g) (+-(Omega / w0)^2 relative)"
+    else:
         # released from rest in the rotating frame the swing is an ellipse of minor axis
         # b = a Omega sin(lat) / w0, whose Airy precession runs against the Foucault turn
-        w0 = math.sqrt(g / values["length"])
-        b = values["amplitude"] * theory_rate / w0
-        airy = analytic.airy_precession(values["length"], g, values["amplitude"], b)
-        diagnostics["airy_corrected_rate_deg_per_hour"] = math.degrees(theory_rate - airy) * 3600
+        b = a * foucault_rate / w0
+        airy = analytic.airy_precession(L, g, a, b)
+        theory_rate = foucault_rate - airy
+        rate_label = (f"Omega sin(latitude) minus Airy's finite-amplitude precession (3/8) w0 a b / L^2, leading "
+                      f"order in a / L (+-{2 * (a / L) ** 2:.2g} of the Airy part)")
+        period_theory = float(analytic.pendulum_period(L, g, a))
+        period_label = "exact plane pendulum of amplitude a, 4 sqrt(L / g) K(sin^2(theta0 / 2)) (+-(Omega / w0)^2)"
+    metrics = {"precession_rate_deg_per_hour": rate * per_hour, "period_s": period}
+    theory = {"precession_rate_deg_per_hour": theory_rate * per_hour, "period_s": period_theory}
+    theory_notes = {"precession_rate_deg_per_hour": rate_label, "period_s": period_label}
+    diagnostics = {"simulated_hours": duration / 3600,
+                   "omega_sin_latitude_deg_per_hour": foucault_rate * per_hour}
+    if not values["small_angle"]:
+        diagnostics["airy_precession_deg_per_hour"] = -airy * per_hour
+    if not result.extras.get("resolved", True):
+        metrics["period_s"] = math.nan
+        notes.append(unresolved_note("period_s", "swing", T_swing, duration, per_period=SAMPLES_PER_PERIOD,
+                                     bound=MAX_SAMPLES) + " (the precession rate needs no such resolution)")
+    if not values["small_angle"] and a < 1e4 * np.finfo(float).eps * L:
+        # the string is kept to round-off of its length, eps L: a swing not far above that is noise
+        metrics = {"precession_rate_deg_per_hour": math.nan, "period_s": math.nan}
+        notes.append(f"amplitude {a:.3g} m is within 1e4 round-offs of the string length ({L:g} m): the full "
+                     "pendulum cannot resolve the swing; use small_angle = true")
+    if duration < 2 * T_swing:
+        metrics["precession_rate_deg_per_hour"] = math.nan
+        notes.append(f"precession not measured: the run is shorter than two swings ({2 * T_swing:.4g} s)")
     if model.has("pendulum"):
-        diagnostics["constraint_drift_m"] = float(np.max(np.abs(np.linalg.norm(r - model.pivot, axis=1)
-                                                                - values["length"])))
-        e = energy_in_rotating_frame(r - [0, 0, 0], v, g, model.omega.vector(), model.has("centrifugal"))
-        diagnostics["energy_rel_drift"] = float(np.max(np.abs(e - e[0])) / (g * (r[0, 2] + 1e-300)))
-    if rate != 0:
+        diagnostics["constraint_drift_m"] = float(np.max(np.abs(np.linalg.norm(r - model.pivot, axis=1) - L)))
+    e = jacobi_energy(model, r, v)
+    if e is not None:
+        # relative to the swing's energy (the potential at the release point), not to an arbitrary zero
+        diagnostics["energy_rel_drift"] = float(np.max(np.abs(e - e[0])) / max(abs(float(
+            potential_energy(model, r[:1])[0])), 1e-300))
+    # tolerances: the method's error, the fit's own scatter (5 standard errors) and the theory's accuracy
+    method_rel = method_rel_error(traj, T_swing)
+    tolerance = {
+        "precession_rate_deg_per_hour": (5 * rate_error + method_rel * abs(foucault_rate)
+                                         + 2 * (a / L) ** 2 * abs(airy) + (Omega / w0) ** 2 * abs(foucault_rate)
+                                         + 1e-12 * Omega) * per_hour,
+        "period_s": (method_rel + (Omega / w0) ** 2 + 2 * (a * foucault_rate / w0 / L) ** 2) * period_theory
+                    + T_swing * (w0 * (traj.times[1] - traj.times[0])) ** 3 / max(duration / T_swing, 1.0),
+    }
+    rate = metrics["precession_rate_deg_per_hour"] / per_hour
+    if math.isfinite(rate) and abs(rate) > 5 * rate_error and rate != 0:
         diagnostics["hours_per_turn"] = float(2 * math.pi / abs(rate) / 3600)
-    notes = [f"simulated {traj.times[-1] / 3600:.3g} h of motion ({len(traj.times) - 1} samples)"]
-    return {"metrics": metrics, "theory": theory, "diagnostics": diagnostics, "notes": notes}
+    elif math.isfinite(rate):
+        notes.append("the swing plane does not turn measurably (no hours per turn)")
+    notes.append(f"simulated {duration / 3600:.3g} h of motion ({len(traj.times) - 1} samples)")
+    return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
 
 
 def record(rec, values, result):

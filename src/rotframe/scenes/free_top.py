@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note
 from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
 
 METHODS = FREE_METHODS
@@ -29,8 +30,32 @@ def build(values):
     return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
 
 
+def time_scales(values):
+    """(body precession rate k, space precession rate |L| / I1), rad/s, from the parameters.
+
+    k = omega3 (I3 - I1) / I1 (signed, about +e3); the symmetry axis circles L at |L| / I1.
+    """
+    i1, i3 = values["i1"], values["i3"]
+    k = values["omega3"] * (i3 - i1) / i1
+    space = math.hypot(i1 * values["omega_perp"], i3 * values["omega3"]) / i1
+    return k, space
+
+
+def _periods(values):
+    """The periods (s) the metrics must resolve: of the rates that are not zero."""
+    k, space = time_scales(values)
+    return [2 * math.pi / abs(r) for r in (k, space) if r != 0.0 and math.isfinite(2 * math.pi / abs(r))]
+
+
 def simulate(values, terms, method, run, progress):
-    return simulate_free_body(build(values), values["duration"], method, run, progress)
+    reject_subnormal(values)
+    periods = _periods(values)
+    shortest = min(periods) if periods else math.inf
+    samples, resolved = samples_for(values["duration"], shortest, run.get("samples") or 2000)
+    result = simulate_free_body(build(values), values["duration"], method, dict(run, samples=samples), progress)
+    result.extras["resolved"] = resolved
+    result.extras["shortest_period"] = shortest
+    return result
 
 
 def measured_rates(traj, inertia):
@@ -52,20 +77,70 @@ def measured_rates(traj, inertia):
     return body_rate, space_rate
 
 
-def analyse(values, result):
-    from rotframe import rigid
+def _tolerance(method, rate, traj):
+    """Largest |measured - exact| rate (rad/s) the method allows: round-off for the exact flow.
 
+    The exact flow and the Lie-Poisson splittings (whose free symmetric sub-flows
+    are exact) measure a uniform rotation, fitted over many samples: a relative
+    1e-9 covers the round-off of angles of up to 1e7 rad. RK4 adds its truncation
+    error, (rate h)^4 per unit time in relative terms, with a factor 100 of margin.
+    """
+    tol = 1e-9 * abs(rate)
+    h = traj.extras.get("step")
+    if method == "rk4" and h:
+        tol += 100.0 * abs(rate) * (abs(rate) * h) ** 4 * max(1.0, abs(rate) * traj.times[-1])
+    return tol
+
+
+def analyse(values, result):
     traj, inertia = result.trajectory, result.extras["inertia"]
-    body_rate, space_rate = measured_rates(traj, inertia)
-    k = rigid.free_symmetric_precession(inertia[0], inertia[2], values["omega3"])
-    Lmag = float(np.linalg.norm(traj.L[0]))
+    omega3, omega_perp = values["omega3"], values["omega_perp"]
+    k, space_theory = time_scales(values)
+    duration = float(traj.times[-1])
     e_drift, m_drift, _, _ = invariant_drifts(inertia, traj)
-    sidereal_day = 2 * math.pi / values["omega3"]
-    period = 2 * math.pi / abs(body_rate) if body_rate else math.inf
-    return {"metrics": {"body_precession_period_s": period, "space_precession_rate_rad_s": abs(space_rate)},
-            "theory": {"body_precession_period_s": 2 * math.pi / abs(k), "space_precession_rate_rad_s": Lmag / inertia[0]},
-            "diagnostics": {"body_precession_period_sidereal_days": period / sidereal_day,
-                            "energy_rel_drift": e_drift, "momentum_rel_drift": m_drift}}
+    notes, theory, tolerance = [], {}, {}
+    exact = "exact (closed form of the free symmetric top)"
+    theory_notes = {"body_precession_period_s": exact + ": 2 pi I1 / |omega3 (I3 - I1)|",
+                    "space_precession_rate_rad_s": exact + ": |L| / I1"}
+    metrics = {"body_precession_period_s": math.nan, "space_precession_rate_rad_s": math.nan}
+    diagnostics = {}
+    body_rate = space_rate = math.nan
+    if omega3 == 0.0 and omega_perp == 0.0:
+        notes.append("omega3 = omega_perp = 0: the body does not turn; nothing precesses")
+    elif not result.extras.get("resolved", True):
+        notes.append(unresolved_note("precession", "precession", result.extras["shortest_period"], duration))
+    else:
+        body_rate, space_rate = measured_rates(traj, inertia)
+    if omega_perp == 0.0 and omega3 != 0.0:
+        notes.append("omega_perp = 0: the body spins about its symmetry axis, so omega, L and the axis stay "
+                     "aligned and nothing precesses (both precession metrics are null)")
+    elif k == 0.0 and omega_perp != 0.0:
+        why = ("omega3 = 0: the body spins about an equatorial axis, where omega is fixed in the body"
+               if omega3 == 0.0 else "i1 = i3: every axis is principal, so omega is fixed in the body")
+        notes.append(f"{why}; there is no body precession (period null); the symmetry axis still circles L "
+                     "in space")
+        theory["space_precession_rate_rad_s"] = space_theory
+        metrics["space_precession_rate_rad_s"] = abs(space_rate)
+        tolerance["space_precession_rate_rad_s"] = _tolerance(traj.method, space_theory, traj)
+    elif omega_perp != 0.0:
+        theory = {"body_precession_period_s": 2 * math.pi / abs(k), "space_precession_rate_rad_s": space_theory}
+        if math.isfinite(body_rate):
+            period = 2 * math.pi / abs(body_rate) if body_rate else math.inf
+            metrics = {"body_precession_period_s": period, "space_precession_rate_rad_s": abs(space_rate)}
+            tolerance = {"body_precession_period_s": _tolerance(traj.method, k, traj) / abs(k) * theory[
+                "body_precession_period_s"], "space_precession_rate_rad_s": _tolerance(traj.method, space_theory, traj)}
+            if omega3 != 0.0:
+                # a period is positive; its sense is said apart, relative to the spin
+                diagnostics["body_precession_period_sidereal_days"] = period * abs(omega3) / (2 * math.pi)
+                diagnostics["body_precession_sense"] = ("with the spin (oblate, I3 > I1)" if body_rate * omega3 > 0
+                                                        else "against the spin (prolate, I3 < I1)")
+        periods = duration * abs(k) / (2 * math.pi)
+        notes.append(f"simulated {periods:.4g} body precession periods" if periods < 1e6 else
+                     f"simulated {periods:.4g} body precession periods (the default duration is two Euler periods "
+                     "of the Earth; set duration to suit another body)")
+    diagnostics.update(energy_rel_drift=e_drift, momentum_rel_drift=m_drift)
+    return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes}
 
 
 def record(rec, values, result):

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from rotframe.scenes.base import SceneResult
+from rotframe.scenes.base import SceneResult, reject_subnormal, samples_for, unresolved_note
 from rotframe.scenes.rigid_base import HEAVY_METHODS, guarded, initial_attitude_zxz, integrate_body
 
 METHODS = HEAVY_METHODS
@@ -34,16 +34,47 @@ def build(values):
     return inertia, inertia * omega, initial_attitude_zxz(*angles)
 
 
+def _theory(values):
+    """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket."""
+    from rotframe import rigid
+
+    if not (values["theta0"] > 0 or values["wobble"] != 0):
+        return None
+    try:
+        return rigid.heavy_top_turning_points(values["i1"], values["i3"], values["mass"], values["length"],
+                                              values["g"], math.radians(values["theta0"]), values["wobble"],
+                                              values["phidot0"], values["psidot0"])
+    except Exception:  # the cubic has no bracket (e.g. exactly steady precession)
+        return None
+
+
+def _nutation_period_estimate(values):
+    """A nutation period (s) to size the sampling: the cubic's, else the fast top's 2 pi I1 / (I3 |omega3|)."""
+    tp = _theory(values)
+    if tp is not None and len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0:
+        return float(tp[2])
+    w3 = values["psidot0"] + values["phidot0"] * math.cos(math.radians(values["theta0"]))
+    return 2 * math.pi * values["i1"] / (values["i3"] * abs(w3)) if w3 else math.inf
+
+
 def simulate(values, terms, method, run, progress):
+    reject_subnormal(values)
     inertia, L0, q0 = build(values)
     method = method or run.get("method") or "splitting"
     top = (values["mass"], values["length"], values["g"])
+    period = _nutation_period_estimate(values)
+    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000)
 
     def finish(traj):
         return SceneResult(traj, ["free-rigid-body", "gravity-torque"], traj.method, traj.steps,
-                           extras={"inertia": inertia})
+                           extras={"inertia": inertia, "resolved": resolved, "nutation_period": period})
 
-    return guarded(finish, integrate_body, method, inertia, L0, q0, values["duration"], run, progress, top=top)
+    return guarded(finish, integrate_body, method, inertia, L0, q0, values["duration"], dict(run, samples=samples),
+                   progress, top=top)
+
+
+#: Theory: turning points closer than this (rad) are steady motion (no nutation).
+NUTATION_FLOOR = 1e-12
 
 
 def tilt(traj):
@@ -70,6 +101,11 @@ def euler_angles(q, seq="ZXZ"):
     return np.unwrap(angles, axis=0)
 
 
+def _maxima(theta):
+    """Indices of the strict local maxima of theta (samples)."""
+    return np.nonzero((theta[1:-1] > theta[:-2]) & (theta[1:-1] >= theta[2:]))[0] + 1
+
+
 def analyse(values, result):
     from rotframe import rigid
 
@@ -78,27 +114,71 @@ def analyse(values, result):
     args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])
     threshold = rigid.sleeping_top_threshold(*args)
     w3 = values["psidot0"] + values["phidot0"] * math.cos(math.radians(values["theta0"]))
-    # nutation period from the maxima of theta
-    k = np.nonzero((theta[1:-1] > theta[:-2]) & (theta[1:-1] >= theta[2:]))[0] + 1
-    period = float(np.mean(np.diff(traj.times[k]))) if len(k) >= 2 else math.nan
+    dt = float(traj.times[1] - traj.times[0]) if len(traj.times) > 1 else math.inf
+    h = traj.extras.get("step") or dt
+    amplitude = float(theta.max() - theta.min())
+    # round-off of theta after n steps grows like eps sqrt(n) (a random walk); 100 times that is not motion
+    floor = NUTATION_FLOOR + 100 * np.finfo(float).eps * math.sqrt(max(traj.steps, 1))
+    notes = []
+    # nutation period from the maxima of theta, only where theta really nods and the samples resolve it
+    period = math.nan
+    k = _maxima(theta)
+    if amplitude <= floor:
+        notes.append(f"no nutation: theta stays at {math.degrees(theta[0]):.6g} deg to {math.degrees(amplitude):.2g} deg "
+                     "(round-off), so there is no nutation period")
+    elif not result.extras.get("resolved", True):
+        notes.append(unresolved_note("nutation (theta_min_deg, theta_max_deg, nutation_period_s)", "nutation",
+                                     result.extras["nutation_period"], float(traj.times[-1])))
+    elif len(k) >= 2:
+        period = float((traj.times[k[-1]] - traj.times[k[0]]) / (len(k) - 1))
+    else:
+        notes.append("fewer than two maxima of theta in the simulated time: no nutation period")
     metrics = {"theta_min_deg": math.degrees(theta.min()), "theta_max_deg": math.degrees(theta.max()),
                "nutation_period_s": period}
-    theory = {}
-    notes = []
+    if not result.extras.get("resolved", True):  # extremes of unresolved samples are not the motion's
+        metrics.update(theta_min_deg=math.nan, theta_max_deg=math.nan)
+    T_nut = result.extras.get("nutation_period", math.inf)
+    if amplitude > floor and math.isfinite(T_nut) and float(traj.times[-1]) < T_nut:
+        metrics.update(theta_min_deg=math.nan, theta_max_deg=math.nan)
+        notes.append(f"the run is shorter than one nutation period ({T_nut:.4g} s): theta has not reached both "
+                     "turning points, so theta_min_deg and theta_max_deg are null")
+    theory, tolerance = {}, {}
+    exact = "exact: roots of Goldstein's cubic f(u) of the same top"
+    theory_notes = {"theta_min_deg": exact, "theta_max_deg": exact,
+                    "nutation_period_s": "exact: 2 int du / sqrt(f(u)) between the roots (elliptic integral)"}
+    tp = _theory(values)
     if values["theta0"] > 0 or values["wobble"] != 0:
-        try:
-            tp = rigid.heavy_top_turning_points(*args, math.radians(values["theta0"]), values["wobble"],
-                                                values["phidot0"], values["psidot0"])
+        if tp is None:
+            notes.append("no turning-point theory: the cubic f(u) has no bracketing roots (steady precession)")
+        else:
             theory = {"theta_min_deg": math.degrees(tp[0]), "theta_max_deg": math.degrees(tp[1]),
                       "nutation_period_s": float(tp[2]) if len(tp) > 2 else math.nan}
-        except Exception as exc:  # the cubic has no bracket (e.g. exactly steady precession)
-            notes.append(f"no turning-point theory: {exc}")
+            if tp[1] - tp[0] <= NUTATION_FLOOR:
+                theory["nutation_period_s"] = math.nan
+                notes.append(f"theory: theta stays at {math.degrees(tp[0]):.6g} deg (steady to the resolution of the cubic; the period of "
+                             f"small nods about it would be {tp[2]:.6g} s)")
+            # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin;
+            # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
+            T = float(tp[2]) if len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0 else math.inf
+            w_fast = max(abs(w3), abs(values["phidot0"]), 2 * math.pi / T)
+            method_rel = 10 * (w_fast * h) ** 2 if traj.method != "exact" else 1e-9
+            amp_deg = math.degrees(tp[1] - tp[0])
+            for key, i in (("theta_min_deg", int(np.argmin(theta))), ("theta_max_deg", int(np.argmax(theta)))):
+                # the true extreme lies within a sample of the sampled one, so it differs from it by at most
+                # the larger change to a neighbouring sample (whether the extreme is smooth or a kink at 180 deg)
+                near = theta[max(i - 1, 0):i + 2]
+                sampled = math.degrees(float(np.max(np.abs(near - theta[i]))))
+                tolerance[key] = sampled + method_rel * max(amp_deg, 1e-300) + 1e-9 * abs(theory[key])
+            if math.isfinite(period) and math.isfinite(theory["nutation_period_s"]):
+                # each maximum is on a sample (within dt / 2 of the true one): the mean is good to dt / (n - 1)
+                tolerance["nutation_period_s"] = dt / (len(k) - 1) + method_rel * T
     diagnostics = {"sleeping_threshold_omega3_rad_s": threshold, "omega3_rad_s": w3,
                    "sleeping_top_stable": bool(abs(w3) > threshold)}
     if values["theta0"] == 0:
         notes.append(f"sleeping top: stable above omega3 = {threshold:.4g} rad/s; this one spins at {w3:.4g}"
                      + (" (stays up)" if abs(w3) > threshold else " (falls)"))
-    return {"metrics": metrics, "theory": theory, "diagnostics": diagnostics, "notes": notes}
+    return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes}
 
 
 def record(rec, values, result):

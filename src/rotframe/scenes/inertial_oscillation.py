@@ -17,7 +17,8 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import default_method
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, earth_model_constants, rel_drift, run_particles
+from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, reject_subnormal, rel_drift,
+                                  run_particles, samples_for, unresolved_note)
 
 METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
 
@@ -32,39 +33,89 @@ def build(values, terms):
 
 
 def simulate(values, terms, method, run, progress):
+    reject_subnormal(values)
     model, r0, v0, Omega = build(values, terms)
     method = method or default_method(model)
+    f = abs(2 * Omega * math.sin(math.radians(values["latitude"])))
+    period = 2 * math.pi / f if f > 0 else math.inf
+    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000)
 
     def finish(traj):
-        return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev, extras={"Omega": Omega})
+        return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
+                           extras={"Omega": Omega, "resolved": resolved, "period": period})
 
-    return run_particles(model, r0, v0, values["duration"], method, run, progress, finish)
+    return run_particles(model, r0, v0, values["duration"], method, dict(run, samples=samples), progress, finish)
+
+
+#: A heading that turns by less than this (rad) over the run is round-off, not rotation.
+TURN_FLOOR = 1e-12
 
 
 def measured(times, r, v):
-    """(period s, radius m, sense) from the motion: the turning rate of v and a circle fit."""
+    """(period s, radius m, sense) from the motion: the turning rate of v and a circle fit.
+
+    When the run covers less than a quarter turn the circle fit is ill-conditioned
+    and the radius is the curvature radius |v| / |turning rate| instead.
+    """
     heading = np.unwrap(np.arctan2(v[:, 1], v[:, 0]))
     rate = np.polyfit(times, heading, 1)[0]
-    if abs(rate) * (times[-1] - times[0]) < 1e-9:
+    turned = abs(rate) * (times[-1] - times[0])
+    if turned < TURN_FLOOR:
         return math.inf, math.inf, 0.0
-    # algebraic circle fit x^2 + y^2 + D x + E y + F = 0
-    x, y = r[:, 0], r[:, 1]
-    M = np.stack([x, y, np.ones_like(x)], axis=1)
-    D, E, F = np.linalg.lstsq(M, -(x * x + y * y), rcond=None)[0]
-    radius = math.sqrt(max(D * D / 4 + E * E / 4 - F, 0.0))
+    if turned < 0.5 * math.pi:
+        radius = float(np.mean(np.linalg.norm(v, axis=1))) / abs(rate)
+    else:
+        # algebraic circle fit x^2 + y^2 + D x + E y + F = 0, in units of the path's extent so that
+        # squares neither underflow nor overflow whatever the speed
+        scale = float(np.max(np.abs(r[:, :2]))) or 1.0
+        x, y = r[:, 0] / scale, r[:, 1] / scale
+        M = np.stack([x, y, np.ones_like(x)], axis=1)
+        D, E, F = np.linalg.lstsq(M, -(x * x + y * y), rcond=None)[0]
+        radius = scale * math.sqrt(max(D * D / 4 + E * E / 4 - F, 0.0))
     return 2 * math.pi / abs(rate), radius, math.copysign(1.0, rate)
 
 
 def analyse(values, result):
     traj = result.trajectory
     r, v = traj.r[:, 0], traj.v[:, 0]
-    period, radius, sense = measured(traj.times, r, v)
-    theory = analytic.inertial_oscillation(math.radians(values["latitude"]), values["speed"], result.extras["Omega"])
-    metrics = {"period_s": period, "radius_m": radius}
-    diagnostics = {"speed_rel_drift": rel_drift(np.linalg.norm(v, axis=1)),
+    lat = math.radians(values["latitude"])
+    theory = analytic.inertial_oscillation(lat, values["speed"], result.extras["Omega"])
+    notes = []
+    metrics = {"period_s": math.nan, "radius_m": math.nan}
+    sense = 0.0
+    if values["speed"] == 0:
+        metrics["radius_m"] = float(np.max(np.linalg.norm(r, axis=1)))
+        notes.append("speed = 0: the puck stays at rest; nothing circles, so there is no period")
+    elif not result.extras.get("resolved", True):
+        notes.append(unresolved_note("period_s and radius_m", "inertial", result.extras["period"],
+                                     float(traj.times[-1])))
+    else:
+        period, radius, sense = measured(traj.times, r, v)
+        metrics = {"period_s": period, "radius_m": radius}
+        if not math.isfinite(period):
+            notes.append("on the equator f = 2 Omega sin(latitude) = 0: the puck goes straight, period and radius "
+                         "are infinite (null)" if lat == 0 else
+                         f"the velocity turns by less than {TURN_FLOOR:g} rad in the run, below round-off: period "
+                         "and radius not measured (lengthen duration)")
+            if lat != 0:  # on the equator infinity is the answer; elsewhere the run could not tell
+                metrics = {"period_s": math.nan, "radius_m": math.nan}
+    theory_vals = {"period_s": float(theory.period), "radius_m": float(theory.radius)}
+    exact = "exact: 2 pi / |f| and speed / |f|, f = 2 Omega sin(latitude), of the same f-plane model"
+    theory_notes = {"period_s": exact, "radius_m": exact}
+    # the method's error, and the heading's round-off (1e-15 rad) over the angle turned in the run
+    turned = 2 * math.pi * float(traj.times[-1]) / metrics["period_s"] if math.isfinite(metrics["period_s"]) else 0
+    method_rel = method_rel_error(traj, result.extras["period"]) + (1e-15 / turned if turned else 0.0)
+    tolerance = {k: method_rel * abs(t) for k, t in theory_vals.items()
+                 if math.isfinite(t) and (k != "period_s" or values["speed"] > 0)}
+    expected = -math.copysign(1.0, lat) if lat != 0 and values["speed"] > 0 else 0.0
+    diagnostics = {"speed_rel_drift": rel_drift(np.linalg.norm(v, axis=1)) if values["speed"] > 0 else 0.0,
                    "sense": "clockwise" if sense < 0 else "counter-clockwise" if sense > 0 else "none"}
-    return {"metrics": metrics, "theory": {"period_s": float(theory.period), "radius_m": float(theory.radius)},
-            "diagnostics": diagnostics}
+    warnings = []
+    if math.isfinite(metrics["period_s"]) and sense != expected:
+        warnings.append(f"sense of rotation: measured {diagnostics['sense']}, but f = 2 Omega sin(latitude) says "
+                        + ("clockwise" if expected < 0 else "counter-clockwise"))
+    return {"metrics": metrics, "theory": theory_vals, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
 
 
 def record(rec, values, result):

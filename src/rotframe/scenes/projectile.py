@@ -8,8 +8,10 @@ ground is the sphere |r - c| = R, so the shell flies further before it lands),
 ``centrifugal`` (its variation along the path) and ``quadratic-drag`` (with an
 isothermal atmosphere, density exp(-z / H)). Range is measured along the
 ground (the great circle when ``curvature`` is on); the lateral deflection is
-positive to the right of the aim. Theory: flat Earth, vacuum, first order in
-Omega (:func:`rotframe.analytic.projectile_lateral_deflection_first_order`).
+positive to the right of the aim. Theory: flat Earth, vacuum, zeroth order in
+Omega for range and flight time, first order for the lateral deflection
+(:func:`rotframe.analytic.projectile_lateral_deflection_first_order`), each with
+its stated accuracy (:func:`theory_and_accuracy`).
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import Event
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, earth_model_constants, resolve_terms, run_particles, until_event
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, reject_subnormal,
+                                  rel_drift, resolve_terms, run_particles, until_event)
 
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 
@@ -39,10 +42,12 @@ def build(values, terms):
     v0 = values["speed"] * (math.cos(el) * aim + math.sin(el) * np.array([0.0, 0.0, 1.0]))
     ground = Event("ground", "altitude" if "curvature" in terms else "r", 2, 0.0, -1, True)
     flight = 2 * values["speed"] * max(math.sin(el), 1e-3) / g
-    return model, np.zeros(3), v0, ground, 3.0 * flight + 10.0, g
+    # room to land, from the shot's own time scale (an absolute margin would swamp a short flight)
+    return model, np.zeros(3), v0, ground, 3.0 * flight + min(10.0, 3.0 * flight), g
 
 
 def simulate(values, terms, method, run, progress):
+    reject_subnormal(values)
     model, r0, v0, ground, duration, g = build(values, terms)
     method = method or run.get("method") or "dop853"
 
@@ -69,6 +74,41 @@ def ground_track(values, r, model):
     return r @ aim, r @ right
 
 
+def theory_and_accuracy(values, g, Omega, model):
+    """Flat-vacuum closed forms, their labels and the absolute accuracy each one claims.
+
+    The expansion parameter is eps = 2 Omega v / g (Omega times the longest time
+    scale of the shot, v / g, which exceeds the flight time for a low shot):
+    range and flight time are zeroth order in Omega (error 2 eps times the size
+    of the trajectory, max(range, apex), or the flight time), the lateral
+    deflection first order (error 2 eps^2 times that size). The factor 2 covers
+    the largest ratio found over azimuths, latitudes, elevations and speeds
+    (tests/test_theory_warnings.py). With any term beyond flat ground, uniform
+    gravity and Coriolis (curvature, central gravity, centrifugal, drag) the
+    closed forms describe another model: they are shown as indicative only and
+    no accuracy is claimed (a difference there is the physics of the extra
+    terms, which ``--audit`` measures, not an error of the run).
+    """
+    el, az, lat = (math.radians(values[k]) for k in ("elevation", "azimuth", "latitude"))
+    v = values["speed"]
+    flat = analytic.projectile_flat_vacuum(v, el, g)
+    theory = {"range_m": float(flat.range), "flight_time_s": float(flat.flight_time),
+              "lateral_deflection_m": float(analytic.projectile_lateral_deflection_first_order(v, el, az, lat, g, Omega))}
+    eps = 2 * Omega * v / g
+    size = max(abs(theory["range_m"]), (v * math.sin(el)) ** 2 / (2 * g))
+    accuracy = {"range_m": 2 * eps * size, "flight_time_s": 2 * eps * theory["flight_time_s"],
+                "lateral_deflection_m": 2 * eps**2 * size}
+    labels = {"range_m": "zeroth order in Omega, flat ground, uniform gravity, vacuum",
+              "flight_time_s": "zeroth order in Omega, flat ground, uniform gravity, vacuum",
+              "lateral_deflection_m": "first order in Omega, flat ground, uniform gravity, vacuum"}
+    extra = [t for t in model.terms if t not in ("gravity", "coriolis")]
+    if extra:
+        return theory, {k: None for k in theory}, {
+            k: f"{lab}: indicative only, the model also has {', '.join(extra)}" for k, lab in labels.items()}
+    return theory, accuracy, {k: f"{lab} (+-{accuracy[k]:.2g} {'s' if k == 'flight_time_s' else 'm'})"
+                              for k, lab in labels.items()}
+
+
 def analyse(values, result):
     traj = result.trajectory
     model = result.extras["model"]
@@ -77,21 +117,27 @@ def analyse(values, result):
     landed = len(traj.event_times["ground"][0]) > 0
     rng, lateral = ground_track(values, r, model)
     Omega = float(np.linalg.norm(model.omega.vector()))
-    el, az, lat = (math.radians(values[k]) for k in ("elevation", "azimuth", "latitude"))
-    flat = analytic.projectile_flat_vacuum(values["speed"], el, g)
-    theory = {"range_m": float(flat.range), "flight_time_s": float(flat.flight_time),
-              "lateral_deflection_m": float(analytic.projectile_lateral_deflection_first_order(
-                  values["speed"], el, az, lat, g, Omega))}
+    theory, accuracy, theory_notes = theory_and_accuracy(values, g, Omega, model)
     metrics = {"range_m": float(rng[-1]), "lateral_deflection_m": float(lateral[-1]),
                "flight_time_s": float(times[-1]) if landed else math.nan}
     diagnostics = {"apex_m": float(np.max(r[:, 2]))}
+    e = jacobi_energy(model, r, v)
+    if e is not None:
+        diagnostics["energy_rel_drift"] = rel_drift(e)
     notes = []
     extra = [t for t in model.terms if t not in ("gravity", "coriolis")]
     if extra:
         notes.append(f"theory is flat-Earth vacuum; the scene also has {', '.join(extra)}")
     if not landed:
         notes.append("the shell had not landed at the end of the simulated time")
-    return {"metrics": metrics, "theory": theory, "diagnostics": diagnostics, "notes": notes}
+        metrics.update(range_m=math.nan, lateral_deflection_m=math.nan)
+        notes.append("range and lateral deflection are of a landing, so they are null")
+    method_rel = method_rel_error(traj, theory["flight_time_s"])
+    size = max(abs(theory["range_m"]), float(np.max(np.abs(r))))
+    tolerance = {k: acc + method_rel * (theory[k] if k == "flight_time_s" else size)
+                 for k, acc in accuracy.items() if acc is not None}
+    return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes}
 
 
 def record(rec, values, result):

@@ -18,7 +18,8 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.integrators import Event, default_method
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, energy_in_rotating_frame, rel_drift,
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, rel_drift,
+                                  reject_subnormal,
                                   resolve_terms, run_particles, until_event)
 
 METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
@@ -33,11 +34,13 @@ def build(values, terms):
     h = values["height"]
     t_vac = math.sqrt(2 * h / g)
     t_drag = h * math.sqrt(values["drag"] / g) if values["drag"] > 0 else 0.0
-    duration = 1.5 * (t_vac + t_drag) + 1.0
+    # room to land from the problem's own time scale (an absolute margin would swamp a short fall)
+    duration = 1.5 * (t_vac + t_drag) + min(1.0, 1.5 * (t_vac + t_drag))
     return model, np.array([0.0, 0.0, h]), np.zeros(3), duration, g
 
 
 def simulate(values, terms, method, run, progress):
+    reject_subnormal(values)
     model, r0, v0, duration, g = build(values, terms)
     method = method or default_method(model)
 
@@ -48,6 +51,43 @@ def simulate(values, terms, method, run, progress):
     return run_particles(model, r0, v0, duration, method, run, progress, finish, events=[GROUND])
 
 
+#: Magnitudes below this (m or s) have lost float64's relative precision (normal range ends at 2.2e-308).
+UNDERFLOW = 1e-290
+
+
+def theory_and_accuracy(values, model, g, Omega):
+    """Closed forms for the drop and the relative accuracy each one claims, for this model.
+
+    East: (1/3) Omega g t^3 cos(lat), first order in Omega (neglected: relative
+    (Omega t)^2). North: second order in Omega, -(1/6) Omega^2 g t^4 sin cos from
+    Coriolis, plus -(5/24) Omega^2 g t^4 sin cos when the model has the
+    centrifugal variation (neglected: relative Omega t). Fall time sqrt(2 h / g)
+    (neglected: relative (Omega t)^2). Altitude gravity weakens g by up to 2 h / R
+    along the fall, which moves every value by a relative h / R at most. With
+    drag the vacuum forms are indicative only (accuracy None).
+    """
+    h, lat = values["height"], math.radians(values["latitude"])
+    t = math.sqrt(2 * h / g)
+    north = analytic.drop_north_deflection_second_order(h, lat, g, Omega)
+    label = "second order in Omega, uniform gravity, vacuum"
+    if model.has("centrifugal"):
+        north += analytic.drop_north_deflection_centrifugal_second_order(h, lat, g, Omega)
+        label = "second order in Omega (Coriolis and the centrifugal variation), uniform gravity, vacuum"
+    theory = {"east_deflection_m": float(analytic.drop_east_deflection_first_order(h, lat, g, Omega)),
+              "north_deflection_m": float(north), "fall_time_s": t}
+    wt = Omega * t
+    extra = h / earth.R_EARTH if (model.has("altitude-gravity") or model.has("central-gravity")) else 0.0
+    accuracy = {"east_deflection_m": 2 * wt**2 + 2 * extra, "north_deflection_m": 2 * wt + 2 * extra,
+                "fall_time_s": 2 * wt**2 + 2 * extra}
+    labels = {"east_deflection_m": "first order in Omega, uniform gravity, vacuum",
+              "north_deflection_m": label, "fall_time_s": "no rotation, uniform gravity, vacuum"}
+    if values["drag"] > 0:
+        return theory, {k: None for k in theory}, {k: v + ": indicative only (the model has drag)"
+                                                   for k, v in labels.items()}
+    notes = {k: f"{labels[k]} (+-{accuracy[k]:.2g} relative)" for k in theory}
+    return theory, accuracy, notes
+
+
 def analyse(values, result):
     traj = result.trajectory
     g = result.extras["g"]
@@ -55,26 +95,39 @@ def analyse(values, result):
     times, r, v = until_event(traj, "ground")
     landed = len(traj.event_times["ground"][0]) > 0
     Omega = float(np.linalg.norm(model.omega.vector()))
-    lat = math.radians(values["latitude"])
     metrics = {"east_deflection_m": float(r[-1, 0]), "north_deflection_m": float(r[-1, 1]),
                "fall_time_s": float(times[-1]) if landed else math.nan}
-    theory = {
-        "east_deflection_m": float(analytic.drop_east_deflection_first_order(values["height"], lat, g, Omega)),
-        "north_deflection_m": float(analytic.drop_north_deflection_second_order(values["height"], lat, g, Omega)),
-        "fall_time_s": math.sqrt(2 * values["height"] / g),
-    }
+    theory, accuracy, theory_notes = theory_and_accuracy(values, model, g, Omega)
     diagnostics = {}
     notes = []
-    if values["drag"] == 0:
-        e = energy_in_rotating_frame(r, v, g, model.omega.vector(), model.has("centrifugal"))
+    e = jacobi_energy(model, r, v)
+    if e is not None:
         diagnostics["energy_rel_drift"] = rel_drift(e)
     else:
-        notes.append("theory is the vacuum closed form; with drag the body falls longer and deflects more")
-    if model.has("altitude-gravity") or model.has("centrifugal"):
-        notes.append("theory assumes uniform gravity; the extra terms move the result slightly")
+        notes.append("theory is the vacuum closed form, indicative only with drag: the body falls longer, and the "
+                     "air both prolongs the Coriolis push and damps the eastward drift (no energy invariant either)")
+    if model.has("altitude-gravity") or model.has("central-gravity"):
+        notes.append("theory assumes uniform gravity; weaker gravity aloft changes every value by up to a "
+                     f"relative h / R = {values['height'] / earth.R_EARTH:.2g}")
     if not landed:
         notes.append("the body did not reach the ground in the simulated time")
-    return {"metrics": metrics, "theory": theory, "diagnostics": diagnostics, "notes": notes}
+    # a deflection below float64's normal range has no significant digits left: null, not a number
+    log_east = math.log10(Omega / 3) + math.log10(g) + 1.5 * math.log10(2 * values["height"] / g)
+    if log_east < math.log10(UNDERFLOW):
+        for key in ("east_deflection_m", "north_deflection_m"):
+            metrics[key] = theory[key] = math.nan
+        notes.append(f"the deflections (about 1e{log_east:.0f} m) are below float64's normal range: not computed")
+    # tolerance: the method's error on top of the closed form's stated accuracy, and round-off of positions
+    method_rel = method_rel_error(traj, theory["fall_time_s"])
+    # (the horizontal motion is fed by the vertical one through Omega: its round-off scales with the east deflection)
+    floor = {"fall_time_s": 1e-14 * theory["fall_time_s"]}
+    tolerance = {}
+    for key, acc in accuracy.items():
+        if acc is not None and math.isfinite(theory[key]):
+            tolerance[key] = (acc + method_rel) * abs(theory[key]) + floor.get(
+                key, 1e-13 * abs(theory["east_deflection_m"]))
+    return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
+            "diagnostics": diagnostics, "notes": notes}
 
 
 def record(rec, values, result):
@@ -97,8 +150,8 @@ def record(rec, values, result):
                   1e3 * Omega * g * times ** 3 * math.cos(math.radians(values["latitude"])) / 3,
                   label="(1/3) Omega g t^3 cos(lat)")
     rec.scalars("diagnostics/north_deflection_mm", times, 1e3 * r[:, 1], label="north (simulated)")
-    if values["drag"] == 0:
-        e = energy_in_rotating_frame(r, v, result.extras["g"], model.omega.vector(), model.has("centrifugal"))
+    e = jacobi_energy(model, r, v)
+    if e is not None:
         rec.scalars("diagnostics/energy_rel_error", times, (e - e[0]) / abs(e[0]))
     rec.exact_values("world/body/landing", state=np.concatenate([r[-1], v[-1]]), time=[times[-1]])
 

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, rel_drift, run_particles
+from rotframe.scenes.base import SceneResult, method_rel_error, reject_subnormal, rel_drift, run_particles
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -31,7 +31,14 @@ def _setup(values, terms):
     return model, omega, r0, v0, T
 
 
+#: A run whose distance from the exact line exceeds this fraction of the motion's size has diverged.
+DIVERGED = 0.1
+
+
 def simulate(values, terms, method, run, progress):
+    from rotframe.errors import IntegrationError
+
+    reject_subnormal(values)
     model, omega, r0, v0, T = _setup(values, terms)
 
     def finish(traj):
@@ -39,7 +46,26 @@ def simulate(values, terms, method, run, progress):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
                            extras={"oracle": oracle, "omega": omega})
 
-    return run_particles(model, r0, v0, T, method, run, progress, finish)
+    result = run_particles(model, r0, v0, T, method, run, progress, finish)
+    # a numerical instability that stays finite is still a failure: stop where the path left the exact line
+    traj = result.trajectory
+    err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
+    size = motion_size(values, traj.times)
+    bad = np.nonzero(~(err <= DIVERGED * size))[0]
+    if len(bad):
+        good = max(int(bad[0]), 1)
+        partial = finish(traj.truncated(good))
+        raise IntegrationError(f"the {traj.method} run diverged: {err[bad[0]]:.3g} m from the exact inertial line "
+                               f"at t = {traj.times[bad[0]]:.6g} s, more than {DIVERGED:g} of the motion's size "
+                               f"{size[bad[0]]:.3g} m (a smaller step or another method may hold it)",
+                               t_reached=float(traj.times[good - 1]), partial=partial)
+    return result
+
+
+def motion_size(values, times):
+    """Size of the motion (m) up to each time: start radius plus the inertial distance travelled."""
+    v_in = math.hypot(values["speed"], values["omega0"] * values["start_radius"])
+    return values["start_radius"] + v_in * np.asarray(times) + 1e-300
 
 
 def inertial_line(omega, r0, v0, times):
@@ -62,13 +88,24 @@ def analyse(values, result):
     traj = result.trajectory
     err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
     turns = float(result.extras["omega"].angle(traj.times[-1])[0] / (2 * math.pi))
+    T = float(traj.times[-1])
+    w_max = max(abs(values["omega0"]), abs(values["omega0"] + values["alpha"] * T))
+    # the method's error over the path: relative to the motion's size, on the spin's time scale 1 / w_max
+    size = float(motion_size(values, [T])[0])
+    tol = method_rel_error(traj, 1.0 / w_max if w_max > 0 else T) * size
+    notes = []
+    if values["alpha"] != 0 and values["omega0"] * (values["omega0"] + values["alpha"] * T) < 0:
+        notes.append("the spin reverses during the run: turns counts the net angle (the two senses cancel)")
     return {
         "metrics": {"position_error_m": float(err[-1]), "turns": turns},
         "theory": {"position_error_m": 0.0,
-                   "turns": (values["omega0"] * values["duration"]
-                             + 0.5 * values["alpha"] * values["duration"] ** 2) / (2 * math.pi)},
+                   "turns": (values["omega0"] * T + 0.5 * values["alpha"] * T**2) / (2 * math.pi)},
+        "theory_notes": {"position_error_m": "exact: the inertial straight line seen from the turntable",
+                         "turns": "exact: (omega0 T + alpha T^2 / 2) / 2 pi"},
+        "tolerance": {"position_error_m": tol, "turns": 1e-12 * max(abs(turns), 1.0)},
         "diagnostics": {"max_position_error_m": float(np.max(err)),
                         "inertial_speed_rel_drift": rel_drift(_inertial_speed(result))},
+        "notes": notes,
     }
 
 
