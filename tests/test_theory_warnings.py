@@ -319,8 +319,14 @@ BEFORE = {
 }
 
 
+#: where a default method changed since then, the old method's own error bounds the change: Foucault's
+#: full pendulum moved from splitting (step 0.01 s) to dop853 (rtol 1e-10), and splitting's period is
+#: off by its O(h^2) error, about 6e-7 relative (the rate by about 3e-9).
+REL = {"foucault": 2e-6}
+
+
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_default_metrics_are_unchanged(name):
     s = run(name)
     for key, before in BEFORE[name].items():
-        assert s["metrics"][key] == pytest.approx(before, rel=1e-12, abs=1e-15), key
+        assert s["metrics"][key] == pytest.approx(before, rel=REL.get(name, 1e-12), abs=1e-15), key
