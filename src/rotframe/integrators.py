@@ -367,6 +367,14 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
             raise ScenarioError(f"event {ev.name!r}: kind {ev.kind!r} needs a nonlinear model, not 'exact'")
         col = ev.component + (0 if ev.kind == "r" else 3)
         g = out[:, col, :] - ev.value  # (samples + 1, N)
+        # a function that starts at exactly zero takes the sign it has just after the start
+        # (first non-zero derivative), as in the kernels (docs/physics/events.md)
+        g = g.copy()
+        zero = g[0] == 0.0
+        if zero.any():
+            d1 = M[col] @ out[0]
+            d2 = M[col] @ (M @ out[0])
+            g[0] = np.where(zero, np.where(d1 != 0.0, np.sign(d1), np.sign(d2)) * 1e-300, g[0])
         rising = (g[:-1] < 0.0) & (g[1:] >= 0.0)
         falling = (g[:-1] > 0.0) & (g[1:] <= 0.0)
         crossed = rising if ev.direction > 0 else falling if ev.direction < 0 else rising | falling

@@ -81,7 +81,11 @@ def locate_crossings(M, s_start, dt, g_lo, g_hi, column, value, t_start, max_ite
     """
     lo, hi = np.zeros_like(dt), np.array(dt, dtype=float)
     g_lo = np.array(g_lo, dtype=float)
-    tau = dt * g_lo / (g_lo - g_hi)
+    g_hi = np.asarray(g_hi, dtype=float)
+    # a bracket that starts on the zero (g_lo is then a signed tiny number: the sign just after
+    # the start) has its root inside, not at tau = 0: start from its middle
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = np.where(np.abs(g_lo) > 1e-290, dt * g_lo / (g_lo - g_hi), 0.5 * dt)
     for _ in range(max_iter):
         s = propagate(M, s_start, tau)
         g = s[column] - value
