@@ -51,17 +51,22 @@ RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
 
 def scenario_dir() -> Path:
-    """The ``scenarios/`` folder: ``$ROTFRAME_SCENARIOS``, else the repository's, else the package's."""
+    """The ``scenarios/`` folder: ``$ROTFRAME_SCENARIOS``, else the checkout's, else the installed package's.
+
+    In a source checkout (``src/rotframe`` beside ``pyproject.toml``) the
+    top-level ``scenarios/`` is the source; a wheel ships the same files as
+    package data in ``rotframe/scenarios/``.
+    """
     import os
 
     env = os.environ.get("ROTFRAME_SCENARIOS")
     if env:
         return Path(env)
     here = Path(__file__).resolve()
-    for base in (here.parents[2], here.parent):
-        if (base / "scenarios").is_dir():
-            return base / "scenarios"
-    return here.parents[2] / "scenarios"
+    repo = here.parents[2]
+    if (repo / "pyproject.toml").is_file() and (repo / "scenarios").is_dir():
+        return repo / "scenarios"
+    return here.parent / "scenarios"
 
 
 def names() -> list[str]:
