@@ -270,6 +270,7 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
+    guard = _energy_guard(model, r0, v0)
     chunk = max(1, int(4e6 // max(cost, 1)))
     done = 0
     nfev = 0
@@ -309,6 +310,14 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
                 raise IntegrationError(
                     f"non-finite state of particle {bad} after t = {times[good - 1]:.6g} s "
                     f"(method {info.name})", t_reached=float(times[good - 1]), partial=partial)
+            bad_k = _energy_growth(model, guard, times, out_r, out_v, done + 1, done + 1 + m)
+            if bad_k is not None:
+                partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(bad_k)
+                evb.attach(partial, events)
+                raise IntegrationError(
+                    f"unstable step: the inertial speed of a particle under no real force grew by more than "
+                    f"{_GROWTH_LIMIT:g} (relative) by t = {times[bad_k]:.6g} s (method {info.name}, step {h:.3g} s); "
+                    "use a smaller step or dop853", t_reached=float(times[bad_k - 1]), partial=partial)
             done += m
             if progress is not None:
                 progress(done / samples)
@@ -326,6 +335,46 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
     traj.extras["compile_s"] = compile_s
     evb.attach(traj, events)
     return traj
+
+
+#: Relative growth of the inertial speed beyond which a run of a force-free model is unstable.
+_GROWTH_LIMIT = 1e-3
+
+
+def _inertial_speed(model, t, r, v):
+    """|v + w(t) x r| for positions and velocities (..., N, 3) at times t (...,)."""
+    w = np.interp(t, model.omega.times, model.omega.values)
+    wv = np.asarray(w)[..., None, None] * model.omega.axis
+    return np.linalg.norm(v + np.cross(wv, r), axis=-1)
+
+
+def _energy_guard(model, r0, v0):
+    """The initial inertial speeds when the model's true motion keeps them (else None).
+
+    A particle under the fictitious forces alone (Coriolis, centrifugal, and
+    Euler when the rate varies) moves on a straight line at constant speed in
+    inertial space; drag only slows it. So its inertial speed |v + w x r| never
+    grows, whatever the frame does, and a growth beyond :data:`_GROWTH_LIMIT`
+    is the mark of an unstable step (docs/physics/stability.md). Models with a
+    real force that can add energy (gravity, springs, a pendulum) return None.
+    """
+    terms = set(model.terms)
+    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
+    if not fictitious <= terms or not terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}:
+        return None
+    return _inertial_speed(model, 0.0, r0, v0)
+
+
+def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
+    """Index of the first sample in [lo, hi) where the inertial speed grew past the limit, or None."""
+    if guard is None:
+        return None
+    speed = _inertial_speed(model, times[lo:hi], out_r[lo:hi], out_v[lo:hi])
+    scale = np.maximum(guard, 1e-300)
+    grown = np.any(speed > (1.0 + _GROWTH_LIMIT) * scale + 1e-12, axis=1) | ~np.all(np.isfinite(speed), axis=1)
+    if not grown.any():
+        return None
+    return lo + int(np.argmax(grown))
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
