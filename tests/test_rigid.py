@@ -6,7 +6,7 @@ References used here, each written in this file and not taken from rigid.py:
 * 40-digit mpmath Jacobi functions for the separatrix side cases (where DOP853
   itself loses digits at each flip);
 * Goldstein's cubic for the heavy top, angular velocities built from scipy
-  rotations, textbook numbers (PHYSICS.md 4: 39.1/71.0/102.9 s, Earth's 304.5 days).
+  rotations, textbook numbers (docs/physics/rigid-bodies.md: 39.1/71.0/102.9 s, Earth's 304.5 days).
 """
 
 import math

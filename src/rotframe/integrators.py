@@ -28,7 +28,7 @@ Methods
     (drag, close approach), or as a tight reference.
 ``exact``
     Matrix exponential of the augmented linear system (r, v, 1)
-    (PHYSICS.md section 2). Exact to round-off; applies only when the model is
+    (docs/physics/earth.md, the exact linear flow). Exact to round-off; applies only when the model is
     linear with constant coefficients (:attr:`ParticleModel.is_linear`), and is
     then the default.
 """
@@ -378,7 +378,7 @@ def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
-    """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (PHYSICS.md section 2).
+    """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (docs/physics/earth.md).
 
     expm is evaluated directly at every 64th sample and the samples between
     are reached by powers of the one-interval propagator, so round-off stays

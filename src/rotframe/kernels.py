@@ -7,7 +7,7 @@ the flat parameter vector ``P`` described below and calls the drivers in
 chunks of output samples, so that a progress bar, Ctrl-C and a numerical
 failure can be handled between chunks without losing data.
 
-Equation of motion (rotating frame, PHYSICS.md section 1)::
+Equation of motion (rotating frame, docs/physics/rotating-frames.md)::
 
     r'' = g(r) - 2 w(t) x v - w x (w x r) - w'(t) x r - k1 v - k2 |v| v  [+ tension]
 
@@ -623,7 +623,7 @@ def _step_in_place(method, r, v, t, h, P, wt, wv, wint):
 def step_splitting(r, v, t, h, P, wt, wv, wint, a):
     """Exact-rotation splitting, order 2 (drift, kick, rotate, kick, drift).
 
-    Strang composition of exact sub-flows (PHYSICS.md section 3): drift
+    Strang composition of exact sub-flows (docs/physics/splitting.md): drift
     r += v h/2; kick v += a_pos(r, t + h/2) h/2 and exact drag; rotate v about
     w_hat by -2 * integral of w over the step (the exact Coriolis flow, no
     tan() as in Boris); drag and kick again; drift h/2. Explicit, symmetric

@@ -3,7 +3,7 @@
 When a scene is linear with constant coefficients (uniform gravity, constant
 omega, linear drag, the small-angle spring), r'' = K r + C v + b, and the
 augmented state s = (r, v, 1) obeys s' = M s with the constant 7x7 matrix
-M = [[0, I, 0], [K, C, b], [0, 0, 0]] (PHYSICS.md section 2). Then
+M = [[0, I, 0], [K, C, b], [0, 0, 0]] (docs/physics/earth.md, the exact linear flow). Then
 s(t) = expm(M t) s(0) exactly. This module holds M, a vectorised propagator
 for many states over many different times at once, and the location of event
 crossings on the exact flow, all particles and brackets in one call.

@@ -55,7 +55,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
 
 
 def summarize(scn, values, result, timing):
-    """The run summary (the JSON contract of DESIGN.md)."""
+    """The run summary (the JSON contract described in README.md)."""
     from rotframe import scenes
 
     scene = scenes.get(scn.scene)
