@@ -59,6 +59,11 @@ def _rhs_factory(terms, p):
             a += -p["k1"] * rho * v
         if "quadratic-drag" in terms:
             a += -p["k2"] * rho * np.linalg.norm(v) * v
+        if "pendulum" in terms:
+            # textbook index-1 form of the string: remove the applied acceleration along the string
+            # and add the centripetal |v|^2 / L towards the pivot (v is tangent on the sphere)
+            n = (r - p["pivot"]) / p["L"]
+            a = a - (a @ n) * n - (v @ v) / p["L"] * n
         return np.concatenate([v, a])
     return rhs
 
@@ -73,6 +78,10 @@ CASES = {
     "quadratic-drag+density": (("gravity", "quadratic-drag"), {"g": np.array([0, 0, -9.8]), "k2": 4e-4, "H": 300.0}),
     "quadratic-drag-uniform-air": (("gravity", "quadratic-drag"), {"g": np.array([0, 0, -9.8]), "k2": 4e-4}),
     "spring": (("spring", "coriolis"), {"spring": 2.0, "w0": 0.4}),
+    "pendulum": (("gravity", "coriolis", "pendulum"),
+                 {"g": np.array([0, 0, -9.8]), "w0": 0.3, "L": 5.0, "pivot": np.array([1.0, 2.0, 8.0]),
+                  "r0": np.array([1.0, 2.0, 8.0]) + 5.0 * np.array([0.6, 0.0, -0.8]),
+                  "v0": np.array([1.6, 2.5, 1.2])}),  # v0 . (0.6, 0, -0.8) = 0: tangent to the sphere
 }
 
 
@@ -83,6 +92,7 @@ def _model(terms, p):
     else:
         omega = OmegaSchedule.constant(w0 * AXIS)
     return ParticleModel(terms, omega=omega, g=p.get("g", np.zeros(3)), g0=G0, radius=R_SMALL,
+                         pendulum_length=p.get("L", 0.0), pivot=p.get("pivot", np.zeros(3)),
                          gm=G0 * R_SMALL**2, k_linear=p.get("k1", 0.0), k_quadratic=p.get("k2", 0.0),
                          scale_height=p.get("H", 0.0), spring=p.get("spring", 0.0))
 
@@ -96,10 +106,11 @@ V0 = np.array([40.0, 25.0, 300.0])  # climbs ~1 km: altitude, density and centra
 def test_force_term_matches_hand_written_rhs(case, method):
     terms, p = CASES[case]
     T = 4.0
-    ref = solve_ivp(_rhs_factory(terms, p), (0.0, T), np.concatenate([R0, V0]), method="DOP853",
+    r0, v0 = p.get("r0", R0), p.get("v0", V0)
+    ref = solve_ivp(_rhs_factory(terms, p), (0.0, T), np.concatenate([r0, v0]), method="DOP853",
                     rtol=1e-13, atol=1e-13, t_eval=[T]).y[:, -1]
     kw = {"rtol": 1e-12} if method == "dop853" else {"step": 2e-4}
-    traj = integrate_particles(_model(terms, p), R0, V0, T, method=method, samples=4, **kw)
+    traj = integrate_particles(_model(terms, p), r0, v0, T, method=method, samples=4, **kw)
     got = np.concatenate([traj.r[-1, 0], traj.v[-1, 0]])
     scale = np.max(np.abs(ref))
     # splitting4 at h = 2e-4: global error ~ (h w)^4 T * scale ~ 1e-12 relative; dop853 at 1e-12: ~1e-10
@@ -116,6 +127,7 @@ DISTINCTIVE = {  # case -> (terms, parameters) without the term under test, or w
     "quadratic-drag+density": (None, {"H": 0.0}),
     "quadratic-drag-uniform-air": (("gravity",), None),
     "spring": (("coriolis",), None),
+    "pendulum": (("gravity", "pendulum"), None),
 }
 
 
@@ -124,7 +136,7 @@ def test_each_term_matters_in_its_case(case):
     """The term under test moves the final state by > 1e-3 of its scale, 1e4 times the tolerance above."""
     terms, p = CASES[case]
     other_terms, changes = DISTINCTIVE[case]
-    y0 = np.concatenate([R0, V0])
+    y0 = np.concatenate([p.get("r0", R0), p.get("v0", V0)])
     full = solve_ivp(_rhs_factory(terms, p), (0, 4.0), y0, rtol=1e-10, atol=1e-10).y[:, -1]
     without = solve_ivp(_rhs_factory(other_terms or terms, dict(p, **(changes or {}))), (0, 4.0), y0,
                         rtol=1e-10, atol=1e-10).y[:, -1]
