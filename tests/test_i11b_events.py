@@ -122,3 +122,28 @@ def test_turntable_instability_ends_in_integration_error_with_partial_samples():
     partial = exc.value.partial
     assert partial is not None and 1 < len(partial.times) < 201
     assert np.all(np.isfinite(partial.r))
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("height", [1e-300, 1e-30, 1e-3])
+def test_drop_from_a_tiny_height_lands_at_sqrt_2h_over_g(method, height):
+    """A crossing far below the step: bisection/Newton must go down to round-off of tau itself.
+
+    Closed form t = sqrt(2 h / g) (no rotation); every method is exact for constant gravity
+    up to round-off, so 1e-9 relative. (A fixed 60 halvings of the step stopped at 1e-21 s.)
+    """
+    traj = integrate_particles(_vacuum(), np.array([0.0, 0.0, height]), np.zeros(3), 1.0, method=method,
+                               samples=10, events=[GROUND])
+    assert traj.event_times["ground"][0] == pytest.approx([math.sqrt(2 * height / G)], rel=1e-9)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_overflow_ends_in_integration_error_with_finite_partial_samples(method):
+    """An anti-spring a = +1e4 r grows like e^(100 t) and overflows after ~7 s: every method must
+    raise IntegrationError and keep only finite samples (never write inf into a recording)."""
+    model = ParticleModel(("spring",), spring=-1e4)
+    with pytest.raises(IntegrationError) as exc:
+        integrate_particles(model, [1.0, 0, 0], [0.0, 0, 0], 100.0, method=method, samples=100)
+    partial = exc.value.partial
+    assert partial is not None and 1 <= len(partial.times) < 101
+    assert np.all(np.isfinite(partial.r)) and np.all(np.isfinite(partial.v))

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -369,7 +370,8 @@ def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
     """Index of the first sample in [lo, hi) where the inertial speed grew past the limit, or None."""
     if guard is None:
         return None
-    speed = _inertial_speed(model, times[lo:hi], out_r[lo:hi], out_v[lo:hi])
+    with np.errstate(all="ignore"):
+        speed = _inertial_speed(model, times[lo:hi], out_r[lo:hi], out_v[lo:hi])
     scale = np.maximum(guard, 1e-300)
     grown = np.any(speed > (1.0 + _GROWTH_LIMIT) * scale + 1e-12, axis=1) | ~np.all(np.isfinite(speed), axis=1)
     if not grown.any():
@@ -396,21 +398,28 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     times = np.arange(samples + 1) * dt
     times[-1] = duration
     block = 64
-    powers = [np.eye(7)]
-    step_matrix = expm(M * dt)
-    for _ in range(block - 1):
-        powers.append(step_matrix @ powers[-1])
-    out = np.empty((samples + 1, 7, n))
-    for start in range(0, samples + 1, block):
-        anchor = expm(M * times[start]) @ s0
-        for j in range(min(block, samples + 1 - start)):
-            out[start + j] = powers[j] @ anchor
-        if progress is not None:
-            progress(min(1.0, (start + block) / (samples + 1)))
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        # an overflow (an unstable linear model run far) is caught below as a non-finite state
+        warnings.simplefilter("ignore", RuntimeWarning)
+        powers = [np.eye(7)]
+        step_matrix = expm(M * dt)
+        for _ in range(block - 1):
+            powers.append(step_matrix @ powers[-1])
+        out = np.empty((samples + 1, 7, n))
+        for start in range(0, samples + 1, block):
+            anchor = expm(M * times[start]) @ s0
+            for j in range(min(block, samples + 1 - start)):
+                out[start + j] = powers[j] @ anchor
+            if progress is not None:
+                progress(min(1.0, (start + block) / (samples + 1)))
     traj = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)).copy(),
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)
-    if not np.all(np.isfinite(out)):
-        raise IntegrationError("exact propagator produced a non-finite state", t_reached=0.0, partial=traj)
+    finite = np.all(np.isfinite(out), axis=(1, 2))
+    if not finite.all():
+        k = int(np.argmin(finite))  # the first sample with a non-finite state; keep those before it
+        partial = traj.truncated(max(k, 1))
+        raise IntegrationError(f"exact propagator produced a non-finite state at t = {times[k]:.6g} s",
+                               t_reached=float(times[max(k - 1, 0)]), partial=partial)
     for ev in events:
         if ev.kind not in ("r", "v"):
             raise ScenarioError(f"event {ev.name!r}: kind {ev.kind!r} needs a nonlinear model, not 'exact'")

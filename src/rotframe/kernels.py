@@ -865,15 +865,16 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 def _locate(method, events, e, start, g_start, t, h, m, wt, wv, wint):
     """Sub-step tau in (0, h] at which the event function of the one-step map vanishes.
 
-    Bisection on tau of g(step(start, tau)), 60 halvings: the bracket shrinks
-    to round-off. ``g_start`` is the event function at ``start`` as used for
+    Bisection on tau of g(step(start, tau)), halving until the bracket cannot
+    shrink (round-off of tau itself, even for a crossing at tau ~ 1e-161 s, which
+    a fixed 60 halvings of h would miss by 1e140). ``g_start`` is the event function at ``start`` as used for
     the crossing test (its sign just after the start when it is zero there,
     :func:`_start_value`). Returns tau and the state at the event.
     """
     lo = 0.0
     hi = h
     g_lo = g_start
-    for _ in range(60):
+    for _ in range(2200):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
@@ -1038,7 +1039,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                     lo = 0.0
                     hi = h_used
                     g_lo = g_old[e]
-                    for _ in range(60):
+                    for _ in range(2200):
                         mid = 0.5 * (lo + hi)
                         if mid <= lo or mid >= hi:
                             break
