@@ -50,7 +50,7 @@ def test_omega_earth_is_the_earth_rotation_angle_rate():
     assert OMEGA_EARTH == pytest.approx(expected, rel=1e-13)
     # The value quoted in IERS/IAU documents, 7.292115146706979e-5 rad/s ...
     assert OMEGA_EARTH == pytest.approx(7.292115146706979e-5, rel=1e-13)
-    # ... which rounds to the DESIGN.md value 7.292115147e-5 (10 significant digits).
+    # ... which rounds to the published value 7.292115147e-5 (docs/physics/earth.md) (10 significant digits).
     assert OMEGA_EARTH == pytest.approx(7.292115147e-5, rel=1e-10)
     # Not one turn per sidereal day against the equinox, nor one turn per solar day.
     assert abs(OMEGA_EARTH - 2 * math.pi / 86164.0905) > 5e-13

@@ -382,7 +382,7 @@ def test_fictitious_accelerations_are_the_three_cross_products():
 
 
 def test_free_particle_seen_from_a_turning_frame_feels_only_fictitious_forces():
-    """Straight line in space, mapped by R(theta(t))^T with a fixed axis (PHYSICS.md 1)."""
+    """Straight line in space, mapped by R(theta(t))^T with a fixed axis (docs/physics/rotating-frames.md)."""
     n = np.array([1.0, 2.0, 2.0]) / 3.0
     x0, u = np.array([1.0, -0.5, 2.0]), np.array([0.3, 0.8, -0.2])
     a0, a1 = 0.4, 0.15  # theta = a0 t + a1 t^2: omega = (a0 + 2 a1 t) n, omega_dot = 2 a1 n

@@ -16,7 +16,7 @@ def run(name, method=None, **sets):
 
 @pytest.mark.parametrize("eps,period", [(1e-2, 39.1), (1e-4, 71.0), (1e-6, 102.9)])
 def test_flip_interval_follows_the_ln_one_over_eps_law(eps, period):
-    # PHYSICS.md: for I = (1, 2, 3), w0 = (eps, 1, eps) the period of w is 39.1, 71.0, 102.9 s
+    # docs/physics/rigid-bodies.md: for I = (1, 2, 3), w0 = (eps, 1, eps) the period of w is 39.1, 71.0, 102.9 s
     s, _ = run("dzhanibekov", omega=f"{eps},1,{eps}", duration=4 * period)
     assert s["metrics"]["flip_interval_s"] == pytest.approx(period / 2, abs=0.06)
     assert s["metrics"]["flip_interval_s"] == pytest.approx(s["theory"]["flip_interval_s"], rel=1e-6)

@@ -57,6 +57,8 @@ __all__ = [
     "parse_angle",
     "parse_latitude",
     "parse_longitude",
+    "parse_azimuth",
+    "read_angle_text",
     "parse_length",
     "Site",
     "SITES",
@@ -184,12 +186,7 @@ def parse_latitude(value, name: str = "latitude") -> float:
         If the value cannot be read as an angle or lies beyond +-90 deg; the message names
         the value and the allowed range.
     """
-    if isinstance(value, str) and re.search(r"[EWew]\s*$", value.strip()):
-        raise ScenarioError(
-            f"{name} {value!r} is marked east/west; a latitude is -90 deg..90 deg, "
-            "north positive (N/S suffix allowed)"
-        )
-    ang = _to_angle(value, name)
+    ang = _to_angle(value, name, "latitude")
     try:
         with astropy_offline():
             lat = Latitude(ang)
@@ -206,15 +203,109 @@ def parse_longitude(value, name: str = "longitude") -> float:
 
     Accepts the same forms as :func:`parse_angle`; a trailing N or S is refused.
     """
-    if isinstance(value, str) and re.search(r"[NSns]\s*$", value.strip()):
-        raise ScenarioError(
-            f"{name} {value!r} is marked north/south; a longitude is east positive "
-            "(E/W suffix allowed)"
-        )
-    ang = _to_angle(value, name)
+    ang = _to_angle(value, name, "longitude")
     with astropy_offline():
         lon = Longitude(ang, wrap_angle=180 * u.deg)
     return float(lon.to_value(u.rad))
+
+
+def parse_azimuth(value, name: str = "azimuth") -> float:
+    """Parse an azimuth or heading (clockwise from north) and return it in radians (not wrapped).
+
+    Accepts the same forms as :func:`parse_angle`; a trailing E or W reads as
+    east or west of north (``"30 W"`` is -30 deg, astropy's sign), N or S is refused.
+    """
+    return float(_to_angle(value, name, "azimuth").to_value(u.rad))
+
+
+#: Hemisphere letters each kind of angle accepts after its value.
+HEMISPHERE_LETTERS = {"latitude": "NS", "longitude": "EW", "azimuth": "EW", "angle": "", "any": "NSEW"}
+
+
+def angle_kind(name: str) -> str:
+    """The kind of angle a parameter named ``name`` holds: latitude, longitude, azimuth or angle."""
+    key = name.lower()
+    if "latitude" in key or key in ("lat", "phi"):
+        return "latitude"
+    if "longitude" in key or key in ("lon", "lng"):
+        return "longitude"
+    if any(w in key for w in ("azimuth", "heading", "bearing")):
+        return "azimuth"
+    return "angle"
+
+
+def read_angle_text(text: str, name: str = "angle", kind: str = "angle"):
+    """Read an angle string as astropy does, with hemisphere letters checked for ``kind``.
+
+    Every string that :class:`astropy.coordinates.Angle` reads (with degrees as
+    the default unit) means what astropy says: ``"48d50m46s"`` is +48.846 deg
+    (the ``s`` is seconds), ``"48 50 46"``, ``"48:50:46"``, ``"48°50′46″"``,
+    ``"0.8 rad"``, ``"12h30m"``; also any astropy Quantity string with an
+    angular unit (``"3e1 deg"``, ``"100 arcmin"``). An upper-case hemisphere
+    letter may follow the value, after a plain number too (``"33.9 S"``,
+    ``"45N"``, ``"48d50m46s N"``): S and W negate. Refused with
+    :class:`ScenarioError` naming ``name``, the value and what is allowed: a
+    letter the kind does not take (N/S only for latitudes, E/W only for
+    longitudes and azimuths, none for other named angles, any for ``kind="any"``,
+    as astropy does) and a minus sign together
+    with a letter (``"-45d S"``, a contradiction).
+
+    Returns
+    -------
+    astropy.coordinates.Angle
+    """
+    text = text.strip()
+    allowed = HEMISPHERE_LETTERS.get(kind, "")
+    if _NUMBER_RE.match(text):
+        return Angle(float(text), unit=u.deg)
+    letter = None
+    m = re.fullmatch(r"(.*?[^\s])\s*([NSEW])", text)
+    if m:
+        body = m.group(1)
+        try:
+            base = Angle(float(body), unit=u.deg) if _NUMBER_RE.match(body.strip()) else _astropy_angle(body)
+        except (ValueError, TypeError, u.UnitsError):
+            base = None
+        if base is not None:
+            sign = -1.0 if m.group(2) in "SW" else 1.0
+            try:
+                whole = _astropy_angle(text)
+            except (ValueError, TypeError, u.UnitsError):
+                whole = None
+            # a letter astropy reads as a hemisphere (or that only makes sense as one)
+            if whole is None or whole.deg == sign * base.deg or (body.lstrip().startswith("-")):
+                letter = m.group(2)
+    if letter is not None:
+        what = {"latitude": "a latitude", "longitude": "a longitude", "azimuth": "an azimuth"}.get(kind, "this angle")
+        if letter not in allowed:
+            takes = f"takes only {'/'.join(allowed)}" if allowed else "takes no hemisphere letter (give a signed number)"
+            raise ScenarioError(f"{name} {text!r}: {what} {takes}; e.g. "
+                                f"{_ANGLE_EXAMPLES.get(kind, _ANGLE_EXAMPLES['angle'])}")
+        if m.group(1).lstrip().startswith(("-", "+")):
+            raise ScenarioError(f"{name} {text!r}: a sign and a hemisphere letter together; give either "
+                                f"'{m.group(1).lstrip()[1:].strip()} {letter}' or a signed number")
+        return Angle((-1.0 if letter in "SW" else 1.0) * base.deg, unit=u.deg)
+    return _astropy_angle(text)
+
+
+_ANGLE_EXAMPLES = {
+    "latitude": "'48d50m46s N', '33.9 S', '-33.9' or '48.846 deg'",
+    "longitude": "'2d21m E', '70.6 W', '-70.6' or '2.35 deg'",
+    "azimuth": "'232', '52 W' (west of north), '232 deg' or '4.05 rad'",
+    "angle": "'50', '50d30m', '50.5 deg' or '0.88 rad'",
+}
+
+
+def _astropy_angle(text: str):
+    """astropy's reading of ``text`` (degrees by default); a Quantity string with an angular unit as fallback."""
+    with astropy_offline():
+        try:
+            return Angle(text, unit=u.deg)
+        except (ValueError, TypeError, u.UnitsError):
+            q = u.Quantity(text)
+            if not q.unit.is_equivalent(u.rad):
+                raise u.UnitTypeError(f"unit {q.unit} is not an angle") from None
+            return Angle(q)
 
 
 def parse_length(value, name: str = "length", *, positive: bool = False) -> float:
@@ -719,7 +810,7 @@ def _as_radians(x):
     return float(a) if a.ndim == 0 else a
 
 
-def _to_angle(value, name: str) -> Angle:
+def _to_angle(value, name: str, kind: str = "any") -> Angle:
     """Read a scalar angle (numbers in degrees) as an astropy Angle; ScenarioError if not."""
     if isinstance(value, (bool, np.bool_)):
         raise ScenarioError(f"{name} {value!r} is not an angle; give {_ANGLE_HELP}")
@@ -733,11 +824,7 @@ def _to_angle(value, name: str) -> Angle:
                     )
                 ang = Angle(value)
             elif isinstance(value, str):
-                text = value.strip()
-                if _NUMBER_RE.match(text):
-                    ang = Angle(float(text), unit=u.deg)
-                else:
-                    ang = Angle(text, unit=u.deg)
+                ang = read_angle_text(value, name, kind)
             elif np.ndim(value) == 0 and isinstance(
                 value, (int, float, np.integer, np.floating)
             ):

@@ -5,13 +5,13 @@ Conventions
 Direction-cosine matrix ``A`` (passive)
     ``A`` maps SPACE components of a vector to BODY components,
     ``x_body = A @ x_space``; its rows are the body unit vectors written in space
-    axes (the seed lecture's ``A = B C D``). ``A.T`` maps body components to space
+    axes (the rigid-body lecture's ``A = B C D``, docs/physics/seed-errata.md). ``A.T`` maps body components to space
     components. scipy's ``Rotation.as_matrix()`` is the active matrix, i.e. ``A.T``:
     ``A = Rotation.from_euler(seq, angles).as_matrix().T``. Wherever a matrix ``A``
     is accepted, a ``scipy.spatial.transform.Rotation`` is accepted too and is
     converted with ``as_matrix().T``.
 Elemental rotations
-    ``elemental(axis, t)`` is passive, like the seed's ``D``, ``C`` and ``B``: the
+    ``elemental(axis, t)`` is passive, like the lecture's ``D``, ``C`` and ``B``: the
     components of a fixed vector in axes turned by ``t`` about ``axis``. About x it
     is ``[[1, 0, 0], [0, cos t, sin t], [0, -sin t, cos t]]``.
 Euler-angle sequences
@@ -118,7 +118,7 @@ def direction_cosines(v: ArrayLike) -> np.ndarray:
 
 
 def elemental(axis: int | str, angle: ArrayLike, degrees: bool = False) -> np.ndarray:
-    """Passive rotation matrix about one coordinate axis (the seed's ``D``, ``C``, ``B``).
+    """Passive rotation matrix about one coordinate axis (the lecture's ``D``, ``C``, ``B``; docs/physics/seed-errata.md).
 
     Parameters
     ----------
@@ -157,7 +157,7 @@ def euler_to_dcm(angles: ArrayLike, seq: str = "ZXZ", degrees: bool = False) -> 
     Returns
     -------
     ndarray, shape (..., 3, 3)
-        ``A`` with ``x_body = A @ x_space``. For ``"ZXZ"`` this is the seed's
+        ``A`` with ``x_body = A @ x_space``. For ``"ZXZ"`` this is the lecture's
         ``A = B C D``. Equals ``Rotation.from_euler(seq, angles).as_matrix().T``.
     Examples
     --------

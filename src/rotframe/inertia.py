@@ -7,7 +7,7 @@ Conventions
   (the centre of mass unless a function says otherwise). For a mass element
   ``dm`` at ``r`` relative to that point,
   ``I = integral (|r|^2 E - r r^T) dm``, i.e. ``I_xx = sum m (y^2 + z^2)``,
-  ``I_xy = -sum m x y`` and cyclically (Goldstein ch. 5.3; the seed lecture's
+  ``I_xy = -sum m x y`` and cyclically (Goldstein ch. 5.3; the rigid-body lecture's
   "Angular momentum, moment of inertia" section).
 * Principal moments are returned ascending with the principal axes as the
   columns of a proper rotation, by :func:`rotframe.principal.principal_axes`.

@@ -28,7 +28,7 @@ Methods
     (drag, close approach), or as a tight reference.
 ``exact``
     Matrix exponential of the augmented linear system (r, v, 1)
-    (PHYSICS.md section 2). Exact to round-off; applies only when the model is
+    (docs/physics/earth.md, the exact linear flow). Exact to round-off; applies only when the model is
     linear with constant coefficients (:attr:`ParticleModel.is_linear`), and is
     then the default.
 """
@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -280,6 +281,7 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
+    guard = _energy_guard(model, r0, v0)
     chunk = max(1, int(4e6 // max(cost, 1)))
     done = 0
     nfev = 0
@@ -319,6 +321,14 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
                 raise IntegrationError(
                     f"non-finite state of particle {bad} after t = {times[good - 1]:.6g} s "
                     f"(method {info.name})", t_reached=float(times[good - 1]), partial=partial)
+            bad_k = _energy_growth(model, guard, times, out_r, out_v, done + 1, done + 1 + m)
+            if bad_k is not None:
+                partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(bad_k)
+                evb.attach(partial, events)
+                raise IntegrationError(
+                    f"unstable step: the inertial speed of a particle under no real force grew by more than "
+                    f"{_GROWTH_LIMIT:g} (relative) by t = {times[bad_k]:.6g} s (method {info.name}, step {h:.3g} s); "
+                    "use a smaller step or dop853", t_reached=float(times[bad_k - 1]), partial=partial)
             done += m
             if progress is not None:
                 progress(done / samples)
@@ -338,8 +348,49 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
     return traj
 
 
+#: Relative growth of the inertial speed beyond which a run of a force-free model is unstable.
+_GROWTH_LIMIT = 1e-3
+
+
+def _inertial_speed(model, t, r, v):
+    """|v + w(t) x r| for positions and velocities (..., N, 3) at times t (...,)."""
+    w = np.interp(t, model.omega.times, model.omega.values)
+    wv = np.asarray(w)[..., None, None] * model.omega.axis
+    return np.linalg.norm(v + np.cross(wv, r), axis=-1)
+
+
+def _energy_guard(model, r0, v0):
+    """The initial inertial speeds when the model's true motion keeps them (else None).
+
+    A particle under the fictitious forces alone (Coriolis, centrifugal, and
+    Euler when the rate varies) moves on a straight line at constant speed in
+    inertial space; drag only slows it. So its inertial speed |v + w x r| never
+    grows, whatever the frame does, and a growth beyond :data:`_GROWTH_LIMIT`
+    is the mark of an unstable step (docs/physics/stability.md). Models with a
+    real force that can add energy (gravity, springs, a pendulum) return None.
+    """
+    terms = set(model.terms)
+    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
+    if not fictitious <= terms or not terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}:
+        return None
+    return _inertial_speed(model, 0.0, r0, v0)
+
+
+def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
+    """Index of the first sample in [lo, hi) where the inertial speed grew past the limit, or None."""
+    if guard is None:
+        return None
+    with np.errstate(all="ignore"):
+        speed = _inertial_speed(model, times[lo:hi], out_r[lo:hi], out_v[lo:hi])
+    scale = np.maximum(guard, 1e-300)
+    grown = np.any(speed > (1.0 + _GROWTH_LIMIT) * scale + 1e-12, axis=1) | ~np.all(np.isfinite(speed), axis=1)
+    if not grown.any():
+        return None
+    return lo + int(np.argmax(grown))
+
+
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
-    """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (PHYSICS.md section 2).
+    """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (docs/physics/earth.md).
 
     expm is evaluated directly at every 64th sample and the samples between
     are reached by powers of the one-interval propagator, so round-off stays
@@ -357,26 +408,41 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     times = np.arange(samples + 1) * dt
     times[-1] = duration
     block = 64
-    powers = [np.eye(7)]
-    step_matrix = expm(M * dt)
-    for _ in range(block - 1):
-        powers.append(step_matrix @ powers[-1])
-    out = np.empty((samples + 1, 7, n))
-    for start in range(0, samples + 1, block):
-        anchor = expm(M * times[start]) @ s0
-        for j in range(min(block, samples + 1 - start)):
-            out[start + j] = powers[j] @ anchor
-        if progress is not None:
-            progress(min(1.0, (start + block) / (samples + 1)))
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        # an overflow (an unstable linear model run far) is caught below as a non-finite state
+        warnings.simplefilter("ignore", RuntimeWarning)
+        powers = [np.eye(7)]
+        step_matrix = expm(M * dt)
+        for _ in range(block - 1):
+            powers.append(step_matrix @ powers[-1])
+        out = np.empty((samples + 1, 7, n))
+        for start in range(0, samples + 1, block):
+            anchor = expm(M * times[start]) @ s0
+            for j in range(min(block, samples + 1 - start)):
+                out[start + j] = powers[j] @ anchor
+            if progress is not None:
+                progress(min(1.0, (start + block) / (samples + 1)))
     traj = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)).copy(),
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)
-    if not np.all(np.isfinite(out)):
-        raise IntegrationError("exact propagator produced a non-finite state", t_reached=0.0, partial=traj)
+    finite = np.all(np.isfinite(out), axis=(1, 2))
+    if not finite.all():
+        k = int(np.argmin(finite))  # the first sample with a non-finite state; keep those before it
+        partial = traj.truncated(max(k, 1))
+        raise IntegrationError(f"exact propagator produced a non-finite state at t = {times[k]:.6g} s",
+                               t_reached=float(times[max(k - 1, 0)]), partial=partial)
     for ev in events:
         if ev.kind not in ("r", "v"):
             raise ScenarioError(f"event {ev.name!r}: kind {ev.kind!r} needs a nonlinear model, not 'exact'")
         col = ev.component + (0 if ev.kind == "r" else 3)
         g = out[:, col, :] - ev.value  # (samples + 1, N)
+        # a function that starts at exactly zero takes the sign it has just after the start
+        # (first non-zero derivative), as in the kernels (docs/physics/events.md)
+        g = g.copy()
+        zero = g[0] == 0.0
+        if zero.any():
+            d1 = M[col] @ out[0]
+            d2 = M[col] @ (M @ out[0])
+            g[0] = np.where(zero, np.where(d1 != 0.0, np.sign(d1), np.sign(d2)) * 1e-300, g[0])
         rising = (g[:-1] < 0.0) & (g[1:] >= 0.0)
         falling = (g[:-1] > 0.0) & (g[1:] <= 0.0)
         crossed = rising if ev.direction > 0 else falling if ev.direction < 0 else rising | falling

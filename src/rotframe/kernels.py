@@ -7,7 +7,7 @@ the flat parameter vector ``P`` described below and calls the drivers in
 chunks of output samples, so that a progress bar, Ctrl-C and a numerical
 failure can be handled between chunks without losing data.
 
-Equation of motion (rotating frame, PHYSICS.md section 1)::
+Equation of motion (rotating frame, docs/physics/rotating-frames.md)::
 
     r'' = g(r) - 2 w(t) x v - w x (w x r) - w'(t) x r - k1 v - k2 |v| v  [+ tension]
 
@@ -623,7 +623,7 @@ def _step_in_place(method, r, v, t, h, P, wt, wv, wint):
 def step_splitting(r, v, t, h, P, wt, wv, wint, a):
     """Exact-rotation splitting, order 2 (drift, kick, rotate, kick, drift).
 
-    Strang composition of exact sub-flows (PHYSICS.md section 3): drift
+    Strang composition of exact sub-flows (docs/physics/splitting.md): drift
     r += v h/2; kick v += a_pos(r, t + h/2) h/2 and exact drag; rotate v about
     w_hat by -2 * integral of w over the step (the exact Coriolis flow, no
     tan() as in Boris); drag and kick again; drift h/2. Explicit, symmetric
@@ -691,6 +691,46 @@ def _event_value(events, e, state, radius):
     x, y, z = state[0], state[1], state[2]
     dz = z + radius
     return np.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
+
+
+@_jit
+def _start_value(events, e, state, m, w, wd):
+    """Event function of row ``e`` at the start of a run or chunk, for crossing detection.
+
+    The rule for a function that is exactly zero at the start (a shell fired
+    from the ground, z = 0): it takes the sign it has just after the start,
+    the sign of its first non-zero time derivative (first or second); the
+    start itself is never an event. A shell fired upward from z = 0 thus
+    lands at its first return to z = 0, however soon (even inside the first
+    step), and a ``direction = -1`` ground event is not triggered by the
+    launch. Only the sign of the returned value is meaningful when ``g = 0``
+    (see docs/physics/events.md).
+    """
+    g = _event_value(events, e, state, m.radius)
+    if g != 0.0:
+        return g
+    kind = events[e, 0]
+    c = int(events[e, 1])
+    x, y, z, vx, vy, vz = state
+    a = _acceleration(state, m, w, wd)
+    if kind == 0.0:
+        d1 = state[3 + c]
+        d2 = a[c]
+    elif kind == 1.0:
+        d1 = a[c]
+        d2 = 0.0
+    else:
+        dx, dy, dz = x, y, z + m.radius
+        n = np.sqrt(dx * dx + dy * dy + dz * dz)
+        dv = dx * vx + dy * vy + dz * vz
+        da = dx * a[0] + dy * a[1] + dz * a[2]
+        d1 = dv / n
+        d2 = (vx * vx + vy * vy + vz * vz + da) / n - dv * dv / (n * n * n)
+    if d1 != 0.0:
+        return 1e-300 if d1 > 0.0 else -1e-300
+    if d2 != 0.0:
+        return 1e-300 if d2 > 0.0 else -1e-300
+    return 0.0
 
 
 @_jit
@@ -764,8 +804,10 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
         k_step = 0
-        for e in range(n_ev):
-            g_old[e] = _event_value(events, e, state, m.radius)
+        if n_ev > 0:
+            w0, wd0 = _rates(t0, m.steady, m.w, wt, wv)
+            for e in range(n_ev):
+                g_old[e] = _start_value(events, e, state, m, w0, wd0)
         for s in range(n_samples):
             if is_alive:
                 if n_ev == 0:
@@ -787,7 +829,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         for e in range(n_ev):
                             g_new = _event_value(events, e, state, m.radius)
                             if _crossed(events[e, 3], g_old[e], g_new):
-                                tau, hit = _locate(method, events, e, start, t, h, m, wt, wv, wint)
+                                tau, hit = _locate(method, events, e, start, g_old[e], t, h, m, wt, wv, wint)
                                 k = ev_count[p]
                                 if k < max_events:
                                     ev_t[p, k] = t + tau
@@ -820,16 +862,19 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 
 @_jit
-def _locate(method, events, e, start, t, h, m, wt, wv, wint):
+def _locate(method, events, e, start, g_start, t, h, m, wt, wv, wint):
     """Sub-step tau in (0, h] at which the event function of the one-step map vanishes.
 
-    Bisection on tau of g(step(start, tau)), 60 halvings: the bracket shrinks
-    to round-off. Returns tau and the state at the event.
+    Bisection on tau of g(step(start, tau)), halving until the bracket cannot
+    shrink (round-off of tau itself, even for a crossing at tau ~ 1e-161 s, which
+    a fixed 60 halvings of h would miss by 1e140). ``g_start`` is the event function at ``start`` as used for
+    the crossing test (its sign just after the start when it is zero there,
+    :func:`_start_value`). Returns tau and the state at the event.
     """
     lo = 0.0
     hi = h
-    g_lo = _event_value(events, e, start, m.radius)
-    for _ in range(60):
+    g_lo = g_start
+    for _ in range(2200):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
@@ -951,7 +996,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         f0 = _deriv(_as_state(y), m, w, wd)
         nf = 1
         for e in range(n_ev):
-            g_old[e] = _event_value(events, e, _as_state(y), m.radius)
+            g_old[e] = _start_value(events, e, _as_state(y), m, w, wd)
         k_out = 0
         while k_out < n_out and sample_times[k_out] <= t:
             _store(out_r, out_v, k_out, p, y)
@@ -994,7 +1039,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                     lo = 0.0
                     hi = h_used
                     g_lo = g_old[e]
-                    for _ in range(60):
+                    for _ in range(2200):
                         mid = 0.5 * (lo + hi)
                         if mid <= lo or mid >= hi:
                             break

@@ -1,4 +1,4 @@
-"""Recordings of runs in rerun's ``.rrd`` format (layout fixed in DESIGN.md).
+"""Recordings of runs in rerun's ``.rrd`` format (layout described in README.md, Recordings).
 
 * Timeline ``sim_time`` (a duration, integer nanoseconds rounded here, since
   ``TimeColumn(duration=float seconds)`` would truncate).

@@ -108,7 +108,7 @@ def free_body_exact(
     """Exact motion of the torque-free rigid body.
 
     Angular momentum (Landau & Lifshitz par. 37, in the notation of
-    PHYSICS.md 4): in a frame of principal axes ordered so that ``L`` circulates
+    docs/physics/rigid-bodies.md): in a frame of principal axes ordered so that ``L`` circulates
     about axis 3 (moments ascending when ``M^2 > 2 E I2``, descending otherwise,
     which is the "swap 1 and 3" of the textbook),
     ``L = (J1 a1 cn u, +-J2 a2 sn u, J3 a3 dn u)`` with ``u = u0 + lambda t``,
@@ -389,7 +389,7 @@ def heavy_top_splitting(
     (orientation frozen, exact flow of the potential):
     ``L_body += (h/2) l e3 x (-m g z_body)``, ``z_body = R(q)^T (0, 0, 1)``;
     then the exact free symmetric flow over ``h``; then the kick again
-    (PHYSICS.md 4). Orders 4 and 6 by Yoshida's triple jump. ``p_phi = L . z``
+    (docs/physics/rigid-bodies.md). Orders 4 and 6 by Yoshida's triple jump. ``p_phi = L . z``
     and ``p_psi = L3`` are kept to round-off (the kick is horizontal and normal
     to ``e3``). Spin and nutation enter only through exact rotations, so no
     stability limit on ``h`` comes from the spin; the error is ``O(h^order)``
@@ -617,7 +617,7 @@ def symmetric_top_euler_energy(
     """Kinetic energy (J) of a symmetric top from ZXZ Euler angles and rates.
 
     ``T = I1/2 (phidot^2 sin^2 theta + thetadot^2) + I3/2 (phidot cos theta + psidot)^2``
-    (the seed lecture; Goldstein 5.7). ``phi`` and ``psi`` do not enter.
+    (docs/physics/rigid-bodies.md; Goldstein 5.7). ``phi`` and ``psi`` do not enter.
 
     Parameters
     ----------
@@ -739,7 +739,7 @@ def free_symmetric_precession(i1: float, i3: float, omega3: float) -> float:
 
     ``k = omega3 (I3 - I1) / I1``: ``(omega1, omega2)`` turns about body axis 3 at
     ``k`` (positive: counter-clockwise seen from ``+e3``). The seed prints it
-    with the sign of ``I1 - I3``; see DESIGN.md, Seed errata.
+    with the sign of ``I1 - I3``; see docs/physics/seed-errata.md.
 
     Parameters
     ----------
@@ -885,7 +885,7 @@ def _elliptic_frame(moments, L0):
     J = moments[order]
     norm_L, J_max = math.hypot(*L0), J[2]
     n = P @ L0 / norm_L  # scale-free: unit momentum, moments / J_max
-    # M^2 - 2 E J2 from same-sign terms (PHYSICS.md 4: reduced numerator of 1 - m),
+    # M^2 - 2 E J2 from same-sign terms (docs/physics/rigid-bodies.md: reduced numerator of 1 - m),
     # its sign taken with (L1, L3) scaled to order one so that nothing underflows
     s = max(abs(n[0]), abs(n[2]))
     if s == 0.0:

@@ -55,7 +55,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
 
 
 def summarize(scn, values, result, timing):
-    """The run summary (the JSON contract of DESIGN.md).
+    """The run summary (the JSON contract described in README.md).
 
     Besides the contract's keys it always has ``warnings`` (a list of strings,
     empty on a clean run) and ``theory_notes`` ({metric: what its theory value is:

@@ -51,17 +51,22 @@ RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
 
 def scenario_dir() -> Path:
-    """The ``scenarios/`` folder: ``$ROTFRAME_SCENARIOS``, else the repository's, else the package's."""
+    """The ``scenarios/`` folder: ``$ROTFRAME_SCENARIOS``, else the checkout's, else the installed package's.
+
+    In a source checkout (``src/rotframe`` beside ``pyproject.toml``) the
+    top-level ``scenarios/`` is the source; a wheel ships the same files as
+    package data in ``rotframe/scenarios/``.
+    """
     import os
 
     env = os.environ.get("ROTFRAME_SCENARIOS")
     if env:
         return Path(env)
     here = Path(__file__).resolve()
-    for base in (here.parents[2], here.parent):
-        if (base / "scenarios").is_dir():
-            return base / "scenarios"
-    return here.parents[2] / "scenarios"
+    repo = here.parents[2]
+    if (repo / "pyproject.toml").is_file() and (repo / "scenarios").is_dir():
+        return repo / "scenarios"
+    return here.parent / "scenarios"
 
 
 def names() -> list[str]:
@@ -294,17 +299,14 @@ def _parse_quantity(p: Parameter, text: str, where: str) -> float:
 def _parse_quantity_enabled(p: Parameter, text: str, where: str, unit: str, u) -> float:
     try:
         if unit in ("deg", "rad"):
-            from astropy.coordinates import Angle
+            from rotframe.earth import angle_kind, read_angle_text
 
-            sign = 1.0
-            stripped = text
-            if text[-1:].upper() in ("N", "S", "E", "W") and not text[-2:].lower().endswith("rad"):
-                sign = -1.0 if text[-1].upper() in ("S", "W") else 1.0
-                stripped = text[:-1].strip()
-            return sign * float(Angle(stripped).to_value(unit))
+            return float(read_angle_text(text, p.name, angle_kind(p.name)).to_value(unit))
         q = u.Quantity(text)
         target = u.Unit(unit) if unit else u.dimensionless_unscaled
         return float(q.to_value(target))
+    except ScenarioError as exc:  # an angle with a letter it does not take, or a sign and a letter
+        raise ScenarioError(f"{where}{exc}") from None
     except (u.UnitConversionError, u.UnitTypeError) as exc:
         raise ScenarioError(f"{where}{p.name} = {text!r}: wrong dimension; expected a value in "
                             f"{unit or 'no unit'} ({_first_line(exc)})") from None

@@ -6,7 +6,7 @@ simple polygon (:class:`PolygonRegion`) or an exact circle
 with many sides. From the section come its area, centroid, second moments of
 area about the centroid or any point, principal moments and axes (the major
 axis is the strongest in bending, the minor the weakest; see the end of the
-inertia section of ``seed/rigid-bodies-lecture.md``), radii of gyration, and
+inertia section of the rigid-body lecture, docs/physics/seed-errata.md), radii of gyration, and
 the bending stress and neutral axis under a bending moment (Mx, My).
 
 Conventions

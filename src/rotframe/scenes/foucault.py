@@ -6,7 +6,7 @@ Earth: effective gravity, Coriolis, the string kept exactly (the splitting on
 the sphere in :func:`rotframe.kernels.step_sphere`). The bob is released from
 rest in the rotating frame at ``amplitude`` east of the rest position, which
 gives a swing of tiny ellipticity and so negligible Airy precession
-(PHYSICS.md section 2). ``small_angle = true`` uses instead the linearised
+(docs/physics/earth.md). ``small_angle = true`` uses instead the linearised
 model x'' = -w0^2 x - 2 Omega_z z_hat x x' (w0^2 = g / L; the horizontal
 components of omega act only on the vertical, which the string takes), solved
 exactly by the matrix exponential.

@@ -2,7 +2,7 @@
 
 For I1 = I2 the body-frame angular velocity (w1, w2) turns about the symmetry
 axis at k = w3 (I3 - I1) / I1 while w3 stays constant, and in space the
-symmetry axis turns about the fixed L at |L| / I1 (PHYSICS.md 4). With
+symmetry axis turns about the fixed L at |L| / I1 (docs/physics/rigid-bodies.md). With
 Earth's principal moments, (C - A) / A = 0.0032845, the body precession
 period is A / (C - A) sidereal days, about 304.5 (Euler's period; the observed
 Chandler wobble is longer, 433 days, because the Earth is not rigid). Both

@@ -4,7 +4,7 @@ The turntable spins about the vertical z axis at w(t) = omega0 + alpha t. The
 puck starts at (start_radius, 0, 0) on the turntable, shoved towards the centre
 at ``speed`` relative to the turntable. In inertial space it moves on a straight
 line; seen from the turntable it feels Coriolis, centrifugal and (while the
-turntable spins up) Euler forces. Oracle (PHYSICS.md section 1): the inertial
+turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md): the inertial
 line mapped into the rotating frame, r_rot(t) = R_z(-theta(t)) (r0 + v_in t),
 theta(t) = integral of w.
 """

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# CI: build a wheel, install it outside the checkout, and run rotframe from there.
+# Uses the current python (the CI venv, whose packages are rotframe's dependencies): the
+# wheel is installed with --no-deps into a fresh target folder that is put first on the
+# path, and the check runs from a folder outside the checkout, after proving that
+# `import rotframe` resolves to the installed copy (not to src/ or an editable install).
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+py="${PYTHON:-python}"
+work="$(mktemp -d "${TMPDIR:-/tmp}/rotframe-wheel.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+# an isolated build (pip fetches the build backend from the package registry)
+"$py" -m pip wheel --no-deps -q -w "$work/dist" "$repo"
+wheel="$(ls "$work"/dist/rotframe-*.whl)"
+"$py" -m zipfile -l "$wheel" | grep -q "rotframe/scenarios/tower-drop.toml" \
+  || { echo "wheel-check: the wheel has no rotframe/scenarios/*.toml" >&2; exit 1; }
+"$py" -m pip install -q --no-deps --target "$work/site" "$wheel"
+mkdir -p "$work/run"
+cd "$work/run"
+export PYTHONPATH="$work/site"
+unset ROTFRAME_SCENARIOS || true
+where="$("$py" -c 'import rotframe, os; print(os.path.dirname(rotframe.__file__))')"
+[ "$where" = "$work/site/rotframe" ] \
+  || { echo "wheel-check: import rotframe resolved to $where, not the installed wheel" >&2; exit 1; }
+listed="$("$py" -m rotframe list)"
+echo "$listed"
+for name in $(ls "$repo/scenarios" | sed 's/\.toml$//'); do
+  grep -q "$name" <<<"$listed" || { echo "wheel-check: scenario $name missing from 'rotframe list'" >&2; exit 1; }
+done
+"$py" -m rotframe run tower-drop --no-record --json >"$work/out.json"
+"$py" -c 'import json, sys; d = json.load(open(sys.argv[1])); assert d["metrics"], d' "$work/out.json"
+echo "wheel-check: ok ($(basename "$wheel"))"
