@@ -1,4 +1,4 @@
-"""The Python API (rotframe.run and Result): contract of DESIGN.md, metrics recomputed from the arrays.
+"""The Python API (rotframe.run and Result): the documented contract, metrics recomputed from the arrays.
 
 Each metric check recomputes the metric from ``Result.trajectory`` by a route
 that shares no code with the scene's analysis, so a wrong array (frame, units,
