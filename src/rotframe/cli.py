@@ -16,38 +16,167 @@ import argparse
 import json
 import math
 import os
-import signal
 import sys
 import time
 
-EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
-_T_START = time.perf_counter()
+EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERNAL = 0, 2, 3, 1
 
 
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM, delivered as an interrupt so the run stops cleanly between chunks."""
+class _UsageError(Exception):
+    """argparse's usage error, turned into one line and exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise _UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
 
 
 def main(argv=None) -> int:
+    """Run one command; returns its exit code (never raises for a user's error, a signal or an I/O error)."""
+    from rotframe.signals import InterruptScope
+
+    t_start = time.perf_counter()
     parser = _parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as exc:
+        _error(str(exc))
+        return EXIT_INPUT
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_OK
+    args._t_start = t_start
+    with InterruptScope() as scope, _JsonStdout(getattr(args, "json", False)):
+        args._scope = scope
+        try:
+            return _dispatch(args)
+        except KeyboardInterrupt as exc:
+            scope.note(exc)
+            _error(f"{scope.verb} before anything was computed; nothing was written")
+            return scope.exit_code
+
+
+def _dispatch(args) -> int:
     from rotframe.errors import IntegrationError, RotframeError
 
     try:
         return args.func(args)
     except IntegrationError as exc:
-        _error(f"numerical failure: {exc}")
+        _error(f"numerical failure: {_one_line(exc)}")
         return EXIT_NUMERICAL
     except RotframeError as exc:
-        _error(str(exc))
+        _error(_one_line(exc))
         return EXIT_INPUT
+    except MemoryError:
+        _error("out of memory; ask for less work (fewer samples, rows or a shorter duration)")
+        return EXIT_NUMERICAL
+    except OSError as exc:
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        _error(f"cannot read or write{where}: {exc.strerror or _one_line(exc)}")
+        return EXIT_INPUT
+    except (KeyboardInterrupt, SystemExit):
+        raise
+    except Exception as exc:  # noqa: BLE001 -- a bug: one line, the traceback only on request
+        if os.environ.get("ROTFRAME_DEBUG"):
+            raise
+        _error(f"internal error ({type(exc).__name__}: {_one_line(exc)}); set ROTFRAME_DEBUG=1 for the traceback "
+               "and please report it")
+        return EXIT_INTERNAL
+
+
+def _one_line(exc) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+class _JsonStdout:
+    """With --json, file descriptor 1 is pointed at stderr while a command runs.
+
+    Only the JSON document itself goes to the real stdout (through ``sys.stdout``,
+    which writes to a saved copy of fd 1): a C library (LAPACK, a BLAS, numba)
+    printing to fd 1 cannot spoil it. In-process callers whose ``sys.stdout`` has no
+    file descriptor (pytest's capsys) are left as they are.
+    """
+
+    def __init__(self, enabled):
+        self.enabled = bool(enabled)
+        self.saved = None
+
+    def __enter__(self):
+        if not self.enabled:
+            return self
+        try:
+            if sys.stdout.fileno() != 1:
+                return self
+            sys.stdout.flush()
+            self.saved = os.dup(1)
+            os.dup2(2, 1)
+        except (AttributeError, ValueError, OSError):
+            self.saved = None
+            return self
+        self._old = sys.stdout
+        sys.stdout = open(self.saved, "w", closefd=False, encoding=getattr(self._old, "encoding", None) or "utf-8")
+        return self
+
+    def __exit__(self, *exc):
+        if self.saved is not None:
+            try:
+                sys.stdout.flush()
+            except (OSError, ValueError):
+                pass
+            sys.stdout.close()
+            sys.stdout = self._old
+            os.dup2(self.saved, 1)
+            os.close(self.saved)
+            self.saved = None
+        return False
+
+
+def _add_limits(q, rows=False):
+    q.add_argument("--max-steps", type=_positive_count, default=None, metavar="N",
+                   help="refuse a run of more integration steps than N (default 2e9)")
+    q.add_argument("--max-samples", type=_positive_count, default=None, metavar="N",
+                   help="refuse a run that keeps more output samples than N (default 5e6)")
+    if rows:
+        q.add_argument("--max-rows", type=_positive_count, default=None, metavar="N",
+                       help="refuse a sweep of more rows than N (default 2e6)")
+
+
+def _positive_count(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (value >= 1 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number >= 1")
+    return value
+
+
+def _seed(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= value < 2 ** 63:
+        raise argparse.ArgumentTypeError(f"{value} is out of range; allowed 0 <= seed < 2**63")
+    return value
+
+
+def _count(text):
+    try:
+        value = int(text)
+    except ValueError:
+        try:
+            f = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not (math.isfinite(f) and f == int(f)):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        value = int(f)
+    return value
 
 
 def _parser():
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="rotframe",
         description="Dynamics seen from rotating frames: run named scenarios, record them for the rerun "
                     "viewer, benchmark methods.",
@@ -75,6 +204,7 @@ def _parser():
     q.add_argument("--json", action="store_true", help="print one JSON object on stdout and nothing else")
     q.add_argument("--audit", action="store_true",
                    help="also rerun with each optional model term toggled and report what each term changes")
+    _add_limits(q)
     q.set_defaults(func=cmd_run)
 
     q = sub.add_parser("bench", help="speed against error for every method")
@@ -92,20 +222,23 @@ def _parser():
                    help="N evenly spaced values from START to STOP (inclusive)")
     q.add_argument("--log-grid", action="append", default=[], metavar="KEY=START:STOP:N",
                    help="N logarithmically spaced values from START to STOP (inclusive, both > 0)")
-    q.add_argument("--samples", type=int, default=None, metavar="N", help="Monte Carlo samples")
+    q.add_argument("--samples", type=_count, default=None, metavar="N", help="Monte Carlo samples")
     q.add_argument("--vary", action="append", default=[], metavar="KEY=normal(MEAN,SD)|uniform(LO,HI)")
-    q.add_argument("--seed", type=int, default=0, metavar="S")
+    q.add_argument("--seed", type=_seed, default=0, metavar="S", help="random seed, 0 <= S < 2**63")
     q.add_argument("--method", metavar="M")
     g = q.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None, metavar="N", help="a LocalCluster of N processes")
+    g.add_argument("--workers", type=_count, default=None, metavar="N", help="a LocalCluster of N processes")
     g.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786")
     q.add_argument("--out", metavar="PATH.parquet", default=None)
     q.add_argument("--resume", action="store_true", help="compute only the rows missing from --out")
     q.add_argument("--json", action="store_true")
+    _add_limits(q, rows=True)
     q.set_defaults(func=cmd_sweep)
 
     q = sub.add_parser("view", help="open a recording in the rerun viewer")
     q.add_argument("path", metavar="PATH")
+    q.add_argument("--bind", metavar="ADDRESS", default="127.0.0.1",
+                   help="address the viewer's server listens on (default 127.0.0.1, this machine only)")
     q.set_defaults(func=cmd_view)
 
     q = sub.add_parser("section", help="properties of a cross-section (area, centroid, principal axes)",
@@ -171,19 +304,33 @@ def cmd_show(args) -> int:
     return EXIT_OK
 
 
-def cmd_run(args) -> int:
-    from rotframe import runner, scenario as sc, scenes
-    from rotframe.errors import IntegrationError
-    from rotframe.integrators import RunInterrupted
+def _limits(args):
+    from rotframe import limits
 
+    return limits.applied(limits.current().with_overrides(
+        max_steps=getattr(args, "max_steps", None), max_samples=getattr(args, "max_samples", None),
+        max_rows=getattr(args, "max_rows", None)))
+
+
+def cmd_run(args) -> int:
+    with _limits(args):
+        return _run(args)
+
+
+def _run(args) -> int:
+    from rotframe import runner, scenario as sc, scenes
+    from rotframe.integrators import RunInterrupted
+    from rotframe.errors import IntegrationError
+    from rotframe.progress import Progress
+
+    scope = args._scope
     sets = _parse_sets(args.sets)
     scn = sc.load(args.name)
     values = scn.with_values(sets)
     out = None if args.no_record else (args.out or str(_default_recording(scn.name)))
     if out is not None:
         _check_writable(out)
-    _install_sigterm()
-    progress = _Progress(enabled=sys.stderr.isatty() and not args.json)
+    progress = Progress("run", "%", enabled=not args.json)
     scenes.get(scn.scene)  # import the scene (and astropy, numba) before the clock starts
     t0 = time.perf_counter()
     status = EXIT_OK
@@ -193,12 +340,17 @@ def cmd_run(args) -> int:
     except IntegrationError as exc:
         status = EXIT_NUMERICAL
         result = exc.partial
-        message = f"numerical failure: {exc} (simulated time reached: {exc.t_reached:.6g} s)"
+        message = f"numerical failure: {_one_line(exc)} (simulated time reached: {exc.t_reached:.6g} s)"
     except RunInterrupted as exc:
-        status = 143 if _TERMINATED[0] else 130
+        scope.interrupted = True
+        status = scope.exit_code
         result = exc.partial
         reached = result.trajectory.t_reached if result is not None else 0.0
-        message = f"{'terminated' if _TERMINATED[0] else 'interrupted'} at simulated time {reached:.6g} s"
+        message = f"{scope.verb} at simulated time {reached:.6g} s"
+    except KeyboardInterrupt as exc:  # while the scene prepared (compiling, an oracle): nothing to keep
+        scope.note(exc)
+        _error(f"{scope.verb} before the integration started; nothing was recorded")
+        return scope.exit_code
     finally:
         progress.close()
     simulate_s = time.perf_counter() - t0
@@ -207,6 +359,11 @@ def cmd_run(args) -> int:
         return status
     try:
         summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s})
+    except KeyboardInterrupt as exc:  # during the analysis: keep the trajectory as a partial recording
+        scope.note(exc)
+        status = scope.exit_code
+        message = message or f"{scope.verb} during the analysis"
+        summary = runner.summarize_minimal(scn, values, result, {"simulate_s": simulate_s})
     except Exception:
         if status == EXIT_OK:
             raise
@@ -214,12 +371,18 @@ def cmd_run(args) -> int:
     record_s = 0.0
     if out is not None:
         t1 = time.perf_counter()
-        final = runner.record_result(scn, values, result, summary, out, complete=status == EXIT_OK)
+        try:
+            final = runner.record_result(scn, values, result, summary, out, complete=status == EXIT_OK)
+        except KeyboardInterrupt as exc:  # during the recording: write what there is as a partial
+            scope.note(exc)
+            status = scope.exit_code
+            message = message or f"{scope.verb} while recording"
+            final = runner.record_result(scn, values, result, summary, out, complete=False)
         record_s = time.perf_counter() - t1
         summary["recording"] = str(final)
     compile_s = float(getattr(result.trajectory, "extras", {}).get("compile_s", 0.0))
     summary["timing"].update({"compile_s": compile_s, "simulate_s": simulate_s - compile_s,
-                              "record_s": record_s, "total_s": time.perf_counter() - _T_START})
+                              "record_s": record_s, "total_s": time.perf_counter() - args._t_start})
     if args.audit and status == EXIT_OK:
         from rotframe.audit import audit
 
@@ -237,21 +400,51 @@ def cmd_run(args) -> int:
 def cmd_bench(args) -> int:
     from rotframe.bench import main as bench_main
 
+    if args.plots:
+        from rotframe.outputs import check_output_dir
+
+        check_output_dir(args.plots, "--plots")
+
     return bench_main(args)
 
 
 def cmd_sweep(args) -> int:
     from rotframe.sweep import main as sweep_main
 
-    return sweep_main(args)
+    with _limits(args):
+        return sweep_main(args)
 
 
 def cmd_view(args) -> int:
     import subprocess
 
-    if not os.path.isfile(args.path):
-        raise _input_error(f"view: no recording at {args.path!r}")
-    return subprocess.call([sys.executable, "-m", "rerun", args.path])
+    path = args.path
+    if not os.path.isfile(path):
+        raise _input_error(f"view: no recording at {path!r}" + (" (a folder)" if os.path.isdir(path) else ""))
+    _check_recording(path)
+    bind = args.bind
+    if not bind or any(c.isspace() for c in bind):
+        raise _input_error(f"view --bind {bind!r}: expected an IP address such as 127.0.0.1")
+    return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, path])
+
+
+def _check_recording(path):
+    """A readable rerun recording: the RRD magic, then every chunk decodes."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4)
+    except OSError as exc:
+        raise _input_error(f"view: cannot read {path!r}: {exc.strerror or exc}") from None
+    if head[:3] != b"RRF":
+        raise _input_error(f"view: {path!r} is not a rerun recording (.rrd); allowed: a file written by "
+                           "'rotframe run' or 'rotframe sweep'")
+    from rerun.chunk import RrdReader
+
+    try:
+        for _ in RrdReader(str(path)).stream():
+            pass
+    except Exception as exc:  # noqa: BLE001 -- rerun raises RuntimeError/ValueError for damaged files
+        raise _input_error(f"view: {path!r} is a damaged or truncated recording ({_one_line(exc)[:200]})") from None
 
 
 def cmd_section(args) -> int:
@@ -266,20 +459,6 @@ def cmd_section(args) -> int:
 # ---------------------------------------------------------------------------
 # helpers
 # ---------------------------------------------------------------------------
-
-
-_TERMINATED = [False]
-
-
-def _install_sigterm():
-    def handler(signum, frame):
-        _TERMINATED[0] = True
-        raise _Terminated()
-
-    try:
-        signal.signal(signal.SIGTERM, handler)
-    except ValueError:  # not the main thread
-        pass
 
 
 def _parse_sets(items):
@@ -299,13 +478,14 @@ def _default_recording(name):
 
 
 def _check_writable(out):
-    folder = os.path.dirname(os.path.abspath(out)) or "."
-    if not out.endswith(".rrd"):
-        raise _input_error(f"--out {out!r}: a recording path must end in .rrd")
-    if os.path.exists(folder) and not os.access(folder, os.W_OK):
-        raise _input_error(f"--out {out!r}: folder {folder!r} is not writable")
-    if os.path.exists(folder) and not os.path.isdir(folder):
-        raise _input_error(f"--out {out!r}: {folder!r} is not a folder")
+    """The recording (and its partial) can be written: checked before any computing starts."""
+    from rotframe.outputs import check_output_file
+    from rotframe.record import partial_path
+
+    check_output_file(out, "--out", ".rrd")
+    partial = partial_path(out)
+    if os.path.isdir(partial):
+        raise _input_error(f"--out {out!r}: {str(partial)!r} (where an interrupted run goes) is a folder")
 
 
 def _input_error(message):
@@ -364,32 +544,3 @@ def _short(v):
     if isinstance(v, list):
         return ",".join(_short(x) for x in v)
     return str(v)
-
-
-class _Progress:
-    """A progress bar on stderr, shown only once a run has taken more than a second."""
-
-    def __init__(self, enabled=True, delay=1.0):
-        self.enabled = enabled
-        self.delay = delay
-        self.start = time.perf_counter()
-        self.shown = False
-
-    def __call__(self, fraction):
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        if elapsed < self.delay:
-            return
-        self.shown = True
-        width = 30
-        filled = int(round(width * min(max(fraction, 0.0), 1.0)))
-        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
-        sys.stderr.write(f"\r  [{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
-                         f"{elapsed:6.1f} s elapsed, {eta:6.1f} s left ")
-        sys.stderr.flush()
-
-    def close(self):
-        if self.shown:
-            sys.stderr.write("\n")
-            sys.stderr.flush()

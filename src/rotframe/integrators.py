@@ -185,6 +185,7 @@ def integrate_particles(model, r0, v0, duration, *, method=None, step=None, rtol
     if not duration > 0:
         raise ScenarioError(f"duration: {duration} s; must be > 0")
     samples = max(1, int(samples))
+    _check_work(info, duration, step, samples, r0.shape[0])
     if info.kind == "exact":
         if not model.is_linear:
             nonlinear = [t for t in model.terms if t in ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum")]
@@ -197,6 +198,19 @@ def integrate_particles(model, r0, v0, duration, *, method=None, step=None, rtol
 
 
 # ---------------------------------------------------------------------------
+
+
+def _check_work(info, duration, step, samples, n):
+    """Refuse, before allocating anything, a run over the work limits (:mod:`rotframe.limits`)."""
+    from rotframe import limits
+
+    steps = 0.0
+    if info.kind == "fixed":
+        dt_sample = duration / samples
+        h_req = float(step) if step else dt_sample / 20.0
+        if h_req > 0:
+            steps = samples * max(1.0, math.ceil(dt_sample / h_req - 1e-9))
+    limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
 
 
 def _event_table(events):
@@ -352,12 +366,19 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     for _ in range(block - 1):
         powers.append(step_matrix @ powers[-1])
     out = np.empty((samples + 1, 7, n))
-    for start in range(0, samples + 1, block):
-        anchor = expm(M * times[start]) @ s0
-        for j in range(min(block, samples + 1 - start)):
-            out[start + j] = powers[j] @ anchor
-        if progress is not None:
-            progress(min(1.0, (start + block) / (samples + 1)))
+    done = 0
+    try:
+        for start in range(0, samples + 1, block):
+            anchor = expm(M * times[start]) @ s0
+            for j in range(min(block, samples + 1 - start)):
+                out[start + j] = powers[j] @ anchor
+            done = min(samples + 1, start + block)
+            if progress is not None:
+                progress(min(1.0, (start + block) / (samples + 1)))
+    except KeyboardInterrupt:
+        partial = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)), np.transpose(out[:, 3:6, :], (0, 2, 1)),
+                             "exact", 1, 0).truncated(max(done, 1)) if done else None
+        raise RunInterrupted(partial) from None
     traj = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)).copy(),
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)
     if not np.all(np.isfinite(out)):

@@ -9,15 +9,18 @@
   TextDocument at ``scenario``. A blueprint opens a 3D view beside the time series.
 * Bulk data goes by columns (``send_columns``); nothing is logged step by step.
   Positions are float32 in rerun, so scenes log them in a local frame (ENU, body).
-* Files are deterministic (fixed recording id, no ``log_time``) and written to a
-  temporary name, then renamed: an earlier complete recording is only ever
-  replaced by a complete one. An interrupted or failed run is finalised as
+* Files are deterministic (fixed recording id, no ``log_time``). The recording
+  is encoded into memory (rerun's binary stream) and the bytes are written by
+  Python to a temporary file of this writer's own in the target folder, then
+  renamed (:mod:`rotframe.outputs`): an earlier complete recording is only ever
+  replaced by a complete one, two writers never share a temporary file, and
+  every I/O error (full disk, ``ulimit -f``) ends the run with one line and no
+  file left behind. An interrupted or failed run is finalised as
   ``<name>.partial.rrd``.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +59,7 @@ class Recording:
     Parameters
     ----------
     path : path-like
-        Final name (``.rrd``). Data goes to ``<path>.tmp`` until :meth:`finish`.
+        Final name (``.rrd``). Data is held in memory until :meth:`finish` writes it.
     application_id : str
         Shown in the viewer (the scenario name).
     """
@@ -65,14 +68,13 @@ class Recording:
         import rerun as rr
 
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.tmp = self.path.with_name(self.path.name + ".tmp")
         self.rec = rr.RecordingStream(application_id, recording_id=f"rotframe-{application_id}",
                                       send_properties=False)
         self.rec.set_log_time_enabled(False)
         self.rec.set_log_tick_enabled(False)
-        self.rec.save(str(self.tmp))
+        self._stream = self.rec.binary_stream()
         self._done = False
+        self.final = None
 
     # -- logging -------------------------------------------------------------
 
@@ -166,22 +168,26 @@ class Recording:
     # -- finishing -----------------------------------------------------------
 
     def finish(self, complete: bool = True) -> Path:
-        """Flush, write the footer and move the file to its final or partial name."""
+        """Encode, write through a temporary file and rename to the final or partial name.
+
+        Raises :class:`rotframe.outputs.OutputError` (nothing left behind) when the
+        file cannot be written.
+        """
+        from rotframe.outputs import write_bytes_atomic
+
         if self._done:
             return self.final
-        self.rec.flush()
-        self.rec.disconnect()
-        self.final = self.path if complete else partial_path(self.path)
-        os.replace(self.tmp, self.final)
         self._done = True
-        return self.final
+        self.rec.flush()
+        data = self._stream.read(flush=True) or b""
+        self.rec.disconnect()
+        final = self.path if complete else partial_path(self.path)
+        write_bytes_atomic(final, data, what="recording")
+        self.final = final
+        return final
 
     def abandon(self):
-        """Drop the temporary file (nothing useful was logged)."""
+        """Drop what was logged (nothing is written)."""
         if not self._done:
-            self.rec.disconnect()
-            try:
-                self.tmp.unlink()
-            except FileNotFoundError:
-                pass
             self._done = True
+            self.rec.disconnect()

@@ -44,7 +44,13 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """
     from rotframe import rigid
 
+    from rotframe import limits
+
     samples = max(1, int(run.get("samples") or 2000))
+    per_sample = 1.0 if method == "exact" else max(1.0, math.ceil(
+        (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
+    limits.check_run(steps=0.0 if method == "exact" else samples * per_sample, samples=samples + 1,
+                     what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
     if method == "exact":
         if top is not None:
