@@ -28,7 +28,8 @@ class _UsageError(Exception):
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise _UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
+        where = self.prog.partition(" ")[2]
+        raise _UsageError(f"{where + ': ' if where else ''}{message} (see '{self.prog} --help')")
 
 
 def main(argv=None) -> int:
