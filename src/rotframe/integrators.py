@@ -305,7 +305,13 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
             m = min(chunk, samples - done)
             t0 = times[done]
             sl = slice(done + 1, done + 1 + m)
-            if info.kind == "fixed":
+            if info.kind == "fixed" and cost > 4e6:
+                # one sample interval is more than a chunk of work: advance it in pieces, so that
+                # Python regains control (signals, progress) about every 0.1 s
+                n_done, bad, nf = _fixed_in_pieces(kernels, info, r, v, alive, t0, h, sps, n, P, wt, wv, wint,
+                                                   ev_tab, out_r[sl], out_v[sl], evb)
+                steps += sps * n_done
+            elif info.kind == "fixed":
                 n_done, bad, nf = kernels.run_fixed(
                     info.code, r, v, alive, t0, h, sps, m, P, wt, wv, wint, ev_tab,
                     out_r[sl], out_v[sl], *evb.args())
@@ -340,6 +346,26 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
     traj.extras["compile_s"] = compile_s
     evb.attach(traj, events)
     return traj
+
+
+def _fixed_in_pieces(kernels, info, r, v, alive, t0, h, sps, n, P, wt, wv, wint, ev_tab, out_r, out_v, evb):
+    """One sample interval of ``sps`` fixed steps as several kernel calls of about 4e6 step-evaluations."""
+    factor = 3 if info.code == 1 else 4 if info.code == 2 else 1
+    piece = max(1, int(4e6 // (n * factor)))
+    scratch_r, scratch_v = np.empty((1, n, 3)), np.empty((1, n, 3))
+    j = 0
+    nfev = 0
+    while j < sps:
+        k = min(piece, sps - j)
+        last = j + k == sps
+        n_done, bad, nf = kernels.run_fixed(info.code, r, v, alive, t0 + j * h, h, k, 1, P, wt, wv, wint, ev_tab,
+                                            out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
+                                            *evb.args())
+        nfev += nf
+        if n_done < 1 or bad >= 0:
+            return 0, bad, nfev
+        j += k
+    return 1, -1, nfev
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):

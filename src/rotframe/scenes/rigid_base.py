@@ -91,7 +91,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
         while done < samples:
             m = min(chunk, samples - done)
             try:
-                Ls, qs, _ = stepper(L, q, h, m * sps, sps)
+                if sps > 2e6:  # a sample interval longer than a chunk: in pieces, so that signals are seen
+                    L, q = _advance_in_pieces(stepper, L, q, h, sps - 1)
+                Ls, qs, _ = stepper(L, q, h, m * sps if sps <= 2e6 else 1, sps if sps <= 2e6 else 1)
             except IntegrationError as exc:
                 # the kernel keeps the finite samples of this chunk in exc.partial = (L, q, times)
                 Ls, qs = exc.partial[0], exc.partial[1]
@@ -113,6 +115,21 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     traj = BodyTrajectory(times, out_L, out_q, method, samples * sps, True, duration)
     traj.extras.update(compile_s=compile_s, step=h)
     return traj
+
+
+def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
+    """The state after ``steps`` steps, taken in kernel calls of ``piece`` steps (Python runs between)."""
+    done = 0
+    while done < steps:
+        k = min(piece, steps - done)
+        try:
+            Ls, qs, _ = stepper(L, q, h, k, k)
+        except IntegrationError as exc:  # no sample was completed in this interval
+            exc.partial = (np.asarray([L]), np.asarray([q]), None)
+            raise
+        L, q = Ls[-1], qs[-1]
+        done += k
+    return L, q
 
 
 def simulate_free_body(body, duration, method, run, progress):
