@@ -439,11 +439,15 @@ def _check_recording(path):
     if head[:3] != b"RRF":
         raise _input_error(f"view: {path!r} is not a rerun recording (.rrd); allowed: a file written by "
                            "'rotframe run' or 'rotframe sweep'")
+    import warnings
+
     from rerun.chunk import RrdReader
 
     try:
-        for _ in RrdReader(str(path)).stream():
-            pass
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "no footer": a truncated file, reported below if it does not decode
+            for _ in RrdReader(str(path)).stream():
+                pass
     except Exception as exc:  # noqa: BLE001 -- rerun raises RuntimeError/ValueError for damaged files
         raise _input_error(f"view: {path!r} is a damaged or truncated recording ({_one_line(exc)[:200]})") from None
 
