@@ -37,21 +37,24 @@ def _first_existing_parent(folder: Path) -> Path:
     return p
 
 
-def check_output_dir(path, option: str) -> Path:
+def check_output_dir(path, option: str, shown=None) -> Path:
     """``path`` is (or can be made) a writable folder; returns it.
 
     Raises OutputError when ``path`` or one of its parents is a file, or the nearest
-    existing folder is not writable.
+    existing folder is not writable. ``shown`` is the value the user typed (default ``path``).
     """
     folder = Path(path)
+    shown = str(path) if shown is None else str(shown)
     if folder.exists() and not folder.is_dir():
-        raise OutputError(f"{option} {str(path)!r}: exists and is not a folder; allowed: a folder path")
+        if shown == str(path):
+            raise OutputError(f"{option} {shown!r}: exists and is not a folder; allowed: a folder path")
+        raise OutputError(f"{option} {shown!r}: {str(folder)!r} is a file, so it cannot hold a folder")
     base = _first_existing_parent(folder)
     if not base.is_dir():
-        raise OutputError(f"{option} {str(path)!r}: {str(base)!r} is a file, so it cannot hold a folder; "
-                          "allowed: a folder path")
+        raise OutputError(f"{option} {shown!r}: {str(base)!r} is a file, so it cannot hold a folder; "
+                          "allowed: a path under a folder")
     if not os.access(base, os.W_OK | os.X_OK):
-        raise OutputError(f"{option} {str(path)!r}: folder {str(base)!r} is not writable")
+        raise OutputError(f"{option} {shown!r}: folder {str(base)!r} is not writable")
     return folder
 
 
@@ -59,15 +62,15 @@ def check_output_file(path, option: str, suffix: str | None = None) -> Path:
     """``path`` can be written as a file: not a folder, its folder writable; returns it."""
     text = str(path)
     p = Path(path)
-    if suffix and not text.endswith(suffix):
-        raise OutputError(f"{option} {text!r}: the path must end in {suffix}")
     if text.endswith(("/", os.sep)) or p.is_dir():
         raise OutputError(f"{option} {text!r}: is a folder; allowed: a file path ending in {suffix or 'a name'}")
+    if suffix and not text.endswith(suffix):
+        raise OutputError(f"{option} {text!r}: the path must end in {suffix}")
     if p.name in ("", ".", "..") or (suffix and p.name == suffix):
         raise OutputError(f"{option} {text!r}: no file name; allowed: e.g. out{suffix or ''}")
     if p.exists() and not os.access(p, os.W_OK) and not os.access(p.parent, os.W_OK):
         raise OutputError(f"{option} {text!r}: exists and cannot be replaced")
-    check_output_dir(p.parent if str(p.parent) else Path("."), option)
+    check_output_dir(p.parent if str(p.parent) else Path("."), option, shown=text)
     return p
 
 

@@ -271,7 +271,7 @@ def check_outputs(spec, out, resume=False):
     if files.parts.exists() and not files.parts.is_dir():
         raise ScenarioError(f"{option} {str(files.out)!r}: {str(files.parts)!r} (where finished batches go) "
                             "is a file, not a folder; remove it or choose another --out")
-    check_output_dir(files.parts, option)
+    check_output_dir(files.parts, option, shown=files.out)
     if files.recording.is_dir():
         raise ScenarioError(f"{option} {str(files.out)!r}: {str(files.recording)!r} (the recording) is a folder")
     return files
