@@ -53,7 +53,7 @@ def main(argv=None) -> int:
             return _dispatch(args)
         except KeyboardInterrupt as exc:
             scope.note(exc)
-            _error(f"{scope.verb} before anything was computed; nothing was written")
+            _error(f"{scope.verb}; stopped before any result was written")
             return scope.exit_code
 
 
@@ -374,11 +374,13 @@ def _run(args) -> int:
         t1 = time.perf_counter()
         try:
             final = runner.record_result(scn, values, result, summary, out, complete=status == EXIT_OK)
-        except KeyboardInterrupt as exc:  # during the recording: write what there is as a partial
+        except KeyboardInterrupt as exc:  # during the recording: what there is was written as a partial
             scope.note(exc)
             status = scope.exit_code
             message = message or f"{scope.verb} while recording"
-            final = runner.record_result(scn, values, result, summary, out, complete=False)
+            final = getattr(exc, "recording", None)
+            if final is None:
+                final = runner.record_result(scn, values, result, summary, out, complete=False)
         record_s = time.perf_counter() - t1
         summary["recording"] = str(final)
     compile_s = float(getattr(result.trajectory, "extras", {}).get("compile_s", 0.0))
@@ -387,7 +389,12 @@ def _run(args) -> int:
     if args.audit and status == EXIT_OK:
         from rotframe.audit import audit
 
-        summary["audit"] = audit(scn, values, result, summary, method=args.method)
+        try:
+            summary["audit"] = audit(scn, values, result, summary, method=args.method)
+        except KeyboardInterrupt as exc:  # the run and its recording are complete; the audit is dropped
+            scope.note(exc)
+            status = scope.exit_code
+            message = f"{scope.verb} during the audit (the run itself is complete)"
     if args.json:
         print(json.dumps(_jsonable(summary)))
     else:

@@ -74,6 +74,7 @@ class Recording:
         self.rec.set_log_tick_enabled(False)
         self._stream = self.rec.binary_stream()
         self._done = False
+        self._data = None
         self.final = None
 
     # -- logging -------------------------------------------------------------
@@ -171,23 +172,34 @@ class Recording:
         """Encode, write through a temporary file and rename to the final or partial name.
 
         Raises :class:`rotframe.outputs.OutputError` (nothing left behind) when the
-        file cannot be written.
+        file cannot be written. If the write is interrupted, ``finish(complete=False)``
+        may be called again: the encoded bytes are kept until a write succeeds.
         """
         from rotframe.outputs import write_bytes_atomic
 
         if self._done:
             return self.final
-        self._done = True
-        self.rec.flush()
-        data = self._stream.read(flush=True) or b""
-        self.rec.disconnect()
+        data = self._encoded()
         final = self.path if complete else partial_path(self.path)
         write_bytes_atomic(final, data, what="recording")
+        self._done = True
         self.final = final
         return final
+
+    def _encoded(self) -> bytes:
+        """Everything logged, as the bytes of an ``.rrd`` file (read from rerun once)."""
+        if self._data is None:
+            self.rec.flush()
+            self._data = self._stream.read(flush=True) or b""
+            self.rec.disconnect()
+        return self._data
 
     def abandon(self):
         """Drop what was logged (nothing is written)."""
         if not self._done:
             self._done = True
-            self.rec.disconnect()
+            try:
+                self._encoded()  # drained, so that rerun does not warn about dropped data
+            except Exception:  # noqa: BLE001 -- nothing is kept anyway
+                pass
+            self._data = None

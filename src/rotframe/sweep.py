@@ -243,6 +243,12 @@ def main(args) -> int:
         cli._error(f"{scope.verb}: {exc.saved} of {exc.total} rows are saved in {exc.parts}; "
                    "run the same command with --resume to compute the rest")
         return scope.exit_code
+    except KeyboardInterrupt as exc:  # while merging, plotting or recording: the parts are still there
+        progress.close()
+        scope.note(exc)
+        cli._error(f"{scope.verb} while writing the results; every computed row is kept in "
+                   f"{_Files.for_spec(spec, args.out).parts}; run the same command with --resume to finish")
+        return scope.exit_code
     finally:
         progress.close()
     if args.json:
@@ -422,6 +428,44 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
     t_start = time.perf_counter()
     _require("pyarrow", "rotframe sweep")
     files = _Files.for_spec(spec, out)
+    with _exclusive(files):
+        return _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                                 recording)
+
+
+def _exclusive(files):
+    """Hold ``.<out>.lock`` beside the table: a second sweep into the same ``out`` is refused, not interleaved."""
+    import contextlib
+
+    @contextlib.contextmanager
+    def lock():
+        try:
+            import fcntl
+        except ImportError:  # not POSIX: no lock
+            yield
+            return
+        from rotframe.outputs import OutputError
+
+        try:
+            files.out.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(files.out.parent / f".{files.out.name}.lock", os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise OutputError(f"--out {str(files.out)!r}: cannot create a lock beside it ({exc.strerror})") from None
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise OutputError(f"--out {str(files.out)!r}: another sweep is writing it now; wait for it or "
+                                  "choose another --out") from None
+            yield
+        finally:
+            os.close(fd)
+
+    return lock()
+
+
+def _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                      recording):
     meta = spec.describe()
     done = _prepare(files, meta, resume)
     pending = np.setdiff1d(np.arange(spec.n_rows), np.fromiter(done, dtype=np.int64, count=len(done)))
