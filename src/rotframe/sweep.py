@@ -62,6 +62,8 @@ ENSEMBLE_BATCH = 1 << 17
 MIN_ENSEMBLE_BATCH = 4096
 #: Dask retries of a task whose worker failed
 RETRIES = 3
+#: seconds allowed to connect to a scheduler and for the Dask handshake, each
+CONNECT_TIMEOUT_S = 10.0
 #: particle-samples held at once by :func:`integrate_ensemble` (13 floats each)
 PATH_BUDGET = 2_000_000
 _DISTRIBUTIONS = {"normal": ("MEAN", "SD"), "uniform": ("LO", "HI")}
@@ -230,7 +232,7 @@ def main(args) -> int:
     if args.workers is not None and args.workers > 256:
         raise ScenarioError(f"--workers {args.workers}: at most 256 local processes")
     check_outputs(spec, args.out, args.resume)
-    if args.scheduler:
+    if args.scheduler is not None:
         check_scheduler(args.scheduler)
     scope = getattr(args, "_scope", None) or InterruptScope()
     progress = Progress("sweep", "rows", enabled=not args.json)
@@ -283,7 +285,7 @@ def check_outputs(spec, out, resume=False):
     return files
 
 
-def check_scheduler(address, timeout=5.0):
+def check_scheduler(address, timeout=None):
     """A Dask scheduler address: ``tcp://HOST:PORT`` (or ``tls://``), reachable within ``timeout`` seconds.
 
     Only the TCP connection is tried here; the Dask handshake itself is bounded in
@@ -293,6 +295,7 @@ def check_scheduler(address, timeout=5.0):
     from urllib.parse import urlsplit
 
     allowed = "allowed: tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786"
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
     text = str(address).strip()
     if "://" not in text:
         text_full = "tcp://" + text
@@ -1119,7 +1122,7 @@ def _connect(workers, scheduler):
     return Client(cluster)
 
 
-def _client_bounded(Client, address, given, timeout=10.0):
+def _client_bounded(Client, address, given, timeout=None):
     """A Dask client of ``address``, or ScenarioError within ``timeout`` s whatever answers there.
 
     Dask's own connect timeout does not bound the handshake: a listener that is not a
@@ -1128,6 +1131,7 @@ def _client_bounded(Client, address, given, timeout=10.0):
     """
     import threading
 
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
     box = {}
 
     def make():
@@ -1142,8 +1146,28 @@ def _client_bounded(Client, address, given, timeout=10.0):
         worker.join(timeout + 2.0)
     if "client" in box:
         return box["client"]
+    _quiet_dask_unraisable()
     why = _one_line(box["error"])[:200] if "error" in box else f"no Dask handshake within {timeout:g} s"
     raise ScenarioError(f"--scheduler {given!r}: not a Dask scheduler or not answering ({why})")
+
+
+def _quiet_dask_unraisable():
+    """A half-made Dask client prints a traceback from its ``__del__`` (at exit): keep that one quiet."""
+    import sys
+
+    previous = sys.unraisablehook
+    if getattr(previous, "_rotframe_quiet", False):
+        return
+
+    def hook(unraisable):
+        obj = unraisable.object
+        module = getattr(obj, "__module__", "") or getattr(type(obj), "__module__", "") or ""
+        if str(module).startswith(("distributed", "tornado")):
+            return
+        previous(unraisable)
+
+    hook._rotframe_quiet = True
+    sys.unraisablehook = hook
 
 
 def _quiet_dask_logs():
