@@ -68,6 +68,13 @@ def _dispatch(args) -> int:
     except RotframeError as exc:
         _error(_one_line(exc))
         return EXIT_INPUT
+    except BrokenPipeError:  # the reader of stdout went away (``| head``): nothing more to say
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return EXIT_INPUT
     except MemoryError:
         _error("out of memory; ask for less work (fewer samples, rows or a shorter duration)")
         return EXIT_NUMERICAL

@@ -629,8 +629,13 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
         fig.suptitle(f"{spec.name}: {metric} ({table.num_rows} runs)")
         fig.tight_layout()
         path = Path(f"{stem}-{_safe(metric)}.png")
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        from rotframe.outputs import atomic_path
+
+        try:
+            with atomic_path(path, "plot") as tmp:
+                fig.savefig(tmp, dpi=110, format="png")
+        finally:
+            plt.close(fig)
         paths.append(path)
     return paths
 
