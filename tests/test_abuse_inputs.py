@@ -108,7 +108,7 @@ def test_generated_sweep_specs_never_traceback(tmp_path, capsys, monkeypatch, ax
         spec = ["--samples", n or "3", "--vary", f"{key}=uniform({a},{b})", "--seed", seed]
     else:
         spec = [f"--{mode}", f"{key}={a}:{b}:{n}"]
-    code, out, err = call(capsys, "sweep", "tower-drop", *spec, "--max-rows", "4", "--out",
+    code, out, err = call(capsys, "sweep", "tower-drop", *spec, "--max-rows", "4", *BOUNDS, "--out",
                           str(tmp_path / "s.parquet"), "--json")
     assert_clean(code, out, err)
 

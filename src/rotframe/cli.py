@@ -3,7 +3,14 @@
 Exit codes: 0 done; 2 bad input (one line on stderr naming the file, key, value
 and what is allowed; no traceback); 3 numerical failure (the message gives the
 simulated time reached; the recording keeps everything up to it); 130 / 143
-interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed).
+interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed); 1 an
+internal error (one line; ``ROTFRAME_DEBUG=1`` shows the traceback).
+
+Work is estimated before it starts (:mod:`rotframe.limits`: ``--max-steps``,
+``--max-samples``, ``--max-rows``), outputs are checked before computing and
+written atomically (:mod:`rotframe.outputs`), signals are handled per command
+(:mod:`rotframe.signals`) and long work shows a progress line on a terminal
+(:mod:`rotframe.progress`). With ``--json`` only the JSON document reaches stdout.
 
 This module imports only the standard library at start-up: numpy, astropy,
 numba and rerun are imported by the commands that need them, so that

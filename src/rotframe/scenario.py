@@ -310,8 +310,7 @@ def load(name_or_path: str) -> Scenario:
         if term not in known:
             raise ScenarioError(f"{src}: model term {term!r} unknown{_did_you_mean(term, list(known))}; "
                                 f"allowed: {', '.join(known)}")
-    return Scenario(name=name, path=path, title=data.get("title", builtin.get("title", "") if not data.get("name")
-                                                        else ""),
+    return Scenario(name=name, path=path, title=data.get("title", ""),
                     description=data.get("description", "").strip(), scene=scene, model=model,
                     optional_terms=optional, parameters=params, run=run)
 

@@ -229,8 +229,10 @@ def main(args) -> int:
                       samples=args.samples, vary=args.vary, seed=args.seed, method=args.method)
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers {args.workers}: must be >= 1")
-    if args.workers is not None and args.workers > 256:
-        raise ScenarioError(f"--workers {args.workers}: at most 256 local processes")
+    most = max(2, 2 * (os.cpu_count() or 1))  # each worker is a process of a few hundred MB
+    if args.workers is not None and args.workers > most:
+        raise ScenarioError(f"--workers {args.workers}: at most {most} local processes on this machine "
+                            f"({os.cpu_count()} CPUs); use --scheduler for a larger cluster")
     check_outputs(spec, args.out, args.resume)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
@@ -258,7 +260,8 @@ def main(args) -> int:
     else:
         print(format_result(result, spec))
     if result.rows and result.failed == result.rows:
-        invalid = sum(1 for e in result.table.column("error").to_pylist() if e.startswith("ScenarioError"))
+        invalid = sum(1 for e in result.table.column("error").to_pylist()
+                      if e.startswith(("ScenarioError", "LimitError", "OutputError")))
         if invalid == result.rows:
             first = result.table.column("error")[0].as_py()
             cli._error(f"every row was invalid input ({first}); the messages are in the error column of "
@@ -515,6 +518,7 @@ class BatchTask:
     method: str | None
     path: str
     track_rows: frozenset
+    limits: object = None  # the command's rotframe.limits.Limits, applied on the worker too
 
 
 @dataclass
@@ -534,6 +538,13 @@ def run_batch(task: BatchTask) -> BatchOutput:
     one call; if that call fails as a whole (one particle's numerical failure), the
     batch falls back to one run per row so the failure lands in that row's ``error``.
     """
+    from rotframe import limits
+
+    with limits.applied(task.limits or limits.current()):
+        return _run_batch(task)
+
+
+def _run_batch(task):
     from rotframe import scenario as sc, scenes
     from rotframe.integrators import RunInterrupted
 
@@ -1048,8 +1059,14 @@ class _Context:
         rows = np.asarray(rows, dtype=np.int64)
         values = points_of(self.spec, rows) if self.points is None else self.points[rows]
         return BatchTask(index=index, scenario=self.scenario_path, sets=dict(self.spec.sets), keys=self.spec.keys,
-                         rows=rows, values=values, method=self.spec.method, path=self.path,
+                         rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
                          track_rows=self.track_rows.intersection(rows.tolist()))
+
+
+def _limits_now():
+    from rotframe import limits
+
+    return limits.current()
 
 
 def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_batch):
