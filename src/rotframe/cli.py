@@ -3,7 +3,14 @@
 Exit codes: 0 done; 2 bad input (one line on stderr naming the file, key, value
 and what is allowed; no traceback); 3 numerical failure (the message gives the
 simulated time reached; the recording keeps everything up to it); 130 / 143
-interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed).
+interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed); 1 an
+internal error (one line; ``ROTFRAME_DEBUG=1`` shows the traceback).
+
+Work is estimated before it starts (:mod:`rotframe.limits`: ``--max-steps``,
+``--max-samples``, ``--max-rows``), outputs are checked before computing and
+written atomically (:mod:`rotframe.outputs`), signals are handled per command
+(:mod:`rotframe.signals`) and long work shows a progress line on a terminal
+(:mod:`rotframe.progress`). With ``--json`` only the JSON document reaches stdout.
 
 This module imports only the standard library at start-up: numpy, astropy,
 numba and rerun are imported by the commands that need them, so that
@@ -16,38 +23,175 @@ import argparse
 import json
 import math
 import os
-import signal
 import sys
 import time
 
-EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
-_T_START = time.perf_counter()
+EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERNAL = 0, 2, 3, 1
 
 
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM, delivered as an interrupt so the run stops cleanly between chunks."""
+class _UsageError(Exception):
+    """argparse's usage error, turned into one line and exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        where = self.prog.partition(" ")[2]
+        raise _UsageError(f"{where + ': ' if where else ''}{message} (see '{self.prog} --help')")
 
 
 def main(argv=None) -> int:
+    """Run one command; returns its exit code (never raises for a user's error, a signal or an I/O error)."""
+    from rotframe.signals import InterruptScope
+
+    t_start = time.perf_counter()
     parser = _parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as exc:
+        _error(str(exc))
+        return EXIT_INPUT
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_OK
+    args._t_start = t_start
+    with InterruptScope() as scope, _JsonStdout(getattr(args, "json", False)):
+        args._scope = scope
+        try:
+            return _dispatch(args)
+        except KeyboardInterrupt as exc:
+            scope.note(exc)
+            _error(f"{scope.verb}; stopped before any result was written")
+            return scope.exit_code
+
+
+def _dispatch(args) -> int:
     from rotframe.errors import IntegrationError, RotframeError
 
     try:
         return args.func(args)
     except IntegrationError as exc:
-        _error(f"numerical failure: {exc}")
+        _error(f"numerical failure: {_one_line(exc)}")
         return EXIT_NUMERICAL
     except RotframeError as exc:
-        _error(str(exc))
+        _error(_one_line(exc))
         return EXIT_INPUT
+    except BrokenPipeError:  # the reader of stdout went away (``| head``): nothing more to say
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return EXIT_INPUT
+    except MemoryError:
+        _error("out of memory; ask for less work (fewer samples, rows or a shorter duration)")
+        return EXIT_NUMERICAL
+    except OSError as exc:
+        where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+        _error(f"cannot read or write{where}: {exc.strerror or _one_line(exc)}")
+        return EXIT_INPUT
+    except (KeyboardInterrupt, SystemExit):
+        raise
+    except Exception as exc:  # noqa: BLE001 -- a bug: one line, the traceback only on request
+        if os.environ.get("ROTFRAME_DEBUG"):
+            raise
+        _error(f"internal error ({type(exc).__name__}: {_one_line(exc)}); set ROTFRAME_DEBUG=1 for the traceback "
+               "and please report it")
+        return EXIT_INTERNAL
+
+
+def _one_line(exc) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+class _JsonStdout:
+    """With --json, file descriptor 1 is pointed at stderr while a command runs.
+
+    Only the JSON document itself goes to the real stdout (through ``sys.stdout``,
+    which writes to a saved copy of fd 1): a C library (LAPACK, a BLAS, numba)
+    printing to fd 1 cannot spoil it. In-process callers whose ``sys.stdout`` has no
+    file descriptor (pytest's capsys) are left as they are.
+    """
+
+    def __init__(self, enabled):
+        self.enabled = bool(enabled)
+        self.saved = None
+
+    def __enter__(self):
+        if not self.enabled:
+            return self
+        try:
+            if sys.stdout.fileno() != 1:
+                return self
+            sys.stdout.flush()
+            self.saved = os.dup(1)
+            os.dup2(2, 1)
+        except (AttributeError, ValueError, OSError):
+            self.saved = None
+            return self
+        self._old = sys.stdout
+        sys.stdout = open(self.saved, "w", closefd=False, encoding=getattr(self._old, "encoding", None) or "utf-8")
+        return self
+
+    def __exit__(self, *exc):
+        if self.saved is not None:
+            try:
+                sys.stdout.flush()
+            except (OSError, ValueError):
+                pass
+            sys.stdout.close()
+            sys.stdout = self._old
+            os.dup2(self.saved, 1)
+            os.close(self.saved)
+            self.saved = None
+        return False
+
+
+def _add_limits(q, rows=False):
+    q.add_argument("--max-steps", type=_positive_count, default=None, metavar="N",
+                   help="refuse a run of more integration steps than N (default 2e9)")
+    q.add_argument("--max-samples", type=_positive_count, default=None, metavar="N",
+                   help="refuse a run that keeps more output samples than N (default 5e6)")
+    if rows:
+        q.add_argument("--max-rows", type=_positive_count, default=None, metavar="N",
+                       help="refuse a sweep of more rows than N (default 2e6)")
+
+
+def _positive_count(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (value >= 1 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number >= 1")
+    return value
+
+
+def _seed(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= value < 2 ** 63:
+        raise argparse.ArgumentTypeError(f"{value} is out of range; allowed 0 <= seed < 2**63")
+    return value
+
+
+def _count(text):
+    try:
+        value = int(text)
+    except ValueError:
+        try:
+            f = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not (math.isfinite(f) and f == int(f)):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        value = int(f)
+    return value
 
 
 def _parser():
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="rotframe",
         description="Dynamics seen from rotating frames: run named scenarios, record them for the rerun "
                     "viewer, benchmark methods.",
@@ -83,6 +227,7 @@ def _parser():
                    help="also write the trajectory to FILE: .npz (arrays), .csv or .parquet (a table, one row per "
                         "sample and particle; SI units in the column names)")
     q.add_argument("--png", metavar="FILE", default=None, help="also write a picture of the run (PNG, matplotlib)")
+    _add_limits(q)
     q.set_defaults(func=cmd_run)
 
     q = sub.add_parser("bench", help="speed against error for every method")
@@ -100,24 +245,28 @@ def _parser():
                    help="N evenly spaced values from START to STOP (inclusive)")
     q.add_argument("--log-grid", action="append", default=[], metavar="KEY=START:STOP:N",
                    help="N logarithmically spaced values from START to STOP (inclusive, both > 0)")
-    q.add_argument("--samples", type=int, default=None, metavar="N", help="Monte Carlo samples")
+    q.add_argument("--samples", type=_count, default=None, metavar="N", help="Monte Carlo samples")
     q.add_argument("--vary", action="append", default=[], metavar="KEY=normal(MEAN,SD)|uniform(LO,HI)",
                    help="draw KEY from a distribution for each Monte Carlo sample (with --samples)")
-    q.add_argument("--seed", type=int, default=0, metavar="S", help="random seed of the Monte Carlo samples")
+    q.add_argument("--seed", type=_seed, default=0, metavar="S",
+                   help="random seed of the Monte Carlo samples, 0 <= S < 2**63")
     q.add_argument("--method", metavar="M", help="integrator (see 'rotframe show NAME')")
     g = q.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None, metavar="N", help="a LocalCluster of N processes")
+    g.add_argument("--workers", type=_count, default=None, metavar="N", help="a LocalCluster of N processes")
     g.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786")
     q.add_argument("--out", metavar="PATH.parquet", default=None,
                    help="result table (default sweeps/<name>.parquet; plots and a recording go beside it)")
     q.add_argument("--resume", action="store_true", help="compute only the rows missing from --out")
     q.add_argument("--json", action="store_true", help="print the result as JSON on stdout and nothing else")
+    _add_limits(q, rows=True)
     q.set_defaults(func=cmd_sweep)
 
     q = sub.add_parser("view", help="open a recording in the rerun viewer",
                        description="Open a recording in the rerun viewer. Without a display (no DISPLAY or "
                                    "WAYLAND_DISPLAY) it prints a text summary instead and says how to use --web.")
     q.add_argument("path", metavar="PATH", help="a .rrd recording")
+    q.add_argument("--bind", metavar="ADDRESS", default="127.0.0.1",
+                   help="address the viewer's server listens on (default 127.0.0.1, this machine only)")
     g = q.add_mutually_exclusive_group()
     g.add_argument("--web", action="store_true",
                    help="serve rerun's web viewer instead of opening a window (open the printed URL in a browser)")
@@ -189,11 +338,26 @@ def cmd_show(args) -> int:
     return EXIT_OK
 
 
-def cmd_run(args) -> int:
-    from rotframe import runner, scenario as sc, scenes
-    from rotframe.errors import IntegrationError
-    from rotframe.integrators import RunInterrupted
+def _limits(args):
+    from rotframe import limits
 
+    return limits.applied(limits.current().with_overrides(
+        max_steps=getattr(args, "max_steps", None), max_samples=getattr(args, "max_samples", None),
+        max_rows=getattr(args, "max_rows", None)))
+
+
+def cmd_run(args) -> int:
+    with _limits(args):
+        return _run(args)
+
+
+def _run(args) -> int:
+    from rotframe import runner, scenario as sc, scenes
+    from rotframe.integrators import RunInterrupted
+    from rotframe.errors import IntegrationError
+    from rotframe.progress import Progress
+
+    scope = args._scope
     sets = _parse_sets(args.sets)
     scn = sc.load(args.name)
     values = scn.with_values(sets)
@@ -201,8 +365,7 @@ def cmd_run(args) -> int:
     if out is not None:
         _check_writable(out)
     _check_outputs(args)
-    _install_sigterm()
-    progress = _Progress(enabled=sys.stderr.isatty() and not args.json)
+    progress = Progress("run", "%", enabled=not args.json)
     scenes.get(scn.scene)  # import the scene (and astropy, numba) before the clock starts
     t0 = time.perf_counter()
     status = EXIT_OK
@@ -212,12 +375,17 @@ def cmd_run(args) -> int:
     except IntegrationError as exc:
         status = EXIT_NUMERICAL
         result = exc.partial
-        message = f"numerical failure: {exc} (simulated time reached: {exc.t_reached:.6g} s)"
+        message = f"numerical failure: {_one_line(exc)} (simulated time reached: {exc.t_reached:.6g} s)"
     except RunInterrupted as exc:
-        status = 143 if _TERMINATED[0] else 130
+        scope.interrupted = True
+        status = scope.exit_code
         result = exc.partial
         reached = result.trajectory.t_reached if result is not None else 0.0
-        message = f"{'terminated' if _TERMINATED[0] else 'interrupted'} at simulated time {reached:.6g} s"
+        message = f"{scope.verb} at simulated time {reached:.6g} s"
+    except KeyboardInterrupt as exc:  # while the scene prepared (compiling, an oracle): nothing to keep
+        scope.note(exc)
+        _error(f"{scope.verb} before the integration started; nothing was recorded")
+        return scope.exit_code
     finally:
         progress.close()
     simulate_s = time.perf_counter() - t0
@@ -226,6 +394,11 @@ def cmd_run(args) -> int:
         return status
     try:
         summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s})
+    except KeyboardInterrupt as exc:  # during the analysis: keep the trajectory as a partial recording
+        scope.note(exc)
+        status = scope.exit_code
+        message = message or f"{scope.verb} during the analysis"
+        summary = runner.summarize_minimal(scn, values, result, {"simulate_s": simulate_s})
     except Exception:
         if status == EXIT_OK:
             raise
@@ -233,18 +406,31 @@ def cmd_run(args) -> int:
     record_s = 0.0
     if out is not None:
         t1 = time.perf_counter()
-        final = runner.record_result(scn, values, result, summary, out, complete=status == EXIT_OK)
+        try:
+            final = runner.record_result(scn, values, result, summary, out, complete=status == EXIT_OK)
+        except KeyboardInterrupt as exc:  # during the recording: what there is was written as a partial
+            scope.note(exc)
+            status = scope.exit_code
+            message = message or f"{scope.verb} while recording"
+            final = getattr(exc, "recording", None)
+            if final is None:
+                final = runner.record_result(scn, values, result, summary, out, complete=False)
         record_s = time.perf_counter() - t1
         summary["recording"] = str(final)
     compile_s = float(getattr(result.trajectory, "extras", {}).get("compile_s", 0.0))
     summary["timing"].update({"compile_s": compile_s, "simulate_s": simulate_s - compile_s,
-                              "record_s": record_s, "total_s": time.perf_counter() - _T_START})
+                              "record_s": record_s, "total_s": time.perf_counter() - args._t_start})
     summary["units"] = _units(scn, summary)
     _write_outputs(args, scn, values, result, summary)
     if args.audit and status == EXIT_OK:
         from rotframe.audit import audit
 
-        summary["audit"] = audit(scn, values, result, summary, method=args.method)
+        try:
+            summary["audit"] = audit(scn, values, result, summary, method=args.method)
+        except KeyboardInterrupt as exc:  # the run and its recording are complete; the audit is dropped
+            scope.note(exc)
+            status = scope.exit_code
+            message = f"{scope.verb} during the audit (the run itself is complete)"
     if args.json:
         print(json.dumps(_jsonable(summary)))
     else:
@@ -258,35 +444,69 @@ def cmd_run(args) -> int:
 def cmd_bench(args) -> int:
     from rotframe.bench import main as bench_main
 
+    if args.plots:
+        from rotframe.outputs import check_output_dir
+
+        check_output_dir(args.plots, "--plots")
+
     return bench_main(args)
 
 
 def cmd_sweep(args) -> int:
     from rotframe.sweep import main as sweep_main
 
-    return sweep_main(args)
+    with _limits(args):
+        return sweep_main(args)
 
 
 def cmd_view(args) -> int:
     import subprocess
 
-    if not os.path.isfile(args.path):
-        raise _input_error(f"view: no recording at {args.path!r}")
+    path = args.path
+    if not os.path.isfile(path):
+        raise _input_error(f"view: no recording at {path!r}" + (" (a folder)" if os.path.isdir(path) else ""))
+    _check_recording(path)
+    bind = args.bind
+    if not bind or any(c.isspace() for c in bind):
+        raise _input_error(f"view --bind {bind!r}: expected an IP address such as 127.0.0.1")
     if args.summary:
         from rotframe.recording_summary import describe
 
-        print(describe(args.path))
+        print(describe(path))
         return EXIT_OK
     if args.web:
-        return subprocess.call([sys.executable, "-m", "rerun", "--web-viewer", args.path])
+        return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, "--web-viewer", path])
     if not _has_display():
         from rotframe.recording_summary import describe
 
         print(f"rotframe: view: no display here (DISPLAY and WAYLAND_DISPLAY are unset), so a text summary "
-              f"follows; 'rotframe view {args.path} --web' serves rerun's web viewer to a browser", file=sys.stderr)
-        print(describe(args.path))
+              f"follows; 'rotframe view {path} --web' serves rerun's web viewer to a browser", file=sys.stderr)
+        print(describe(path))
         return EXIT_OK
-    return subprocess.call([sys.executable, "-m", "rerun", args.path])
+    return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, path])
+
+
+def _check_recording(path):
+    """A readable rerun recording: the RRD magic, then every chunk decodes."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(4)
+    except OSError as exc:
+        raise _input_error(f"view: cannot read {path!r}: {exc.strerror or exc}") from None
+    if head[:3] != b"RRF":
+        raise _input_error(f"view: {path!r} is not a rerun recording (.rrd); allowed: a file written by "
+                           "'rotframe run' or 'rotframe sweep'")
+    import warnings
+
+    from rerun.chunk import RrdReader
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "no footer": a truncated file, reported below if it does not decode
+            for _ in RrdReader(str(path)).stream():
+                pass
+    except Exception as exc:  # noqa: BLE001 -- rerun raises RuntimeError/ValueError for damaged files
+        raise _input_error(f"view: {path!r} is a damaged or truncated recording ({_one_line(exc)[:200]})") from None
 
 
 def _has_display() -> bool:
@@ -310,20 +530,6 @@ def cmd_section(args) -> int:
 # ---------------------------------------------------------------------------
 
 
-_TERMINATED = [False]
-
-
-def _install_sigterm():
-    def handler(signum, frame):
-        _TERMINATED[0] = True
-        raise _Terminated()
-
-    try:
-        signal.signal(signal.SIGTERM, handler)
-    except ValueError:  # not the main thread
-        pass
-
-
 def _parse_sets(items):
     sets = {}
     for item in items:
@@ -341,24 +547,28 @@ def _default_recording(name):
 
 
 def _check_writable(out):
-    folder = os.path.dirname(os.path.abspath(out)) or "."
-    if not out.endswith(".rrd"):
-        raise _input_error(f"--out {out!r}: a recording path must end in .rrd")
-    if os.path.exists(folder) and not os.access(folder, os.W_OK):
-        raise _input_error(f"--out {out!r}: folder {folder!r} is not writable")
-    if os.path.exists(folder) and not os.path.isdir(folder):
-        raise _input_error(f"--out {out!r}: {folder!r} is not a folder")
+    """The recording (and its partial) can be written: checked before any computing starts."""
+    from rotframe.outputs import check_output_file
+    from rotframe.record import partial_path
+
+    check_output_file(out, "--out", ".rrd")
+    partial = partial_path(out)
+    if os.path.isdir(partial):
+        raise _input_error(f"--out {out!r}: {str(partial)!r} (where an interrupted run goes) is a folder")
 
 
 def _check_outputs(args):
-    """Refuse a bad --export or --png path before the run starts."""
+    """Refuse a bad --export or --png path before the run starts (suffix, folder, writable)."""
     from rotframe.export import FORMATS
+    from rotframe.outputs import check_output_file
 
     export, png = getattr(args, "export", None), getattr(args, "png", None)
-    if export is not None and os.path.splitext(export)[1].lower() not in FORMATS:
-        raise _input_error(f"--export {export!r}: the file must end in {', '.join(FORMATS)}")
-    if png is not None and not png.lower().endswith(".png"):
-        raise _input_error(f"--png {png!r}: the file must end in .png")
+    if export is not None:
+        if os.path.splitext(export)[1].lower() not in FORMATS:
+            raise _input_error(f"--export {export!r}: the file must end in {', '.join(FORMATS)}")
+        check_output_file(export, "--export")
+    if png is not None:
+        check_output_file(png, "--png", ".png")
 
 
 def _units(scn, summary):
@@ -454,32 +664,3 @@ def _short(v):
     if isinstance(v, list):
         return ",".join(_short(x) for x in v)
     return str(v)
-
-
-class _Progress:
-    """A progress bar on stderr, shown only once a run has taken more than a second."""
-
-    def __init__(self, enabled=True, delay=1.0):
-        self.enabled = enabled
-        self.delay = delay
-        self.start = time.perf_counter()
-        self.shown = False
-
-    def __call__(self, fraction):
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        if elapsed < self.delay:
-            return
-        self.shown = True
-        width = 30
-        filled = int(round(width * min(max(fraction, 0.0), 1.0)))
-        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
-        sys.stderr.write(f"\r  [{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
-                         f"{elapsed:6.1f} s elapsed, {eta:6.1f} s left ")
-        sys.stderr.flush()
-
-    def close(self):
-        if self.shown:
-            sys.stderr.write("\n")
-            sys.stderr.flush()

@@ -752,3 +752,9 @@ def _g_name(seq):
 
 def _angle_text(angle):
     return f"{float(angle):.9g} rad ({np.degrees(float(angle)):.6g} deg)"
+
+
+# text, complex and object input to the public functions: a _InputError, not a numpy TypeError
+from rotframe._guard import guard_public  # noqa: E402
+
+guard_public(globals(), __all__, _InputError, error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "dcm_to_euler", "from_scipy", "to_scipy")})

@@ -469,3 +469,9 @@ def _length(v, name):
     if not np.isfinite(x) or x < 0.0:
         raise InvalidBodyError(f"{name} = {x!r} m; allowed: a finite length >= 0 m")
     return x
+
+
+# text, complex and object input to the public functions: a InvalidBodyError, not a numpy TypeError
+from rotframe._guard import guard_public  # noqa: E402
+
+guard_public(globals(), __all__, InvalidBodyError)

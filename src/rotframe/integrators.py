@@ -196,6 +196,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     if not duration > 0:
         raise ScenarioError(f"duration: {duration} s; must be > 0")
     samples = max(1, int(samples))
+    _check_work(info, duration, step, samples, r0.shape[0])
     if info.kind == "exact":
         if not model.is_linear:
             nonlinear = [t for t in model.terms if t in ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum")]
@@ -208,6 +209,19 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
 
 
 # ---------------------------------------------------------------------------
+
+
+def _check_work(info, duration, step, samples, n):
+    """Refuse, before allocating anything, a run over the work limits (:mod:`rotframe.limits`)."""
+    from rotframe import limits
+
+    steps = 0.0
+    if info.kind == "fixed":
+        dt_sample = duration / samples
+        h_req = float(step) if step else dt_sample / 20.0
+        if h_req > 0:
+            steps = samples * max(1.0, math.ceil(dt_sample / h_req - 1e-9))
+    limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
 
 
 def _event_table(events):
@@ -303,7 +317,13 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
             m = min(chunk, samples - done)
             t0 = times[done]
             sl = slice(done + 1, done + 1 + m)
-            if info.kind == "fixed":
+            if info.kind == "fixed" and cost > 4e6:
+                # one sample interval is more than a chunk of work: advance it in pieces, so that
+                # Python regains control (signals, progress) about every 0.1 s
+                n_done, bad, nf = _fixed_in_pieces(kernels, info, r, v, alive, t0, h, sps, n, P, wt, wv, wint,
+                                                   ev_tab, out_r[sl], out_v[sl], evb)
+                steps += sps * n_done
+            elif info.kind == "fixed":
                 n_done, bad, nf = kernels.run_fixed(
                     info.code, r, v, alive, t0, h, sps, m, P, wt, wv, wint, ev_tab,
                     out_r[sl], out_v[sl], *evb.args())
@@ -389,6 +409,26 @@ def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
     return lo + int(np.argmax(grown))
 
 
+def _fixed_in_pieces(kernels, info, r, v, alive, t0, h, sps, n, P, wt, wv, wint, ev_tab, out_r, out_v, evb):
+    """One sample interval of ``sps`` fixed steps as several kernel calls of about 4e6 step-evaluations."""
+    factor = 3 if info.code == 1 else 4 if info.code == 2 else 1
+    piece = max(1, int(4e6 // (n * factor)))
+    scratch_r, scratch_v = np.empty((1, n, 3)), np.empty((1, n, 3))
+    j = 0
+    nfev = 0
+    while j < sps:
+        k = min(piece, sps - j)
+        last = j + k == sps
+        n_done, bad, nf = kernels.run_fixed(info.code, r, v, alive, t0 + j * h, h, k, 1, P, wt, wv, wint, ev_tab,
+                                            out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
+                                            *evb.args())
+        nfev += nf
+        if n_done < 1 or bad >= 0:
+            return 0, bad, nfev
+        j += k
+    return 1, -1, nfev
+
+
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (docs/physics/earth.md).
 
@@ -408,20 +448,27 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     times = np.arange(samples + 1) * dt
     times[-1] = duration
     block = 64
-    with np.errstate(all="ignore"), warnings.catch_warnings():
-        # an overflow (an unstable linear model run far) is caught below as a non-finite state
-        warnings.simplefilter("ignore", RuntimeWarning)
-        powers = [np.eye(7)]
-        step_matrix = expm(M * dt)
-        for _ in range(block - 1):
-            powers.append(step_matrix @ powers[-1])
-        out = np.empty((samples + 1, 7, n))
-        for start in range(0, samples + 1, block):
-            anchor = expm(M * times[start]) @ s0
-            for j in range(min(block, samples + 1 - start)):
-                out[start + j] = powers[j] @ anchor
-            if progress is not None:
-                progress(min(1.0, (start + block) / (samples + 1)))
+    out = np.empty((samples + 1, 7, n))
+    done = 0
+    try:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            # an overflow (an unstable linear model run far) is caught below as a non-finite state
+            warnings.simplefilter("ignore", RuntimeWarning)
+            powers = [np.eye(7)]
+            step_matrix = expm(M * dt)
+            for _ in range(block - 1):
+                powers.append(step_matrix @ powers[-1])
+            for start in range(0, samples + 1, block):
+                anchor = expm(M * times[start]) @ s0
+                for j in range(min(block, samples + 1 - start)):
+                    out[start + j] = powers[j] @ anchor
+                done = min(samples + 1, start + block)
+                if progress is not None:
+                    progress(min(1.0, (start + block) / (samples + 1)))
+    except KeyboardInterrupt:
+        partial = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)), np.transpose(out[:, 3:6, :], (0, 2, 1)),
+                             "exact", 1, 0).truncated(max(done, 1)) if done else None
+        raise RunInterrupted(partial) from None
     traj = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)).copy(),
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)
     finite = np.all(np.isfinite(out), axis=(1, 2))

@@ -14,15 +14,18 @@
   numbers of different sizes do not share an axis.
 * Bulk data goes by columns (``send_columns``); nothing is logged step by step.
   Positions are float32 in rerun, so scenes log them in a local frame (ENU, body).
-* Files are deterministic (fixed recording id, no ``log_time``) and written to a
-  temporary name, then renamed: an earlier complete recording is only ever
-  replaced by a complete one. An interrupted or failed run is finalised as
+* Files are deterministic (fixed recording id, no ``log_time``). The recording
+  is encoded into memory (rerun's binary stream) and the bytes are written by
+  Python to a temporary file of this writer's own in the target folder, then
+  renamed (:mod:`rotframe.outputs`): an earlier complete recording is only ever
+  replaced by a complete one, two writers never share a temporary file, and
+  every I/O error (full disk, ``ulimit -f``) ends the run with one line and no
+  file left behind. An interrupted or failed run is finalised as
   ``<name>.partial.rrd``.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -87,7 +90,7 @@ class Recording:
     Parameters
     ----------
     path : path-like
-        Final name (``.rrd``). Data goes to ``<path>.tmp`` until :meth:`finish`.
+        Final name (``.rrd``). Data is held in memory until :meth:`finish` writes it.
     application_id : str
         Shown in the viewer (the scenario name).
     """
@@ -96,15 +99,15 @@ class Recording:
         import rerun as rr
 
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.tmp = self.path.with_name(self.path.name + ".tmp")
         self.rec = rr.RecordingStream(application_id, recording_id=f"rotframe-{application_id}",
                                       send_properties=False)
         self.rec.set_log_time_enabled(False)
         self.rec.set_log_tick_enabled(False)
-        self.rec.save(str(self.tmp))
+        self._stream = self.rec.binary_stream()
         self._done = False
         self._series: list[tuple[str, str]] = []  # (entity, kind) of the scalar series, for the blueprint
+        self._data = None
+        self.final = None
 
     # -- logging -------------------------------------------------------------
 
@@ -277,22 +280,37 @@ class Recording:
 
 
     def finish(self, complete: bool = True) -> Path:
-        """Flush, write the footer and move the file to its final or partial name."""
+        """Encode, write through a temporary file and rename to the final or partial name.
+
+        Raises :class:`rotframe.outputs.OutputError` (nothing left behind) when the
+        file cannot be written. If the write is interrupted, ``finish(complete=False)``
+        may be called again: the encoded bytes are kept until a write succeeds.
+        """
+        from rotframe.outputs import write_bytes_atomic
+
         if self._done:
             return self.final
-        self.rec.flush()
-        self.rec.disconnect()
-        self.final = self.path if complete else partial_path(self.path)
-        os.replace(self.tmp, self.final)
+        data = self._encoded()
+        final = self.path if complete else partial_path(self.path)
+        write_bytes_atomic(final, data, what="recording")
         self._done = True
-        return self.final
+        self.final = final
+        return final
+
+    def _encoded(self) -> bytes:
+        """Everything logged, as the bytes of an ``.rrd`` file (read from rerun once)."""
+        if self._data is None:
+            self.rec.flush()
+            self._data = self._stream.read(flush=True) or b""
+            self.rec.disconnect()
+        return self._data
 
     def abandon(self):
-        """Drop the temporary file (nothing useful was logged)."""
+        """Drop what was logged (nothing is written)."""
         if not self._done:
-            self.rec.disconnect()
-            try:
-                self.tmp.unlink()
-            except FileNotFoundError:
-                pass
             self._done = True
+            try:
+                self._encoded()  # drained, so that rerun does not warn about dropped data
+            except Exception:  # noqa: BLE001 -- nothing is kept anyway
+                pass
+            self._data = None

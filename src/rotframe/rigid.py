@@ -1336,3 +1336,9 @@ def _rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_e
             if not np.all(np.isfinite(y)):
                 return kept - 1
     return kept
+
+
+# text, complex and object input to the public functions: a InvalidStateError, not a numpy TypeError
+from rotframe._guard import guard_public  # noqa: E402
+
+guard_public(globals(), __all__, InvalidStateError)

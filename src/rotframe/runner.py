@@ -142,10 +142,17 @@ def record_result(scn, values, result, summary, path, complete=True):
         scene.record(rec, params, result)
         rec.text("scenario", summary_markdown(scn, summary))
         rec.blueprint()
-    except BaseException:
-        rec.finish(complete=False)
+    except BaseException as exc:
+        if isinstance(exc, KeyboardInterrupt):
+            exc.recording = rec.finish(complete=False)  # what was logged, finalized as the partial
+        else:
+            rec.abandon() if isinstance(exc, Exception) and not complete else rec.finish(complete=False)
         raise
-    return rec.finish(complete=complete)
+    try:
+        return rec.finish(complete=complete)
+    except KeyboardInterrupt as exc:  # interrupted while writing: the same bytes go to the partial name
+        exc.recording = rec.finish(complete=False) if complete else None
+        raise
 
 
 def summary_markdown(scn, summary) -> str:

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -161,7 +162,7 @@ class Scenario:
             if key in self.parameters:
                 values[key] = parse_value(self.parameters[key], raw, source="--set")
             elif key in RUN_KEYS:
-                run[key] = _parse_run_value(key, raw, source="--set")
+                run[key] = _parse_run_value(key, raw, source="--set", scene=self.scene)
             else:
                 allowed = list(self.parameters) + list(RUN_KEYS)
                 raise ScenarioError(f"--set: unknown key {key!r} for scenario {self.name!r}"
@@ -170,18 +171,115 @@ class Scenario:
         return values
 
 
-def load(name_or_path: str) -> Scenario:
-    """Load and validate a scenario by name or path."""
-    path = find(name_or_path)
-    src = path.name
+#: A scenario name: it names the recording ``recordings/<name>.rrd``, so it is a slug.
+_SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
+_TYPES = ("float", "int", "bool", "str", "vector")
+
+
+def _read_toml(path: Path, src: str) -> dict:
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"{src}: cannot read the file ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(f"{src}: not a text file (byte {exc.start} is not UTF-8); allowed: a TOML "
+                            "scenario file in UTF-8") from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{src}: not valid TOML: {exc}") from None
+
+
+def _builtin_for_scene(scene: str, path: Path) -> dict | None:
+    """The built-in scenario file of ``scene`` (its own name first), as TOML data; None if there is none."""
+    folder = scenario_dir()
+    candidates = [folder / f"{scene}.toml"] + sorted(folder.glob("*.toml"))
+    for cand in candidates:
+        try:
+            if not cand.is_file() or cand.resolve() == path.resolve():
+                continue
+            data = tomllib.loads(cand.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            continue
+        if data.get("scene") == scene:
+            return data
+    return None
+
+
+def _expect(value, kinds, src: str, where: str, allowed: str):
+    if isinstance(value, bool) and bool not in kinds or not isinstance(value, kinds):
+        raise ScenarioError(f"{src}: {where} = {value!r}: expected {allowed}")
+    return value
+
+
+def _check_top_types(data: dict, src: str):
+    for key in ("name", "title", "description", "scene"):
+        if key in data:
+            _expect(data[key], (str,), src, key, "a string")
+    for key in ("model", "optional_terms"):
+        if key in data:
+            _expect(data[key], (list,), src, key, "a list of term names, e.g. [\"gravity\", \"coriolis\"]")
+            for term in data[key]:
+                _expect(term, (str,), src, f"{key} item", "a term name (a string)")
+    if "parameters" in data:
+        _expect(data["parameters"], (dict,), src, "parameters", "a table: [parameters.NAME] with default = ...")
+    if "run" in data:
+        _expect(data["run"], (dict,), src, "run", "a table: [run] with method, step, rtol or samples")
+
+
+def _parameter(key: str, spec: dict, src: str) -> Parameter:
+    where = f"parameters.{key}"
+    for k in ("min", "max"):
+        if spec.get(k) is not None:
+            _expect(spec[k], (int, float), src, f"{where}.{k}", "a number")
+            if not math.isfinite(float(spec[k])):
+                raise ScenarioError(f"{src}: {where}.{k} = {spec[k]!r}: expected a finite number")
+    for k in ("unit", "doc"):
+        if k in spec:
+            _expect(spec[k], (str,), src, f"{where}.{k}", "a string")
+    for k in ("exclusive_min", "exclusive_max"):
+        if k in spec:
+            _expect(spec[k], (bool,), src, f"{where}.{k}", "true or false")
+    if "shape" in spec:
+        _expect(spec["shape"], (int,), src, f"{where}.shape", "a whole number of components (0 or 3)")
+        if not 0 <= spec["shape"] <= 16:
+            raise ScenarioError(f"{src}: {where}.shape = {spec['shape']!r}: expected 0 (scalar) to 16 components")
+    if "choices" in spec:
+        _expect(spec["choices"], (list,), src, f"{where}.choices", "a list of allowed strings")
+    kind = spec.get("type", None)
+    if kind is not None:
+        _expect(kind, (str,), src, f"{where}.type", f"one of {', '.join(_TYPES)}")
+        if kind not in _TYPES:
+            raise ScenarioError(f"{src}: {where}.type = {kind!r}: allowed {', '.join(_TYPES)}"
+                                f"{_did_you_mean(kind, list(_TYPES))}")
+    unit = spec.get("unit", "")
+    p = Parameter(name=key, default=None, unit=unit, doc=spec.get("doc", ""),
+                  min=spec.get("min"), max=spec.get("max"),
+                  exclusive_min=bool(spec.get("exclusive_min", False)),
+                  exclusive_max=bool(spec.get("exclusive_max", False)),
+                  shape=int(spec.get("shape", 0)), choices=tuple(spec.get("choices", ())),
+                  type=kind or _infer_type(spec))
+    p.default = parse_value(p, spec["default"], source=src)
+    return p
+
+
+def load(name_or_path: str) -> Scenario:
+    """Load and validate a scenario by name or path.
+
+    A file that names a built-in scene but leaves out some of that scene's
+    parameters (or its ``model``, ``optional_terms`` or ``[run]``) takes them from
+    the built-in scenario of the same scene, so a file may declare only what it
+    changes.
+    """
+    path = find(name_or_path)
+    src = path.name
+    data = _read_toml(path, src)
     _check_keys(data, _TOP_KEYS, src, "top level")
-    for required in ("scene", "parameters"):
-        if required not in data:
-            raise ScenarioError(f"{src}: missing {required!r}")
+    _check_top_types(data, src)
+    if "scene" not in data:
+        raise ScenarioError(f"{src}: missing 'scene'")
     from rotframe.scenes import SCENES, load_plugins
 
     load_plugins()
@@ -190,41 +288,48 @@ def load(name_or_path: str) -> Scenario:
         raise ScenarioError(f"{src}: scene {scene!r} unknown{_did_you_mean(scene, list(SCENES))}; "
                             f"available: {', '.join(SCENES)} (a scene of your own: rotframe.register_scene, "
                             "and ROTFRAME_PLUGINS=module for the command line)")
+    name = data.get("name", path.stem)
+    if not _SLUG.fullmatch(name) or name in (".", ".."):
+        raise ScenarioError(f"{src}: name = {name!r}: not allowed; a name is 1 to 64 letters, digits, '-', '_' "
+                            "or '.', starting with a letter or digit (it names the recording file)")
+    builtin = _builtin_for_scene(scene, path) or {}
+    specs = dict(builtin.get("parameters", {}))
+    specs.update(data.get("parameters", {}))
+    if not specs:
+        raise ScenarioError(f"{src}: missing 'parameters'")
     params = {}
-    for key, spec in data["parameters"].items():
+    for key, spec in specs.items():
         if not isinstance(spec, dict):
             spec = {"default": spec}
+        elif key in data.get("parameters", {}) and key in builtin.get("parameters", {}) \
+                and isinstance(builtin["parameters"][key], dict):
+            spec = {**builtin["parameters"][key], **spec}  # a file may override only the default
         _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
         if "default" not in spec:
             raise ScenarioError(f"{src}: parameters.{key} has no default")
-        p = Parameter(name=key, default=None, unit=spec.get("unit", ""), doc=spec.get("doc", ""),
-                      min=spec.get("min"), max=spec.get("max"),
-                      exclusive_min=bool(spec.get("exclusive_min", False)),
-                      exclusive_max=bool(spec.get("exclusive_max", False)),
-                      shape=int(spec.get("shape", 0)), choices=tuple(spec.get("choices", ())),
-                      type=spec.get("type", _infer_type(spec)))
-        p.default = parse_value(p, spec["default"], source=src)
-        params[key] = p
+        params[key] = _parameter(key, spec, src)
     clash = set(params) & set(RUN_KEYS)
     if clash:
         raise ScenarioError(f"{src}: parameter names {sorted(clash)} are reserved for [run]")
     run = {"method": None, "step": None, "rtol": 1e-10, "samples": 2000}
-    for key, raw in data.get("run", {}).items():
+    run_data = data["run"] if "run" in data else builtin.get("run", {})
+    for key, raw in run_data.items():
         if key not in RUN_KEYS:
             raise ScenarioError(f"{src}: unknown key 'run.{key}'{_did_you_mean(key, list(RUN_KEYS))}; "
                                 f"allowed: {', '.join(RUN_KEYS)}")
-        run[key] = _parse_run_value(key, raw, source=src)
-    model = list(data.get("model", []))
+        run[key] = _parse_run_value(key, raw, source=src, scene=scene)
+    model = list(data["model"] if "model" in data else builtin.get("model", []))
+    optional = list(data["optional_terms"] if "optional_terms" in data else builtin.get("optional_terms", []))
     from rotframe.model import TERMS
 
     known = TERMS + RIGID_TERMS
-    for term in model + list(data.get("optional_terms", [])):
+    for term in model + optional:
         if term not in known:
-            raise ScenarioError(f"{src}: model term {term!r} unknown{_did_you_mean(term, list(TERMS))}; "
+            raise ScenarioError(f"{src}: model term {term!r} unknown{_did_you_mean(term, list(known))}; "
                                 f"allowed: {', '.join(known)}")
-    return Scenario(name=data.get("name", path.stem), path=path, title=data.get("title", ""),
+    return Scenario(name=name, path=path, title=data.get("title", ""),
                     description=data.get("description", "").strip(), scene=scene, model=model,
-                    optional_terms=list(data.get("optional_terms", [])), parameters=params, run=run)
+                    optional_terms=optional, parameters=params, run=run)
 
 
 # ---------------------------------------------------------------------------
@@ -310,9 +415,10 @@ def _parse_quantity_enabled(p: Parameter, text: str, where: str, unit: str, u) -
     except (u.UnitConversionError, u.UnitTypeError) as exc:
         raise ScenarioError(f"{where}{p.name} = {text!r}: wrong dimension; expected a value in "
                             f"{unit or 'no unit'} ({_first_line(exc)})") from None
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, ArithmeticError) as exc:
+        example = p.default if isinstance(p.default, (int, float)) and not isinstance(p.default, bool) else 1
         raise ScenarioError(f"{where}{p.name} = {text!r}: not a number or quantity; expected e.g. "
-                            f"'{_fmt(p.default)} {unit}'. ({_first_line(exc)})") from None
+                            f"'{_fmt(example)}{(' ' + unit) if unit else ''}' ({_first_line(exc)})") from None
 
 
 def _check_bounds(p: Parameter, value: float, raw, where: str):
@@ -327,17 +433,33 @@ def _check_bounds(p: Parameter, value: float, raw, where: str):
         raise ScenarioError(f"{where}{p.name} = {shown}: out of range; allowed {bad}{unit}")
 
 
-def _parse_run_value(key, raw, source):
+#: Methods by kind of scene (the scene modules check their own list again when they run).
+_PARTICLE_METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+_FREE_BODY_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
+_HEAVY_TOP_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
+_SCENE_METHODS = {"free-top": _FREE_BODY_METHODS, "dzhanibekov": _FREE_BODY_METHODS,
+                  "heavy-top": _HEAVY_TOP_METHODS}
+_RUN_EXAMPLES = {"step": 1e-3, "rtol": 1e-10, "samples": 2000}
+
+
+def methods_for(scene: str | None) -> tuple:
+    """Integrator names a ``[run] method`` or ``--set method=`` may take for ``scene``."""
+    if scene is None:
+        return tuple(dict.fromkeys(_PARTICLE_METHODS + _FREE_BODY_METHODS + _HEAVY_TOP_METHODS))
+    return _SCENE_METHODS.get(scene, _PARTICLE_METHODS)
+
+
+def _parse_run_value(key, raw, source, scene=None):
     kind = RUN_KEYS[key]
     where = f"{source}: " if source else ""
     if kind is str:
-        from rotframe.integrators import METHODS
-
-        if str(raw) not in METHODS:
-            raise ScenarioError(f"{where}method = {raw!r}: allowed {', '.join(METHODS)}"
-                                f"{_did_you_mean(str(raw), list(METHODS))}")
-        return str(raw)
-    p = Parameter(name=key, default=raw, unit="s" if key == "step" else "", min=0.0, exclusive_min=True)
+        allowed = methods_for(scene)
+        if not isinstance(raw, str) or raw not in allowed:
+            raise ScenarioError(f"{where}method = {raw!r}: allowed {', '.join(allowed)}"
+                                f"{_did_you_mean(str(raw), list(allowed))}")
+        return raw
+    p = Parameter(name=key, default=_RUN_EXAMPLES[key], unit="s" if key == "step" else "", min=0.0,
+                  exclusive_min=True)
     value = _to_float(p, raw, where)
     _check_bounds(p, value, raw, where)
     if kind is int:

@@ -30,6 +30,8 @@ import json
 import math
 import sys
 
+import numpy as np
+
 from rotframe.sections import (
     PROPERTY_UNITS,
     SectionError,
@@ -95,6 +97,8 @@ SHAPE_SUMMARIES: dict[str, str] = {
 }
 
 _LENGTH_ALLOWED = "a positive number in metres or a length quantity such as '120 mm'"
+#: Lengths whose fourth power (a second moment) stays a normal double, with room to spare.
+_MIN_LENGTH, _MAX_LENGTH = 1e-60, 1e60
 
 _LABELS = {
     "area": "area A",
@@ -136,9 +140,13 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
     try:
         name = _resolve_shape(shape)
         raw = _parse_sets(name, sets)
-        params, section = _build(name, raw)
+        with np.errstate(all="ignore"):
+            params, section = _build(name, raw)
     except (_InputError, SectionError) as exc:
         return _fail(str(exc))
+    except (ArithmeticError, ValueError) as exc:
+        return _fail(f"{shape}: the values give no usable section ({' '.join(str(exc).split())}); "
+                     f"allowed: {_LENGTH_ALLOWED}")
 
     written = None
     if png:
@@ -147,7 +155,10 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
         except OSError as exc:
             return _fail(f"--png {png!r}: cannot write the file ({exc.strerror or exc}); allowed: a writable path")
 
-    props = section.properties()
+    try:
+        props = _properties(name, params, section)
+    except (SectionError, _InputError) as exc:
+        return _fail(str(exc))
     if as_json:
         print(
             json.dumps(
@@ -157,6 +168,23 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
     else:
         print(_table(name, params, props, written))
     return 0
+
+
+def _properties(name: str, params: dict, section) -> dict:
+    """``section.properties()`` as plain floats; a failure or an overflow names the shape and its values."""
+    given = _params_text(params)
+    try:
+        with np.errstate(all="ignore"):
+            props = {k: float(v) for k, v in section.properties().items()}
+    except SectionError as exc:
+        raise _InputError(f"{name}: {given}: {exc}") from None
+    except (ArithmeticError, ValueError) as exc:
+        raise _InputError(f"{name}: {given}: the properties cannot be computed ({exc})") from None
+    bad = [k for k, v in props.items() if not math.isfinite(v)]
+    if bad:
+        raise _InputError(f"{name}: {given}: {', '.join(bad)} overflow double precision (over 1.8e308); "
+                          "allowed: lengths below about 1e70 m")
+    return props
 
 
 def shapes_help() -> str:
@@ -249,6 +277,9 @@ def _parse_length(shape: str, key: str, text: str) -> float:
         raise _InputError(f"{shape}: {key} = {text!r} is not finite; allowed: {_LENGTH_ALLOWED}")
     if value <= 0.0:
         raise _InputError(f"{shape}: {key} = {text!r} is not positive; allowed: {_LENGTH_ALLOWED}")
+    if not _MIN_LENGTH <= value <= _MAX_LENGTH:
+        raise _InputError(f"{shape}: {key} = {text!r} ({value:g} m) is out of range; allowed: "
+                          f"{_MIN_LENGTH:g} m to {_MAX_LENGTH:g} m (second moments, length^4, must fit a double)")
     return value
 
 
@@ -308,7 +339,11 @@ def _parse_points(key: str, text: str, scale: float) -> list[list[float]]:
             raise _InputError(
                 f"polygon: {key} = {text!r}: pair {k + 1} {pair.strip()!r} is not finite; allowed: {allowed}"
             )
-        points.append([x * scale, y * scale])
+        x, y = x * scale, y * scale
+        if max(abs(x), abs(y)) > _MAX_LENGTH:
+            raise _InputError(f"polygon: {key} = {text!r}: pair {k + 1} {pair.strip()!r} is out of range; "
+                              f"allowed: coordinates up to {_MAX_LENGTH:g} m")
+        points.append([x, y])
     if len(points) < 3:
         raise _InputError(f"polygon: {key} = {text!r} has {len(points)} vertices; allowed: {allowed}")
     return points

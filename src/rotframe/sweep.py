@@ -63,6 +63,8 @@ ENSEMBLE_BATCH = 1 << 17
 MIN_ENSEMBLE_BATCH = 4096
 #: Dask retries of a task whose worker failed
 RETRIES = 3
+#: seconds allowed to connect to a scheduler and for the Dask handshake, each
+CONNECT_TIMEOUT_S = 10.0
 _DISTRIBUTIONS = {"normal": ("MEAN", "SD"), "uniform": ("LO", "HI")}
 _META_KEY = b"rotframe.sweep"
 
@@ -198,27 +200,102 @@ def main(args) -> int:
         Bad input (the command line turns it into exit code 2 and one line).
     """
     from rotframe import cli
+    from rotframe.progress import Progress
+    from rotframe.signals import InterruptScope
 
     spec = parse_spec(args.name, sets=cli._parse_sets(args.sets), grid=args.grid, log_grid=args.log_grid,
                       samples=args.samples, vary=args.vary, seed=args.seed, method=args.method)
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers {args.workers}: must be >= 1")
-    cli._install_sigterm()
+    most = max(2, 2 * (os.cpu_count() or 1))  # each worker is a process of a few hundred MB
+    if args.workers is not None and args.workers > most:
+        raise ScenarioError(f"--workers {args.workers}: at most {most} local processes on this machine "
+                            f"({os.cpu_count()} CPUs); use --scheduler for a larger cluster")
+    check_outputs(spec, args.out, args.resume)
+    if args.scheduler is not None:
+        check_scheduler(args.scheduler)
+    scope = getattr(args, "_scope", None) or InterruptScope()
+    progress = Progress("sweep", "rows", enabled=not args.json)
     try:
-        result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume)
+        result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
+                           on_batch=progress.update)
     except SweepInterrupted as exc:
-        what = "terminated" if cli._TERMINATED[0] else "interrupted"
-        cli._error(f"{what}: {exc.saved} of {exc.total} rows are saved in {exc.parts}; "
+        progress.close()
+        scope.interrupted = True
+        cli._error(f"{scope.verb}: {exc.saved} of {exc.total} rows are saved in {exc.parts}; "
                    "run the same command with --resume to compute the rest")
-        return 143 if cli._TERMINATED[0] else 130
+        return scope.exit_code
+    except KeyboardInterrupt as exc:  # while merging, plotting or recording: the parts are still there
+        progress.close()
+        scope.note(exc)
+        cli._error(f"{scope.verb} while writing the results; every computed row is kept in "
+                   f"{_Files.for_spec(spec, args.out).parts}; run the same command with --resume to finish")
+        return scope.exit_code
+    finally:
+        progress.close()
     if args.json:
         print(json.dumps(cli._jsonable(result.as_json())))
     else:
         print(format_result(result, spec))
     if result.rows and result.failed == result.rows:
+        invalid = sum(1 for e in result.table.column("error").to_pylist()
+                      if e.startswith(("ScenarioError", "LimitError", "OutputError")))
+        if invalid == result.rows:
+            first = result.table.column("error")[0].as_py()
+            cli._error(f"every row was invalid input ({first}); the messages are in the error column of "
+                       f"{result.out}")
+            return cli.EXIT_INPUT
         cli._error(f"every run failed; the messages are in the error column of {result.out}")
         return cli.EXIT_NUMERICAL
     return cli.EXIT_OK
+
+
+def check_outputs(spec, out, resume=False):
+    """Every path the sweep will write can be written: checked before any computing starts."""
+    from rotframe.outputs import check_output_dir, check_output_file
+
+    files = _Files.for_spec(spec, out)
+    option = "--out" if out else "sweep output"
+    check_output_file(files.out, option, ".parquet")
+    if files.parts.exists() and not files.parts.is_dir():
+        raise ScenarioError(f"{option} {str(files.out)!r}: {str(files.parts)!r} (where finished batches go) "
+                            "is a file, not a folder; remove it or choose another --out")
+    check_output_dir(files.parts, option, shown=files.out)
+    if files.recording.is_dir():
+        raise ScenarioError(f"{option} {str(files.out)!r}: {str(files.recording)!r} (the recording) is a folder")
+    return files
+
+
+def check_scheduler(address, timeout=None):
+    """A Dask scheduler address: ``tcp://HOST:PORT`` (or ``tls://``), reachable within ``timeout`` seconds.
+
+    Only the TCP connection is tried here; the Dask handshake itself is bounded in
+    :func:`_connect`. Raises ScenarioError in one line.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    allowed = "allowed: tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786"
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
+    text = str(address).strip()
+    if "://" not in text:
+        text_full = "tcp://" + text
+    else:
+        text_full = text
+    try:
+        parts = urlsplit(text_full)
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise ScenarioError(f"--scheduler {address!r}: not an address ({exc}); {allowed}") from None
+    if parts.scheme not in ("tcp", "tls") or not host or port is None or parts.path not in ("", "/"):
+        raise ScenarioError(f"--scheduler {address!r}: not a scheduler address; {allowed}")
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            pass
+    except OSError as exc:
+        why = "timed out" if isinstance(exc, (TimeoutError, socket.timeout)) else (exc.strerror or str(exc))
+        raise ScenarioError(f"--scheduler {address!r}: cannot connect to {host}:{port} ({why})") from None
+    return f"{parts.scheme}://{host}:{port}"
 
 
 def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=(), seed=0, method=None):
@@ -255,6 +332,10 @@ def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=
     axes += [_parse_axis(scn, base, text, log=True) for text in log_grid]
     varies = [_parse_vary(scn, base, text) for text in vary]
     _check_shape(axes, varies, samples)
+    from rotframe import limits
+
+    rows = math.prod(len(a.values) for a in axes) if axes else int(samples or 0)
+    limits.check_rows(rows, what="sweep")
     spec = SweepSpec(scenario=str(scenario), name=scn.name, sets=sets, axes=axes, samples=samples,
                      vary=varies, seed=int(seed), method=method)
     _check_keys_once(spec)
@@ -275,6 +356,21 @@ def sweep_points(spec: SweepSpec) -> np.ndarray:
     cols = [rng.normal(v.a, v.b, spec.samples) if v.dist == "normal" else rng.uniform(v.a, v.b, spec.samples)
             for v in spec.vary]
     return np.stack(cols, axis=1).astype(np.float64)
+
+
+def points_of(spec: SweepSpec, rows) -> np.ndarray:
+    """The swept values of the given ``rows`` only (as :func:`sweep_points` would give them).
+
+    Grid points are computed from their row index, so a large grid is never held
+    whole; Monte Carlo rows are drawn in order from the seed.
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    if spec.axes:
+        shape = tuple(len(a.values) for a in spec.axes)
+        idx = np.unravel_index(rows, shape) if len(rows) else [np.zeros(0, np.int64)] * len(shape)
+        cols = [np.asarray(a.values, dtype=np.float64)[i] for a, i in zip(spec.axes, idx)]
+        return np.stack(cols, axis=1) if cols else np.zeros((len(rows), 0))
+    return sweep_points(spec)[rows]
 
 
 def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client=None, resume=False,
@@ -316,6 +412,44 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
     t_start = time.perf_counter()
     _require("pyarrow", "rotframe sweep")
     files = _Files.for_spec(spec, out)
+    with _exclusive(files):
+        return _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                                 recording)
+
+
+def _exclusive(files):
+    """Hold ``.<out>.lock`` beside the table: a second sweep into the same ``out`` is refused, not interleaved."""
+    import contextlib
+
+    @contextlib.contextmanager
+    def lock():
+        try:
+            import fcntl
+        except ImportError:  # not POSIX: no lock
+            yield
+            return
+        from rotframe.outputs import OutputError
+
+        try:
+            files.out.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(files.out.parent / f".{files.out.name}.lock", os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise OutputError(f"--out {str(files.out)!r}: cannot create a lock beside it ({exc.strerror})") from None
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise OutputError(f"--out {str(files.out)!r}: another sweep is writing it now; wait for it or "
+                                  "choose another --out") from None
+            yield
+        finally:
+            os.close(fd)
+
+    return lock()
+
+
+def _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                      recording):
     meta = spec.describe()
     done = _prepare(files, meta, resume)
     pending = np.setdiff1d(np.arange(spec.n_rows), np.fromiter(done, dtype=np.int64, count=len(done)))
@@ -362,6 +496,7 @@ class BatchTask:
     method: str | None
     path: str
     track_rows: frozenset
+    limits: object = None  # the command's rotframe.limits.Limits, applied on the worker too
 
 
 @dataclass
@@ -381,6 +516,13 @@ def run_batch(task: BatchTask) -> BatchOutput:
     one call; if that call fails as a whole (one particle's numerical failure), the
     batch falls back to one run per row so the failure lands in that row's ``error``.
     """
+    from rotframe import limits
+
+    with limits.applied(task.limits or limits.current()):
+        return _run_batch(task)
+
+
+def _run_batch(task):
     from rotframe import scenario as sc, scenes
     from rotframe.integrators import RunInterrupted
 
@@ -424,8 +566,13 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
         fig.suptitle(f"{spec.name}: {metric} ({table.num_rows} runs)")
         fig.tight_layout()
         path = Path(f"{stem}-{_safe(metric)}.png")
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        from rotframe.outputs import atomic_path
+
+        try:
+            with atomic_path(path, "plot") as tmp:
+                fig.savefig(tmp, dpi=110, format="png")
+        finally:
+            plt.close(fig)
         paths.append(path)
     return paths
 
@@ -507,6 +654,9 @@ def _parse_axis(scn, base, text, log):
     if len(parts) != 3:
         raise ScenarioError(f"{option} {text!r}: expected KEY=START:STOP:N (N values from START to STOP)")
     n = _parse_count(option, text, parts[2])
+    from rotframe import limits
+
+    limits.check_rows(n, what=f"{option} {text!r}")
     lo, hi = (_parse_number(scn, key, option, text, s) for s in parts[:2])
     if log and not (lo > 0 and hi > 0):
         raise ScenarioError(f"{option} {text!r}: START and STOP must both be > 0 for a logarithmic grid")
@@ -666,7 +816,12 @@ def _prepare(files, meta, resume):
     files.parts.mkdir(exist_ok=True)
     done = set()
     for path in _tables(files, include_out=True):
-        table, found = read_table(path)
+        try:
+            table, found = read_table(path)
+            table.column("row")
+        except (OSError, ValueError, KeyError, TypeError) as exc:  # pyarrow's ArrowInvalid is a ValueError
+            raise ScenarioError(f"--resume: {str(path)!r} is not a readable sweep table ({_one_line(exc)[:160]}); "
+                                "remove it or run without --resume") from None
         if _fingerprint(found) != _fingerprint(meta):
             raise ScenarioError(f"--resume: {str(path)!r} belongs to a different sweep "
                                 f"({_describe_difference(found, meta)}); remove it or run without --resume")
@@ -701,11 +856,12 @@ def _write_part(files, output, keys, meta):
     first = min(r["row"] for r in output.rows)
     table = _rows_table(output.rows, keys, meta)
     path = files.parts / f"part-{first:09d}.parquet"
-    tmp = path.with_name(path.name + ".tmp")
-    pq.write_table(table, str(tmp))
-    if output.tracks:
-        _write_tracks(files.parts / f"tracks-{first:09d}.npz", output.tracks)
-    os.replace(tmp, path)
+    from rotframe.outputs import atomic_path
+
+    with atomic_path(path, "sweep part") as tmp:
+        pq.write_table(table, str(tmp))
+        if output.tracks:
+            _write_tracks(files.parts / f"tracks-{first:09d}.npz", output.tracks)
 
 
 def _rows_table(rows, keys, meta):
@@ -755,9 +911,10 @@ def _merge(files, meta, spec, include_out):
             col = pc.fill_null(col.cast(pa.float64()), math.nan)
         columns[name] = col
     merged = pa.table(columns).replace_schema_metadata({_META_KEY: json.dumps(meta)})
-    tmp = files.out.with_name(files.out.name + ".tmp")
-    pq.write_table(merged, str(tmp))
-    os.replace(tmp, files.out)
+    from rotframe.outputs import atomic_path
+
+    with atomic_path(files.out, "sweep table") as tmp:
+        pq.write_table(merged, str(tmp))
     return merged
 
 
@@ -781,10 +938,11 @@ def _column(table, name):
 def _write_tracks(path, tracks):
     rows = sorted(tracks)
     lengths = [len(tracks[r][0]) for r in rows]
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez(tmp, rows=np.array(rows, np.int64), offsets=np.concatenate([[0], np.cumsum(lengths)]),
-             t=np.concatenate([tracks[r][0] for r in rows]), pos=np.concatenate([tracks[r][1] for r in rows]))
-    os.replace(tmp, path)
+    from rotframe.outputs import atomic_path
+
+    with atomic_path(path, "sweep tracks") as tmp, open(tmp, "wb") as f:
+        np.savez(f, rows=np.array(rows, np.int64), offsets=np.concatenate([[0], np.cumsum(lengths)]),
+                 t=np.concatenate([tracks[r][0] for r in rows]), pos=np.concatenate([tracks[r][1] for r in rows]))
 
 
 def _read_tracks(parts):
@@ -809,7 +967,7 @@ class _Context:
     meta: dict
     scenario_path: str
     path: str
-    points: np.ndarray
+    points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
 
     @classmethod
@@ -820,13 +978,21 @@ class _Context:
         scn = sc.load(spec.scenario)
         path = "ensemble" if hasattr(scenes.get(scn.scene), "simulate_ensemble") else "runs"
         track_rows = frozenset(int(i) for i in decimate(spec.n_rows, MAX_TRACKS))
-        return cls(spec, files, meta, str(scn.path.resolve()), path, sweep_points(spec), track_rows)
+        points = None if spec.axes else sweep_points(spec)  # a grid is computed row by row, lazily
+        return cls(spec, files, meta, str(scn.path.resolve()), path, points, track_rows)
 
     def task(self, index, rows):
         rows = np.asarray(rows, dtype=np.int64)
+        values = points_of(self.spec, rows) if self.points is None else self.points[rows]
         return BatchTask(index=index, scenario=self.scenario_path, sets=dict(self.spec.sets), keys=self.spec.keys,
-                         rows=rows, values=self.points[rows], method=self.spec.method, path=self.path,
+                         rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
                          track_rows=self.track_rows.intersection(rows.tolist()))
+
+
+def _limits_now():
+    from rotframe import limits
+
+    return limits.current()
 
 
 def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_batch):
@@ -862,12 +1028,12 @@ def _execute(ctx, pending, workers, scheduler, client, batch_rows, finished):
             if batch_rows is None:
                 pending, batch_rows = _probe(ctx, pending, n_workers, finished)
             size = batch_rows
-        tasks = [ctx.task(i, pending[s:s + size]) for i, s in enumerate(range(0, len(pending), size))]
-        if client is None:
+        tasks = (ctx.task(i, pending[s:s + size]) for i, s in enumerate(range(0, len(pending), size)))
+        if client is None:  # one batch generated at a time
             for task in tasks:
                 finished(run_batch(task))
         else:
-            _execute_dask(client, tasks, finished)
+            _execute_dask(client, list(tasks), finished)
     finally:
         if own is not None:
             _close(own)
@@ -898,13 +1064,78 @@ def _connect(workers, scheduler):
     from distributed import Client, LocalCluster
 
     if scheduler:
-        try:
-            return Client(scheduler, timeout="10s")
-        except (OSError, TimeoutError) as exc:
-            raise ScenarioError(f"--scheduler {scheduler!r}: cannot connect ({_one_line(exc)})") from None
+        return _client_bounded(Client, check_scheduler(scheduler), scheduler)
     cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None,
                            silence_logs=logging.ERROR)
     return Client(cluster)
+
+
+def _client_bounded(Client, address, given, timeout=None):
+    """A Dask client of ``address``, or ScenarioError within ``timeout`` s whatever answers there.
+
+    Dask's own connect timeout does not bound the handshake: a listener that is not a
+    scheduler can keep it waiting for ever (or send a frame header announcing exabytes).
+    The client is made in a daemon thread that this one waits for at most ``timeout``.
+    """
+    import threading
+
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
+    box = {}
+
+    def make():
+        try:
+            box["client"] = Client(address, timeout=f"{timeout}s", set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 -- reported below
+            box["error"] = exc
+
+    with _quiet_dask_logs():
+        worker = threading.Thread(target=make, daemon=True, name="rotframe-dask-connect")
+        worker.start()
+        worker.join(timeout + 2.0)
+    if "client" in box:
+        return box["client"]
+    _quiet_dask_unraisable()
+    why = _one_line(box["error"])[:200] if "error" in box else f"no Dask handshake within {timeout:g} s"
+    raise ScenarioError(f"--scheduler {given!r}: not a Dask scheduler or not answering ({why})")
+
+
+def _quiet_dask_unraisable():
+    """A half-made Dask client prints a traceback from its ``__del__`` (at exit): keep that one quiet."""
+    import sys
+
+    previous = sys.unraisablehook
+    if getattr(previous, "_rotframe_quiet", False):
+        return
+
+    def hook(unraisable):
+        obj = unraisable.object
+        module = getattr(obj, "__module__", "") or getattr(type(obj), "__module__", "") or ""
+        if str(module).startswith(("distributed", "tornado")):
+            return
+        previous(unraisable)
+
+    hook._rotframe_quiet = True
+    sys.unraisablehook = hook
+
+
+def _quiet_dask_logs():
+    import contextlib
+    import logging
+
+    @contextlib.contextmanager
+    def quiet():
+        loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
+                                                  "distributed.client", "tornado")]
+        levels = [lg.level for lg in loggers]
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+        try:
+            yield
+        finally:
+            for lg, level in zip(loggers, levels):
+                lg.setLevel(level)
+
+    return quiet()
 
 
 def _require(module, what):

@@ -44,7 +44,13 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """
     from rotframe import rigid
 
+    from rotframe import limits
+
     samples = max(1, int(run.get("samples") or 2000))
+    per_sample = 1.0 if method == "exact" else max(1.0, math.ceil(
+        (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
+    limits.check_run(steps=0.0 if method == "exact" else samples * per_sample, samples=samples + 1,
+                     what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
     if method == "exact":
         if top is not None:
@@ -85,7 +91,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
         while done < samples:
             m = min(chunk, samples - done)
             try:
-                Ls, qs, _ = stepper(L, q, h, m * sps, sps)
+                if sps > 2e6:  # a sample interval longer than a chunk: in pieces, so that signals are seen
+                    L, q = _advance_in_pieces(stepper, L, q, h, sps - 1)
+                Ls, qs, _ = stepper(L, q, h, m * sps if sps <= 2e6 else 1, sps if sps <= 2e6 else 1)
             except IntegrationError as exc:
                 # the kernel keeps the finite samples of this chunk in exc.partial = (L, q, times)
                 Ls, qs = exc.partial[0], exc.partial[1]
@@ -107,6 +115,21 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     traj = BodyTrajectory(times, out_L, out_q, method, samples * sps, True, duration)
     traj.extras.update(compile_s=compile_s, step=h)
     return traj
+
+
+def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
+    """The state after ``steps`` steps, taken in kernel calls of ``piece`` steps (Python runs between)."""
+    done = 0
+    while done < steps:
+        k = min(piece, steps - done)
+        try:
+            Ls, qs, _ = stepper(L, q, h, k, k)
+        except IntegrationError as exc:  # no sample was completed in this interval
+            exc.partial = (np.asarray([L]), np.asarray([q]), None)
+            raise
+        L, q = Ls[-1], qs[-1]
+        done += k
+    return L, q
 
 
 def simulate_free_body(body, duration, method, run, progress):

@@ -1,0 +1,78 @@
+"""Public functions refuse text, complex and object input with a RotframeError.
+
+:func:`guard_public` wraps the plain-Python functions a module exports so that
+
+* an argument holding complex numbers is refused before anything is computed
+  (``np.asarray(z, dtype=float)`` would silently drop the imaginary part: a
+  complex matrix is not a rotation);
+* a ``TypeError`` / ``ValueError`` / ``IndexError`` raised while numpy converts
+  junk (a string, ``None``, an object, a ragged list) becomes the module's
+  :class:`~rotframe.errors.RotframeError` subclass, which is still a
+  ``ValueError``, with one line naming the function.
+
+Errors the functions raise on purpose pass unchanged. Compiled (numba)
+functions are left alone.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import types
+
+import numpy as np
+
+from rotframe.errors import RotframeError
+
+__all__ = ["guard_public"]
+
+
+def _has_complex(value) -> bool:
+    if isinstance(value, (complex, np.complexfloating)):
+        return True
+    if isinstance(value, np.ndarray):
+        return np.iscomplexobj(value)
+    if isinstance(value, (list, tuple)) and len(value) <= 100_000:
+        return any(_has_complex(v) for v in value)
+    return False
+
+
+def _guard(func, error_cls, error_for=None):
+    names = list(inspect.signature(func).parameters)
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        for i, value in enumerate(args):
+            if _has_complex(value):
+                name = names[i] if i < len(names) else f"argument {i + 1}"
+                raise _error(error_cls, error_for, func.__name__, f"{name} has complex values; allowed: real numbers")
+        for name, value in kwargs.items():
+            if _has_complex(value):
+                raise _error(error_cls, error_for, func.__name__, f"{name} has complex values; allowed: real numbers")
+        try:
+            return func(*args, **kwargs)
+        except RotframeError:
+            raise
+        except (TypeError, ValueError, IndexError) as exc:
+            text = " ".join(str(exc).split())[:200] or type(exc).__name__
+            raise _error(error_cls, error_for, func.__name__,
+                         f"invalid input ({text}); allowed: real numbers or arrays of them as documented") from exc
+
+    wrapper.__wrapped_public__ = True
+    return wrapper
+
+
+def _error(error_cls, error_for, fname, message):
+    cls = (error_for or {}).get(fname, error_cls)
+    return cls(f"{fname}: {message}")
+
+
+def guard_public(namespace: dict, names, error_cls, error_for=None) -> None:
+    """Wrap, in ``namespace``, every plain function among ``names`` (see the module docstring).
+
+    ``error_for`` maps a function name to a more specific error class.
+    """
+    for name in names:
+        func = namespace.get(name)
+        if isinstance(func, types.FunctionType) and not getattr(func, "__wrapped_public__", False):
+            namespace[name] = _guard(func, error_cls, error_for)

@@ -1,0 +1,95 @@
+"""Work limits: estimate a run's steps, samples and rows before starting; refuse what cannot finish.
+
+A run is refused, in one line with the estimate and the limit, when it would
+take more integration steps than :attr:`Limits.max_steps` (about a minute of
+compiled work for one particle) or keep more output samples than
+:attr:`Limits.max_samples` (memory); a sweep when it has more rows than
+:attr:`Limits.max_rows`. The command line raises them with ``--max-steps``,
+``--max-samples`` and ``--max-rows``.
+
+The limits in force are held in a :class:`contextvars.ContextVar` set for the
+duration of one command (:func:`applied`), so nothing outlives it; code that
+runs outside any command (the Python API, tests) gets :data:`DEFAULT`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+from dataclasses import dataclass, replace
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["Limits", "LimitError", "DEFAULT", "current", "applied", "check_run", "check_rows"]
+
+
+class LimitError(ScenarioError):
+    """The work asked for exceeds a limit (exit code 2); the message gives the estimate and the flag."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Upper bounds on one command's work.
+
+    Attributes
+    ----------
+    max_steps : float
+        Integration steps times particles of one run.
+    max_samples : float
+        Output samples of one run (each particle's state, 48 bytes, twice over while analysed).
+    max_rows : float
+        Rows of one sweep.
+    """
+
+    max_steps: float = 2e9
+    max_samples: float = 5e6
+    max_rows: float = 2e6
+
+    def with_overrides(self, **kw) -> "Limits":
+        return replace(self, **{k: float(v) for k, v in kw.items() if v is not None})
+
+
+DEFAULT = Limits()
+_CURRENT: contextvars.ContextVar[Limits] = contextvars.ContextVar("rotframe_limits", default=DEFAULT)
+
+
+def current() -> Limits:
+    """The limits in force."""
+    return _CURRENT.get()
+
+
+@contextlib.contextmanager
+def applied(limits: Limits):
+    """Make ``limits`` the ones in force inside the block."""
+    token = _CURRENT.set(limits)
+    try:
+        yield limits
+    finally:
+        _CURRENT.reset(token)
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.3g}"
+
+
+def check_run(*, steps: float = 0.0, samples: float = 0.0, particles: int = 1, what: str = "run") -> None:
+    """Refuse a run whose estimated ``steps`` (per particle) or ``samples`` exceed the limits."""
+    lim = current()
+    work = float(steps) * max(int(particles), 1)
+    if work > lim.max_steps:
+        raise LimitError(f"{what}: about {_fmt(work)} integration steps, over the limit of {_fmt(lim.max_steps)}; "
+                         "shorten duration or enlarge step, or raise the limit with --max-steps N")
+    stored = float(samples) * max(int(particles), 1)
+    if stored > lim.max_samples:
+        gb = stored * 6 * 8 * 2 / 1e9
+        raise LimitError(f"{what}: {_fmt(stored)} output samples (about {gb:.3g} GB), over the limit of "
+                         f"{_fmt(lim.max_samples)}; lower samples or duration, or raise the limit with "
+                         "--max-samples N")
+
+
+def check_rows(rows: float, what: str = "sweep") -> None:
+    """Refuse a sweep of more than ``max_rows`` rows."""
+    lim = current()
+    if float(rows) > lim.max_rows:
+        raise LimitError(f"{what}: {_fmt(float(rows))} rows, over the limit of {_fmt(lim.max_rows)}; use fewer "
+                         "points, or raise the limit with --max-rows N")
