@@ -14,6 +14,15 @@ trap 'rm -rf "$work"' EXIT
 wheel="$(ls "$work"/dist/rotframe-*.whl)"
 "$py" -m zipfile -l "$wheel" | grep -q "rotframe/scenarios/tower-drop.toml" \
   || { echo "wheel-check: the wheel has no rotframe/scenarios/*.toml" >&2; exit 1; }
+# every module of the source tree is in the wheel (a package missing from pyproject's list is not)
+"$py" - "$wheel" "$repo/src" <<'PY'
+import pathlib, sys, zipfile
+names = set(zipfile.ZipFile(sys.argv[1]).namelist())
+src = pathlib.Path(sys.argv[2])
+missing = [str(p.relative_to(src)) for p in src.rglob("rotframe/**/*.py") if str(p.relative_to(src)) not in names]
+if missing:
+    sys.exit(f"wheel-check: the wheel lacks {', '.join(sorted(missing))}")
+PY
 "$py" -m pip install -q --no-deps --target "$work/site" "$wheel"
 mkdir -p "$work/run"
 cd "$work/run"
@@ -27,6 +36,10 @@ echo "$listed"
 for name in $(ls "$repo/scenarios" | sed 's/\.toml$//'); do
   grep -q "$name" <<<"$listed" || { echo "wheel-check: scenario $name missing from 'rotframe list'" >&2; exit 1; }
 done
-"$py" -m rotframe run tower-drop --no-record --json >"$work/out.json"
-"$py" -c 'import json, sys; d = json.load(open(sys.argv[1])); assert d["metrics"], d' "$work/out.json"
+# every built-in scenario runs from the installed copy
+for name in $(ls "$repo/scenarios" | sed 's/\.toml$//'); do
+  "$py" -m rotframe run "$name" --no-record --json >"$work/out.json"
+  "$py" -c 'import json, sys; d = json.load(open(sys.argv[1])); assert d["metrics"], d' "$work/out.json"
+  echo "wheel-check: $name ran"
+done
 echo "wheel-check: ok ($(basename "$wheel"))"

@@ -224,6 +224,21 @@ def _check_work(info, duration, step, samples, n):
     limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
 
 
+def _adaptive_chunk(info, steps, done, samples, n):
+    """Samples in the next call of an adaptive kernel, from the steps its first ``done`` samples took.
+
+    The run's total is projected from the rate so far and refused (:mod:`rotframe.limits`)
+    when it is over the work limit, and a call is sized to about 2e5 particle-steps
+    (a tenth of a second), so that Python regains control (signals, progress) that often.
+    """
+    from rotframe import limits
+
+    per_sample = max(steps, 1) / max(done, 1)
+    limits.check_run(steps=steps + per_sample * (samples - done), particles=n,
+                     what=f"method {info.name} (projected from its first {done} samples)")
+    return int(min(max(1.0, 2e5 / (per_sample * max(n, 1))), 1e6))
+
+
 def _event_table(events):
     if not events:
         return np.zeros((0, 5))
@@ -296,7 +311,8 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
     guard = _energy_guard(model, r0, v0)
-    chunk = max(1, int(4e6 // max(cost, 1)))
+    # an adaptive method's cost per sample is known only once it ran: it starts with one sample
+    chunk = max(1, int(4e6 // max(cost, 1))) if info.kind == "fixed" else 1
     done = 0
     nfev = 0
     steps = 0
@@ -333,6 +349,7 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
                     r, v, alive, t0, times[sl], P, wt, wv, float(rtol), atol, dt_sample / 10.0,
                     A, B, C, E3, E5, ev_tab, out_r[sl], out_v[sl], *evb.args(), h_state)
                 steps += st
+                chunk = _adaptive_chunk(info, steps, done + m, samples, n)
             nfev += nf
             if n_done < m or bad >= 0:
                 good = done + 1 + n_done
