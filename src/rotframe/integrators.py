@@ -224,19 +224,19 @@ def _check_work(info, duration, step, samples, n):
     limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
 
 
-def _adaptive_chunk(info, steps, done, samples, n):
-    """Samples in the next call of an adaptive kernel, from the steps its first ``done`` samples took.
+def _adaptive_chunk(info, per_sample, samples, n):
+    """Samples per call of an adaptive kernel that took ``per_sample`` steps over its first sample.
 
-    The run's total is projected from the rate so far and refused (:mod:`rotframe.limits`)
-    when it is over the work limit, and a call is sized to about 2e5 particle-steps
-    (a tenth of a second), so that Python regains control (signals, progress) that often.
+    The run's total is projected from that rate and refused (:mod:`rotframe.limits`) when it
+    is over the work limit; a call is kept under about 2e5 particle-steps (a tenth of a
+    second), so that Python regains control (signals, progress) that often.
     """
     from rotframe import limits
 
-    per_sample = max(steps, 1) / max(done, 1)
-    limits.check_run(steps=steps + per_sample * (samples - done), particles=n,
-                     what=f"method {info.name} (projected from its first {done} samples)")
-    return int(min(max(1.0, 2e5 / (per_sample * max(n, 1))), 1e6))
+    per_sample = max(float(per_sample), 1.0)
+    limits.check_run(steps=per_sample * samples, particles=n,
+                     what=f"method {info.name} (projected from its first sample interval)")
+    return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
 
 
 def _event_table(events):
@@ -311,8 +311,7 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
     guard = _energy_guard(model, r0, v0)
-    # an adaptive method's cost per sample is known only once it ran: it starts with one sample
-    chunk = max(1, int(4e6 // max(cost, 1))) if info.kind == "fixed" else 1
+    chunk = max(1, int(4e6 // max(cost, 1)))
     done = 0
     nfev = 0
     steps = 0
@@ -329,6 +328,14 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
                                C, E3, E5, ev_tab, out_r[:0], out_v[:0], *_EventBuffers(0, 1).args(), h_state[:0])
         _LOADED.add(info.kind)
         compile_s = time.perf_counter() - t_load
+        if info.kind != "fixed":
+            # an adaptive method's cost is known only once it ran: a probe of the first sample
+            # interval, on copies (the run itself is untouched), projects the work and sizes the calls
+            probe = kernels.run_dop853(
+                r.copy(), v.copy(), alive.copy(), 0.0, times[1:2], P, wt, wv, float(rtol), atol, dt_sample / 10.0,
+                A, B, C, E3, E5, ev_tab, out_r[1:2].copy(), out_v[1:2].copy(),
+                *_EventBuffers(n, max_events).args(), h_state.copy())
+            chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
         while done < samples:
             m = min(chunk, samples - done)
             t0 = times[done]
@@ -349,7 +356,6 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
                     r, v, alive, t0, times[sl], P, wt, wv, float(rtol), atol, dt_sample / 10.0,
                     A, B, C, E3, E5, ev_tab, out_r[sl], out_v[sl], *evb.args(), h_state)
                 steps += st
-                chunk = _adaptive_chunk(info, steps, done + m, samples, n)
             nfev += nf
             if n_done < m or bad >= 0:
                 good = done + 1 + n_done

@@ -548,6 +548,17 @@ def _is_peer(r):
     return r.get("family") == "peer" or r["method"].startswith(("scipy", "diffrax"))
 
 
+
+def _problem_keys(rows):
+    """The (scenario, horizon) of each benchmarked problem, in order of first appearance."""
+    keys = []
+    for r in rows:
+        k = (r["scenario"], r.get("horizon"))
+        if r.get("horizon") and r.get("kind") != "summary" and k not in keys:
+            keys.append(k)
+    return keys
+
+
 def level_summary(rows, levels=LEVELS):
     """Summary rows: per (scenario, horizon) and error level, the fastest rotframe and peer runs and their ratio.
 
@@ -557,11 +568,7 @@ def level_summary(rows, levels=LEVELS):
     says why a level has no ratio.
     """
     out = []
-    keys = []
-    for r in rows:
-        k = (r["scenario"], r.get("horizon"))
-        if r.get("horizon") and r.get("kind") != "summary" and k not in keys:
-            keys.append(k)
+    keys = _problem_keys(rows)
     for scenario, horizon in keys:
         sel = [r for r in rows if (r["scenario"], r.get("horizon")) == (scenario, horizon)
                and r.get("kind") != "summary" and r["error"] is not None and np.isfinite(r["error"])]
@@ -875,11 +882,7 @@ def plot(rows, folder):
 
     os.makedirs(folder, exist_ok=True)
     paths = []
-    keys = []
-    for r in rows:
-        k = (r["scenario"], r.get("horizon"))
-        if r.get("horizon") and r.get("kind") != "summary" and k not in keys:
-            keys.append(k)
+    keys = _problem_keys(rows)
     for scenario, horizon in keys:
         fig = Figure(figsize=(7, 5))
         FigureCanvasAgg(fig)
