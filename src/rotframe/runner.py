@@ -78,10 +78,10 @@ def summarize(scn, values, result, timing):
         "model": list(result.terms),
         "method": result.method,
         "steps": int(result.steps),
-        "metrics": analysis["metrics"],
-        "theory": theory,
+        "metrics": _plain(analysis["metrics"]),
+        "theory": _plain(theory),
         "theory_notes": dict(analysis.get("theory_notes", {})),
-        "diagnostics": analysis.get("diagnostics", {}),
+        "diagnostics": _plain(analysis.get("diagnostics", {})),
         "warnings": list(analysis.get("warnings", [])) + theory_warnings(
             analysis["metrics"], theory, analysis.get("tolerance", {}), analysis.get("theory_notes", {})),
         "timing": dict(timing),
@@ -93,6 +93,11 @@ def summarize(scn, values, result, timing):
         summary["complete"] = False
         summary["t_reached_s"] = float(result.trajectory.t_reached)
     return summary
+
+
+def _plain(values: dict) -> dict:
+    """Numbers as Python's own (a numpy scalar becomes a float, int or bool), as JSON will have them."""
+    return {k: v.item() if hasattr(v, "item") and getattr(v, "ndim", 1) == 0 else v for k, v in values.items()}
 
 
 def theory_warnings(metrics, theory, tolerance, notes=None):
