@@ -67,8 +67,9 @@ def scenarios() -> list[str]:
     ['dzhanibekov', 'foucault', 'free-top']
     """
     from rotframe import scenario as sc
-    from rotframe.scenes import SCENARIO_FILES
+    from rotframe.scenes import SCENARIO_FILES, load_plugins
 
+    load_plugins()  # as the command line: the modules named in $ROTFRAME_PLUGINS register theirs
     return sorted(set(sc.names()) | set(SCENARIO_FILES))
 
 
