@@ -341,7 +341,7 @@ class Result:
         self.scenario = scenario
         self._values = values
         self._scene_result = scene_result
-        self._summary = summary
+        self._summary = _python_scalars(summary)  # np.float64(11.3) -> 11.3: reads as the JSON does
         self.trajectory = TrajectoryArrays.from_scene(scene_result.trajectory, scenario.scene)
 
     metrics = property(lambda self: self._summary["metrics"])
@@ -444,6 +444,17 @@ def _in_notebook() -> bool:
     except Exception:  # pragma: no cover
         return False
     return ip is not None and "IPKernelApp" in getattr(ip, "config", {})
+
+
+def _python_scalars(obj):
+    """``obj`` with numpy scalars turned into Python numbers (in dicts and lists; arrays and NaN kept)."""
+    if isinstance(obj, dict):
+        return {k: _python_scalars(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_python_scalars(v) for v in obj]
+    if type(obj).__module__ == "numpy" and getattr(obj, "ndim", None) == 0:
+        return obj.item()
+    return obj
 
 
 def _jsonable(obj):
