@@ -63,16 +63,18 @@ def test_dop853_ends_each_call_on_its_last_sample():
     """
     from rotframe.scenes import foucault
 
-    model, r0, v0, g, _ = foucault.build({"latitude": 51.4667, "length": 20.0, "amplitude": 3.0,
-                                          "small_angle": False, "g_model": "wgs84"},
-                                         ["gravity", "coriolis", "pendulum"])
     from rotframe.integrators import integrate_particles
 
-    samples = int(32 * 3600 / (2 * math.pi * math.sqrt(20.0 / g)))
-    traj = integrate_particles(model, r0, v0, 3600.0, method="dop853", samples=samples)
-    r = traj.r[:, 0]
-    assert np.isfinite(r).all() and r.shape == (samples + 1, 3)
-    assert np.abs(np.linalg.norm(r - [0.0, 0.0, 20.0], axis=1) - 20.0).max() < 1e-7
+    for latitude in (51.4667, 51 + 28 / 60):
+        model, r0, v0, g, _ = foucault.build({"latitude": latitude, "length": 20.0, "amplitude": 3.0,
+                                              "small_angle": False, "g_model": "wgs84"},
+                                             ["gravity", "coriolis", "pendulum"])
+        for duration in (3600.0, 7200.0):
+            samples = int(32 * duration / (2 * math.pi * math.sqrt(20.0 / g)))
+            traj = integrate_particles(model, r0, v0, duration, method="dop853", samples=samples)
+            r = traj.r[:, 0]
+            assert np.isfinite(r).all() and r.shape == (samples + 1, 3)
+            assert np.abs(np.linalg.norm(r - [0.0, 0.0, 20.0], axis=1) - 20.0).max() < 1e-7
 
 
 def test_metrics_print_as_plain_numbers():
