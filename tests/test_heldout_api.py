@@ -163,3 +163,32 @@ def test_foucault_example_labels_its_theory_truly(capsys, monkeypatch):
     runpy.run_path(str(ROOT / "examples" / "foucault_my_latitude.py"), run_name="__main__")
     out = capsys.readouterr().out
     assert "Airy" in out and "clockwise" in out
+
+
+def test_a_file_on_a_user_scene_declares_only_what_it_changes(tmp_path):
+    """A file with scene = "spin-gravity" takes the other parameters (and height's unit) from the
+    scenario file the scene was registered with; it was read with no unit ("20 ft": wrong dimension).
+
+    The metrics are checked against the closed form of the straight inertial line (the ball keeps
+    omega (R - h) and the floor turns under it), computed here from R, h and g_floor alone.
+    """
+    import runpy
+
+    runpy.run_path(str(ROOT / "examples" / "spin_gravity.py"))  # registers the scene, as a user's import does
+    path = tmp_path / "tall.toml"
+    path.write_text('name = "tall-drop"\nscene = "spin-gravity"\n\n[parameters.height]\ndefault = "20 ft"\n',
+                    encoding="utf-8")
+    r = rotframe.run(path)
+    R, h = 224.0, 20 * 0.3048
+    assert r.params == {"radius": R, "g_floor": 9.81, "height": pytest.approx(h)}
+    w = math.sqrt(9.81 / R)
+    d = math.sqrt(R * R - (R - h) ** 2)
+    t = d / (w * (R - h))
+    # the fall time comes from linear interpolation between 2000 samples over 1.2 t: the error is
+    # (1/8) |r''| dt^2 / |r'|, far below 1e-6 of t
+    assert r.metrics["fall_time_s"] == pytest.approx(t, rel=1e-6)
+    assert r.metrics["spinward_offset_m"] == pytest.approx(R * (math.atan2(d, R - h) - w * t), rel=1e-4)
+    env = _env(ROTFRAME_PLUGINS=str(ROOT / "examples" / "spin_gravity.py"))
+    out = subprocess.run([sys.executable, "-m", "rotframe", "run", str(path), "--json", "--no-record"],
+                         capture_output=True, text=True, env=env, cwd=tmp_path, check=True).stdout
+    assert json.loads(out)["params"]["height"] == pytest.approx(h)
