@@ -485,12 +485,17 @@ class Progress:
         self.width = width
         self.start = time.perf_counter()
         self.shown = False
+        self.first = None  # (elapsed, fraction) at the first report: the rate is measured from there
 
     def __call__(self, fraction: float) -> None:
         fraction = min(max(float(fraction), 0.0), 1.0)
         elapsed = time.perf_counter() - self.start
         filled = int(round(self.width * fraction))
-        left = f"{elapsed * (1 - fraction) / fraction:6.1f} s left" if fraction > 0 else ""
+        if self.first is None:
+            # the time before the first report (loading, compiling kernels) says nothing about the rate
+            self.first = (elapsed, fraction)
+        t1, f1 = self.first
+        left = f"{(elapsed - t1) * (1 - fraction) / (fraction - f1):6.1f} s left" if fraction > f1 else ""
         self.stream.write(f"\r{self.label}[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
                           f"{elapsed:6.1f} s {left}")
         self.stream.flush()
