@@ -1018,6 +1018,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                         # the steps summed to within a few ulp of the end: it is reached (the state
                         # is off by |f| * 10 ulp(t), far below any tolerance); not a collapsed step
                         at_end = True
+                        h = h_ctrl  # the next call starts from the controller's step, not from the ulps
                     else:
                         failed = True
                     break
@@ -1034,11 +1035,6 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                     fac = max(0.2, 0.9 * err ** (-1.0 / 8.0))
                 h_used = h
                 h = h * fac
-                if accepted and truncated and h < h_ctrl:
-                    # a step cut short to land on t_end (a call's last sample) says nothing against
-                    # the controller's own proposal: the next call starts from that, not from the
-                    # cut (a cut of a few ulp would otherwise be carried on as the step size)
-                    h = h_ctrl
             if failed:
                 break
             if at_end:
