@@ -18,8 +18,10 @@ args = parser.parse_args()
 
 r = rotframe.run("foucault", latitude=args.latitude, length=args.length, duration=args.duration)
 rate, theory = r.metrics["precession_rate_deg_per_hour"], r.theory["precession_rate_deg_per_hour"]
-sense = "clockwise" if rate > 0 else "anticlockwise"
+sense = "clockwise" if rate > 5e-4 else "anticlockwise" if rate < -5e-4 else "(not measurably)"
 print(f"latitude {r.params['latitude']:.4f} deg, string {r.params['length']:g} m, period {r.metrics['period_s']:.3f} s")
-print(f"the swing plane turns {abs(rate):.3f} deg/h {sense} seen from above (Omega sin(lat): {abs(theory):.3f} deg/h)")
-if rate:
+omega_sin = r.diagnostics["omega_sin_latitude_deg_per_hour"]
+print(f"the swing plane turns {abs(rate):.3f} deg/h {sense} seen from above "
+      f"(theory {abs(theory):.3f} deg/h: Omega sin(lat) = {abs(omega_sin):.3f} less Airy's finite-swing correction)")
+if abs(rate) > 5e-4:
     print(f"a full turn takes {360 / abs(rate):.1f} h")

@@ -67,8 +67,9 @@ def scenarios() -> list[str]:
     ['dzhanibekov', 'foucault', 'free-top']
     """
     from rotframe import scenario as sc
-    from rotframe.scenes import SCENARIO_FILES
+    from rotframe.scenes import SCENARIO_FILES, load_plugins
 
+    load_plugins()  # as the command line: the modules named in $ROTFRAME_PLUGINS register theirs
     return sorted(set(sc.names()) | set(SCENARIO_FILES))
 
 
@@ -340,7 +341,7 @@ class Result:
         self.scenario = scenario
         self._values = values
         self._scene_result = scene_result
-        self._summary = summary
+        self._summary = _python_scalars(summary)  # np.float64(11.3) -> 11.3: reads as the JSON does
         self.trajectory = TrajectoryArrays.from_scene(scene_result.trajectory, scenario.scene)
 
     metrics = property(lambda self: self._summary["metrics"])
@@ -445,6 +446,17 @@ def _in_notebook() -> bool:
     return ip is not None and "IPKernelApp" in getattr(ip, "config", {})
 
 
+def _python_scalars(obj):
+    """``obj`` with numpy scalars turned into Python numbers (in dicts and lists; arrays and NaN kept)."""
+    if isinstance(obj, dict):
+        return {k: _python_scalars(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_python_scalars(v) for v in obj]
+    if type(obj).__module__ == "numpy" and getattr(obj, "ndim", None) == 0:
+        return obj.item()
+    return obj
+
+
 def _jsonable(obj):
     if isinstance(obj, dict):
         return {str(k): _jsonable(v) for k, v in obj.items()}
@@ -473,12 +485,17 @@ class Progress:
         self.width = width
         self.start = time.perf_counter()
         self.shown = False
+        self.first = None  # (elapsed, fraction) at the first report: the rate is measured from there
 
     def __call__(self, fraction: float) -> None:
         fraction = min(max(float(fraction), 0.0), 1.0)
         elapsed = time.perf_counter() - self.start
         filled = int(round(self.width * fraction))
-        left = f"{elapsed * (1 - fraction) / fraction:6.1f} s left" if fraction > 0 else ""
+        if self.first is None:
+            # the time before the first report (loading, compiling kernels) says nothing about the rate
+            self.first = (elapsed, fraction)
+        t1, f1 = self.first
+        left = f"{(elapsed - t1) * (1 - fraction) / (fraction - f1):6.1f} s left" if fraction > f1 else ""
         self.stream.write(f"\r{self.label}[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
                           f"{elapsed:6.1f} s {left}")
         self.stream.flush()

@@ -295,9 +295,13 @@ def cmd_list(args) -> int:
     import tomllib
 
     from rotframe.scenario import scenario_dir
+    from rotframe.scenes import SCENARIO_FILES, load_plugins
 
+    load_plugins()  # scenes registered by $ROTFRAME_PLUGINS, with their scenario files, are listed too
+    paths = {p.stem: p for p in scenario_dir().glob("*.toml")}
+    paths.update(SCENARIO_FILES)
     rows = []
-    for path in sorted(scenario_dir().glob("*.toml")):
+    for path in (paths[k] for k in sorted(paths)):
         try:
             data = tomllib.loads(path.read_text(encoding="utf-8"))
         except (OSError, tomllib.TOMLDecodeError) as exc:

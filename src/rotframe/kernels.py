@@ -1005,12 +1005,22 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         while is_alive and t < t_end:
             # one accepted step
             accepted = False
+            at_end = False
+            truncated = False
             while not accepted:
-                if t + h > t_end:
+                h_ctrl = h
+                truncated = t + h > t_end
+                if truncated:
                     h = t_end - t
                 min_h = 10.0 * abs(np.nextafter(t, np.inf) - t)
                 if h < min_h:
-                    failed = True
+                    if t_end - t < min_h:
+                        # the steps summed to within a few ulp of the end: it is reached (the state
+                        # is off by |f| * 10 ulp(t), far below any tolerance); not a collapsed step
+                        at_end = True
+                        h = h_ctrl  # the next call starts from the controller's step, not from the ulps
+                    else:
+                        failed = True
                     break
                 _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
                 nf += 12
@@ -1027,7 +1037,11 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 h = h * fac
             if failed:
                 break
-            t_new = t + h_used
+            if at_end:
+                t = t_end
+                break
+            # a step cut to land on t_end ends there exactly (t + (t_end - t) may round below it)
+            t_new = t_end if truncated else t + h_used
             if p == 0:
                 steps0 += 1
             # events inside (t, t_new]

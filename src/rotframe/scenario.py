@@ -193,9 +193,14 @@ def _read_toml(path: Path, src: str) -> dict:
 
 
 def _builtin_for_scene(scene: str, path: Path) -> dict | None:
-    """The built-in scenario file of ``scene`` (its own name first), as TOML data; None if there is none."""
+    """The built-in scenario file of ``scene`` (its own name first), as TOML data; None if there is none.
+
+    A scene registered with ``rotframe.register_scene(..., scenario=FILE)`` has FILE as its built-in.
+    """
+    from rotframe.scenes import SCENARIO_FILES
+
     folder = scenario_dir()
-    candidates = [folder / f"{scene}.toml"] + sorted(folder.glob("*.toml"))
+    candidates = [folder / f"{scene}.toml", *SCENARIO_FILES.values()] + sorted(folder.glob("*.toml"))
     for cand in candidates:
         try:
             if not cand.is_file() or cand.resolve() == path.resolve():
