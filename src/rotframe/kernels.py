@@ -1006,7 +1006,10 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             # one accepted step
             accepted = False
             while not accepted:
-                if t + h > t_end:
+                # a step cut to end at t_end lands on it exactly: t + (t_end - t) can round to just
+                # below t_end, and the gap left (an ulp) is below min_h, which read as a failure
+                clipped = t + h >= t_end
+                if clipped:
                     h = t_end - t
                 min_h = 10.0 * abs(np.nextafter(t, np.inf) - t)
                 if h < min_h:
@@ -1027,7 +1030,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 h = h * fac
             if failed:
                 break
-            t_new = t + h_used
+            t_new = t_end if clipped else t + h_used
             if p == 0:
                 steps0 += 1
             # events inside (t, t_new]
