@@ -40,3 +40,18 @@ def test_earth_default_is_still_eulers_304_days():
     A, C = 8.0101e37, 8.03641e37
     s = run("free-top")
     assert s["diagnostics"]["body_precession_period_sidereal_days"] == pytest.approx(A / (C - A), rel=1e-6)
+
+
+def _wgs84_g(lat_deg):
+    # Somigliana's normal gravity, WGS84 constants typed in
+    s2 = math.sin(math.radians(lat_deg)) ** 2
+    return 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
+
+
+@pytest.mark.parametrize("h", [7e-4, 2e-3, 5e-3, 3e-2])
+def test_short_drops_land_with_the_adaptive_method(h):
+    # before: a step cut to end on a sample could stop an ulp short of it, and the gap, below the
+    # minimum step, was read as a failure (exit 3 on valid input). The fall takes sqrt(2 h / g);
+    # corrections are (Omega t)^2 < 3e-11 here, and dop853 at rtol 1e-10 is good to 1e-9 of t.
+    s = run("tower-drop", method="dop853", height=h)
+    assert s["metrics"]["fall_time_s"] == pytest.approx(math.sqrt(2 * h / _wgs84_g(50 + 53 / 60)), rel=1e-9)
