@@ -96,3 +96,18 @@ def test_apex_of_a_flight_too_short_to_sample_is_null_with_a_note():
     assert math.isnan(s["diagnostics"]["apex_m"])
     assert any("apex_m not measured" in n for n in s["notes"])
     assert s["metrics"]["flight_time_s"] > 0  # the landing is an event, found whatever the samples
+
+
+@pytest.mark.parametrize("omega", ["1,0,0", "0,1,0", "0,0,-2"])
+@pytest.mark.parametrize("method", ["exact", "rk4"])
+def test_a_spin_about_a_principal_axis_never_flips_and_claims_no_flip_interval(omega, method):
+    # Euler's equations: I1 dw1/dt = (I2 - I3) w2 w3 etc. vanish when two components are zero, so omega
+    # is constant (closed form, exact for every method: each step keeps the zero components zero).
+    # Before: theory printed 5.44 s ("exact") for omega = 1,0,0 and the note said "lengthen duration".
+    s = run("dzhanibekov", method=method, omega=omega, duration=50)
+    assert s["metrics"]["flip_interval_s"] is None or math.isnan(s["metrics"]["flip_interval_s"])
+    assert s["theory"]["flip_interval_s"] is None or math.isnan(s["theory"]["flip_interval_s"])
+    text = " ".join(s["notes"])
+    assert "steady and never flips" in text and "lengthen duration" not in text
+    assert s["diagnostics"]["flips"] == 0
+    assert s["warnings"] == []
