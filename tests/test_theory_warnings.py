@@ -314,8 +314,9 @@ BEFORE = {
                    "flight_time_s": 247.9121502117859},
     "free-top": {"body_precession_period_s": 26232727.57559629, "space_precession_rate_rad_s": 7.316066704183455e-05},
     "dzhanibekov": {"flip_interval_s": 19.55286685077705},
-    "heavy-top": {"theta_min_deg": 19.999999999999993, "theta_max_deg": 28.382765591078282,
-                  "nutation_period_s": 0.21955555555555556},
+    # nutation_period_s left out: it was read from sampled maxima, 2.8e-5 short of Goldstein's period
+    # (0.219556 for 0.219562); it is now checked against an mpmath quadrature in test_heldout_numbers.py
+    "heavy-top": {"theta_min_deg": 19.999999999999993, "theta_max_deg": 28.382765591078282},
 }
 
 

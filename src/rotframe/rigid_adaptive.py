@@ -171,7 +171,9 @@ def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
     h = min(100 * h, h1, h_max)
     steps = 0
     while t < t_end:
-        if t + h > t_end:
+        # a step cut to end at t_end lands on it exactly (t + (t_end - t) can round to an ulp short)
+        clipped = t + h >= t_end
+        if clipped:
             h = t_end - t
         if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
             return k_out, nfev, steps
@@ -201,7 +203,7 @@ def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
         if err >= 1.0:
             h *= max(0.2, 0.9 * err ** (-1.0 / 8.0))
             continue
-        t_new = t + h
+        t_new = t_end if clipped else t + h
         steps += 1
         if k_out < n_out and times[k_out] < t_new:
             # dense output (7th order) for the samples inside (t, t_new)

@@ -89,13 +89,26 @@ def analyse(values, result):
                                        "(Jacobi elliptic functions)",
                     "energy_rel_drift": exact, "momentum_rel_drift": exact}
     interval = math.nan
+    # omega along one principal axis: a steady rotation (Euler's equations give d omega / dt = 0), so
+    # nothing flips however long the run; the elliptic period there is the limit of nearby motions only
+    axis = np.nonzero(traj.L[0])[0]
+    steady = len(axis) == 1
+    if steady:
+        which = {0: "smallest", 1: "intermediate", 2: "largest"}[int(np.argsort(np.argsort(inertia))[axis[0]])]
+        notes.append(f"omega lies along a principal axis (of the {which} moment): the rotation is steady and never "
+                     "flips, so flip_interval_s and its theory are null" + (
+                         " (the intermediate axis is an unstable equilibrium: any tilt, however small, "
+                         "makes it flip, the more rarely the smaller the tilt)" if which == "intermediate" and
+                         len(set(inertia.tolist())) == 3 else ""))
     if not result.extras.get("resolved", True):
         notes.append(unresolved_note("flip_interval_s", "omega", period, float(traj.times[-1]),
                                      per_period=SAMPLES_PER_OMEGA_PERIOD))
         flips = np.array([])
     else:
         flips = flip_times(traj.times, traj.L[:, mid])
-        if len(flips) >= 2:
+        if steady:
+            pass
+        elif len(flips) >= 2:
             interval = float((flips[-1] - flips[0]) / (len(flips) - 1))
             tolerance["flip_interval_s"] = _flip_tolerance(traj, inertia, mid, len(flips) - 1, interval, traj.method)
         else:
@@ -103,9 +116,11 @@ def analyse(values, result):
     if len(set(inertia.tolist())) < 3:
         notes.append("two principal moments are equal: there is no intermediate axis; flip_interval_s is the "
                      "interval between sign changes of omega about the axis of the middle moment as sorted")
-    elif abs(traj.L[0, mid]) < 0.5 * np.linalg.norm(traj.L[0]):
+    elif abs(traj.L[0, mid]) < 0.5 * np.linalg.norm(traj.L[0]) and not steady:
         notes.append("the body starts far from its intermediate axis: omega changes sign about that axis as the "
                      "body wobbles about a stable one; it does not turn over")
+    if steady:
+        period = math.nan
     theory = {"flip_interval_s": period / 2 if math.isfinite(period) else math.nan,
               "energy_rel_drift": 0.0, "momentum_rel_drift": 0.0}
     return {"metrics": {"flip_interval_s": interval, "energy_rel_drift": e_drift, "momentum_rel_drift": m_drift},

@@ -130,8 +130,13 @@ def analyse(values, result):
             tolerance = {"body_precession_period_s": _tolerance(traj.method, k, traj) / abs(k) * theory[
                 "body_precession_period_s"], "space_precession_rate_rad_s": _tolerance(traj.method, space_theory, traj)}
             if omega3 != 0.0:
-                # a period is positive; its sense is said apart, relative to the spin
-                diagnostics["body_precession_period_sidereal_days"] = period * abs(omega3) / (2 * math.pi)
+                # a period is positive; its sense is said apart, relative to the spin. The unit is the
+                # Earth's sidereal day 2 pi / OMEGA_EARTH whatever the body (not a turn of this body's
+                # spin, which would call a top's 1.26 s period "2 days"); for the Earth's spin it is
+                # A / (C - A), Euler's 304.5 days
+                from rotframe.earth import OMEGA_EARTH
+
+                diagnostics["body_precession_period_sidereal_days"] = period * OMEGA_EARTH / (2 * math.pi)
                 diagnostics["body_precession_sense"] = ("with the spin (oblate, I3 > I1)" if body_rate * omega3 > 0
                                                         else "against the spin (prolate, I3 < I1)")
         periods = duration * abs(k) / (2 * math.pi)

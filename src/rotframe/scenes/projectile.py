@@ -24,7 +24,7 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.integrators import Event
 from rotframe.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, reject_subnormal,
-                                  rel_drift, resolve_terms, run_particles, until_event)
+                                  rel_drift, resolve_terms, run_particles, samples_for, until_event)
 
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 
@@ -51,11 +51,38 @@ def simulate(values, terms, method, run, progress):
     model, r0, v0, ground, duration, g = build(values, terms)
     method = method or run.get("method") or "dop853"
 
+    # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
+    flight = 2 * values["speed"] * math.sin(math.radians(values["elevation"])) / g
+    samples, resolved = samples_for(duration, flight, run.get("samples") or 2000)
+
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g})
+                           extras={"model": model, "g": g, "apex_resolved": resolved, "flight": flight})
 
-    return run_particles(model, r0, v0, duration, method, run, progress, finish, events=[ground])
+    return run_particles(model, r0, v0, duration, method, dict(run, samples=samples), progress, finish,
+                         events=[ground])
+
+
+def apex_height(times, r):
+    """Highest altitude (m) of the sampled flight: the vertex of the parabola through the highest sample and its neighbours.
+
+    Between samples the altitude is a parabola to O(dt^3) (gravity dominates the vertical
+    acceleration), so the vertex of the three-point fit is good to that order, where the
+    highest sample alone misses the apex by up to g dt^2 / 8.
+    """
+    z = r[:, 2]
+    i = int(np.argmax(z))
+    if i == 0 or i == len(z) - 1:
+        return float(z[i])
+    t0, t1, t2 = times[i - 1:i + 2]
+    z0, z1, z2 = z[i - 1:i + 2]
+    # Newton form of the parabola through the three points; its vertex
+    d1 = (z1 - z0) / (t1 - t0)
+    d2 = ((z2 - z1) / (t2 - t1) - d1) / (t2 - t0)
+    if not d2 < 0:
+        return float(z1)
+    tv = 0.5 * (t0 + t1) - d1 / (2 * d2)
+    return float(max(z1, z0 + d1 * (tv - t0) + d2 * (tv - t0) * (tv - t1)))
 
 
 def ground_track(values, r, model):
@@ -120,11 +147,15 @@ def analyse(values, result):
     theory, accuracy, theory_notes = theory_and_accuracy(values, g, Omega, model)
     metrics = {"range_m": float(rng[-1]), "lateral_deflection_m": float(lateral[-1]),
                "flight_time_s": float(times[-1]) if landed else math.nan}
-    diagnostics = {"apex_m": float(np.max(r[:, 2]))}
+    diagnostics = {"apex_m": apex_height(times, r)}
+    notes = []
+    if not result.extras.get("apex_resolved", True):
+        diagnostics["apex_m"] = math.nan
+        notes.append(f"apex_m not measured: the flight ({result.extras['flight']:.4g} s) is too short for the "
+                     "samples the run may keep (32 per flight needed)")
     e = jacobi_energy(model, r, v)
     if e is not None:
         diagnostics["energy_rel_drift"] = rel_drift(e)
-    notes = []
     extra = [t for t in model.terms if t not in ("gravity", "coriolis")]
     if extra:
         notes.append(f"theory is flat-Earth vacuum; the scene also has {', '.join(extra)}")
