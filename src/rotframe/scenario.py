@@ -301,9 +301,10 @@ def load(name_or_path: str) -> Scenario:
     for key, spec in specs.items():
         if not isinstance(spec, dict):
             spec = {"default": spec}
-        elif key in data.get("parameters", {}) and key in builtin.get("parameters", {}) \
-                and isinstance(builtin["parameters"][key], dict):
-            spec = {**builtin["parameters"][key], **spec}  # a file may override only the default
+        base = builtin.get("parameters", {}).get(key)
+        if key in data.get("parameters", {}) and isinstance(base, dict):
+            # a file may override only the default; the scene's parameter keeps its kind
+            spec = {"type": _infer_type(base), **base, **spec}
         _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
         if "default" not in spec:
             raise ScenarioError(f"{src}: parameters.{key} has no default")
@@ -350,6 +351,9 @@ def parse_value(p: Parameter, raw, source: str = ""):
             return False
         raise ScenarioError(f"{where}{p.name} = {raw!r}: expected true or false")
     if p.type == "str":
+        if not isinstance(raw, (str, int, float)):
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a string"
+                                + (f"; allowed {', '.join(map(str, p.choices))}" if p.choices else ""))
         value = str(raw)
         if p.choices and value not in p.choices:
             raise ScenarioError(f"{where}{p.name} = {value!r}: allowed {', '.join(map(str, p.choices))}"
@@ -361,8 +365,8 @@ def parse_value(p: Parameter, raw, source: str = ""):
             vec = [_to_float(p, x, where) for x in items]
         except ScenarioError:
             raise
-        if p.shape and len(vec) != p.shape:
-            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected {p.shape} comma-separated numbers "
+        if not vec or (p.shape and len(vec) != p.shape):
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected {p.shape or 'one or more'} comma-separated numbers "
                                 f"in {p.unit or 'the documented unit'}")
         return vec
     value = _to_float(p, raw, where)

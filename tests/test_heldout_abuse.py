@@ -1,0 +1,87 @@
+"""Held-out abuse (issue 12 follow-up): classes of bad input found after the issue's own catalogue.
+
+Every case must end with exit 0, 2 or 3, ONE line on stderr when non-zero and no
+traceback; a run that fails must not print a NaN as if it were a result.
+Each case is a single short run (tower-drop with the exact propagator, or a
+refusal before any integration), so the file runs in a few seconds.
+"""
+
+import json
+
+import pytest
+
+from rotframe.cli import main
+
+
+def call(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_clean(code, out, err, allowed=(0, 2, 3)):
+    assert code in allowed, (code, out, err)
+    assert "Traceback" not in err and "Traceback" not in out
+    if code != 0:
+        lines = err.strip().splitlines()
+        assert len(lines) == 1, err
+        assert lines[0].startswith("rotframe"), err
+
+
+def scenario_file(tmp_path, parameters: str) -> str:
+    path = tmp_path / "s.toml"
+    path.write_text('scene = "tower-drop"\nname = "s"\n' + parameters)
+    return str(path)
+
+
+@pytest.mark.parametrize("parameters", [
+    # a bare value overrides only the default: the built-in bounds (height > 0) still hold
+    "[parameters]\nheight = -1\n",
+    # a list where the scene takes a number: refused, not a TypeError deep in the scene
+    "[parameters]\nheight = []\n",
+    "[parameters.latitude]\ndefault = []\n",
+    "[parameters.drag]\ndefault = [1, 2]\n",
+    # a string parameter given a list or a table
+    "[parameters.g_model]\ndefault = [\"wgs84\"]\n",
+])
+def test_file_overrides_keep_the_scenes_kind_and_bounds(tmp_path, capsys, parameters):
+    code, out, err = call(capsys, "run", scenario_file(tmp_path, parameters), "--no-record", "--json")
+    assert_clean(code, out, err, allowed=(2,))
+    assert "parameters" in err or "height" in err or "latitude" in err or "drag" in err or "g_model" in err
+
+
+@pytest.mark.parametrize("parameters", [
+    "[parameters.height]\ndefault = 1e308\n",  # the fall time overflows to inf
+    "[parameters]\nheight = 1e308\n",
+])
+def test_overflowing_duration_is_refused_in_one_line(tmp_path, capsys, parameters):
+    code, out, err = call(capsys, "run", scenario_file(tmp_path, parameters), "--no-record", "--json")
+    assert_clean(code, out, err, allowed=(2, 3))
+    assert "RuntimeWarning" not in err
+    assert "nan" not in err.lower().replace("finite", "")
+
+
+def test_empty_vector_is_refused():
+    from rotframe.errors import ScenarioError
+    from rotframe.scenario import Parameter, parse_value
+
+    p = Parameter(name="v", default=[0.0, 0.0, 0.0], unit="m", type="vector")
+    with pytest.raises(ScenarioError, match="one or more"):
+        parse_value(p, [])
+    with pytest.raises(ScenarioError):
+        parse_value(p, "")
+
+
+def test_api_refuses_a_non_finite_duration_or_state():
+    import numpy as np
+
+    from rotframe.errors import ScenarioError
+    from rotframe.integrators import integrate_particles
+    from rotframe.model import ParticleModel
+
+    model = ParticleModel(terms=("gravity",), g=np.array([0.0, 0.0, -9.8]))
+    for duration in (float("inf"), float("nan"), -1.0, 0.0):
+        with pytest.raises(ScenarioError, match="duration"):
+            integrate_particles(model, [0, 0, 1], [0, 0, 0], duration, method="exact")
+    with pytest.raises(ScenarioError, match="non-finite"):
+        integrate_particles(model, [0, 0, float("inf")], [0, 0, 0], 1.0, method="exact")
