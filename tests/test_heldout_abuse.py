@@ -85,3 +85,25 @@ def test_api_refuses_a_non_finite_duration_or_state():
             integrate_particles(model, [0, 0, 1], [0, 0, 0], duration, method="exact")
     with pytest.raises(ScenarioError, match="non-finite"):
         integrate_particles(model, [0, 0, float("inf")], [0, 0, 0], 1.0, method="exact")
+
+
+def test_an_interrupt_swallowed_in_a_destructor_is_delivered_again(capsys):
+    """Python swallows (and prints) an exception raised in ``__del__`` or a weakref callback.
+
+    A Ctrl-C whose handler ran there was lost and printed a traceback; the scope keeps it
+    quiet and delivers the signal again, so the work still stops.
+    """
+    import time
+
+    from rotframe.signals import InterruptScope
+
+    class Dies:
+        def __del__(self):
+            raise KeyboardInterrupt()
+
+    with pytest.raises(KeyboardInterrupt):
+        with InterruptScope():
+            Dies()
+            time.sleep(5)  # the signal delivered again interrupts this within 0.1 s
+    err = capsys.readouterr().err
+    assert "Exception ignored" not in err and "Traceback" not in err

@@ -54,14 +54,22 @@ def main(argv=None) -> int:
         parser.print_help()
         return EXIT_OK
     args._t_start = t_start
-    with InterruptScope() as scope, _JsonStdout(getattr(args, "json", False)):
+    code = EXIT_OK
+    # from the command line (argv None) a signal after the work ends the process with the
+    # command's own exit code, never a traceback from the interpreter's shutdown
+    with InterruptScope(final=argv is None) as scope, _JsonStdout(getattr(args, "json", False)):
         args._scope = scope
         try:
-            return _dispatch(args)
+            code = _dispatch(args)
         except KeyboardInterrupt as exc:
+            scope.closing = True  # a second signal does not cut the one line short
             scope.note(exc)
             _error(f"{scope.verb}; stopped before any result was written")
-            return scope.exit_code
+            code = scope.exit_code
+        finally:
+            scope.exit_status = code
+            scope.closing = True
+    return code
 
 
 def _dispatch(args) -> int:
