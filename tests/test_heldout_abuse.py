@@ -107,3 +107,32 @@ def test_an_interrupt_swallowed_in_a_destructor_is_delivered_again(capsys):
             time.sleep(5)  # the signal delivered again interrupts this within 0.1 s
     err = capsys.readouterr().err
     assert "Exception ignored" not in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("call_it", [
+    # an integer too large for a float: OverflowError, an ArithmeticError, not a ValueError
+    lambda: __import__("rotframe").frames.euler_to_dcm([10**400, 0, 0], "zyx"),
+    lambda: __import__("rotframe").inertia.solid_sphere(10**400, 1.0),
+    # object input whose arithmetic divides by zero
+    lambda: __import__("rotframe").rigid.rigid_rhs(__import__("numpy").array([1, 2, 3], dtype=object),
+                                                   [0.0, 0.0, 1.0]),
+])
+def test_arithmetic_errors_from_junk_input_are_rotframe_errors(call_it):
+    from rotframe.errors import RotframeError
+
+    with pytest.raises(RotframeError):
+        call_it()
+
+
+@pytest.mark.parametrize("call_it", [
+    lambda: __import__("rotframe").frames.euler_to_dcm([float("nan"), 0, 0], "zyx"),
+    lambda: __import__("rotframe").frames.space_derivative([0, 0, 1.0], [float("nan"), 0, 0], [0, 0, 0]),
+    lambda: __import__("rotframe").inertia.point_masses([1e308, 1e308], [[1e200, 0, 0], [-1e200, 0, 0]]),
+])
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # numpy's overflow warning comes before the refusal
+def test_a_nan_result_is_refused_not_returned(call_it):
+    """NaN in, or an overflow inside, must not come back as a silent NaN."""
+    from rotframe.errors import RotframeError
+
+    with pytest.raises(RotframeError, match="NaN"):
+        call_it()
