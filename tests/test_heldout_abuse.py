@@ -136,3 +136,23 @@ def test_a_nan_result_is_refused_not_returned(call_it):
 
     with pytest.raises(RotframeError, match="NaN"):
         call_it()
+
+
+@pytest.mark.parametrize("kw", [{"height": 10**400}, {"samples": 10**400}])
+def test_api_integers_beyond_a_float_are_refused(kw):
+    import rotframe
+    from rotframe.errors import RotframeError
+
+    with pytest.raises(RotframeError, match="finite"):
+        rotframe.run("tower-drop", **kw)
+
+
+@pytest.mark.parametrize("name", ["a" * 5000 + ".toml", "a" * 5000, "x\x00.toml"])
+def test_scenario_names_the_system_cannot_open_are_refused(capsys, name):
+    import rotframe
+    from rotframe.errors import RotframeError
+
+    with pytest.raises(RotframeError):
+        rotframe.load(name)
+    code, out, err = call(capsys, "show", name)
+    assert_clean(code, out, err, allowed=(2,))

@@ -84,7 +84,12 @@ def find(name_or_path: str) -> Path:
     text = str(name_or_path)
     if text.endswith(".toml"):
         path = Path(text)
-        if not path.is_file():
+        try:
+            found = path.is_file()
+        except (OSError, ValueError) as exc:  # a name too long, a NUL byte
+            raise ScenarioError(f"scenario file {text[:80]!r}{'...' if len(text) > 80 else ''}: cannot be "
+                                f"read ({_first_line(exc)[:80]}); allowed: a path to a .toml file") from None
+        if not found:
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
     from rotframe.scenes import SCENARIO_FILES, load_plugins
@@ -97,7 +102,11 @@ def find(name_or_path: str) -> Path:
         raise ScenarioError(f"scenario {text!r}: not a scenario name; use one of {', '.join(valid)} "
                             "or a path ending in .toml")
     path = scenario_dir() / f"{text}.toml"
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):  # a name too long, a NUL byte: no such scenario
+        found = False
+    if not found:
         raise ScenarioError(f"unknown scenario {text!r}{_did_you_mean(text, valid)}; available: {', '.join(valid)}")
     return path
 
@@ -382,7 +391,10 @@ def _to_float(p: Parameter, raw, where: str) -> float:
     if isinstance(raw, bool):
         raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a number in {p.unit or 'the documented unit'}")
     if isinstance(raw, (int, float)):
-        value = float(raw)
+        try:
+            value = float(raw)
+        except OverflowError:  # an integer beyond a float's range
+            value = math.inf
     elif isinstance(raw, str):
         value = _parse_quantity(p, raw.strip(), where)
     else:
