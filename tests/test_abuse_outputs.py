@@ -171,6 +171,7 @@ def test_view_starts_the_viewer_on_loopback(tmp_path, capsys, monkeypatch):
 
     seen = []
     monkeypatch.setattr(sp, "call", lambda argv, **k: seen.append(argv) or 0)
+    monkeypatch.setenv("DISPLAY", ":0")  # a headless machine gets a text summary instead of the viewer
     good = tmp_path / "good.rrd"
     assert main(["run", "turntable", "--out", str(good), "--set", "samples=100"]) == 0
     assert main(["view", str(good)]) == 0
