@@ -187,7 +187,7 @@ def test_file_recording_goes_under_recordings(tmp_path, capsys, monkeypatch):
 @pytest.mark.parametrize("argv,fragment", [
     (["run", "foucault", "--set", "samples=1e12"], "--max-"),
     (["run", "foucault", "--set", "duration=100 yr"], "--max-steps"),
-    (["run", "foucault", "--set", "step=1e-12"], "--max-steps"),
+    (["run", "foucault", "--set", "step=1e-12", "--set", "method=splitting"], "--max-steps"),  # step: a fixed-step method
     (["run", "free-top", "--set", "samples=1e12"], "--max-samples"),
     (["run", "heavy-top", "--set", "step=1e-12"], "--max-steps"),
     (["sweep", "tower-drop", "--grid", "latitude=0:90:1000000000"], "--max-rows"),
