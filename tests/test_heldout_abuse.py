@@ -156,3 +156,11 @@ def test_scenario_names_the_system_cannot_open_are_refused(capsys, name):
         rotframe.load(name)
     code, out, err = call(capsys, "show", name)
     assert_clean(code, out, err, allowed=(2,))
+
+
+def test_a_toml_file_nested_thousands_deep_is_refused(tmp_path, capsys):
+    path = tmp_path / "deep.toml"
+    path.write_text("a = " + "[" * 5000 + "]" * 5000 + "\n")
+    code, out, err = call(capsys, "show", str(path))
+    assert_clean(code, out, err, allowed=(2,))
+    assert "nested too deeply" in err

@@ -199,6 +199,9 @@ def _read_toml(path: Path, src: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{src}: not valid TOML: {exc}") from None
+    except RecursionError:  # arrays or inline tables nested thousands deep
+        raise ScenarioError(f"{src}: nested too deeply to read; allowed: a scenario file "
+                            "(tables of values, a few levels deep)") from None
 
 
 def _builtin_for_scene(scene: str, path: Path) -> dict | None:
