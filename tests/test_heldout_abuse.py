@@ -164,3 +164,23 @@ def test_a_toml_file_nested_thousands_deep_is_refused(tmp_path, capsys):
     code, out, err = call(capsys, "show", str(path))
     assert_clean(code, out, err, allowed=(2,))
     assert "nested too deeply" in err
+
+
+def test_more_periods_than_a_float_counts_are_unresolved_not_an_overflow():
+    from rotframe.scenes.base import samples_for
+
+    assert samples_for(1e308, 1e-10, 2000) == (2000, False)
+
+
+def test_the_command_line_prints_no_numpy_warnings():
+    """An overflow inside the analysis is handled (null metric, note); numpy's warning lines stay off stderr."""
+    import os
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "rotframe", "run", "dzhanibekov", "--no-record", "--json",
+                           "--set", "omega=1e200,1e200,1e200"], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONWARNINGS": ""})
+    assert proc.returncode == 0, proc.stderr
+    assert "RuntimeWarning" not in proc.stderr
+    json.loads(proc.stdout)
