@@ -184,3 +184,18 @@ def test_the_command_line_prints_no_numpy_warnings():
     assert proc.returncode == 0, proc.stderr
     assert "RuntimeWarning" not in proc.stderr
     json.loads(proc.stdout)
+
+
+@pytest.mark.parametrize("sig,code", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_while_starting_is_one_line_and_the_shells_code(sig, code):
+    """The entry point handles signals before importing the command line (no import traceback)."""
+    import subprocess
+    import sys
+
+    script = ("import os, signal, time, rotframe._console\n"
+              f"os.kill(os.getpid(), signal.{sig})\n"
+              "time.sleep(10)\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == code
+    assert proc.stderr.strip().splitlines() == [proc.stderr.strip()] and "while starting" in proc.stderr
+    assert "Traceback" not in proc.stderr
