@@ -1,3 +1,3 @@
-from rotframe.cli import main
+from rotframe._console import main
 
 raise SystemExit(main())

@@ -8,7 +8,10 @@
 * a ``TypeError`` / ``ValueError`` / ``IndexError`` raised while numpy converts
   junk (a string, ``None``, an object, a ragged list) becomes the module's
   :class:`~rotframe.errors.RotframeError` subclass, which is still a
-  ``ValueError``, with one line naming the function.
+  ``ValueError``, with one line naming the function; so does an arithmetic error
+  (an integer too large for a float, a division by zero in object input);
+* a result holding a NaN (from a NaN or infinite input, an overflow, a degenerate
+  body) is refused the same way, never returned silently.
 
 Errors the functions raise on purpose pass unchanged. Compiled (numba)
 functions are left alone.
@@ -37,6 +40,17 @@ def _has_complex(value) -> bool:
     return False
 
 
+def _has_nan(value) -> bool:
+    """True if ``value`` (a number, an array, or a tuple or list of them) holds a NaN."""
+    if isinstance(value, (float, np.floating)):
+        return value != value
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind in "fc" and bool(np.isnan(value).any())
+    if isinstance(value, (tuple, list)) and len(value) <= 64:
+        return any(_has_nan(v) for v in value)
+    return False
+
+
 def _guard(func, error_cls, error_for=None):
     names = list(inspect.signature(func).parameters)
 
@@ -50,13 +64,19 @@ def _guard(func, error_cls, error_for=None):
             if _has_complex(value):
                 raise _error(error_cls, error_for, func.__name__, f"{name} has complex values; allowed: real numbers")
         try:
-            return func(*args, **kwargs)
+            result = func(*args, **kwargs)
         except RotframeError:
             raise
-        except (TypeError, ValueError, IndexError) as exc:
+        except (TypeError, ValueError, IndexError, ArithmeticError) as exc:
             text = " ".join(str(exc).split())[:200] or type(exc).__name__
             raise _error(error_cls, error_for, func.__name__,
                          f"invalid input ({text}); allowed: real numbers or arrays of them as documented") from exc
+
+        if _has_nan(result):
+            raise _error(error_cls, error_for, func.__name__,
+                         "the result is not a number (NaN): an input is NaN or infinite, too large, or "
+                         "degenerate; allowed: finite inputs in the documented ranges")
+        return result
 
     wrapper.__wrapped_public__ = True
     return wrapper

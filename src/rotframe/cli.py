@@ -25,6 +25,7 @@ import math
 import os
 import sys
 import time
+import warnings
 
 EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERNAL = 0, 2, 3, 1
 
@@ -54,14 +55,27 @@ def main(argv=None) -> int:
         parser.print_help()
         return EXIT_OK
     args._t_start = t_start
-    with InterruptScope() as scope, _JsonStdout(getattr(args, "json", False)):
+    code = EXIT_OK
+    # from the command line (argv None) a signal after the work ends the process with the
+    # command's own exit code, never a traceback from the interpreter's shutdown
+    with InterruptScope(final=argv is None) as scope, _JsonStdout(getattr(args, "json", False)), \
+            warnings.catch_warnings():
+        if argv is None:
+            # on the command line numpy's overflow warnings are not messages for the user: an
+            # overflow that matters is caught as a non-finite value and reported in one line
+            warnings.simplefilter("ignore", RuntimeWarning)
         args._scope = scope
         try:
-            return _dispatch(args)
+            code = _dispatch(args)
         except KeyboardInterrupt as exc:
+            scope.closing = True  # a second signal does not cut the one line short
             scope.note(exc)
             _error(f"{scope.verb}; stopped before any result was written")
-            return scope.exit_code
+            code = scope.exit_code
+        finally:
+            scope.exit_status = code
+            scope.closing = True
+    return code
 
 
 def _dispatch(args) -> int:

@@ -193,8 +193,11 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     if r0.shape != v0.shape or r0.shape[-1] != 3:
         raise ScenarioError(f"initial state: r0 and v0 must be (N, 3), got {r0.shape} and {v0.shape}")
     duration = float(duration)
-    if not duration > 0:
-        raise ScenarioError(f"duration: {duration} s; must be > 0")
+    if not (math.isfinite(duration) and duration > 0):
+        raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
+    if not (np.isfinite(r0).all() and np.isfinite(v0).all()):
+        raise ScenarioError("initial state: the parameters give a non-finite position or velocity "
+                            "(a parameter too large?)")
     samples = max(1, int(samples))
     _check_work(info, duration, step, samples, r0.shape[0])
     if info.kind == "exact":

@@ -84,7 +84,12 @@ def find(name_or_path: str) -> Path:
     text = str(name_or_path)
     if text.endswith(".toml"):
         path = Path(text)
-        if not path.is_file():
+        try:
+            found = path.is_file()
+        except (OSError, ValueError) as exc:  # a name too long, a NUL byte
+            raise ScenarioError(f"scenario file {text[:80]!r}{'...' if len(text) > 80 else ''}: cannot be "
+                                f"read ({_first_line(exc)[:80]}); allowed: a path to a .toml file") from None
+        if not found:
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
     from rotframe.scenes import SCENARIO_FILES, load_plugins
@@ -97,7 +102,11 @@ def find(name_or_path: str) -> Path:
         raise ScenarioError(f"scenario {text!r}: not a scenario name; use one of {', '.join(valid)} "
                             "or a path ending in .toml")
     path = scenario_dir() / f"{text}.toml"
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):  # a name too long, a NUL byte: no such scenario
+        found = False
+    if not found:
         raise ScenarioError(f"unknown scenario {text!r}{_did_you_mean(text, valid)}; available: {', '.join(valid)}")
     return path
 
@@ -190,6 +199,9 @@ def _read_toml(path: Path, src: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{src}: not valid TOML: {exc}") from None
+    except RecursionError:  # arrays or inline tables nested thousands deep
+        raise ScenarioError(f"{src}: nested too deeply to read; allowed: a scenario file "
+                            "(tables of values, a few levels deep)") from None
 
 
 def _builtin_for_scene(scene: str, path: Path) -> dict | None:
@@ -306,9 +318,10 @@ def load(name_or_path: str) -> Scenario:
     for key, spec in specs.items():
         if not isinstance(spec, dict):
             spec = {"default": spec}
-        elif key in data.get("parameters", {}) and key in builtin.get("parameters", {}) \
-                and isinstance(builtin["parameters"][key], dict):
-            spec = {**builtin["parameters"][key], **spec}  # a file may override only the default
+        base = builtin.get("parameters", {}).get(key)
+        if key in data.get("parameters", {}) and isinstance(base, dict):
+            # a file may override only the default; the scene's parameter keeps its kind
+            spec = {"type": _infer_type(base), **base, **spec}
         _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
         if "default" not in spec:
             raise ScenarioError(f"{src}: parameters.{key} has no default")
@@ -355,6 +368,9 @@ def parse_value(p: Parameter, raw, source: str = ""):
             return False
         raise ScenarioError(f"{where}{p.name} = {raw!r}: expected true or false")
     if p.type == "str":
+        if not isinstance(raw, (str, int, float)):
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a string"
+                                + (f"; allowed {', '.join(map(str, p.choices))}" if p.choices else ""))
         value = str(raw)
         if p.choices and value not in p.choices:
             raise ScenarioError(f"{where}{p.name} = {value!r}: allowed {', '.join(map(str, p.choices))}"
@@ -366,8 +382,8 @@ def parse_value(p: Parameter, raw, source: str = ""):
             vec = [_to_float(p, x, where) for x in items]
         except ScenarioError:
             raise
-        if p.shape and len(vec) != p.shape:
-            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected {p.shape} comma-separated numbers "
+        if not vec or (p.shape and len(vec) != p.shape):
+            raise ScenarioError(f"{where}{p.name} = {raw!r}: expected {p.shape or 'one or more'} comma-separated numbers "
                                 f"in {p.unit or 'the documented unit'}")
         return vec
     value = _to_float(p, raw, where)
@@ -383,7 +399,10 @@ def _to_float(p: Parameter, raw, where: str) -> float:
     if isinstance(raw, bool):
         raise ScenarioError(f"{where}{p.name} = {raw!r}: expected a number in {p.unit or 'the documented unit'}")
     if isinstance(raw, (int, float)):
-        value = float(raw)
+        try:
+            value = float(raw)
+        except OverflowError:  # an integer beyond a float's range
+            value = math.inf
     elif isinstance(raw, str):
         value = _parse_quantity(p, raw.strip(), where)
     else:

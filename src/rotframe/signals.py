@@ -12,7 +12,9 @@ SIGTERM.
 
 from __future__ import annotations
 
+import os
 import signal
+import sys
 
 __all__ = ["Terminated", "InterruptScope", "EXIT_SIGINT", "EXIT_SIGTERM"]
 
@@ -34,23 +36,63 @@ class InterruptScope:
         True once either signal arrived.
     """
 
-    def __init__(self):
+    def __init__(self, final: bool = False):
         self.terminated = False
         self.interrupted = False
+        #: set once the command's work is over (its files are in place, its output written):
+        #: a signal from then on no longer raises into the code that is closing up
+        self.closing = False
+        #: a whole process's command (the command line, not an in-process call): on leaving the
+        #: scope, a late signal ends the process at once with the command's own exit code
+        #: instead of a traceback from the interpreter's shutdown or a death by signal
+        self.final = final
+        self.exit_status = 0
         self._previous = {}
 
     # the handlers --------------------------------------------------------------
 
     def _on_term(self, signum, frame):
+        if self.closing:
+            return
         self.terminated = True
         self.interrupted = True
         raise Terminated()
 
     def _on_int(self, signum, frame):
+        if self.closing:
+            return
         self.interrupted = True
         raise KeyboardInterrupt()
 
+    def _on_late(self, signum, frame):
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except Exception:  # a write the signal cut into: what was written stays written
+                pass
+        os._exit(self.exit_status)
+
+    def _unraisable(self, info):
+        """A signal's exception raised inside a weakref callback or ``__del__`` is swallowed by Python.
+
+        It is not printed (no traceback); the signal is delivered again a moment later, when
+        the main thread is most likely back in ordinary code, so that the stop is not lost.
+        """
+        if isinstance(info.exc_value, KeyboardInterrupt) and not self.closing:
+            import threading
+
+            sig = signal.SIGTERM if isinstance(info.exc_value, Terminated) else signal.SIGINT
+            timer = threading.Timer(0.05, os.kill, (os.getpid(), sig))
+            timer.daemon = True
+            timer.start()
+            return
+        if isinstance(info.exc_value, KeyboardInterrupt):
+            return
+        self._previous_hook(info)
+
     def __enter__(self):
+        self._previous_hook = sys.unraisablehook
+        sys.unraisablehook = self._unraisable
         for sig, handler in ((signal.SIGTERM, self._on_term), (signal.SIGINT, self._on_int)):
             try:
                 self._previous[sig] = signal.signal(sig, handler)
@@ -59,7 +101,11 @@ class InterruptScope:
         return self
 
     def __exit__(self, *exc):
+        if sys.unraisablehook == self._unraisable:
+            sys.unraisablehook = self._previous_hook
         for sig, handler in self._previous.items():
+            if self.final:
+                handler = self._on_late
             try:
                 signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
             except (ValueError, OSError):

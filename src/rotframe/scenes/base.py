@@ -194,7 +194,10 @@ def samples_for(duration, shortest_period, requested, per_period=SAMPLES_PER_PER
     requested = max(1, int(requested))
     if not (shortest_period > 0 and math.isfinite(shortest_period)):
         return requested, True
-    need = math.ceil(per_period * duration / shortest_period)
+    ratio = per_period * duration / shortest_period
+    if not math.isfinite(ratio):  # more periods than a float counts: no bound of samples resolves them
+        return requested, False
+    need = math.ceil(ratio)
     if need <= requested:
         return requested, True
     if need > max(requested, int(bound)):

@@ -46,6 +46,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
 
     from rotframe import limits
 
+    duration = float(duration)
+    if not (math.isfinite(duration) and duration > 0):
+        raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
     samples = max(1, int(run.get("samples") or 2000))
     per_sample = 1.0 if method == "exact" else max(1.0, math.ceil(
         (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))

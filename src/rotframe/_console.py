@@ -1,0 +1,33 @@
+"""The command-line entry point: Ctrl-C and SIGTERM are handled before anything else is imported.
+
+While rotframe starts (imports, argument parsing) nothing has been computed or
+written, so a signal then ends the process at once with one line and the shell's
+exit code (130 after Ctrl-C, 143 after SIGTERM) instead of a traceback from an
+import. :func:`rotframe.cli.main` then installs its own handlers for the command.
+"""
+
+import os
+import signal
+
+
+def _starting(signum, frame):
+    verb = "terminated" if signum == signal.SIGTERM else "interrupted"
+    try:
+        os.write(2, f"rotframe: error: {verb} while starting; nothing was done\n".encode())
+    except OSError:
+        pass
+    os._exit(143 if signum == signal.SIGTERM else 130)
+
+
+for _sig in (signal.SIGINT, signal.SIGTERM):
+    try:
+        signal.signal(_sig, _starting)
+    except (ValueError, OSError):  # not the main thread
+        pass
+
+from rotframe.cli import main as _cli_main  # noqa: E402
+
+
+def main() -> int:
+    """Run the command named on the command line (``sys.argv``); returns its exit code."""
+    return _cli_main()
