@@ -13,24 +13,11 @@ import pytest
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
-from rotframe.cli import main  # noqa: E402
 
 BOUNDS = ["--max-steps", "2e5", "--max-samples", "2e4"]
 
 
-def call(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def assert_clean(code, out, err, allowed=(0, 2, 3)):
-    assert code in allowed, (code, out, err)
-    assert "Traceback" not in err and "Traceback" not in out
-    if code != 0:
-        lines = err.strip().splitlines()
-        assert len(lines) == 1, err
-        assert lines[0].startswith("rotframe"), err
+from cli_calls import assert_clean, call  # noqa: E402
 
 
 # ---------------------------------------------------------------------------

@@ -10,22 +10,9 @@ import json
 
 import pytest
 
-from rotframe.cli import main
 
 
-def call(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def assert_clean(code, out, err, allowed=(0, 2, 3)):
-    assert code in allowed, (code, out, err)
-    assert "Traceback" not in err and "Traceback" not in out
-    if code != 0:
-        lines = err.strip().splitlines()
-        assert len(lines) == 1, err
-        assert lines[0].startswith("rotframe"), err
+from cli_calls import assert_clean, call  # noqa: E402
 
 
 def scenario_file(tmp_path, parameters: str) -> str:

@@ -57,7 +57,7 @@ References
 
 from __future__ import annotations
 
-from typing import Callable, Iterable
+from typing import Callable
 
 import math
 
