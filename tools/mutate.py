@@ -54,7 +54,6 @@ class _Collector(ast.NodeVisitor):
     def generic_visit(self, node):
         line = getattr(node, "lineno", None)
         if isinstance(node, ast.BinOp):
-            op = type(node.op).__name__
             if isinstance(node.op, ast.Add):
                 self.sites.append((node, "op", ast.Sub(), f"line {line}: + -> -"))
             elif isinstance(node.op, ast.Sub):
