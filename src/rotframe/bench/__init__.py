@@ -974,25 +974,19 @@ def _json_rows(rows):
     return [{k: clean(v) for k, v in r.items()} for r in rows]
 
 
-def progress_bar(stream=None):
-    """A ``progress(done, total, label)`` that writes one updating line with the time left to ``stream``."""
-    stream = stream or sys.stderr
-    start = time.perf_counter()
-
-    def show(done, total, label):
-        elapsed = time.perf_counter() - start
-        left = elapsed / done * (total - done) if done else math.nan
-        stream.write(f"\r  [{done}/{total}] {elapsed:5.0f} s, about {left:4.0f} s left  {label[:40]:<40}")
-        stream.flush()
-
-    return show
-
-
 def main(args) -> int:
-    progress = progress_bar() if sys.stderr.isatty() else None
-    rows = run_bench(args.names, quick=args.quick, progress=progress)
-    if progress:
-        sys.stderr.write("\n")
+    from rotframe.progress import Progress
+
+    bar = Progress("bench", "runs", enabled=not args.json)  # on a terminal only, never with --json
+
+    def progress(done, total, label):
+        bar.label = f"bench {label[:40]}"
+        bar.update(done, total)
+
+    try:
+        rows = run_bench(args.names, quick=args.quick, progress=progress)
+    finally:
+        bar.close()
     env = environment()
     rows.append({"scenario": "environment", "method": "environment", "setting": None, "wall_s": 0.0,
                  "error": math.nan, "error_kind": "environment", "nfev": 0, "kind": "environment", **env})
