@@ -198,14 +198,14 @@ def test_progress_bar_estimates_time_left_from_the_rate_after_its_first_report()
     """The first report came after the kernels loaded (0.8 s) at 0.1 %: "1544.8 s left" for a 1 s run."""
     import io
 
-    from rotframe.api import Progress
+    from rotframe.progress import Progress
 
     stream = io.StringIO()
-    bar = Progress(stream=stream)
+    bar = Progress("run", "%", delay=0.0, interval=0.0, stream=stream, tty_only=False)
     bar.start -= 10.0  # ten seconds of loading before the first report
     bar(0.001)
-    assert "left" not in stream.getvalue()
+    assert "? left" in stream.getvalue()  # no rate yet
     bar.first = (bar.first[0] - 1.0, bar.first[1])  # then one second for 0.1 -> a rate of 10 % a second
     bar(0.101)
-    left = float(stream.getvalue().rsplit("]", 1)[1].split("s left")[0].split()[-1])
-    assert left == pytest.approx(9.0, abs=0.2)
+    left = stream.getvalue().rsplit("elapsed, ", 1)[1].split(" left")[0]
+    assert left == "9 s" or left.startswith("9."), left

@@ -47,7 +47,7 @@ from typing import Any, Callable, Mapping
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["scenarios", "load", "run", "Result", "TrajectoryArrays", "register_scene", "Progress"]
+__all__ = ["scenarios", "load", "run", "Result", "TrajectoryArrays", "register_scene"]
 
 ProgressLike = Callable[[float], Any] | bool | None
 
@@ -169,7 +169,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
             exc.partial = Result(scn, values, exc.partial, _finish_summary(scn, summary, exc.partial, simulate_s, t_start))
         raise
     finally:
-        if isinstance(callback, Progress):
+        if progress is True:  # the bar is ours to end
             callback.close()
     simulate_s = time.perf_counter() - t0
     summary = runner.summarize(scn, values, scene_result, {"simulate_s": simulate_s})
@@ -476,41 +476,12 @@ def _jsonable(obj):
 # ---------------------------------------------------------------------------
 
 
-class Progress:
-    """A progress bar on stderr: ``Progress()(fraction)`` redraws it; :meth:`close` ends the line."""
-
-    def __init__(self, label: str = "", stream=None, width: int = 30):
-        self.label = label
-        self.stream = stream if stream is not None else sys.stderr
-        self.width = width
-        self.start = time.perf_counter()
-        self.shown = False
-        self.first = None  # (elapsed, fraction) at the first report: the rate is measured from there
-
-    def __call__(self, fraction: float) -> None:
-        fraction = min(max(float(fraction), 0.0), 1.0)
-        elapsed = time.perf_counter() - self.start
-        filled = int(round(self.width * fraction))
-        if self.first is None:
-            # the time before the first report (loading, compiling kernels) says nothing about the rate
-            self.first = (elapsed, fraction)
-        t1, f1 = self.first
-        left = f"{(elapsed - t1) * (1 - fraction) / (fraction - f1):6.1f} s left" if fraction > f1 else ""
-        self.stream.write(f"\r{self.label}[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
-                          f"{elapsed:6.1f} s {left}")
-        self.stream.flush()
-        self.shown = True
-
-    def close(self) -> None:
-        if self.shown:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.shown = False
-
-
 def _progress_callback(progress: ProgressLike):
+    from rotframe.progress import Progress
+
     if progress is True:
-        return Progress()
+        # asked for: drawn on any stream (a notebook's stderr is no terminal), from the first report on
+        return Progress("run", "%", delay=0.0, tty_only=False)
     if progress is False or progress is None:
         return None
     if not callable(progress):

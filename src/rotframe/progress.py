@@ -37,16 +37,17 @@ class Progress:
         Default ``sys.stderr``.
     """
 
-    def __init__(self, label="", unit="", *, enabled=True, delay=1.0, interval=0.2, stream=None):
+    def __init__(self, label="", unit="", *, enabled=True, delay=1.0, interval=0.2, stream=None, tty_only=True):
         self.stream = stream if stream is not None else sys.stderr
         try:
             tty = bool(self.stream.isatty())
         except (AttributeError, ValueError, OSError):
             tty = False
-        self.enabled = bool(enabled) and tty
+        self.enabled = bool(enabled) and (tty or not tty_only)
         self.label, self.unit = label, unit
         self.delay, self.interval = delay, interval
         self.start = time.monotonic()
+        self.first = None  # (elapsed, fraction) at the first report: rate and time left are measured from there
         self._last = 0.0
         self._width = 0
 
@@ -60,12 +61,17 @@ class Progress:
             return
         now = time.monotonic()
         elapsed = now - self.start
+        frac = min(max(done / total, 0.0), 1.0) if total else 0.0
+        if self.first is None:
+            # the time before the first report (loading, compiling kernels) says nothing about the rate
+            self.first = (elapsed, frac)
         if elapsed < self.delay or (now - self._last < self.interval and done < total):
             return
         self._last = now
-        frac = min(max(done / total, 0.0), 1.0) if total else 0.0
-        rate = done / elapsed if elapsed > 0 else 0.0
-        left = elapsed * (1.0 - frac) / frac if frac > 0 else float("nan")
+        t1, f1 = self.first
+        span = elapsed - t1
+        rate = (frac - f1) * (total or 0.0) / span if span > 0 else 0.0
+        left = span * (1.0 - frac) / (frac - f1) if frac > f1 else float("nan")
         if self.unit == "%" or total == 1.0:
             count = f"{100 * frac:5.1f}%"
             speed = ""
