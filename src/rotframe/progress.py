@@ -71,7 +71,7 @@ class Progress:
         t1, f1 = self.first
         span = elapsed - t1
         rate = (frac - f1) * (total or 0.0) / span if span > 0 else 0.0
-        left = span * (1.0 - frac) / (frac - f1) if frac > f1 else float("nan")
+        left = 0.0 if frac >= 1.0 else span * (1.0 - frac) / (frac - f1) if frac > f1 else float("nan")
         if self.unit == "%" or total == 1.0:
             count = f"{100 * frac:5.1f}%"
             speed = ""
