@@ -654,7 +654,8 @@ def _format_summary(scn, s) -> str:
         else:
             lines.append(f"  {key:<30} {shown:>11}")
     for key, value in s["diagnostics"].items():
-        lines.append(f"  {key:<30} {_short(value) if value is not None else 'null':>11}")
+        unresolved = value is None or (isinstance(value, float) and value != value)  # None or NaN: JSON's null
+        lines.append(f"  {key:<30} {'null' if unresolved else _short(value):>11}")
     for key, what in s.get("theory_notes", {}).items():
         if key in s["theory"]:
             lines.append(f"  theory of {key}: {what}")
