@@ -928,11 +928,17 @@ def _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp):
 
 
 @_jit
-def _dop853_error(K, h, y, y_new, rtol, atol, E3, E5):
+def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
+    """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
+
+    ``atol`` holds one absolute tolerance per component of ``y`` (the particle and
+    rigid-body kernels share this function; docs/physics/dop853.md).
+    """
+    n = y.shape[0]
     e5 = 0.0
     e3 = 0.0
-    for j in range(6):
-        sc = atol + rtol * max(abs(y[j]), abs(y_new[j]))
+    for j in range(n):
+        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
         s5 = 0.0
         s3 = 0.0
         for q in range(13):
@@ -942,7 +948,7 @@ def _dop853_error(K, h, y, y_new, rtol, atol, E3, E5):
         e3 += (s3 / sc) ** 2
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
-    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * 6.0)
+    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
 
 
 @_jit
@@ -972,6 +978,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     n_out = sample_times.shape[0]
     n_ev = events.shape[0]
     K = np.empty((13, 6))
+    atol_vec = np.full(6, atol)
     Kt = np.empty((13, 6))
     y = np.empty(6)
     y_new = np.empty(6)
@@ -1024,7 +1031,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                     break
                 _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
                 nf += 12
-                err = _dop853_error(K, h, y, y_new, rtol, atol, E3, E5)
+                err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
                 if not np.isfinite(err):
                     h *= 0.2
                     continue

@@ -31,6 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
+from rotframe.kernels import dop853_error_norm
+
 __all__ = ["rigid_dop853", "RigidRun"]
 
 _jit = njit(cache=True, error_model="numpy", nogil=True)
@@ -129,6 +131,9 @@ def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
         y0[i] /= nq
     atol_q = atol
     atol_L = atol * max(math.sqrt(y0[0] * y0[0] + y0[1] * y0[1] + y0[2] * y0[2]), 1e-300)
+    atol_vec = np.empty(7)
+    for j in range(7):
+        atol_vec[j] = atol_L if j < 3 else atol_q
     K = np.empty((16, 7))
     y = y0.copy()
     y_new = np.empty(7)
@@ -185,18 +190,7 @@ def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
             y_new[j] = y[j] + h * acc
         _f(y_new, p, K, 12)
         nfev += 12
-        e5 = 0.0
-        e3 = 0.0
-        for j in range(7):
-            s = (atol_L if j < 3 else atol_q) + rtol * max(abs(y[j]), abs(y_new[j]))
-            s5 = 0.0
-            s3 = 0.0
-            for q in range(13):
-                s5 += E5[q] * K[q, j]
-                s3 += E3[q] * K[q, j]
-            e5 += (s5 / s) ** 2
-            e3 += (s3 / s) ** 2
-        err = 0.0 if (e5 == 0.0 and e3 == 0.0) else abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 7.0)
+        err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
         if not np.isfinite(err):
             h *= 0.2
             continue
