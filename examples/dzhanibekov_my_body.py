@@ -2,7 +2,7 @@
 
     python examples/dzhanibekov_my_body.py --size 0.147,0.071,0.008 --mass 0.17 --spin 10
 
-Mass properties from ``rotframe.inertia`` (a box of the phone's size), principal axes,
+Mass properties from ``rotframe.rigid.mass_properties`` (a box of the phone's size), principal axes,
 then the free rigid body solved exactly (Jacobi elliptic functions) by the
 ``dzhanibekov`` scene: the intermediate axis flips over every half period.
 """
@@ -12,8 +12,7 @@ import argparse
 import numpy as np
 
 import rotframe
-from rotframe import inertia
-
+from rotframe.rigid import mass_properties as inertia
 parser = argparse.ArgumentParser(description="intermediate-axis flip of a box")
 parser.add_argument("--size", default="0.147,0.071,0.008", help="box edges a,b,c in m (a phone)")
 parser.add_argument("--mass", default=0.17, type=float, help="kg")

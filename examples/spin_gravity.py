@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import rotframe
-from rotframe.integrators import integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import SceneResult
 
 METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")

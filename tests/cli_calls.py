@@ -1,6 +1,6 @@
 """Helpers for tests that drive the command line in-process: one call, and what a clean outcome is."""
 
-from rotframe.cli import main
+from rotframe.app.cli import main
 
 
 def call(capsys, *argv):

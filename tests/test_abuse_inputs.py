@@ -1,7 +1,7 @@
 """Abuse of the command line, in process: whatever the input, exit 0, 2 or 3, one line, no traceback.
 
 A hypothesis test feeds generated ``--set`` values, scenario files and sweep specs
-to :func:`rotframe.cli.main`; the examples are kept small (``--max-steps`` and
+to :func:`rotframe.app.cli.main`; the examples are kept small (``--max-steps`` and
 ``--max-samples`` bound each run's work) so that the whole file runs in well
 under a minute. The named cases below are the ones found by hand (issue 12).
 """
@@ -154,8 +154,9 @@ def test_rigid_method_from_file_or_set_is_accepted(tmp_path, capsys):
 
 
 def test_scenario_methods_match_the_scene_modules():
-    from rotframe import scenario, scenes
-    from rotframe.integrators import METHODS
+    from rotframe import scenes
+    from rotframe.app import scenario
+    from rotframe.particles.integrators import METHODS
 
     for name in scenes.SCENES:
         assert set(scenario.methods_for(name)) == set(getattr(scenes.get(name), "METHODS", METHODS)), name
@@ -257,7 +258,7 @@ def test_section_far_from_the_origin_keeps_its_area(capsys):
 
 
 def test_a_tiny_hole_far_away_is_subtracted():
-    from rotframe.sections import polygon
+    from rotframe.rigid.sections import polygon
 
     o = 3e6
     sq = [[o, o], [o + 1, o], [o + 1, o + 1], [o, o + 1]]
@@ -270,7 +271,11 @@ def test_a_tiny_hole_far_away_is_subtracted():
 def test_python_api_junk_is_a_rotframe_error():
     import numpy as np
 
-    from rotframe import frames, inertia, rigid
+    from rotframe import frames
+
+    from rotframe.rigid import mass_properties as inertia
+
+    from rotframe.rigid import dynamics as rigid
     from rotframe.errors import NotARotationError, RotframeError
 
     junk = ["abc", 1 + 2j, object(), None, [["a"] * 3] * 3, np.eye(3) * (1 + 1j)]
@@ -296,7 +301,9 @@ def test_python_api_junk_is_a_rotframe_error():
 @given(st.one_of(st.text(max_size=5), st.complex_numbers(), st.lists(st.complex_numbers(), min_size=3, max_size=3),
                  st.lists(st.text(max_size=2), min_size=3, max_size=3), st.none(), st.dictionaries(st.text(), st.text())))
 def test_hypothesis_junk_to_the_python_api(value):
-    from rotframe import frames, inertia, rigid
+    from rotframe import frames
+    from rotframe.rigid import mass_properties as inertia
+    from rotframe.rigid import dynamics as rigid
     from rotframe.errors import RotframeError
 
     calls = [lambda: frames.euler_to_dcm(value, "ZXZ"), lambda: frames.check_rotation(value),

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rotframe.cli import main
+from rotframe.app.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -87,8 +87,7 @@ def test_a_file_size_limit_ends_the_run_with_one_line_and_no_file(tmp_path):
 
 
 def test_a_full_disk_ends_the_run_with_one_line_and_no_file(tmp_path, capsys, monkeypatch):
-    from rotframe import outputs
-
+    from rotframe.app import outputs
     def full(fd):
         raise OSError(errno.ENOSPC, "No space left on device")
 
@@ -121,8 +120,11 @@ def test_impossible_outputs_are_refused_before_computing(tmp_path, capsys, monke
     def no_compute(*a, **k):
         raise AssertionError("computing started before the output was checked")
 
-    from rotframe import bench, runner, sweep
+    from rotframe.app import bench
 
+    from rotframe.app import runner
+
+    from rotframe.app import sweep
     monkeypatch.setattr(runner, "simulate", no_compute)
     monkeypatch.setattr(sweep, "run_sweep", no_compute)
     monkeypatch.setattr(bench, "main", no_compute)
@@ -193,7 +195,7 @@ def test_resume_over_a_damaged_table_is_one_line(tmp_path, capsys, damage):
 
 def test_json_stdout_is_guarded_at_the_file_descriptor(tmp_path):
     # LAPACK's xerbla writes to fd 1 (a NaN fit): with --json it must land on stderr, not in the JSON
-    code = ("import numpy as np\nfrom rotframe.cli import _JsonStdout\nwith _JsonStdout(True):\n"
+    code = ("import numpy as np\nfrom rotframe.app.cli import _JsonStdout\nwith _JsonStdout(True):\n"
             "    try:\n        np.polyfit(np.array([0.0, 1.0]), np.array([np.nan, 1.0]), 1)\n"
             "    except Exception:\n        pass\n    print('{\"ok\": 1}')\n")
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,

@@ -2,7 +2,7 @@
 
 import io
 
-from rotframe.progress import Progress
+from rotframe.app.progress import Progress
 
 
 class FakeTTY(io.StringIO):
@@ -38,7 +38,7 @@ def test_progress_as_a_fraction_callback():
 
 
 def test_json_runs_never_show_progress(tmp_path, capsys, monkeypatch):
-    from rotframe.cli import main
+    from rotframe.app.cli import main
 
     monkeypatch.setattr("sys.stderr.isatty", lambda: True, raising=False)
     assert main(["run", "tower-drop", "--no-record", "--json"]) == 0

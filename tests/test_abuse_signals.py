@@ -36,7 +36,7 @@ DRIVER = textwrap.dedent('''
             os.kill(os.getpid(), sig)
         return original(*a, **k)
     setattr(owner, name, wrapped)
-    from rotframe.cli import main
+    from rotframe.app.cli import main
     sys.exit(main(sys.argv[5:]))
 ''')
 
@@ -65,12 +65,12 @@ def readable(path):
 PHASES = [
     # (module, attribute, nth call, scenario and options, partial recording expected)
     ("rotframe.scenes", "get", 1, ["run", "tower-drop"], False),                        # loading the scene
-    ("rotframe.kernels", "run_fixed", 1, ["run", "turntable", "--method", "splitting"], True),  # compiling
-    ("rotframe.kernels", "run_fixed", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
+    ("rotframe.particles.kernels", "run_fixed", 1, ["run", "turntable", "--method", "splitting"], True),  # compiling
+    ("rotframe.particles.kernels", "run_fixed", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
     ("scipy.linalg", "expm", 20, ["run", "inertial-oscillation", "--set", "samples=100000"], True),  # exact
-    ("rotframe.rigid", "free_body_exact", 3, ["run", "free-top", "--set", "samples=20000"], True),   # rigid exact
-    ("rotframe.runner", "summarize", 1, ["run", "tower-drop"], True),                     # analysis
-    ("rotframe.record.Recording", "finish", 1, ["run", "tower-drop"], True),               # recording
+    ("rotframe.rigid.dynamics", "free_body_exact", 3, ["run", "free-top", "--set", "samples=20000"], True),   # rigid exact
+    ("rotframe.app.runner", "summarize", 1, ["run", "tower-drop"], True),                     # analysis
+    ("rotframe.app.record.Recording", "finish", 1, ["run", "tower-drop"], True),               # recording
 ]
 
 
@@ -81,8 +81,8 @@ CASES = [(*p, ("SIGINT", "SIGTERM")[i % 2]) for i, p in enumerate(PHASES)]
 @pytest.mark.parametrize("module,attr,nth,argv,partial,sig", CASES, ids=[f"{c[1]}#{c[2]}-{c[5]}" for c in CASES])
 def test_a_signal_in_every_phase_of_a_run(tmp_path, module, attr, nth, argv, partial, sig):
     target, _, owner_attr = (module, None, attr)
-    if module == "rotframe.record.Recording":
-        target, owner_attr = "rotframe.record", "Recording.finish"
+    if module == "rotframe.app.record.Recording":
+        target, owner_attr = "rotframe.app.record", "Recording.finish"
     res = drive(tmp_path, target, owner_attr, nth, sig, *argv, "--json")
     check(res, sig)
     recordings = list((tmp_path / "recordings").glob("*")) if (tmp_path / "recordings").exists() else []
@@ -102,7 +102,7 @@ def test_a_signal_in_every_phase_of_a_run(tmp_path, module, attr, nth, argv, par
 def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
     # foucault runs row by row: the first two rows are timed alone, so run_batch is called more than once
     argv = ["sweep", "foucault", "--grid", "latitude=0:90:6", "--set", "duration=20", "--out", "s.parquet"]
-    res = drive(tmp_path, "rotframe.sweep", attr, nth, sig, *argv)
+    res = drive(tmp_path, "rotframe.app.sweep", attr, nth, sig, *argv)
     line = check(res, sig)
     assert "--resume" in line
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
@@ -131,7 +131,7 @@ def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path):
 
 
 def test_signal_handlers_do_not_outlive_a_command():
-    from rotframe.cli import main
+    from rotframe.app.cli import main
 
     before = (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM))
     assert main(["list", "--json"]) == 0

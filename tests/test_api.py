@@ -103,7 +103,7 @@ def test_foucault_rate_from_the_turning_points():
 
 
 def test_heavy_top_turning_angles_from_quaternions():
-    """theta min/max from q via scipy's Rotation (not rotframe.rigid), within the sampling error.
+    """theta min/max from q via scipy's Rotation (not rotframe.rigid.dynamics), within the sampling error.
 
     theta(t) is sampled 2000 times a second against a nutation period of 0.22 s; near an
     extremum theta differs from its extreme value by (1/2) theta'' dt^2 <~ 1e-5 deg, so
@@ -157,8 +157,7 @@ def test_quantity_of_wrong_dimension():
 
 
 def test_to_json_has_every_key_of_the_cli_json(tmp_path, capsys):
-    from rotframe import cli
-
+    from rotframe.app import cli
     assert cli.main(["run", "tower-drop", "--json", "--no-record"]) == 0
     cli_json = json.loads(capsys.readouterr().out)
     r = rotframe.run("tower-drop")
@@ -172,8 +171,8 @@ def test_to_json_has_every_key_of_the_cli_json(tmp_path, capsys):
 
 
 def test_record_writes_the_cli_recording(tmp_path):
-    from rotframe import cli
-    from rotframe.recording_summary import entities
+    from rotframe.app import cli
+    from rotframe.app.recording_summary import entities
 
     r = rotframe.run("heavy-top", duration=0.5)
     path = r.record(tmp_path / "api.rrd")
@@ -228,8 +227,7 @@ def test_png(tmp_path):
 def test_cli_version_and_help_for_every_option(capsys):
     import argparse
 
-    from rotframe import cli
-
+    from rotframe.app import cli
     with pytest.raises(SystemExit) as info:
         cli.main(["--version"])
     assert info.value.code == 0 and capsys.readouterr().out.strip() == f"rotframe {rotframe.__version__}"
@@ -244,8 +242,7 @@ def test_cli_version_and_help_for_every_option(capsys):
 
 
 def test_cli_export_and_png(tmp_path, capsys):
-    from rotframe import cli
-
+    from rotframe.app import cli
     assert cli.main(["run", "heavy-top", "--set", "duration=0.2", "--no-record", "--json",
                      "--export", str(tmp_path / "h.npz"), "--png", str(tmp_path / "h.png")]) == 0
     summary = json.loads(capsys.readouterr().out)  # stdout is still one JSON object
@@ -257,8 +254,7 @@ def test_cli_export_and_png(tmp_path, capsys):
 
 
 def test_view_without_a_display(tmp_path, monkeypatch, capsys):
-    from rotframe import cli
-
+    from rotframe.app import cli
     path = rotframe.run("tower-drop").record(tmp_path / "t.rrd")
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
@@ -271,8 +267,7 @@ def test_view_without_a_display(tmp_path, monkeypatch, capsys):
 
 def test_ensemble_sweep_rows_carry_the_theory_of_single_runs(tmp_path, monkeypatch):
     """A tower-drop sweep runs as one ensemble; its rows have the theory columns a single run has."""
-    from rotframe import sweep
-
+    from rotframe.app import sweep
     monkeypatch.chdir(tmp_path)
     spec = sweep.parse_spec("tower-drop", grid=["height=20:300:3", "latitude=-60:60:2"])
     res = sweep.run_sweep(spec, plots=False, recording=False)

@@ -5,7 +5,7 @@ import math
 import subprocess
 import sys
 
-from rotframe.bench import speedups
+from rotframe.app.bench import speedups
 
 
 def test_bench_quick_json_rows_follow_the_contract(tmp_path):

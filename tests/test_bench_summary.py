@@ -1,7 +1,7 @@
 """The bench's summary per problem and error level, and its peers' right-hand sides (no timing asserted).
 
 The summary is checked on hand-made rows (what it must pick is known); the peers'
-right-hand sides against rotframe.rigid.rigid_rhs and the particle equations
+right-hand sides against rotframe.rigid.dynamics.rigid_rhs and the particle equations
 written out here with np.cross (a third, plain writing of the same formulas).
 """
 
@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from rotframe import rigid
-from rotframe.bench import level_summary, peers
+from rotframe.rigid import dynamics as rigid
+from rotframe.app.bench import level_summary, peers
 
 
 def _row(method, wall, error, family, scenario="p", horizon="h"):

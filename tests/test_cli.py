@@ -103,7 +103,7 @@ def test_scenario_file_from_anywhere_runs(tmp_path):
 
 
 def test_list_and_help_do_not_import_heavy_modules(tmp_path):
-    code = ("import sys; from rotframe.cli import main; main(['list']);"
+    code = ("import sys; from rotframe.app.cli import main; main(['list']);"
             "heavy = [m for m in ('rerun', 'astropy', 'numba') if m in sys.modules]; print('HEAVY', heavy)")
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert "HEAVY []" in res.stdout, res.stdout + res.stderr

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rotframe import runner
-
+from rotframe.app import runner
 OMEGA = 2 * math.pi * 1.00273781191135448 / 86400.0  # Earth Rotation Angle rate, written out here
 
 

@@ -1,4 +1,4 @@
-"""Ensembles on several threads give bitwise the same result as on one (rotframe.ensemble).
+"""Ensembles on several threads give bitwise the same result as on one (rotframe.particles.ensemble).
 
 The particles are cut into fixed blocks whatever the number of threads, and
 each particle is integrated on its own, so equality is exact (no tolerance).
@@ -10,9 +10,9 @@ equal bitwise; a small block size keeps the test cheap.
 import numpy as np
 import pytest
 
-from rotframe import ensemble
-from rotframe.integrators import Event, integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles import ensemble
+from rotframe.particles.integrators import Event, integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
 

@@ -50,7 +50,7 @@ def test_overflowing_duration_is_refused_in_one_line(tmp_path, capsys, parameter
 
 def test_empty_vector_is_refused():
     from rotframe.errors import ScenarioError
-    from rotframe.scenario import Parameter, parse_value
+    from rotframe.app.scenario import Parameter, parse_value
 
     p = Parameter(name="v", default=[0.0, 0.0, 0.0], unit="m", type="vector")
     with pytest.raises(ScenarioError, match="one or more"):
@@ -63,8 +63,8 @@ def test_api_refuses_a_non_finite_duration_or_state():
     import numpy as np
 
     from rotframe.errors import ScenarioError
-    from rotframe.integrators import integrate_particles
-    from rotframe.model import ParticleModel
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import ParticleModel
 
     model = ParticleModel(terms=("gravity",), g=np.array([0.0, 0.0, -9.8]))
     for duration in (float("inf"), float("nan"), -1.0, 0.0):
@@ -82,7 +82,7 @@ def test_an_interrupt_swallowed_in_a_destructor_is_delivered_again(capsys):
     """
     import time
 
-    from rotframe.signals import InterruptScope
+    from rotframe.app.signals import InterruptScope
 
     class Dies:
         def __del__(self):
@@ -101,7 +101,7 @@ def test_an_interrupt_swallowed_in_a_destructor_is_delivered_again(capsys):
     lambda: __import__("rotframe").frames.euler_to_dcm([10**400, 0, 0], "zyx"),
     lambda: __import__("rotframe").inertia.solid_sphere(10**400, 1.0),
     # object input whose arithmetic divides by zero
-    lambda: __import__("rotframe").rigid.rigid_rhs(__import__("numpy").array([1, 2, 3], dtype=object),
+    lambda: __import__("rotframe.rigid.dynamics").rigid.dynamics.rigid_rhs(__import__("numpy").array([1, 2, 3], dtype=object),
                                                    [0.0, 0.0, 1.0]),
 ])
 def test_arithmetic_errors_from_junk_input_are_rotframe_errors(call_it):
@@ -179,7 +179,7 @@ def test_a_signal_while_starting_is_one_line_and_the_shells_code(sig, code):
     import subprocess
     import sys
 
-    script = ("import os, signal, time, rotframe._console\n"
+    script = ("import os, signal, time, rotframe.app.console\n"
               f"os.kill(os.getpid(), signal.{sig})\n"
               "time.sleep(10)\n")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)

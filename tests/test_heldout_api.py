@@ -63,7 +63,7 @@ def test_dop853_ends_each_call_on_its_last_sample():
     """
     from rotframe.scenes import foucault
 
-    from rotframe.integrators import integrate_particles
+    from rotframe.particles.integrators import integrate_particles
 
     for latitude in (51.4667, 51 + 28 / 60):
         model, r0, v0, g, _ = foucault.build({"latitude": latitude, "length": 20.0, "amplitude": 3.0,
@@ -118,8 +118,7 @@ def test_particle_arrays_have_the_contract_shapes(name):
 
 
 def test_to_json_has_every_key_of_the_cli_json_for_every_scenario(capsys):
-    from rotframe import cli
-
+    from rotframe.app import cli
     for name in rotframe.scenarios():
         assert cli.main(["run", name, "--json", "--no-record"]) == 0
         cli_json = json.loads(capsys.readouterr().out)
@@ -198,7 +197,7 @@ def test_progress_bar_estimates_time_left_from_the_rate_after_its_first_report()
     """The first report came after the kernels loaded (0.8 s) at 0.1 %: "1544.8 s left" for a 1 s run."""
     import io
 
-    from rotframe.progress import Progress
+    from rotframe.app.progress import Progress
 
     stream = io.StringIO()
     bar = Progress("run", "%", delay=0.0, interval=0.0, stream=stream, tty_only=False)

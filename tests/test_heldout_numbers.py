@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from rotframe import runner
+from rotframe.app import runner
 
 #: The Earth's sidereal rate from the Earth Rotation Angle, written out (IERS conventions).
 OMEGA_EARTH = 2 * math.pi * 1.00273781191135448 / 86400.0

@@ -16,8 +16,7 @@ from hypothesis import strategies as st
 
 from rotframe import earth
 from rotframe.errors import ScenarioError
-from rotframe import scenario
-
+from rotframe.app import scenario
 ASTROPY_FORMS = ["48d50m46s", "48d50m46.5s", "48 50 46", "48:50:46", "48°50′46″", "48.846 deg", "0.8 rad",
                  "100 arcmin", "-33.9", "-33d54m", "12h30m", "1d", "46s", "+45d", "48d50m46s N", "48d50m46s S",
                  "48°50′46″ N", "48 50 46 S"]
@@ -95,7 +94,7 @@ def test_scenario_set_latitude(value, deg):
 @pytest.mark.parametrize("key, value", [("latitude", "-45d S"), ("latitude", "45 E"), ("azimuth", "30 N"),
                                         ("elevation", "45 N")])
 def test_cli_refuses_contradictions_with_exit_2(key, value, capsys):
-    from rotframe.cli import main
+    from rotframe.app.cli import main
 
     name = "tower-drop" if key == "latitude" else "projectile"
     assert main(["run", name, "--set", f"{key}={value}", "--no-record", "--json"]) == 2

@@ -1,4 +1,4 @@
-"""The vendored DOP853 tableau (rotframe._dop853) and the kernel's error estimate.
+"""The vendored DOP853 tableau (rotframe.numerics.dop853) and the kernel's error estimate.
 
 References are independent of the code under test: the order conditions of
 Runge-Kutta theory (Hairer, Norsett & Wanner I, II.2) checked in 40-digit
@@ -14,8 +14,8 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from rotframe import kernels
-from rotframe._dop853 import coefficients, exact_tables
+from rotframe.particles import kernels
+from rotframe.numerics.dop853 import coefficients, exact_tables
 
 
 def _mp_tables():
@@ -170,8 +170,8 @@ def test_adaptive_run_meets_its_tolerance_on_a_known_solution():
     took needlessly tiny steps, as with swapped estimators, is also caught by the
     step count, which must stay below the count for the h^4 estimator).
     """
-    from rotframe.integrators import integrate_particles
-    from rotframe.model import OmegaSchedule, ParticleModel
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     w0 = 2.0
     model = ParticleModel(("spring",), omega=OmegaSchedule.constant([0.0, 0.0, 0.0]), spring=w0 * w0)

@@ -15,8 +15,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rotframe.errors import IntegrationError
-from rotframe.integrators import Event, integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import Event, integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
 G = 9.81

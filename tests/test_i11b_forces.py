@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rotframe import runner
-from rotframe.integrators import integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.app import runner
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 AXIS = np.array([0.3, -0.5, 0.81])
 AXIS = AXIS / np.linalg.norm(AXIS)

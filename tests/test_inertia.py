@@ -11,9 +11,9 @@ import pytest
 from numpy.polynomial.legendre import leggauss
 from scipy.spatial.transform import Rotation
 
-from rotframe import inertia
+from rotframe.rigid import mass_properties as inertia
 from rotframe.errors import RotframeError
-from rotframe.inertia import InvalidBodyError
+from rotframe.rigid.mass_properties import InvalidBodyError
 
 RTOL = 1e-12
 

@@ -10,10 +10,10 @@ functions agree with the drivers.
 import numpy as np
 import pytest
 
-from rotframe import kernels
+from rotframe.particles import kernels
 from rotframe.errors import IntegrationError
-from rotframe.integrators import integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 G = np.array([0.0, 0.1, -9.81])
 PEND = {"pendulum_length": 10.0, "pivot": np.array([0.5, -0.2, 10.0])}

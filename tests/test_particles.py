@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rotframe.integrators import Event, integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import Event, integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.turntable import inertial_line
 
 Z = np.array([0.0, 0.0, 1.0])
@@ -134,7 +134,7 @@ def test_ensemble_equals_separate_runs():
 
 
 def test_dop853_tableau_is_consistent():
-    from rotframe._dop853 import coefficients
+    from rotframe.numerics.dop853 import coefficients
 
     A, B, C, E3, E5 = coefficients()
     assert np.allclose(A.sum(axis=1), C, atol=1e-14)

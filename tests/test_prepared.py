@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from rotframe.errors import ScenarioError
-from rotframe.integrators import integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
-from rotframe.prepared import PreparedRun
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+from rotframe.particles.prepared import PreparedRun
 
 
 def _models():

@@ -95,7 +95,7 @@ def test_heavy_top_L_turns_and_keeps_its_vertical_part(tmp_path):
 
 
 def test_text_summary_of_a_recording(tmp_path):
-    from rotframe.recording_summary import describe
+    from rotframe.app.recording_summary import describe
 
     path = rotframe.run("tower-drop").record(tmp_path / "t.rrd")
     text = describe(path)

@@ -18,10 +18,10 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from rotframe import rigid
+from rotframe.rigid import dynamics as rigid
 from rotframe.errors import IntegrationError
-from rotframe.inertia import InvalidBodyError
-from rotframe.rigid import InvalidStateError
+from rotframe.rigid.mass_properties import InvalidBodyError
+from rotframe.rigid.dynamics import InvalidStateError
 
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 SIDEREAL_DAY = 86164.0905  # s

@@ -1,4 +1,4 @@
-"""Compiled adaptive DOP853 for rigid bodies (rotframe.rigid_adaptive) against independent references.
+"""Compiled adaptive DOP853 for rigid bodies (rotframe.rigid.adaptive) against independent references.
 
 References: the exact free-body flow in elliptic functions (rigid.free_body_exact,
 itself checked against mpmath in test_rigid), scipy's own DOP853 at rtol 1e-13 for
@@ -13,9 +13,9 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from rotframe import rigid
+from rotframe.rigid import dynamics as rigid
 from rotframe.errors import ScenarioError
-from rotframe.rigid_adaptive import rigid_dop853
+from rotframe.rigid.adaptive import rigid_dop853
 
 I = np.array([1.0, 2.0, 3.0])
 L0 = I * np.array([0.01, 1.0, 0.01])  # near the unstable middle axis: the Dzhanibekov flip

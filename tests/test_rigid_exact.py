@@ -1,4 +1,4 @@
-"""The compiled exact free-body flow (rotframe.rigid_exact) against independent references.
+"""The compiled exact free-body flow (rotframe.rigid.exact_flow) against independent references.
 
 Carlson's integrals and K against scipy.special (other implementations of the
 same functions); the flow against rigid.free_body_exact (the same closed form,
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy import special
 
-from rotframe import rigid
-from rotframe.rigid_adaptive import rigid_dop853
-from rotframe.rigid_exact import carlson_rf, carlson_rj, ellipk_agm, free_body_flow
+from rotframe.rigid import dynamics as rigid
+from rotframe.rigid.adaptive import rigid_dop853
+from rotframe.rigid.exact_flow import carlson_rf, carlson_rj, ellipk_agm, free_body_flow
 
 
 def _body(rng):

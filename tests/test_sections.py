@@ -1,4 +1,4 @@
-"""Tests of rotframe.sections and rotframe.section_cli against independent references.
+"""Tests of rotframe.rigid.sections and rotframe.app.section_cli against independent references.
 
 References used here never call the code under test for the expected value:
 closed forms from textbooks, decomposition into rectangles with the
@@ -19,8 +19,8 @@ from hypothesis import strategies as st
 from matplotlib.path import Path as MplPath
 
 from rotframe.errors import RotframeError
-from rotframe.section_cli import SHAPES, run_section, shapes_help
-from rotframe.sections import (
+from rotframe.app.section_cli import SHAPES, run_section, shapes_help
+from rotframe.rigid.sections import (
     CircleRegion,
     PolygonRegion,
     Section,
@@ -39,7 +39,7 @@ REL = 1e-12
 
 
 # --------------------------------------------------------------------------
-# Independent reference helpers (no code from rotframe.sections)
+# Independent reference helpers (no code from rotframe.rigid.sections)
 # --------------------------------------------------------------------------
 
 

@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from rotframe import rigid
+from rotframe.rigid import dynamics as rigid
 from rotframe.errors import IntegrationError
-from rotframe.integrators import integrate_particles
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 pytestmark = pytest.mark.slow
 EPS = np.finfo(float).eps

@@ -14,7 +14,11 @@ import pytest
 
 pq = pytest.importorskip("pyarrow.parquet")
 
-from rotframe import cli, runner, sweep  # noqa: E402
+from rotframe.app import cli
+
+from rotframe.app import runner
+
+from rotframe.app import sweep  # noqa: E402
 from rotframe.errors import IntegrationError, ScenarioError  # noqa: E402
 
 PROJECTILE_MC = ["--samples", "120", "--vary", "speed=normal(1600,5)", "--vary", "azimuth=normal(232,0.05)"]
@@ -86,8 +90,7 @@ def test_foucault_latitude_sweep_matches_omega_sin_latitude(tmp_path, monkeypatc
 
 
 def test_tower_drop_monte_carlo_is_one_ensemble_call(tmp_path, monkeypatch, capsys):
-    from rotframe import integrators
-
+    from rotframe.particles import integrators
     monkeypatch.chdir(tmp_path)
     sizes = []
     real = integrators.integrate_particles
@@ -152,8 +155,7 @@ def test_a_failed_run_is_a_row_not_the_end(tmp_path, monkeypatch):
 
 
 def test_dzhanibekov_flip_interval_on_a_log_grid(tmp_path, monkeypatch):
-    from rotframe import scenario
-
+    from rotframe.app import scenario
     if "dzhanibekov" not in scenario.names():
         pytest.skip("no dzhanibekov scenario yet")
     monkeypatch.chdir(tmp_path)
@@ -233,7 +235,7 @@ def test_interrupted_sweep_resumes_to_the_same_table(tmp_path, monkeypatch):
 
 
 def test_ctrl_c_inside_a_run_stops_the_sweep(tmp_path, monkeypatch):
-    from rotframe.integrators import RunInterrupted
+    from rotframe.particles.integrators import RunInterrupted
 
     monkeypatch.chdir(tmp_path)
     real = runner.run

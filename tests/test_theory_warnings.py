@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from rotframe import runner
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.app import runner
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 OMEGA = 2 * math.pi * 1.00273781191135448 / 86400.0
 SCENARIOS = ["turntable", "tower-drop", "foucault", "inertial-oscillation", "projectile", "free-top",
@@ -26,8 +26,7 @@ SCENARIOS = ["turntable", "tower-drop", "foucault", "inertial-oscillation", "pro
 
 
 def run(name, method=None, terms=None, **sets):
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     scn = sc.load(name)
     values = scn.with_values({k: str(v) for k, v in sets.items()})
     result = runner.simulate(scn, values, method=method, terms=terms)
@@ -81,8 +80,8 @@ def test_a_planted_sign_error_in_the_foucault_theory_gives_a_warning(monkeypatch
 
 
 def test_text_table_names_the_theory_and_prints_each_warning(monkeypatch):
-    from rotframe import cli, scenario as sc
-
+    from rotframe.app import cli
+    from rotframe.app import scenario as sc
     scn = sc.load("free-top")
     summary = {"params": {}, "model": ["m"], "method": "exact", "steps": 1,
                "metrics": {"x": 1.0, "y": float("nan")}, "theory": {"x": 2.0, "y": 1.0},
@@ -99,7 +98,7 @@ def test_cli_prints_each_warning_on_its_own_line_and_keeps_exit_code_0():
     # a planted error (a dropped factor 2 in f) in a fresh interpreter, run through the real CLI
     code = ("import sys; from rotframe import analytic; real = analytic.inertial_oscillation; "
             "analytic.inertial_oscillation = lambda lat, v, w: real(lat, v, w / 2); "
-            "from rotframe.cli import main; sys.exit(main(['run', 'inertial-oscillation', '--no-record']))")
+            "from rotframe.app.cli import main; sys.exit(main(['run', 'inertial-oscillation', '--no-record']))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
@@ -209,7 +208,7 @@ def _shot_reference(v, el, az, lat, g):
 @pytest.mark.parametrize("az,el,lat,v", [(232, 50, 49.6, 1600), (0, 85, 49.6, 1000), (180, 30, -40, 2500),
                                          (90, 1, 0, 3000), (0, 89, 80, 800)])
 def test_projectile_theory_is_within_its_stated_accuracy(az, el, lat, v):
-    from rotframe import scenario as sc
+    from rotframe.app import scenario as sc
     from rotframe.scenes import projectile
 
     scn = sc.load("projectile")

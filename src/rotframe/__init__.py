@@ -5,7 +5,7 @@ The centre of the package is the transport theorem,
 it imports none of numpy's heavy neighbours (astropy, numba, rerun, scipy);
 the functions below and the submodules are loaded when first used.
 
-Running scenarios (:mod:`rotframe.api`)::
+Running scenarios (:mod:`rotframe.app.api`)::
 
     import rotframe
     rotframe.scenarios()                        # names
@@ -14,17 +14,20 @@ Running scenarios (:mod:`rotframe.api`)::
     r.metrics, r.theory, r.trajectory.r         # dicts and numpy arrays (SI)
     r.record("drop.rrd")                        # the same recording as the command line
 
-Building blocks (stable names, each module has ``__all__``):
+The house, from the core up (each layer imports only the layers above it in
+this list; ``docs/architecture.md`` has the arrows):
 
-=====================  ==========================================================
-:mod:`rotframe.frames`  rotations, Euler angles in 12 sequences, transport theorem
-:mod:`rotframe.earth`   Earth's rotation, radius, gravity, sites, ENU frames
-:mod:`rotframe.model`   particle force models (:class:`~rotframe.model.ParticleModel`)
-:mod:`rotframe.integrators`  :func:`~rotframe.integrators.integrate_particles`
-:mod:`rotframe.rigid`   free body (exact, Lie-Poisson), heavy top, torqued bodies
-:mod:`rotframe.inertia` mass properties of bodies
-:mod:`rotframe.errors`  the exceptions
-=====================  ==========================================================
+=============================  ====================================================
+:mod:`rotframe.errors`         the exceptions
+:mod:`rotframe.frames`         rotations, Euler angles in 12 sequences, transport theorem
+:mod:`rotframe.numerics`       tableaus, composition weights, rotation primitives
+:mod:`rotframe.particles`      force models, compiled kernels, integrators, ensembles
+:mod:`rotframe.rigid`          mass properties, free body, heavy top, sections
+:mod:`rotframe.earth`          Earth's rotation, radius, gravity, sites, ENU frames
+:mod:`rotframe.analytic`       closed forms the scenes are checked against
+:mod:`rotframe.scenes`         one module per scenario: model, simulate, analyse
+:mod:`rotframe.app`            scenario files, runner, recordings, CLI, sweep, bench
+=============================  ====================================================
 """
 
 from __future__ import annotations
@@ -36,18 +39,29 @@ __version__ = "0.1.0"
 
 #: public name -> module that defines it (loaded on first access)
 _LAZY = {
-    "scenarios": "rotframe.api",
-    "load": "rotframe.api",
-    "run": "rotframe.api",
-    "Result": "rotframe.api",
-    "TrajectoryArrays": "rotframe.api",
-    "register_scene": "rotframe.api",
+    "scenarios": "rotframe.app.api",
+    "load": "rotframe.app.api",
+    "run": "rotframe.app.api",
+    "Result": "rotframe.app.api",
+    "TrajectoryArrays": "rotframe.app.api",
+    "register_scene": "rotframe.app.api",
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
 }
-_SUBMODULES = ("api", "analytic", "earth", "errors", "export", "frames", "inertia", "integrators", "model",
-               "principal", "record", "rigid", "runner", "scenario", "scenes", "sections", "units")
+_SUBMODULES = ("analytic", "app", "earth", "errors", "frames", "limits", "numerics", "particles",
+               "rigid", "scenes", "validation")
+
+#: Where the modules of the first, flat layout live now: ``rotframe.inertia`` and
+#: ``from rotframe import integrators`` keep working (``import rotframe.inertia`` does not).
+_MOVED = {
+    "inertia": "rotframe.rigid.mass_properties", "principal": "rotframe.rigid.principal",
+    "sections": "rotframe.rigid.sections", "model": "rotframe.particles.model",
+    "integrators": "rotframe.particles.integrators", "kernels": "rotframe.particles.kernels",
+    "ensemble": "rotframe.particles.ensemble", "api": "rotframe.app.api", "runner": "rotframe.app.runner",
+    "scenario": "rotframe.app.scenario", "record": "rotframe.app.record", "units": "rotframe.app.units",
+    "export": "rotframe.app.export", "cli": "rotframe.app.cli", "sweep": "rotframe.app.sweep",
+}
 
 __all__ = ["__version__", *_LAZY]
 
@@ -59,6 +73,8 @@ def __getattr__(name: str) -> Any:
         return value
     if name in _SUBMODULES:
         return importlib.import_module(f"rotframe.{name}")
+    if name in _MOVED:
+        return importlib.import_module(_MOVED[name])
     raise AttributeError(f"module 'rotframe' has no attribute {name!r}")
 
 

@@ -1,3 +1,3 @@
-from rotframe._console import main
+from rotframe.app.console import main
 
 raise SystemExit(main())

@@ -755,6 +755,6 @@ def _angle_text(angle):
 
 
 # text, complex and object input to the public functions: a _InputError, not a numpy TypeError
-from rotframe._guard import guard_public  # noqa: E402
+from rotframe.validation import guard_public  # noqa: E402
 
 guard_public(globals(), __all__, _InputError, error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "dcm_to_euler", "from_scipy", "to_scipy")})

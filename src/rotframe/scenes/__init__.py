@@ -20,7 +20,7 @@ None (choose a default), ``run`` the run settings (``step``, ``rtol``,
 ``samples``), ``progress`` None or a callable taking the fraction done.
 :class:`~rotframe.scenes.base.SceneResult` wraps a trajectory with ``times``
 and either ``r``, ``v`` (n, N, 3) for particles or ``L`` (n, 3), ``q`` (n, 4)
-for a rigid body. ``record`` logs to a :class:`rotframe.record.Recording`.
+for a rigid body. ``record`` logs to a :class:`rotframe.app.record.Recording`.
 
 Your own scene is registered with :func:`rotframe.register_scene` (which calls
 :func:`register`). The command line imports the modules listed in the

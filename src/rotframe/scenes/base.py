@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
-from rotframe.integrators import RunInterrupted, integrate_particles
+from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
 
 @dataclass

@@ -21,8 +21,7 @@ METHODS = FREE_METHODS
 
 
 def build(values):
-    from rotframe import inertia as mass_properties
-
+    from rotframe.rigid import mass_properties
     inertia = np.array([values["i1"], values["i2"], values["i3"]], dtype=float)
     mass_properties.check_moments(inertia)
     omega = np.asarray(values["omega"], dtype=float)
@@ -36,8 +35,7 @@ SAMPLES_PER_OMEGA_PERIOD = 64
 
 
 def simulate(values, terms, method, run, progress):
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     reject_subnormal(values)
     body = build(values)
     period = rigid.elliptic_period(body[0], body[1])
@@ -77,8 +75,7 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
 
 
 def analyse(values, result):
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     traj, inertia = result.trajectory, result.extras["inertia"]
     mid = int(np.argsort(inertia)[1])
     e_drift, m_drift, _, _ = invariant_drifts(inertia, traj)

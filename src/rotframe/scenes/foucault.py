@@ -3,7 +3,7 @@
 Local ENU frame with the origin below the pivot at the bob's rest position,
 pivot at (0, 0, L). The full model is the spherical pendulum on the rotating
 Earth: effective gravity, Coriolis, the string kept exactly (the splitting on
-the sphere in :func:`rotframe.kernels.step_sphere`). The bob is released from
+the sphere in :func:`rotframe.particles.kernels.step_sphere`). The bob is released from
 rest in the rotating frame at ``amplitude`` east of the rest position, which
 gives a swing of tiny ellipticity and so negligible Airy precession
 (docs/physics/earth.md). ``small_angle = true`` uses instead the linearised
@@ -23,8 +23,8 @@ import math
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
-from rotframe.integrators import default_method
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import default_method
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
                                   potential_energy, reject_subnormal, run_particles, unresolved_note)
 
@@ -192,7 +192,7 @@ def analyse(values, result):
 def record(rec, values, result):
     """The bob with a trail that grows with time, the swing plane and its angle beside Omega sin(lat) t,
     the local frame with Earth's rotation vector, the string's length error."""
-    from rotframe.record import decimate
+    from rotframe.numerics.sampling import decimate
 
     traj = result.trajectory
     idx = decimate(len(traj.times), int(values.get("record_samples", 20000)))

@@ -22,8 +22,7 @@ METHODS = FREE_METHODS
 
 
 def build(values):
-    from rotframe import inertia as mass_properties
-
+    from rotframe.rigid import mass_properties
     inertia = np.array([values["i1"], values["i1"], values["i3"]], dtype=float)
     mass_properties.check_moments(inertia)
     omega = np.array([values["omega_perp"], 0.0, values["omega3"]])
@@ -60,8 +59,7 @@ def simulate(values, terms, method, run, progress):
 
 def measured_rates(traj, inertia):
     """(body precession rate of (w1, w2), space precession rate of e3 about L), rad/s, signed."""
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     w = traj.L / inertia
     body_angle = np.unwrap(np.arctan2(w[:, 1], w[:, 0]))
     body_rate = np.polyfit(traj.times, body_angle, 1)[0]

@@ -22,8 +22,7 @@ METHODS = HEAVY_METHODS
 
 def build(values):
     from rotframe import frames
-    from rotframe import inertia as mass_properties
-
+    from rotframe.rigid import mass_properties
     i1, i3 = values["i1"], values["i3"]
     inertia = np.array([i1, i1, i3])
     mass_properties.check_moments(inertia)
@@ -36,8 +35,7 @@ def build(values):
 
 def _theory(values):
     """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket."""
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     if not (values["theta0"] > 0 or values["wobble"] != 0):
         return None
     try:
@@ -79,8 +77,7 @@ NUTATION_FLOOR = 1e-12
 
 def tilt(traj):
     """theta(t) (rad): angle between the symmetry axis and the vertical, from the quaternions."""
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     e3 = rigid.body_to_space(traj.q, np.array([0.0, 0.0, 1.0]))
     return np.arccos(np.clip(e3[:, 2], -1.0, 1.0))
 
@@ -125,8 +122,7 @@ def _peak_times(times, theta, k):
 
 
 def analyse(values, result):
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     traj = result.trajectory
     theta = tilt(traj)
     args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])
@@ -204,7 +200,7 @@ def analyse(values, result):
 def record(rec, values, result):
     """The top, L in space per sample (its horizontal part turns under the gravity torque), theta and its
     turning-angle theory, the Euler angles, the energy error; each kind in its own time-series view."""
-    from rotframe import rigid
+    from rotframe.rigid import dynamics as rigid
     from rotframe.scenes.rigid_base import record_body
 
     traj = result.trajectory
@@ -233,8 +229,7 @@ def record(rec, values, result):
 
 def analyse_theory(values):
     """(theta_min, theta_max, period) from Goldstein's cubic, or None where it has no bracket."""
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     if not (values["theta0"] > 0 or values["wobble"] != 0):
         return None
     args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])

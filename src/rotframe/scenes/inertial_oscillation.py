@@ -15,8 +15,8 @@ import math
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
-from rotframe.integrators import default_method
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import default_method
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, reject_subnormal, rel_drift,
                                   run_particles, samples_for, unresolved_note)
 

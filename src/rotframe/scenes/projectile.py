@@ -21,8 +21,8 @@ import math
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
-from rotframe.integrators import Event
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import Event
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, reject_subnormal,
                                   rel_drift, resolve_terms, run_particles, samples_for, until_event)
 

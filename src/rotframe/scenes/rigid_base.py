@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
-from rotframe.integrators import RunInterrupted
+from rotframe.particles.integrators import RunInterrupted
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow.
 FREE_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
@@ -42,8 +42,7 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     the work is done in chunks so that progress shows, Ctrl-C interrupts and a
     non-finite state stops the run with everything before it kept.
     """
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     from rotframe import limits
 
     duration = float(duration)
@@ -149,8 +148,7 @@ def simulate_free_body(body, duration, method, run, progress):
 
 
 def _stepper(method, inertia, top):
-    from rotframe import rigid
-
+    from rotframe.rigid import dynamics as rigid
     i1, i2, i3 = inertia
     mgl = 0.0 if top is None else top[0] * top[1] * top[2]
     if method == "rk4":
@@ -204,7 +202,7 @@ def initial_attitude_zxz(phi, theta, psi):
 
 def invariant_drifts(inertia, traj):
     """Relative drifts of the energy and |L| along a free-body trajectory."""
-    from rotframe import rigid
+    from rotframe.rigid import dynamics as rigid
     from rotframe.scenes.base import rel_drift
 
     E = rigid.energy(inertia, traj.L)
@@ -222,8 +220,8 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
     """
     import rerun as rr
 
-    from rotframe import rigid
-    from rotframe.record import decimate
+    from rotframe.rigid import dynamics as rigid
+    from rotframe.numerics.sampling import decimate
 
     idx = decimate(len(traj.times), 5000)
     t = traj.times[idx]

@@ -16,8 +16,8 @@ import math
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
-from rotframe.integrators import Event, default_method
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.integrators import Event, default_method
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, rel_drift,
                                   reject_subnormal,
                                   resolve_terms, run_particles, until_event)
@@ -162,7 +162,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model: each such group is one
     ``integrate_particles`` call with one particle per point and the ground event
-    (:func:`rotframe.ensemble.integrate_ensemble`). The metrics are those of
+    (:func:`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
     :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
@@ -181,7 +181,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     list of dict
         ``analyse(...)["metrics"]`` per point, in order.
     """
-    from rotframe.ensemble import group_points, integrate_ensemble
+    from rotframe.particles.ensemble import group_points, integrate_ensemble
 
     metrics = [None] * len(values_list)
     for members in group_points(values_list, varying=("height", "magnify")):

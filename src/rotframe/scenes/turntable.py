@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from rotframe.model import OmegaSchedule, ParticleModel
+from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import SceneResult, method_rel_error, reject_subnormal, rel_drift, run_particles
 
 Z = np.array([0.0, 0.0, 1.0])
@@ -127,7 +127,7 @@ def _record_inertial_axes(rec, times, omega, length):
     """The inertial (lab) axes as seen from the turntable: they turn by -theta(t) about z."""
     import rerun as rr
 
-    from rotframe.record import decimate
+    from rotframe.numerics.sampling import decimate
 
     idx = decimate(len(times), 2000)
     half = -0.5 * np.asarray(omega.angle(times[idx]), dtype=float).reshape(-1)

@@ -10,7 +10,7 @@ Conventions
   ``I_xy = -sum m x y`` and cyclically (Goldstein ch. 5.3; the rigid-body lecture's
   "Angular momentum, moment of inertia" section).
 * Principal moments are returned ascending with the principal axes as the
-  columns of a proper rotation, by :func:`rotframe.principal.principal_axes`.
+  columns of a proper rotation, by :func:`rotframe.rigid.principal.principal_axes`.
 * What cannot be a body is refused with :class:`InvalidBodyError` (a
   ``ValueError``): non-positive or non-finite mass, a tensor that is not
   finite, not symmetric or not positive semi-definite, or principal moments
@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rotframe.errors import RotframeError
-from rotframe.principal import principal_axes
+from rotframe.rigid.principal import principal_axes
 
 __all__ = [
     "InvalidBodyError",
@@ -310,7 +310,7 @@ def principal_moments(tensor: ArrayLike, *, rtol: float = RTOL) -> tuple[np.ndar
 
     The tensor is validated (:func:`check_tensor`: finite, symmetric, positive
     semi-definite, triangle inequality) and diagonalised by
-    :func:`rotframe.principal.principal_axes`.
+    :func:`rotframe.rigid.principal.principal_axes`.
 
     Parameters
     ----------
@@ -472,6 +472,6 @@ def _length(v, name):
 
 
 # text, complex and object input to the public functions: a InvalidBodyError, not a numpy TypeError
-from rotframe._guard import guard_public  # noqa: E402
+from rotframe.validation import guard_public  # noqa: E402
 
 guard_public(globals(), __all__, InvalidBodyError)

@@ -1,6 +1,6 @@
 """Run a scenario: values in, summary and result out (no printing, no recording).
 
-The command line (:mod:`rotframe.cli`) and the Python convenience function
+The command line (:mod:`rotframe.app.cli`) and the Python convenience function
 :func:`run` share this path; recording is downstream of a finished or
 interrupted run (:func:`record_result`).
 """
@@ -28,8 +28,7 @@ def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
     terms : list of str, optional
         Model terms replacing the scenario's ``model`` list.
     """
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     scn = sc.load(name_or_path)
     values = scn.with_values(sets or {})
     t0 = time.perf_counter()
@@ -138,7 +137,7 @@ def summarize_minimal(scn, values, result, timing):
 def record_result(scn, values, result, summary, path, complete=True):
     """Write the recording; returns the final path (``.partial.rrd`` if not complete)."""
     from rotframe import scenes
-    from rotframe.record import Recording
+    from rotframe.app.record import Recording
 
     scene = scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}

@@ -1,8 +1,8 @@
 """Principal axes of a symmetric second-moment tensor, in 2D or 3D.
 
 One routine serves the 3x3 inertia tensor of a rigid body
-(:mod:`rotframe.inertia`) and the 2x2 second-moment-of-area tensor of a
-cross-section (:mod:`rotframe.sections`).
+(:mod:`rotframe.rigid.mass_properties`) and the 2x2 second-moment-of-area tensor of a
+cross-section (:mod:`rotframe.rigid.sections`).
 
 Conventions
 -----------

@@ -17,7 +17,7 @@
 * Files are deterministic (fixed recording id, no ``log_time``). The recording
   is encoded into memory (rerun's binary stream) and the bytes are written by
   Python to a temporary file of this writer's own in the target folder, then
-  renamed (:mod:`rotframe.outputs`): an earlier complete recording is only ever
+  renamed (:mod:`rotframe.app.outputs`): an earlier complete recording is only ever
   replaced by a complete one, two writers never share a temporary file, and
   every I/O error (full disk, ``ulimit -f``) ends the run with one line and no
   file left behind. An interrupted or failed run is finalised as
@@ -30,7 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Recording", "default_path", "decimate", "series_kind"]
+from rotframe.numerics.sampling import decimate
+
+__all__ = ["Recording", "default_path", "series_kind"]
 
 
 def default_path(scenario_name: str) -> Path:
@@ -44,12 +46,6 @@ def partial_path(path: Path) -> Path:
     return path.with_name(path.stem + ".partial.rrd")
 
 
-def decimate(n: int, max_samples: int) -> np.ndarray:
-    """Indices of at most ``max_samples`` evenly spread samples of ``n``, first and last kept."""
-    if n <= max_samples:
-        return np.arange(n)
-    return np.unique(np.linspace(0, n - 1, max_samples).round().astype(np.int64))
-
 
 def series_kind(entity: str) -> str:
     """The time-series view a series goes to, from its name: errors and drifts together, else by unit.
@@ -61,7 +57,7 @@ def series_kind(entity: str) -> str:
     >>> series_kind("diagnostics/omega_body/2")
     'omega_body'
     """
-    from rotframe.units import quantity_unit
+    from rotframe.app.units import quantity_unit
 
     name = entity.rstrip("/").rsplit("/", 1)[-1]
     if "rel_error" in name or "rel_drift" in name:
@@ -282,11 +278,11 @@ class Recording:
     def finish(self, complete: bool = True) -> Path:
         """Encode, write through a temporary file and rename to the final or partial name.
 
-        Raises :class:`rotframe.outputs.OutputError` (nothing left behind) when the
+        Raises :class:`rotframe.app.outputs.OutputError` (nothing left behind) when the
         file cannot be written. If the write is interrupted, ``finish(complete=False)``
         may be called again: the encoded bytes are kept until a write succeeds.
         """
-        from rotframe.outputs import write_bytes_atomic
+        from rotframe.app.outputs import write_bytes_atomic
 
         if self._done:
             return self.final

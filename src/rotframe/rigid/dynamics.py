@@ -68,7 +68,7 @@ from scipy import special
 from scipy.spatial.transform import Rotation
 
 from rotframe.errors import IntegrationError, RotframeError
-from rotframe.inertia import InvalidBodyError, check_mass, check_moments
+from rotframe.rigid.mass_properties import InvalidBodyError, check_mass, check_moments
 
 __all__ = [
     "InvalidStateError",
@@ -1339,6 +1339,6 @@ def _rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_e
 
 
 # text, complex and object input to the public functions: a InvalidStateError, not a numpy TypeError
-from rotframe._guard import guard_public  # noqa: E402
+from rotframe.validation import guard_public  # noqa: E402
 
 guard_public(globals(), __all__, InvalidStateError)

@@ -2,7 +2,7 @@
 
 Everything here works on plain float64 arrays in SI units and radians; there is
 no I/O and no Python object in a step loop. The Python side
-(:mod:`rotframe.integrators`) packs a :class:`rotframe.model.ParticleModel` into
+(:mod:`rotframe.particles.integrators`) packs a :class:`rotframe.particles.model.ParticleModel` into
 the flat parameter vector ``P`` described below and calls the drivers in
 chunks of output samples, so that a progress bar, Ctrl-C and a numerical
 failure can be handled between chunks without losing data.
@@ -15,7 +15,7 @@ with ``w(t) = w_hat * w(t)``, a fixed unit axis times a magnitude that is
 piecewise linear in time (a constant is a one-node table). Each term is
 switched by a flag in ``P``; a term that is off costs one branch.
 
-Layout of ``P`` (see ``pack`` in :mod:`rotframe.model`)::
+Layout of ``P`` (see ``pack`` in :mod:`rotframe.particles.model`)::
 
     0:3   uniform gravity vector g (m/s^2)          [used when gravity mode == 0]
     3:6   unit rotation axis w_hat

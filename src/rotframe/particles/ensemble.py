@@ -92,7 +92,7 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
     r0, v0 : (N, 3) arrays
     duration : float
         Long enough for every particle to reach the event.
-    event : rotframe.integrators.Event
+    event : rotframe.particles.integrators.Event
         Terminal event (kinds ``r`` and ``v`` with ``exact``).
     method : str
     run : dict
@@ -183,7 +183,7 @@ def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, thre
 
 
 def _integrate(model, r0, v0, duration, event, method, run, samples):
-    from rotframe.integrators import integrate_particles
+    from rotframe.particles.integrators import integrate_particles
 
     kw = {}
     if run.get("atol"):

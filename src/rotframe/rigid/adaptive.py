@@ -2,7 +2,7 @@
 
 The state is ``y = (L_body, q)``: angular momentum in principal body axes
 (kg m^2/s) and the body -> space orientation quaternion, scalar-last. The
-equations are those of :func:`rotframe.rigid.rigid_rhs` (docs/physics.md,
+equations are those of :func:`rotframe.rigid.dynamics.rigid_rhs` (docs/physics.md,
 rigid bodies): Euler's equations ``dL/dt = L x omega + N_body``,
 ``omega = L / I``, and the kinematics ``dq/dt = q * (omega, 0) / 2``, with the
 torque of a heavy symmetric top ``mgl (z_b[1], -z_b[0], 0)``, a constant body
@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.kernels import dop853_error_norm
+from rotframe.particles.kernels import dop853_error_norm
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
@@ -52,7 +52,7 @@ def _tableau():
     """(A (16, 16), B (12,), C (16,), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output."""
     from scipy.integrate._ivp import dop853_coefficients as d
 
-    from rotframe._dop853 import coefficients
+    from rotframe.numerics.dop853 import coefficients
 
     _, B, _, E3, E5 = coefficients()
     A = np.ascontiguousarray(d.A, dtype=np.float64)

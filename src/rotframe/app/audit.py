@@ -12,15 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.model import term_accelerations
+from rotframe.particles.model import term_accelerations
 
 __all__ = ["audit"]
 
 
 def audit(scn, values, base_result, base_summary, method=None):
     """Toggle each optional term of the finished run ``base_result``; returns ``{"terms": ..., "text": table}``."""
-    from rotframe import runner
-
+    from rotframe.app import runner
     model = base_result.extras.get("model")
     traj = base_result.trajectory
     peaks = {}

@@ -1,10 +1,10 @@
 """Integrators for particles in a rotating frame, chosen by name.
 
 Every method honours one contract (as REBOUND's integrators do): it takes a
-:class:`~rotframe.model.ParticleModel`, initial positions and velocities of an
+:class:`~rotframe.particles.model.ParticleModel`, initial positions and velocities of an
 ensemble ``(N, 3)`` in the rotating frame, a duration and a number of output
 samples, and returns a :class:`Trajectory`. The work is done by compiled
-kernels (:mod:`rotframe.kernels`) called in chunks, so that progress can be
+kernels (:mod:`rotframe.particles.kernels`) called in chunks, so that progress can be
 shown, Ctrl-C and SIGTERM interrupt cleanly, and a numerical failure returns
 everything computed before it.
 
@@ -50,7 +50,7 @@ if TYPE_CHECKING:  # names used only in annotations
 
     from numpy.typing import ArrayLike
 
-    from rotframe.model import ParticleModel
+    from rotframe.particles.model import ParticleModel
 
 __all__ = ["METHODS", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
 
@@ -277,8 +277,7 @@ class _EventBuffers:
 
 def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, events, progress,
                       max_events):
-    from rotframe import kernels
-
+    from rotframe.particles import kernels
     n = r0.shape[0]
     P = model.pack()
     wt, wv = model.omega.times, model.omega.values
@@ -309,7 +308,7 @@ def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, 
         scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
         atol = float(atol) if atol else float(rtol) * scale
         h_state = np.zeros(n)
-        from rotframe._dop853 import coefficients
+        from rotframe.numerics.dop853 import coefficients
 
         A, B, C, E3, E5 = coefficients()
         cost = n * 200
@@ -461,11 +460,11 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     expm is evaluated directly at every 64th sample and the samples between
     are reached by powers of the one-interval propagator, so round-off stays
     at a few tens of ulps however long the run. Events are located on the exact
-    flow for all particles at once (:func:`rotframe.linear.locate_crossings`).
+    flow for all particles at once (:func:`rotframe.particles.linear.locate_crossings`).
     """
     from scipy.linalg import expm
 
-    from rotframe.linear import flow_matrix, locate_crossings
+    from rotframe.particles.linear import flow_matrix, locate_crossings
 
     M = flow_matrix(model)
     n = r0.shape[0]

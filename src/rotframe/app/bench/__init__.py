@@ -2,7 +2,7 @@
 
 For each problem (a scenario's equations, initial state and horizon) every
 rotframe method runs over a ladder of step sizes or tolerances, and so do the
-peers (:mod:`rotframe.bench.peers`): scipy's ``solve_ivp`` (RK45, DOP853, Radau,
+peers (:mod:`rotframe.app.bench.peers`): scipy's ``solve_ivp`` (RK45, DOP853, Radau,
 LSODA) with an expert's scalar right-hand side, scipy DOP853 with a
 numba-compiled right-hand side, and diffrax (Dopri8, Tsit5; whole solve
 jit-compiled, CPU, 64-bit) where the ``bench`` extra is installed. Each row
@@ -67,7 +67,7 @@ class Problem:
     scipy_budget_s: float = 20.0
     scipy_rtols: tuple = tuple(10.0 ** -k for k in range(3, 14))
     notes: list = field(default_factory=list)
-    spec: dict = None  # the equations for the peers (rotframe.bench.peers)
+    spec: dict = None  # the equations for the peers (rotframe.app.bench.peers)
     ref_error: float = 0.0  # accuracy of the reference itself: smaller errors are not resolved
 
 
@@ -102,13 +102,13 @@ def _ladder(quick, full, short):
     return short if quick else full
 
 
-#: suffix of a rotframe method run through rotframe.prepared.PreparedRun (prepared once, untimed)
+#: suffix of a rotframe method run through rotframe.particles.prepared.PreparedRun (prepared once, untimed)
 PREPARED = " prepared"
 
 
 def _particle_runner(model, r0, v0, t_end, invariant_fn):
-    from rotframe.integrators import integrate_particles
-    from rotframe.prepared import PreparedRun
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.prepared import PreparedRun
 
     prepared = {}
     times = np.array([0.0, t_end])
@@ -140,7 +140,7 @@ def _with_prepared(runs, quick):
 
 
 def _turntable(quick):
-    from rotframe.model import OmegaSchedule, ParticleModel
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
     from rotframe.scenes.turntable import inertial_line
 
     w0, alpha, T = 1.0, 0.2, 4.0
@@ -160,7 +160,7 @@ def _turntable(quick):
     runs = _with_prepared({"splitting": steps, "splitting4": steps, "rk4": steps,
                            "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
     y0 = np.concatenate([r0, v0])
-    from rotframe.bench.peers import python_rhs
+    from rotframe.app.bench.peers import python_rhs
 
     return [Problem("turntable", "4 s, 0.9 turns", T, y0, python_rhs(spec),
                     lambda y: float(np.linalg.norm(y[:3] - r_end)), "analytic: final position error (m)",
@@ -169,9 +169,9 @@ def _turntable(quick):
 
 def _tower_drop(quick):
     from rotframe import earth
-    from rotframe.bench.peers import python_rhs
-    from rotframe.integrators import integrate_particles
-    from rotframe.model import OmegaSchedule, ParticleModel
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     lat = math.radians(50 + 53 / 60)
     g = float(earth.normal_gravity(lat))
@@ -206,9 +206,9 @@ def _tower_drop(quick):
 
 def _foucault(quick):
     from rotframe import earth
-    from rotframe.bench.peers import python_rhs
-    from rotframe.integrators import integrate_particles
-    from rotframe.model import OmegaSchedule, ParticleModel
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     lat = math.radians(48.846)
     g = float(earth.normal_gravity(lat))
@@ -244,7 +244,7 @@ def _foucault(quick):
 
 
 def _rigid_runner(inertia, L0, q0, T, top=None, invariant=None):
-    from rotframe.rigid_adaptive import rigid_dop853
+    from rotframe.rigid.adaptive import rigid_dop853
     from rotframe.scenes.rigid_base import integrate_body
 
     mgl = 0.0 if top is None else top[0] * top[1] * top[2]
@@ -277,9 +277,9 @@ def attitude_error(q, q_ref):
 
 
 def _dzhanibekov(quick):
-    from rotframe import rigid
-    from rotframe.bench.peers import python_rhs
-    from rotframe.rigid_exact import free_body_flow
+    from rotframe.rigid import dynamics as rigid
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.rigid.exact_flow import free_body_flow
 
     inertia = np.array([1.0, 2.0, 3.0])
     L0 = inertia * np.array([0.01, 1.0, 0.01])
@@ -327,7 +327,7 @@ def _dzhanibekov(quick):
 def _heavy_top(quick):
     from scipy.integrate import solve_ivp
 
-    from rotframe.bench.peers import numba_rhs, python_rhs
+    from rotframe.app.bench.peers import numba_rhs, python_rhs
     from rotframe.scenes.heavy_top import build
 
     values = {"i1": 1.9e-4, "i3": 2.5e-5, "mass": 0.1, "length": 0.04, "g": 9.81, "theta0": 20.0,
@@ -444,7 +444,7 @@ def run_problem(p, progress=None, plan=None):
 
     scale = None
     if p.spec is not None:
-        from rotframe.bench.peers import atol_scale
+        from rotframe.app.bench.peers import atol_scale
 
         scale = atol_scale(p.spec, p.y0)
     for method in (SCIPY_METHODS_QUICK if plan.quick else SCIPY_METHODS):
@@ -452,7 +452,7 @@ def run_problem(p, progress=None, plan=None):
                       solve_ivp)
     if plan.quick or p.spec is None:
         return rows
-    from rotframe.bench import peers
+    from rotframe.app.bench import peers
 
     t0 = time.perf_counter()
     rhs = peers.numba_rhs(p.spec)
@@ -669,7 +669,7 @@ def speedups(rows, max_error=1e-2):
 def ensemble_rows(quick):
     """Particle-steps per second of the tower-drop ensemble path on one core and on all, beside hand-written loops.
 
-    rotframe: :func:`rotframe.ensemble.integrate_ensemble` (gravity + Coriolis,
+    rotframe: :func:`rotframe.particles.ensemble.integrate_ensemble` (gravity + Coriolis,
     exact-rotation splitting, the ground event watched every step) with
     ``threads=1`` and with every core. Ceiling: the same splitting written out
     by hand (no event), serial and with ``prange``. ``parallel_efficiency`` is
@@ -677,10 +677,10 @@ def ensemble_rows(quick):
     """
     import numba
 
-    from rotframe.bench import ceiling
-    from rotframe.ensemble import integrate_ensemble, resolve_threads
-    from rotframe.integrators import Event
-    from rotframe.model import OmegaSchedule, ParticleModel
+    from rotframe.app.bench import ceiling
+    from rotframe.particles.ensemble import integrate_ensemble, resolve_threads
+    from rotframe.particles.integrators import Event
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     n, steps = (20000, 50) if quick else (100000, 200)
     cores = resolve_threads(None)
@@ -741,8 +741,8 @@ def sweep_rows(quick):
     """Rows per second of a Foucault sweep (one run per row) on a Dask ``LocalCluster`` of 1, 2 and all workers."""
     import shutil
 
-    from rotframe.ensemble import resolve_threads
-    from rotframe.sweep import parse_spec, run_sweep
+    from rotframe.particles.ensemble import resolve_threads
+    from rotframe.app.sweep import parse_spec, run_sweep
 
     cores = resolve_threads(None)
     n = 8 if quick else 32
@@ -766,12 +766,12 @@ def sweep_rows(quick):
 def startup_rows(scenario="foucault"):
     """Wall time of ``rotframe run SCENARIO --no-record`` in a new process: warm cache, then empty cache.
 
-    ``import_s`` is the time of ``import rotframe.cli`` plus numpy/scipy in a new process, to
+    ``import_s`` is the time of ``import rotframe.app.cli`` plus numpy/scipy in a new process, to
     tell the compile time (``wall_s - import_s``) apart.
     """
     rows = []
     cmd = [sys.executable, "-m", "rotframe", "run", scenario, "--no-record", "--json"]
-    imp = [sys.executable, "-c", "import rotframe.cli, numpy, scipy, numba"]
+    imp = [sys.executable, "-c", "import rotframe.app.cli, numpy, scipy, numba"]
     t0 = time.perf_counter()
     subprocess.run(imp, capture_output=True, check=True)
     import_s = time.perf_counter() - t0
@@ -795,7 +795,7 @@ def startup_rows(scenario="foucault"):
 
 def record_rows(n=10**6):
     """Time to record ``n`` samples of a particle (Points3D + trail + a scalar series)."""
-    from rotframe.record import Recording
+    from rotframe.app.record import Recording
 
     times = np.linspace(0, 100, n)
     pos = np.stack([np.cos(times), np.sin(times), times * 0.01], axis=1)
@@ -830,7 +830,7 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
     notes = []
     plan = Plan(quick, progress)
     probs = problems(scenario_names or None, quick=quick) if (scenario_names or not names) else []
-    from rotframe.bench import peers
+    from rotframe.app.bench import peers
 
     peers_ok, why = peers.diffrax_available()
     if not quick and not peers_ok:
@@ -975,7 +975,7 @@ def _json_rows(rows):
 
 
 def main(args) -> int:
-    from rotframe.progress import Progress
+    from rotframe.app.progress import Progress
 
     bar = Progress("bench", "runs", enabled=not args.json)  # on a terminal only, never with --json
 

@@ -32,7 +32,7 @@ import sys
 
 import numpy as np
 
-from rotframe.sections import (
+from rotframe.rigid.sections import (
     PROPERTY_UNITS,
     SectionError,
     angle,

@@ -25,7 +25,7 @@ Conventions
   The second-moment tensor, with the tensor sign convention of the inertia
   tensor, is ``J = [[Ixx, -Ixy], [-Ixy, Iyy]]``: the second moment about the
   centroidal axis of unit direction ``e`` is ``e @ J @ e``. Its eigenpairs,
-  from :func:`rotframe.principal.principal_axes` (the routine that also serves
+  from :func:`rotframe.rigid.principal.principal_axes` (the routine that also serves
   the 3D inertia tensor), are the principal moments and axes.
 * Principal angle: the angle of the major principal axis, measured from +x
   counter-clockwise, in (-90, 90] degrees. It satisfies
@@ -63,7 +63,7 @@ from pathlib import Path
 import numpy as np
 
 from rotframe.errors import RotframeError
-from rotframe.principal import principal_axes
+from rotframe.rigid.principal import principal_axes
 
 __all__ = [
     "SectionError",

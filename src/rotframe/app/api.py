@@ -66,7 +66,7 @@ def scenarios() -> list[str]:
     >>> rotframe.scenarios()[:3]
     ['dzhanibekov', 'foucault', 'free-top']
     """
-    from rotframe import scenario as sc
+    from rotframe.app import scenario as sc
     from rotframe.scenes import SCENARIO_FILES, load_plugins
 
     load_plugins()  # as the command line: the modules named in $ROTFRAME_PLUGINS register theirs
@@ -74,9 +74,9 @@ def scenarios() -> list[str]:
 
 
 def load(name_or_path: str | Path):
-    """Load and check a scenario; returns a :class:`rotframe.scenario.Scenario`.
+    """Load and check a scenario; returns a :class:`rotframe.app.scenario.Scenario`.
 
-    Its ``parameters`` map each name to a :class:`rotframe.scenario.Parameter`
+    Its ``parameters`` map each name to a :class:`rotframe.app.scenario.Parameter`
     with ``name``, ``unit``, ``default`` (in that unit), ``bounds`` = ``(min, max)``
     (``exclusive_min``/``exclusive_max`` say whether they are allowed),
     ``choices`` and ``doc``. ``scenario.run`` holds the run settings
@@ -97,8 +97,7 @@ def load(name_or_path: str | Path):
     >>> print(scn.parameters["length"].describe())
     67 m (> 0)
     """
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     return sc.load(str(name_or_path))
 
 
@@ -133,7 +132,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     rotframe.errors.IntegrationError
         Numerical failure; ``exc.partial`` holds a :class:`Result` of what was
         computed up to ``exc.t_reached``.
-    rotframe.integrators.RunInterrupted
+    rotframe.particles.integrators.RunInterrupted
         Ctrl-C during the run; ``exc.partial`` holds a :class:`Result` of what was computed.
 
     Examples
@@ -147,9 +146,10 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     ...
     rotframe.errors.ScenarioError: foucault: unknown parameter 'lenght' (did you mean 'length'?); allowed: ...
     """
-    from rotframe import runner, scenes
+    from rotframe import scenes
+    from rotframe.app import runner
     from rotframe.errors import IntegrationError
-    from rotframe.integrators import RunInterrupted
+    from rotframe.particles.integrators import RunInterrupted
 
     t_start = time.perf_counter()
     scn = load(name_or_path)
@@ -182,8 +182,7 @@ def resolve_values(scn, params: Mapping[str, Any]) -> dict:
     Quantities are converted here, at the edge; strings and numbers go through
     the same checks as the scenario file's values.
     """
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     values = {k: p.default for k, p in scn.parameters.items()}
     run_settings = dict(scn.run)
     for key, raw in params.items():
@@ -218,7 +217,7 @@ def _plain(raw, unit: str, key: str, where: str):
 
 
 def _finish_summary(scn, summary, scene_result, simulate_s, t_start):
-    from rotframe.units import summary_units
+    from rotframe.app.units import summary_units
 
     compile_s = float(getattr(scene_result.trajectory, "extras", {}).get("compile_s", 0.0))
     summary["timing"].update({"compile_s": compile_s, "simulate_s": simulate_s - compile_s, "record_s": 0.0,
@@ -333,7 +332,7 @@ class Result:
         Parameter and metric name -> unit string.
     trajectory : TrajectoryArrays
         The samples as numpy arrays.
-    scenario : rotframe.scenario.Scenario
+    scenario : rotframe.app.scenario.Scenario
         The loaded scenario.
     """
 
@@ -373,8 +372,8 @@ class Result:
 
         The default path is ``recordings/<scenario>.rrd`` in the working directory.
         """
-        from rotframe import runner
-        from rotframe.record import default_path
+        from rotframe.app import runner
+        from rotframe.app.record import default_path
 
         path = Path(path) if path is not None else default_path(self.scenario.name)
         if path.suffix != ".rrd":
@@ -387,14 +386,14 @@ class Result:
         return Path(final)
 
     def export(self, path: str | Path) -> Path:
-        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see :mod:`rotframe.export`)."""
-        from rotframe.export import write_trajectory
+        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see :mod:`rotframe.app.export`)."""
+        from rotframe.app.export import write_trajectory
 
         return write_trajectory(self.trajectory, path, summary=self.to_dict())
 
     def plot(self, path: str | Path | None = None):
-        """A matplotlib figure of the run (``path``: also save it as PNG); see :mod:`rotframe.plot`."""
-        from rotframe.plot import plot_result
+        """A matplotlib figure of the run (``path``: also save it as PNG); see :mod:`rotframe.app.plot`."""
+        from rotframe.app.plot import plot_result
 
         return plot_result(self, path)
 
@@ -477,7 +476,7 @@ def _jsonable(obj):
 
 
 def _progress_callback(progress: ProgressLike):
-    from rotframe.progress import Progress
+    from rotframe.app.progress import Progress
 
     if progress is True:
         # asked for: drawn on any stream (a notebook's stderr is no terminal), from the first report on

@@ -1,6 +1,6 @@
 """Repeated particle runs with everything prepared once (a few microseconds of overhead a run).
 
-:func:`rotframe.integrators.integrate_particles` checks its input, packs the
+:func:`rotframe.particles.integrators.integrate_particles` checks its input, packs the
 model, allocates output and event buffers and loads the kernel on every call:
 some 70 microseconds, more than the integration of a short run costs. A
 :class:`PreparedRun` does that once for a model, method, duration and sample
@@ -49,7 +49,7 @@ class PreparedRun:
 
     def __init__(self, model, method, duration, *, step=None, rtol=1e-10, atol=None, samples=1, n=1):
         from rotframe.errors import ScenarioError
-        from rotframe.integrators import METHODS
+        from rotframe.particles.integrators import METHODS
 
         if method not in METHODS or METHODS[method].kind not in ("fixed", "adaptive"):
             raise ScenarioError(f"method: {method!r}; allowed: splitting, splitting4, rk4, dop853")
@@ -78,7 +78,7 @@ class PreparedRun:
             self.sps = max(1, math.ceil(dt / h_req - 1e-9))
             self.h = dt / self.sps
         else:
-            from rotframe._dop853 import coefficients
+            from rotframe.numerics.dop853 import coefficients
 
             self.tableau = coefficients()
             self.h_state = np.zeros(n)
@@ -87,8 +87,7 @@ class PreparedRun:
 
     def run(self, r0, v0):
         """(r, v) samples (samples + 1, n, 3) from initial positions and velocities (n, 3) or (3,)."""
-        from rotframe import kernels
-
+        from rotframe.particles import kernels
         n, samples = self.n, self.samples
         out_r = np.empty((samples + 1, n, 3))
         out_v = np.empty((samples + 1, n, 3))

@@ -8,9 +8,9 @@ internal error (one line; ``ROTFRAME_DEBUG=1`` shows the traceback).
 
 Work is estimated before it starts (:mod:`rotframe.limits`: ``--max-steps``,
 ``--max-samples``, ``--max-rows``), outputs are checked before computing and
-written atomically (:mod:`rotframe.outputs`), signals are handled per command
-(:mod:`rotframe.signals`) and long work shows a progress line on a terminal
-(:mod:`rotframe.progress`). With ``--json`` only the JSON document reaches stdout.
+written atomically (:mod:`rotframe.app.outputs`), signals are handled per command
+(:mod:`rotframe.app.signals`) and long work shows a progress line on a terminal
+(:mod:`rotframe.app.progress`). With ``--json`` only the JSON document reaches stdout.
 
 This module imports only the standard library at start-up: numpy, astropy,
 numba and rerun are imported by the commands that need them, so that
@@ -42,7 +42,7 @@ class _Parser(argparse.ArgumentParser):
 
 def main(argv=None) -> int:
     """Run one command; returns its exit code (never raises for a user's error, a signal or an I/O error)."""
-    from rotframe.signals import InterruptScope
+    from rotframe.app.signals import InterruptScope
 
     t_start = time.perf_counter()
     parser = _parser()
@@ -308,7 +308,7 @@ def _parser():
 def cmd_list(args) -> int:
     import tomllib
 
-    from rotframe.scenario import scenario_dir
+    from rotframe.app.scenario import scenario_dir
     from rotframe.scenes import SCENARIO_FILES, load_plugins
 
     load_plugins()  # scenes registered by $ROTFRAME_PLUGINS, with their scenario files, are listed too
@@ -333,8 +333,7 @@ def cmd_list(args) -> int:
 
 
 def cmd_show(args) -> int:
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     scn = sc.load(args.name)
     print(f"{scn.name}: {scn.title}\n")
     if scn.description:
@@ -370,10 +369,12 @@ def cmd_run(args) -> int:
 
 
 def _run(args) -> int:
-    from rotframe import runner, scenario as sc, scenes
-    from rotframe.integrators import RunInterrupted
+    from rotframe import scenes
+    from rotframe.app import runner
+    from rotframe.app import scenario as sc
+    from rotframe.particles.integrators import RunInterrupted
     from rotframe.errors import IntegrationError
-    from rotframe.progress import Progress
+    from rotframe.app.progress import Progress
 
     scope = args._scope
     sets = _parse_sets(args.sets)
@@ -441,7 +442,7 @@ def _run(args) -> int:
     summary["units"] = _units(scn, summary)
     _write_outputs(args, scn, values, result, summary)
     if args.audit and status == EXIT_OK:
-        from rotframe.audit import audit
+        from rotframe.app.audit import audit
 
         try:
             summary["audit"] = audit(scn, values, result, summary, method=args.method)
@@ -460,10 +461,10 @@ def _run(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from rotframe.bench import main as bench_main
+    from rotframe.app.bench import main as bench_main
 
     if args.plots:
-        from rotframe.outputs import check_output_dir
+        from rotframe.app.outputs import check_output_dir
 
         check_output_dir(args.plots, "--plots")
 
@@ -471,7 +472,7 @@ def cmd_bench(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from rotframe.sweep import main as sweep_main
+    from rotframe.app.sweep import main as sweep_main
 
     with _limits(args):
         return sweep_main(args)
@@ -488,14 +489,14 @@ def cmd_view(args) -> int:
     if not bind or any(c.isspace() for c in bind):
         raise _input_error(f"view --bind {bind!r}: expected an IP address such as 127.0.0.1")
     if args.summary:
-        from rotframe.recording_summary import describe
+        from rotframe.app.recording_summary import describe
 
         print(describe(path))
         return EXIT_OK
     if args.web:
         return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, "--web-viewer", path])
     if not _has_display():
-        from rotframe.recording_summary import describe
+        from rotframe.app.recording_summary import describe
 
         print(f"rotframe: view: no display here (DISPLAY and WAYLAND_DISPLAY are unset), so a text summary "
               f"follows; 'rotframe view {path} --web' serves rerun's web viewer to a browser", file=sys.stderr)
@@ -535,7 +536,7 @@ def _has_display() -> bool:
 
 
 def cmd_section(args) -> int:
-    from rotframe.section_cli import run_section, shapes_help
+    from rotframe.app.section_cli import run_section, shapes_help
 
     if args.shape == "shapes":
         print(shapes_help())
@@ -566,8 +567,8 @@ def _default_recording(name):
 
 def _check_writable(out):
     """The recording (and its partial) can be written: checked before any computing starts."""
-    from rotframe.outputs import check_output_file
-    from rotframe.record import partial_path
+    from rotframe.app.outputs import check_output_file
+    from rotframe.app.record import partial_path
 
     check_output_file(out, "--out", ".rrd")
     partial = partial_path(out)
@@ -577,8 +578,8 @@ def _check_writable(out):
 
 def _check_outputs(args):
     """Refuse a bad --export or --png path before the run starts (suffix, folder, writable)."""
-    from rotframe.export import FORMATS
-    from rotframe.outputs import check_output_file
+    from rotframe.app.export import FORMATS
+    from rotframe.app.outputs import check_output_file
 
     export, png = getattr(args, "export", None), getattr(args, "png", None)
     if export is not None:
@@ -590,7 +591,7 @@ def _check_outputs(args):
 
 
 def _units(scn, summary):
-    from rotframe.units import summary_units
+    from rotframe.app.units import summary_units
 
     return summary_units(scn.parameters, summary)
 
@@ -599,7 +600,7 @@ def _write_outputs(args, scn, values, result, summary):
     """--export and --png: the trajectory and a picture, from the same Result the Python API gives."""
     if not (getattr(args, "export", None) or getattr(args, "png", None)):
         return
-    from rotframe.api import Result
+    from rotframe.app.api import Result
 
     res = Result(scn, values, result, summary)
     if args.export:

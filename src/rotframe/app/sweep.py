@@ -18,7 +18,7 @@ the ensemble next to it.
 Execution. A scene module with ``simulate_ensemble(values_list, terms, method,
 run, tracks=None)`` integrates a whole batch of points in one vectorised call
 of the compiled core (:func:`integrate_ensemble` helps it); otherwise each
-point goes through :func:`rotframe.runner.run`. Points are cut into batches
+point goes through :func:`rotframe.app.runner.run`. Points are cut into batches
 (about 0.2 s to 30 s of work each, at most about four per worker); batches run
 in this process, or as Dask tasks on a ``LocalCluster`` (``--workers N``) or an
 existing scheduler (``--scheduler ADDRESS``), retried when a worker is lost.
@@ -45,7 +45,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rotframe.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (moved; kept importable)
+from rotframe.numerics.sampling import decimate
+
+from rotframe.particles.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (moved; kept importable)
 from rotframe.errors import RotframeError, ScenarioError
 
 __all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "EnsembleRun", "parse_spec",
@@ -53,7 +55,7 @@ __all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "Ense
 
 #: at most this many trajectories and samples per trajectory in the recording
 MAX_TRACKS = 2000
-MAX_TRACK_SAMPLES = 500  # the same as rotframe.ensemble.MAX_TRACK_SAMPLES
+MAX_TRACK_SAMPLES = 500  # the same as rotframe.particles.ensemble.MAX_TRACK_SAMPLES
 #: wall time of one batch of runs (s): long enough that task overhead stays small, short enough to lose little
 MIN_BATCH_S = 0.2
 MAX_BATCH_S = 30.0
@@ -66,7 +68,7 @@ RETRIES = 3
 #: seconds allowed to connect to a scheduler and for the Dask handshake, each
 CONNECT_TIMEOUT_S = 10.0
 _DISTRIBUTIONS = {"normal": ("MEAN", "SD"), "uniform": ("LO", "HI")}
-_META_KEY = b"rotframe.sweep"
+_META_KEY = b"rotframe.app.sweep"
 
 
 # ---------------------------------------------------------------------------
@@ -185,7 +187,7 @@ def main(args) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        As built by :mod:`rotframe.cli` (``name, sets, grid, log_grid, samples, vary, seed, method,
+        As built by :mod:`rotframe.app.cli` (``name, sets, grid, log_grid, samples, vary, seed, method,
         workers, scheduler, out, resume, json``).
 
     Returns
@@ -199,9 +201,9 @@ def main(args) -> int:
     ScenarioError
         Bad input (the command line turns it into exit code 2 and one line).
     """
-    from rotframe import cli
-    from rotframe.progress import Progress
-    from rotframe.signals import InterruptScope
+    from rotframe.app import cli
+    from rotframe.app.progress import Progress
+    from rotframe.app.signals import InterruptScope
 
     spec = parse_spec(args.name, sets=cli._parse_sets(args.sets), grid=args.grid, log_grid=args.log_grid,
                       samples=args.samples, vary=args.vary, seed=args.seed, method=args.method)
@@ -252,7 +254,7 @@ def main(args) -> int:
 
 def check_outputs(spec, out, resume=False):
     """Every path the sweep will write can be written: checked before any computing starts."""
-    from rotframe.outputs import check_output_dir, check_output_file
+    from rotframe.app.outputs import check_output_dir, check_output_file
 
     files = _Files.for_spec(spec, out)
     option = "--out" if out else "sweep output"
@@ -322,8 +324,7 @@ def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=
     ScenarioError
         One line naming the option, key and value and what is allowed.
     """
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     scn = sc.load(scenario)
     sets = dict(sets or {})
     base = scn.with_values(sets)
@@ -428,7 +429,7 @@ def _exclusive(files):
         except ImportError:  # not POSIX: no lock
             yield
             return
-        from rotframe.outputs import OutputError
+        from rotframe.app.outputs import OutputError
 
         try:
             files.out.parent.mkdir(parents=True, exist_ok=True)
@@ -523,8 +524,9 @@ def run_batch(task: BatchTask) -> BatchOutput:
 
 
 def _run_batch(task):
-    from rotframe import scenario as sc, scenes
-    from rotframe.integrators import RunInterrupted
+    from rotframe import scenes
+    from rotframe.app import scenario as sc
+    from rotframe.particles.integrators import RunInterrupted
 
     scn = sc.load(task.scenario)
     base = scn.with_values(task.sets)
@@ -566,7 +568,7 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
         fig.suptitle(f"{spec.name}: {metric} ({table.num_rows} runs)")
         fig.tight_layout()
         path = Path(f"{stem}-{_safe(metric)}.png")
-        from rotframe.outputs import atomic_path
+        from rotframe.app.outputs import atomic_path
 
         try:
             with atomic_path(path, "plot") as tmp:
@@ -707,7 +709,7 @@ def _parse_count(option, text, raw):
 
 def _parse_number(scn, key, option, text, raw):
     """A number (or quantity string) in the parameter's unit; bounds are checked later."""
-    from rotframe.scenario import Parameter, parse_value
+    from rotframe.app.scenario import Parameter, parse_value
 
     p = Parameter(name=key.text, default=0.0, unit=scn.parameters[key.param].unit)
     try:
@@ -754,7 +756,7 @@ def _check_method(scn, method):
     if method is None:
         return
     from rotframe import scenes
-    from rotframe.integrators import METHODS
+    from rotframe.particles.integrators import METHODS
 
     allowed = getattr(scenes.get(scn.scene), "METHODS", None) or list(METHODS)
     if method not in allowed:
@@ -763,7 +765,7 @@ def _check_method(scn, method):
 
 
 def _did_you_mean(word, options):
-    from rotframe.scenario import _did_you_mean as suggest
+    from rotframe.app.scenario import _did_you_mean as suggest
 
     plain = [o.split("[")[0] for o in options]
     return suggest(word, plain) or suggest(word, list(options))
@@ -771,7 +773,7 @@ def _did_you_mean(word, options):
 
 def _apply(scn, values, keys, row):
     """``values`` with the swept keys set to ``row`` (validated); vector components replace one entry."""
-    from rotframe.scenario import parse_value
+    from rotframe.app.scenario import parse_value
 
     for key, x in zip(keys, row):
         p = scn.parameters[key.param]
@@ -856,7 +858,7 @@ def _write_part(files, output, keys, meta):
     first = min(r["row"] for r in output.rows)
     table = _rows_table(output.rows, keys, meta)
     path = files.parts / f"part-{first:09d}.parquet"
-    from rotframe.outputs import atomic_path
+    from rotframe.app.outputs import atomic_path
 
     with atomic_path(path, "sweep part") as tmp:
         pq.write_table(table, str(tmp))
@@ -911,7 +913,7 @@ def _merge(files, meta, spec, include_out):
             col = pc.fill_null(col.cast(pa.float64()), math.nan)
         columns[name] = col
     merged = pa.table(columns).replace_schema_metadata({_META_KEY: json.dumps(meta)})
-    from rotframe.outputs import atomic_path
+    from rotframe.app.outputs import atomic_path
 
     with atomic_path(files.out, "sweep table") as tmp:
         pq.write_table(merged, str(tmp))
@@ -938,7 +940,7 @@ def _column(table, name):
 def _write_tracks(path, tracks):
     rows = sorted(tracks)
     lengths = [len(tracks[r][0]) for r in rows]
-    from rotframe.outputs import atomic_path
+    from rotframe.app.outputs import atomic_path
 
     with atomic_path(path, "sweep tracks") as tmp, open(tmp, "wb") as f:
         np.savez(f, rows=np.array(rows, np.int64), offsets=np.concatenate([[0], np.cumsum(lengths)]),
@@ -972,8 +974,9 @@ class _Context:
 
     @classmethod
     def create(cls, spec, files, meta):
-        from rotframe import scenario as sc, scenes
-        from rotframe.record import decimate
+        from rotframe import scenes
+        from rotframe.app import scenario as sc
+        from rotframe.numerics.sampling import decimate
 
         scn = sc.load(spec.scenario)
         path = "ensemble" if hasattr(scenes.get(scn.scene), "simulate_ensemble") else "runs"
@@ -1207,9 +1210,9 @@ def _ensemble_batch(task, scn, scene, base):
 
 
 def _runs_batch(task, scn, base):
-    """One :func:`rotframe.runner.run` per row; a failure goes to the row's ``error``."""
-    from rotframe import runner
-    from rotframe.integrators import RunInterrupted
+    """One :func:`rotframe.app.runner.run` per row; a failure goes to the row's ``error``."""
+    from rotframe.app import runner
+    from rotframe.particles.integrators import RunInterrupted
 
     rows, tracks, seconds = _start_rows(task), {}, []
     keys = [_key_of(k) for k in task.keys]
@@ -1284,7 +1287,7 @@ def _track(result):
 
 
 def _decimated(times, pos):
-    from rotframe.record import decimate
+    from rotframe.numerics.sampling import decimate
 
     idx = decimate(len(times), MAX_TRACK_SAMPLES)
     return np.asarray(times, np.float64)[idx], np.asarray(pos, np.float64)[idx].astype(np.float32)
@@ -1308,14 +1311,14 @@ def _plot_one(ax, x, y, theory, key, metric, spec):
     if line:
         ax.plot(xs, ys, "o-", ms=3.5, lw=1.2, label="simulated")
     else:
-        pick = _decimate_points(len(xs), 20000)
+        pick = decimate(len(xs), 20000)
         ax.plot(xs[pick], ys[pick], ".", ms=2.0, alpha=0.5, rasterized=True, label="simulated")
     if theory is not None and np.any(np.isfinite(theory[ok])):
         th = theory[ok][order]
         if line:
             ax.plot(xs, th, "-", color="k", lw=0.9, alpha=0.7, label="theory")
         else:
-            pick = _decimate_points(len(xs), 20000)
+            pick = decimate(len(xs), 20000)
             ax.plot(xs[pick], th[pick], ".", ms=1.0, color="k", alpha=0.4, rasterized=True, label="theory")
     if key in spec.log_keys:
         ax.set_xscale("log")
@@ -1336,13 +1339,9 @@ def _histogram(ax, y, metric):
     ax.legend(fontsize=8)
 
 
-def _decimate_points(n, m):
-    return np.arange(n) if n <= m else np.linspace(0, n - 1, m).astype(np.int64)
-
 
 def _label(spec, key):
-    from rotframe import scenario as sc
-
+    from rotframe.app import scenario as sc
     param = key.split("[")[0]
     p = sc.load(spec.scenario).parameters.get(param)
     return f"{key} [{p.unit}]" if p is not None and p.unit else key
@@ -1357,7 +1356,7 @@ def _write_recording(ctx, table):
     tracks = _read_tracks(ctx.files.parts)
     if not tracks:
         return ctx.files.recording if ctx.files.recording.is_file() else None
-    from rotframe.record import Recording
+    from rotframe.app.record import Recording
 
     rows = sorted(tracks)
     times, pos = _common_time(tracks, rows)

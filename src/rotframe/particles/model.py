@@ -7,7 +7,7 @@ the arrays the integrators advance, as MuJoCo keeps ``mjModel`` apart from
 ``mjData``.
 
 All values are SI floats in the rotating frame's axes; units are converted at
-the edge (:mod:`rotframe.scenario`).
+the edge (:mod:`rotframe.app.scenario`).
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ class OmegaSchedule:
 
     def angle(self, t):
         """Angle turned since the first node, exact for the schedule (rad); vectorised."""
-        from rotframe.kernels import omega_angle
+        from rotframe.particles.kernels import omega_angle
 
         wint = self.cumulative()
         return np.array([omega_angle(float(x), self.times, self.values, wint) for x in np.atleast_1d(t)])
@@ -200,7 +200,7 @@ class ParticleModel:
         return not uses_omega or self.omega.is_constant
 
     def pack(self) -> np.ndarray:
-        """The flat parameter vector of :mod:`rotframe.kernels` (made once per model, returned as a copy)."""
+        """The flat parameter vector of :mod:`rotframe.particles.kernels` (made once per model, returned as a copy)."""
         cached = self.__dict__.get("_packed")
         if cached is None:
             cached = self._pack()
@@ -208,8 +208,7 @@ class ParticleModel:
         return cached.copy()
 
     def _pack(self) -> np.ndarray:
-        from rotframe import kernels as k
-
+        from rotframe.particles import kernels as k
         P = np.zeros(k.N_PARAMS)
         P[k.I_AXIS : k.I_AXIS + 3] = self.omega.axis
         P[k.I_CORIOLIS] = float(self.has("coriolis"))

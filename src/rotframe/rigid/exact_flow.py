@@ -1,6 +1,6 @@
 """The exact free asymmetric rigid body in one compiled call (a fast path of ``rigid.free_body_exact``).
 
-:func:`rotframe.rigid.free_body_exact` evaluates the closed-form motion (Jacobi
+:func:`rotframe.rigid.dynamics.free_body_exact` evaluates the closed-form motion (Jacobi
 elliptic functions for the momentum, Carlson's integrals for the angle about
 ``L``; docs/physics.md, rigid bodies) with numpy and scipy on arrays: right for
 many time points, but a few hundred microseconds of setup and small-array calls
@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.rigid import _jacobi_reduced
+from rotframe.rigid.dynamics import _jacobi_reduced
 
 __all__ = ["free_body_flow", "carlson_rf", "carlson_rj", "ellipk_agm"]
 
@@ -252,12 +252,12 @@ def _flow(moments, L0, q0, t, out_L, out_q):
 
 
 def free_body_flow(inertia, L0_body, q0, times):
-    """The exact torque-free motion at ``times``, as :func:`rotframe.rigid.free_body_exact` returns it.
+    """The exact torque-free motion at ``times``, as :func:`rotframe.rigid.dynamics.free_body_exact` returns it.
 
     The same closed form, evaluated in one compiled call for the asymmetric
     body (a few microseconds for a few time points); other cases (two equal
     moments, the separatrix, rotation about the middle axis, ``L = 0``) and
-    invalid input are passed to :func:`rotframe.rigid.free_body_exact`.
+    invalid input are passed to :func:`rotframe.rigid.dynamics.free_body_exact`.
 
     Returns
     -------
@@ -273,6 +273,6 @@ def free_body_flow(inertia, L0_body, q0, times):
         out_q = np.empty((t.size, 4))
         if _flow(moments, L0, q, t, out_L, out_q):
             return out_L, out_q
-    from rotframe.rigid import free_body_exact
+    from rotframe.rigid.dynamics import free_body_exact
 
     return free_body_exact(inertia, L0_body, q0, times)

@@ -47,7 +47,7 @@ _TOP_KEYS = ("name", "title", "description", "scene", "model", "optional_terms",
 _PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusive_max", "shape", "choices", "type")
 #: Settings under ``[run]`` that ``--set`` may change too.
 RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
-#: Model terms of rigid-body scenes (particle terms are in rotframe.model.TERMS).
+#: Model terms of rigid-body scenes (particle terms are in rotframe.particles.model.TERMS).
 RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
 
@@ -63,11 +63,11 @@ def scenario_dir() -> Path:
     env = os.environ.get("ROTFRAME_SCENARIOS")
     if env:
         return Path(env)
-    here = Path(__file__).resolve()
-    repo = here.parents[2]
+    package = Path(__file__).resolve().parents[1]  # rotframe/
+    repo = package.parents[1]
     if (repo / "pyproject.toml").is_file() and (repo / "scenarios").is_dir():
         return repo / "scenarios"
-    return here.parent / "scenarios"
+    return package / "scenarios"
 
 
 def names() -> list[str]:
@@ -338,7 +338,7 @@ def load(name_or_path: str) -> Scenario:
         run[key] = _parse_run_value(key, raw, source=src, scene=scene)
     model = list(data["model"] if "model" in data else builtin.get("model", []))
     optional = list(data["optional_terms"] if "optional_terms" in data else builtin.get("optional_terms", []))
-    from rotframe.model import TERMS
+    from rotframe.particles.model import TERMS
 
     known = TERMS + RIGID_TERMS
     for term in model + optional:

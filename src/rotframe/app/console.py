@@ -3,7 +3,7 @@
 While rotframe starts (imports, argument parsing) nothing has been computed or
 written, so a signal then ends the process at once with one line and the shell's
 exit code (130 after Ctrl-C, 143 after SIGTERM) instead of a traceback from an
-import. :func:`rotframe.cli.main` then installs its own handlers for the command.
+import. :func:`rotframe.app.cli.main` then installs its own handlers for the command.
 """
 
 import os
@@ -25,7 +25,7 @@ for _sig in (signal.SIGINT, signal.SIGTERM):
     except (ValueError, OSError):  # not the main thread
         pass
 
-from rotframe.cli import main as _cli_main  # noqa: E402
+from rotframe.app.cli import main as _cli_main  # noqa: E402
 
 
 def main() -> int:
