@@ -1,15 +1,118 @@
-"""What scenes share: the result type and the particle run."""
+"""What scenes share: typed parameters, the result type and the particle run."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 import sys
+import typing
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
+
+
+__all__ = ["SceneResult", "scene_parameters", "with_parameters", "run_particles", "rel_drift", "until_event",
+           "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
+           "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
+           "unresolved_note", "method_rel_error", "reject_subnormal"]
+
+
+# ---------------------------------------------------------------------------
+# parameters: a frozen dataclass per scene, built once from the validated values
+# ---------------------------------------------------------------------------
+
+_KINDS = {float: "a number", int: "a whole number", bool: "true or false", str: "a string"}
+
+
+def _convert(cls, name, kind, value):
+    """``value`` as the field's type (float, int, bool, str or tuple of floats); ScenarioError otherwise."""
+    origin = typing.get_origin(kind)
+    if origin is tuple:
+        try:
+            return tuple(float(x) for x in value)
+        except (TypeError, ValueError):
+            raise ScenarioError(f"{name} = {value!r}: expected numbers (a vector) for {cls.__name__}") from None
+    if kind is bool:
+        if isinstance(value, bool):
+            return value
+    elif kind is str:
+        if isinstance(value, str):
+            return value
+    elif kind is int:
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and value == int(value):
+            return int(value)
+    elif kind is float:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+    else:
+        raise TypeError(f"{cls.__name__}.{name}: field type {kind!r} is not float, int, bool, str or tuple")
+    raise ScenarioError(f"{name} = {value!r}: expected {_KINDS[kind]}")
+
+
+@functools.cache
+def _fields(cls):
+    hints = typing.get_type_hints(cls)
+    return {f.name: (hints[f.name], f) for f in dataclasses.fields(cls)}
+
+
+def scene_parameters(cls, values):
+    """An instance of the scene's frozen parameter dataclass ``cls`` from the validated ``values``.
+
+    ``values`` maps parameter names to values in their documented units (what
+    :meth:`rotframe.app.scenario.Scenario.with_values` resolves; a ``"run"`` key,
+    the run settings, is not a parameter and is skipped). Each field is
+    converted to its declared type (``float``, ``int``, ``bool``, ``str`` or
+    ``tuple[float, ...]``); a field missing from ``values`` takes its default.
+    An instance of ``cls`` is returned as it is.
+
+    Raises
+    ------
+    ScenarioError
+        For a key that is not a field of ``cls`` (a misspelt or foreign parameter
+        in a scenario file: one line naming it and the allowed names), a field
+        without a value and without a default, or a value of the wrong kind.
+    """
+    if isinstance(values, cls):
+        return values
+    fields = _fields(cls)
+    unknown = [k for k in values if k not in fields and k != "run"]
+    if unknown:
+        key = unknown[0]
+        raise ScenarioError(f"parameter {key} = {values[key]!r}: not a parameter of this scene "
+                            f"({cls.__name__}); allowed: {', '.join(fields)}")
+    kwargs = {}
+    for name, (kind, f) in fields.items():
+        if name in values:
+            kwargs[name] = _convert(cls, name, kind, values[name])
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise ScenarioError(f"parameter {name}: missing; {cls.__name__} needs {', '.join(fields)}")
+    return cls(**kwargs)
+
+
+def with_parameters(cls, position=0):
+    """Decorate a scene function whose argument ``position`` is a ``cls``: it then takes the values mapping too.
+
+    The scene protocol passes ``values`` (a mapping; ``record(rec, values,
+    result)`` has it at position 1); the decorated function receives
+    ``scene_parameters(cls, values)`` in its place, so that scene code reads
+    ``p.latitude`` (a misspelt name is an AttributeError, not a silent default)
+    and callers that pass a dict, as the scene protocol does, keep working.
+    """
+    def decorate(func):
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            args = list(args)
+            args[position] = scene_parameters(cls, args[position])
+            return func(*args, **kwargs)
+
+        wrapper.parameters = cls
+        return wrapper
+
+    return decorate
 
 
 @dataclass
@@ -237,6 +340,8 @@ def reject_subnormal(values):
     to its stated accuracy, so the input is refused (exit 2) rather than run.
     """
     tiny = sys.float_info.min
+    if dataclasses.is_dataclass(values):
+        values = dataclasses.asdict(values)
     for key, value in values.items():
         items = value if isinstance(value, (list, tuple, np.ndarray)) else [value]
         for x in items:
