@@ -4,7 +4,8 @@ The turntable spins about the vertical z axis at w(t) = omega0 + alpha t. The
 puck starts at (start_radius, 0, 0) on the turntable, shoved towards the centre
 at ``speed`` relative to the turntable. In inertial space it moves on a straight
 line; seen from the turntable it feels Coriolis, centrifugal and (while the
-turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md): the inertial
+turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md,
+:func:`rotframe.analytic.turntable_inertial_line`): the inertial
 line mapped into the rotating frame, r_rot(t) = R_z(-theta(t)) (r0 + v_in t),
 theta(t) = integral of w.
 """
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe import analytic
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, method_rel_error, reject_subnormal, rel_drift, run_particles,
                                   with_parameters)
@@ -90,12 +92,16 @@ def motion_size(p, times):
 
 
 def inertial_line(omega, r0, v0, times):
-    """Rotating-frame positions of the inertial straight line (the oracle)."""
+    """Rotating-frame positions (n, 3) of the inertial straight line (the oracle), for the schedule ``omega``.
+
+    ``r0``, ``v0`` are the puck's position and velocity in the turntable's frame
+    at t = 0; its inertial velocity is ``v0 + w(0) x r0``, and the line is
+    :func:`rotframe.analytic.turntable_inertial_line` turned by the schedule's
+    exact angle.
+    """
+    times = np.asarray(times, dtype=float)
     v_in = v0 + np.cross(omega.vector(0.0), r0)
-    theta = omega.angle(times)
-    p = r0[None, :] + v_in[None, :] * np.asarray(times)[:, None]
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1], p[:, 2]], axis=1)
+    return analytic.turntable_inertial_line(r0, v_in, omega.angle(times), times)
 
 
 def _inertial_speed(result):
