@@ -16,6 +16,7 @@ from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
 
 __all__ = ["SceneResult", "scene_parameters", "with_parameters", "run_particles", "rel_drift", "until_event",
+           "landing",
            "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
            "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
            "unresolved_note", "method_rel_error", "reject_subnormal"]
@@ -177,6 +178,12 @@ def until_event(traj, name, particle=0):
     keep = traj.times < t_ev
     return (np.append(traj.times[keep], t_ev), np.vstack([traj.r[keep, particle], state[:3]]),
             np.vstack([traj.v[keep, particle], state[3:]]))
+
+
+def landing(traj, name="ground", particle=0):
+    """``(times, r, v, landed)``: :func:`until_event` of the ``name`` event, and whether it happened."""
+    times, r, v = until_event(traj, name, particle)
+    return times, r, v, len(traj.event_times[name][particle]) > 0
 
 
 def resolve_terms(terms, drag=0.0):

@@ -16,7 +16,8 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
+from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
+                                       simulate_free_body)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -39,13 +40,11 @@ METHODS = FREE_METHODS
 
 @with_parameters(DzhanibekovParameters)
 def build(p):
-    from rotframe.rigid import mass_properties
-    inertia = np.array([p.i1, p.i2, p.i3], dtype=float)
-    mass_properties.check_moments(inertia)
-    omega = np.asarray(p.omega, dtype=float)
-    if not np.any(omega):
+    """``(inertia, L0, q0)``: the body in the identity attitude, spinning at ``omega`` (body axes)."""
+    body = free_body_state([p.i1, p.i2, p.i3], p.omega)
+    if not np.any(p.omega):
         raise ScenarioError("omega = 0,0,0: the body must spin (give 3 numbers in rad/s, body axes)")
-    return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
+    return body
 
 
 #: Samples per period of omega(t): omega_mid changes sign twice a period, so 32 per flip.

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
+from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
+                                       simulate_free_body)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -40,11 +41,8 @@ METHODS = FREE_METHODS
 
 @with_parameters(FreeTopParameters)
 def build(p):
-    from rotframe.rigid import mass_properties
-    inertia = np.array([p.i1, p.i1, p.i3], dtype=float)
-    mass_properties.check_moments(inertia)
-    omega = np.array([p.omega_perp, 0.0, p.omega3])
-    return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
+    """``(inertia, L0, q0)``: the symmetric top spinning at (omega_perp, 0, omega3) in body axes."""
+    return free_body_state([p.i1, p.i1, p.i3], [p.omega_perp, 0.0, p.omega3])
 
 
 @with_parameters(FreeTopParameters)

@@ -56,8 +56,12 @@ def build(p):
     return inertia, inertia * omega, initial_attitude_zxz(*angles)
 
 
-def _theory(p):
-    """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket."""
+@with_parameters(HeavyTopParameters)
+def turning_points(p):
+    """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket.
+
+    None too for a top started upright without a nod (theta0 = 0, wobble = 0): it has no turning points.
+    """
     from rotframe.rigid import dynamics as rigid
     if not (p.theta0 > 0 or p.wobble != 0):
         return None
@@ -71,7 +75,7 @@ def _theory(p):
 
 def _nutation_period_estimate(p):
     """A nutation period (s) to size the sampling: the cubic's, else the fast top's 2 pi I1 / (I3 |omega3|)."""
-    tp = _theory(p)
+    tp = turning_points(p)
     if tp is not None and len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0:
         return float(tp[2])
     w3 = p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
@@ -186,7 +190,7 @@ def analyse(p, result):
     exact = "exact: roots of Goldstein's cubic f(u) of the same top"
     theory_notes = {"theta_min_deg": exact, "theta_max_deg": exact,
                     "nutation_period_s": "exact: 2 int du / sqrt(f(u)) between the roots (elliptic integral)"}
-    tp = _theory(p)
+    tp = turning_points(p)
     if p.theta0 > 0 or p.wobble != 0:
         if tp is None:
             notes.append("no turning-point theory: the cubic f(u) has no bracketing roots (steady precession)")
@@ -236,7 +240,7 @@ def record(rec, p, result):
     t = traj.times[idx]
     theta = tilt(traj)
     rec.scalars("diagnostics/theta_deg", t, np.degrees(theta[idx]), kind="tilt theta (deg)", label="theta (simulated)")
-    theory = analyse_theory(p)
+    theory = turning_points(p)
     if theory is not None:
         rec.reference("diagnostics/theta_deg", t, math.degrees(theory[0]), label="theta_min (Goldstein cubic)",
                       name="theory_min")

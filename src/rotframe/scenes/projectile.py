@@ -24,9 +24,9 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import Event
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   reject_subnormal, rel_drift, resolve_terms, run_particles, samples_for,
-                                  until_event, with_parameters)
+                                  with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -49,6 +49,12 @@ PARAMETERS = ProjectileParameters
 METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
 
 
+def aim_axes(azimuth_deg):
+    """Horizontal unit vectors (ENU) along the aim and to its right, for an azimuth in degrees from north."""
+    az = math.radians(azimuth_deg)
+    return np.array([math.sin(az), math.cos(az), 0.0]), np.array([math.cos(az), -math.sin(az), 0.0])
+
+
 @with_parameters(ProjectileParameters)
 def build(p, terms):
     Omega, w, g = earth_model_constants(p.latitude)
@@ -58,8 +64,8 @@ def build(p, terms):
     model = ParticleModel(terms, omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                           k_quadratic=p.drag, scale_height=p.scale_height, radius=R,
                           gm=g * R * R, g0=g)
-    az, el = math.radians(p.azimuth), math.radians(p.elevation)
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
+    el = math.radians(p.elevation)
+    aim, _ = aim_axes(p.azimuth)
     v0 = p.speed * (math.cos(el) * aim + math.sin(el) * np.array([0.0, 0.0, 1.0]))
     ground = Event("ground", "altitude" if "curvature" in terms else "r", 2, 0.0, -1, True)
     flight = 2 * p.speed * max(math.sin(el), 1e-3) / g
@@ -110,9 +116,7 @@ def apex_height(times, r):
 @with_parameters(ProjectileParameters)
 def ground_track(p, r, model):
     """(range along the ground, lateral deflection right of the aim) of positions r (n, 3)."""
-    az = math.radians(p.azimuth)
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
-    right = np.array([math.cos(az), -math.sin(az), 0.0])
+    aim, right = aim_axes(p.azimuth)
     if model.has("curvature"):
         R = model.radius
         c = np.array([0.0, 0.0, -R])
@@ -165,8 +169,7 @@ def analyse(p, result):
     traj = result.trajectory
     model = result.extras["model"]
     g = result.extras["g"]
-    times, r, v = until_event(traj, "ground")
-    landed = len(traj.event_times["ground"][0]) > 0
+    times, r, v, landed = landing(traj)
     rng, lateral = ground_track(p, r, model)
     Omega = float(np.linalg.norm(model.omega.vector()))
     theory, accuracy, theory_notes = theory_and_accuracy(p, g, Omega, model)
@@ -199,16 +202,14 @@ def analyse(p, result):
 @with_parameters(ProjectileParameters, position=1)
 def record(rec, p, result):
     traj = result.trajectory
-    times, r, v = until_event(traj, "ground")
+    times, r, v, _ = landing(traj)
     rec.points("world/shell", times, r / 1000.0, radius=0.5, color=[230, 90, 40])
     rec.frame_axes("world/frame", 20.0, omega=result.extras["model"].omega.vector())  # km
     rng, lateral = ground_track(p, r, result.extras["model"])
     rec.scalars("diagnostics/altitude_km", times, r[:, 2] / 1000.0)
     rec.scalars("diagnostics/lateral_deflection_m", times, lateral)
     magnify = float(p.magnify)
-    az = math.radians(p.azimuth)
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
-    right = np.array([math.cos(az), -math.sin(az), 0.0])
+    aim, right = aim_axes(p.azimuth)
     shown = (np.outer(rng, aim) + magnify * np.outer(lateral, right)) / 1000.0
     shown[:, 2] = r[:, 2] / 1000.0
     rec.points("world/deflection_magnified", times, shown, radius=0.4, color=[40, 160, 230])

@@ -134,6 +134,19 @@ def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
     return L, q
 
 
+def free_body_state(inertia, omega_body):
+    """``(inertia, L0, q0)`` of a free body: principal moments (checked), L = I omega in body axes, q0 identity.
+
+    Raises ScenarioError for moments that no body has (see
+    :func:`rotframe.rigid.mass_properties.check_moments`).
+    """
+    from rotframe.rigid import mass_properties
+
+    inertia = np.asarray(inertia, dtype=float)
+    mass_properties.check_moments(inertia)
+    return inertia, inertia * np.asarray(omega_body, dtype=float), np.array([0.0, 0.0, 0.0, 1.0])
+
+
 def simulate_free_body(body, duration, method, run, progress):
     """Run a free body ``body = (inertia, L0, q0)``; the default method is the exact flow."""
     from rotframe.scenes.base import SceneResult

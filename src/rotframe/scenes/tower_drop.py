@@ -19,9 +19,8 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
-                                  reject_subnormal, rel_drift, resolve_terms, run_particles, until_event,
-                                  with_parameters)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
+                                  reject_subnormal, rel_drift, resolve_terms, run_particles, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -113,8 +112,7 @@ def analyse(p, result):
     traj = result.trajectory
     g = result.extras["g"]
     model = result.extras["model"]
-    times, r, v = until_event(traj, "ground")
-    landed = len(traj.event_times["ground"][0]) > 0
+    times, r, v, landed = landing(traj)
     Omega = float(np.linalg.norm(model.omega.vector()))
     metrics = {"east_deflection_m": float(r[-1, 0]), "north_deflection_m": float(r[-1, 1]),
                "fall_time_s": float(times[-1]) if landed else math.nan}
@@ -154,7 +152,7 @@ def analyse(p, result):
 @with_parameters(TowerDropParameters, position=1)
 def record(rec, p, result):
     traj = result.trajectory
-    times, r, v = until_event(traj, "ground")
+    times, r, v, _ = landing(traj)
     h = p.height
     rec.points("world/body", times, r, radius=0.5, color=[230, 90, 40])
     magnify = float(p.magnify)
