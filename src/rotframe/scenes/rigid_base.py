@@ -225,16 +225,14 @@ def invariant_drifts(inertia, traj):
 
 def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
                 L_label="L in space (fixed: no torque acts)"):
-    """Body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
+    """Log to ``rec`` (a :class:`rotframe.app.record.Recording`, passed in): body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
 
     ``world/angular_momentum`` is an arrow along L (space frame) at each
     sample, scaled to 1.5 ``axis_length``: fixed for a free body, turning for
     a torqued one (``L_label`` says which).
     """
-    import rerun as rr
-
-    from rotframe.rigid import dynamics as rigid
     from rotframe.numerics.sampling import decimate
+    from rotframe.rigid import dynamics as rigid
 
     idx = decimate(len(traj.times), 5000)
     t = traj.times[idx]
@@ -244,11 +242,11 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
     s = 6.0 / mass * (np.array([I[1] + I[2] - I[0], I[0] + I[2] - I[1], I[0] + I[1] - I[2]]))
     half = 0.5 * np.sqrt(np.clip(s, 1e-12 * s.max(), None))
     half *= axis_length * 0.6 / half.max()
-    rec.rec.log(f"world/{name}/shape", rr.Boxes3D(half_sizes=[half], colors=[[200, 170, 90, 160]]), static=True)
+    rec.static(f"world/{name}/shape", "Boxes3D", half_sizes=[half], colors=[[200, 170, 90, 160]])
     Ls = rigid.angular_momentum_space(traj.q[idx], traj.L[idx])
     scale = 1.5 * axis_length / max(float(np.linalg.norm(Ls[0])), 1e-300)
     rec.segments("world/angular_momentum", t, np.zeros_like(Ls), scale * Ls, color=[250, 250, 250])
-    rec.rec.log("world/angular_momentum", rr.Arrows3D.from_fields(labels=[L_label], show_labels=True), static=True)
+    rec.static("world/angular_momentum", "Arrows3D", labels=[L_label], show_labels=True)
     Lb = traj.L[idx] / np.maximum(np.linalg.norm(traj.L[idx], axis=1), 1e-300)[:, None]
     rec.line(f"world/{name}/polhode", 1.2 * axis_length * Lb, color=[250, 200, 60])
     rec.scalars("diagnostics/omega_body/1", t, traj.L[idx, 0] / I[0] if I[0] else 0 * t)

@@ -154,16 +154,11 @@ def record(rec, p, result):
 
 def _record_inertial_axes(rec, times, omega, length):
     """The inertial (lab) axes as seen from the turntable: they turn by -theta(t) about z."""
-    import rerun as rr
-
     from rotframe.numerics.sampling import decimate
 
     idx = decimate(len(times), 2000)
     half = -0.5 * np.asarray(omega.angle(times[idx]), dtype=float).reshape(-1)
-    quat = np.stack([0 * half, 0 * half, np.sin(half), np.cos(half)], axis=1).astype(np.float32)
-    rec.rec.send_columns("world/inertial_axes", indexes=[rr.TimeColumn(
-        "sim_time", duration=np.round(times[idx] * 1e9).astype(np.int64).astype("timedelta64[ns]"))],
-        columns=rr.Transform3D.columns(quaternion=quat))
-    rec.rec.log("world/inertial_axes/arrows", rr.Arrows3D(
-        vectors=[[length, 0, 0], [0, length, 0]], colors=[[120, 120, 120], [120, 120, 120]],
-        labels=["X (inertial)", "Y (inertial)"]), static=True)
+    quat = np.stack([0 * half, 0 * half, np.sin(half), np.cos(half)], axis=1)
+    rec.body("world/inertial_axes", times[idx], quat, axis_length=None)
+    rec.static("world/inertial_axes/arrows", "Arrows3D", vectors=[[length, 0, 0], [0, length, 0]],
+               colors=[[120, 120, 120], [120, 120, 120]], labels=["X (inertial)", "Y (inertial)"])
