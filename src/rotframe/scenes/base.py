@@ -15,7 +15,7 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
 
-__all__ = ["SceneResult", "scene_parameters", "with_parameters", "run_particles", "rel_drift", "until_event",
+__all__ = ["SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
            "landing",
            "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
            "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
@@ -116,6 +116,47 @@ def with_parameters(cls, position=0):
     return decorate
 
 
+# ---------------------------------------------------------------------------
+# method names: canonical names in order, and the old names still accepted
+# ---------------------------------------------------------------------------
+
+
+class MethodNames(tuple):
+    """A scene's method names: the canonical ones in order, plus old names (aliases) that it still accepts.
+
+    A tuple of the canonical names (iterating, printing and ``len`` see only
+    those, so messages and ``rotframe show`` list them), whose ``in`` also
+    accepts an alias; :meth:`canonical` maps an alias to its name, which is the
+    name a run reports (the JSON ``method``).
+    """
+
+    def __new__(cls, names, aliases=None):
+        self = super().__new__(cls, names)
+        self.aliases = dict(aliases or {})
+        unknown = [a for a, target in self.aliases.items() if not tuple.__contains__(self, target)]
+        if unknown:
+            raise ValueError(f"MethodNames: aliases {unknown} point to no method of {tuple(self)}")
+        return self
+
+    def __contains__(self, name) -> bool:
+        return tuple.__contains__(self, name) or (isinstance(name, str) and name in self.aliases)
+
+    def canonical(self, name):
+        """The canonical name of ``name`` (itself when it is one; None stays None)."""
+        return self.aliases.get(name, name) if isinstance(name, str) else name
+
+
+def particle_methods() -> MethodNames:
+    """The particle integrators' names, from their registry (``rotframe.particles.integrators``).
+
+    Canonical names are the keys of ``integrators.METHODS``; old names are its
+    ``ALIASES`` ({old: canonical}) where the registry has them.
+    """
+    from rotframe.particles import integrators
+
+    return MethodNames(tuple(integrators.METHODS), getattr(integrators, "ALIASES", {}))
+
+
 @dataclass
 class SceneResult:
     """A finished (or interrupted) run of a scene.
@@ -144,6 +185,7 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
     re-raises with a SceneResult in ``exc.partial`` that can be analysed and
     recorded like a complete one.
     """
+    method = particle_methods().canonical(method)
     try:
         traj = integrate_particles(model, r0, v0, duration, method=method, step=step or run.get("step"),
                                    rtol=run.get("rtol") or 1e-10, samples=int(run.get("samples") or 2000),
@@ -326,13 +368,17 @@ def method_rel_error(traj, time_scale):
     """A bound on the relative error of a run's metrics from its method, for a motion of ``time_scale`` s.
 
     ``exact``: 1e-9 (round-off). The adaptive ``dop853`` (rtol <= 1e-10 in the
-    scenes): 1e-8, its local tolerance grown over many steps. Fixed-step methods: 10 (h / T)^p with p = 2 for
-    ``splitting`` and 4 for ``splitting4`` and ``rk4`` (their global error over a
+    scenes): 1e-8, its local tolerance grown over many steps. Fixed-step methods: 10 (h / T)^p with p their
+    order in the particle registry (``rotframe.particles.integrators.METHODS``: 2 for the rotation
+    splitting, 4 for its fourth-order composition and for ``rk4``; their global error over a
     motion of time scale T), a factor 10 of margin over the leading term.
     """
+    from rotframe.particles.integrators import METHODS
+
     h = traj.extras.get("step") or 0.0
-    order = {"splitting": 2, "splitting4": 4, "rk4": 4}.get(traj.method)
-    if traj.method == "dop853":
+    info = METHODS.get(particle_methods().canonical(traj.method))
+    order = info.order if info is not None and info.kind == "fixed" else None
+    if info is not None and info.kind == "adaptive":
         return 1e-8
     if order is None or not h or not time_scale > 0:
         return 1e-9

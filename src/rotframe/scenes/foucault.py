@@ -27,8 +27,8 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
-                                  potential_energy, reject_subnormal, run_particles, unresolved_note,
-                                  with_parameters)
+                                  particle_methods, potential_energy, reject_subnormal, run_particles,
+                                  unresolved_note, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -48,7 +48,8 @@ class FoucaultParameters:
 PARAMETERS = FoucaultParameters
 
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 SAMPLES_PER_PERIOD = 32
 #: Samples kept at most (memory: 48 bytes each); beyond, the period is not measured.
 MAX_SAMPLES = 2_000_000

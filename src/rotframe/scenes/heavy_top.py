@@ -39,6 +39,7 @@ class HeavyTopParameters:
 PARAMETERS = HeavyTopParameters
 
 
+#: ``top-splitting``, ``top-splitting4``, ``top-splitting6``, ``rk4`` (the old ``splitting[4|6]`` accepted).
 METHODS = HEAVY_METHODS
 
 
@@ -86,7 +87,7 @@ def _nutation_period_estimate(p):
 def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     inertia, L0, q0 = build(p)
-    method = method or run.get("method") or "splitting"
+    method = HEAVY_METHODS.canonical(method or run.get("method") or "top-splitting")
     top = (p.mass, p.length, p.g)
     period = _nutation_period_estimate(p)
     samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000)

@@ -18,8 +18,9 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, reject_subnormal,
-                                  rel_drift, run_particles, samples_for, unresolved_note, with_parameters)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, particle_methods,
+                                  reject_subnormal, rel_drift, run_particles, samples_for, unresolved_note,
+                                  with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -36,7 +37,8 @@ class InertialOscillationParameters:
 PARAMETERS = InertialOscillationParameters
 
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 
 
 @with_parameters(InertialOscillationParameters)

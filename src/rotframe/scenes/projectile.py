@@ -25,8 +25,8 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.particles.integrators import Event
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
-                                  reject_subnormal, rel_drift, resolve_terms, run_particles, samples_for,
-                                  with_parameters)
+                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
+                                  samples_for, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -46,7 +46,8 @@ class ProjectileParameters:
 PARAMETERS = ProjectileParameters
 
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 
 
 def aim_axes(azimuth_deg):

@@ -10,11 +10,16 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
+from rotframe.scenes.base import MethodNames
 
-#: Methods of the free body; ``exact`` is the elliptic-function flow.
-FREE_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
-#: Methods of the heavy top.
-HEAVY_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
+#: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
+#: Lie-Poisson splitting of orders 2, 4, 6.
+FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4"))
+#: Methods of the heavy top: ``top-splitting[4|6]`` (exact free symmetric-top flow and gravity kick, orders
+#: 2, 4, 6) and ``rk4``; the old names ``splitting``, ``splitting4``, ``splitting6`` are still accepted.
+HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "rk4"),
+                            {"splitting": "top-splitting", "splitting4": "top-splitting4",
+                             "splitting6": "top-splitting6"})
 
 
 @dataclass
@@ -38,6 +43,8 @@ class BodyTrajectory:
 def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """Integrate a free body, or a heavy symmetric top (``top = (mass, length, g)``), by a named method.
 
+    ``method`` is a name of :data:`FREE_METHODS`, or of :data:`HEAVY_METHODS`
+    (an old name too, run and reported under its canonical name) with ``top``.
     Fixed-step methods use ``run["step"]`` and keep ``run["samples"]`` samples;
     the work is done in chunks so that progress shows, Ctrl-C interrupts and a
     non-finite state stops the run with everything before it kept.
@@ -45,6 +52,8 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     from rotframe.rigid import dynamics as rigid
     from rotframe import limits
 
+    if top is not None:
+        method = HEAVY_METHODS.canonical(method)
     duration = float(duration)
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
@@ -167,7 +176,7 @@ def _stepper(method, inertia, top):
     if method == "rk4":
         return lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)
     order = {"": 2, "4": 4, "6": 6}
-    for prefix in ("lie-poisson", "splitting"):
+    for prefix in ("lie-poisson", "top-splitting"):
         if method.startswith(prefix) and method[len(prefix):] in order:
             k = order[method[len(prefix):]]
             if top is not None:
@@ -225,7 +234,9 @@ def invariant_drifts(inertia, traj):
 
 def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
                 L_label="L in space (fixed: no torque acts)"):
-    """Log to ``rec`` (a :class:`rotframe.app.record.Recording`, passed in): body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
+    """Body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
+
+    Logged to ``rec``, the :class:`rotframe.app.record.Recording` passed in.
 
     ``world/angular_momentum`` is an arrow along L (space frame) at each
     sample, scaled to 1.5 ``axis_length``: fixed for a free body, turning for

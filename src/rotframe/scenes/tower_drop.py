@@ -20,7 +20,8 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
-                                  reject_subnormal, rel_drift, resolve_terms, run_particles, with_parameters)
+                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
+                                  with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -38,7 +39,8 @@ class TowerDropParameters:
 PARAMETERS = TowerDropParameters
 
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
 
 
@@ -211,7 +213,8 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
         r0[:, 2] = heights
         keep = [k for k, i in enumerate(members) if tracks is not None and i in tracks]
         ens = integrate_ensemble(model, r0, np.zeros_like(r0), duration, GROUND,
-                                 method=method or run.get("method") or default_method(model), run=run, keep=keep)
+                                 method=METHODS.canonical(method or run.get("method") or default_method(model)),
+                                 run=run, keep=keep)
         for k, i in enumerate(members):
             metrics[i] = {"east_deflection_m": float(ens.state[k, 0]), "north_deflection_m": float(ens.state[k, 1]),
                           "fall_time_s": float(ens.t_event[k])}

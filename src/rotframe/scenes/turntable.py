@@ -19,8 +19,8 @@ import numpy as np
 
 from rotframe import analytic
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, method_rel_error, reject_subnormal, rel_drift, run_particles,
-                                  with_parameters)
+from rotframe.scenes.base import (SceneResult, method_rel_error, particle_methods, reject_subnormal, rel_drift,
+                                  run_particles, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -38,6 +38,9 @@ class TurntableParameters:
 #: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
 PARAMETERS = TurntableParameters
 
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 
 Z = np.array([0.0, 0.0, 1.0])
 
