@@ -24,9 +24,9 @@ import numpy as np
 import rotframe
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult
+from rotframe.scenes.base import SceneResult, particle_methods
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+METHODS = particle_methods()  # every particle integrator, by the registry's names (old names accepted)
 
 
 def simulate(values, terms, method, run, progress):

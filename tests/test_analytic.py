@@ -396,3 +396,20 @@ def test_turntable_inertial_line_solves_rotating_frame_equations():
     # theta = 0: the inertial line itself
     np.testing.assert_allclose(turntable_inertial_line(r0, v_in, np.zeros(3), [0, 1, 2]),
                                r0 + np.outer([0, 1, 2], v_in))
+
+
+def test_scalar_rotation_rate_is_named_rotation_rate_and_positional_calls_still_work():
+    """``omega`` is a vector elsewhere in rotframe: analytic's scalar rates are ``rotation_rate``."""
+    import inspect
+
+    import rotframe.analytic as an
+
+    for name in ("drop_east_deflection_first_order", "drop_north_deflection_second_order",
+                 "drop_north_deflection_centrifugal_second_order", "drop_exact_linear",
+                 "foucault_precession_rate", "inertial_oscillation", "projectile_lateral_deflection_first_order"):
+        params = inspect.signature(getattr(an, name)).parameters
+        assert "rotation_rate" in params and "omega" not in params, name
+    W = 7.292115e-5
+    assert an.foucault_precession_rate(0.8, W) == an.foucault_precession_rate(0.8, rotation_rate=W)
+    assert an.drop_east_deflection_first_order(100.0, 0.9, 9.81, W) == \
+        an.drop_east_deflection_first_order(100.0, 0.9, 9.81, rotation_rate=W)

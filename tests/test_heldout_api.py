@@ -67,7 +67,7 @@ def test_dop853_ends_each_call_on_its_last_sample():
 
     for latitude in (51.4667, 51 + 28 / 60):
         model, r0, v0, g, _ = foucault.build({"latitude": latitude, "length": 20.0, "amplitude": 3.0,
-                                              "small_angle": False, "g_model": "wgs84"},
+                                              "small_angle": False, "g_model": "wgs84", "duration": 3600.0},
                                              ["gravity", "coriolis", "pendulum"])
         for duration in (3600.0, 7200.0):
             samples = int(32 * duration / (2 * math.pi * math.sqrt(20.0 / g)))

@@ -69,7 +69,7 @@ def _top_state(theta0, psidot, i1=1.9e-4, i3=2.5e-5, phidot=0.0):
     from rotframe.scenes.heavy_top import build
 
     return build({"i1": i1, "i3": i3, "theta0": theta0, "phidot0": phidot, "psidot0": psidot, "wobble": 1e-4,
-                  "mass": 0.1, "length": 0.04, "g": 9.81})
+                  "mass": 0.1, "length": 0.04, "g": 9.81, "duration": 1.0})
 
 
 @pytest.mark.parametrize("factor", [1.02, 0.98])

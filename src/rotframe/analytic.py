@@ -3,8 +3,9 @@
 Pure numpy/scipy: plain floats in SI units and radians, no units objects, no I/O.
 Local frame on the Earth: ENU, x east, y north, z up; Earth's angular velocity there is
 ``Omega (0, cos lat, sin lat)``. Pass ``g`` as the magnitude of the effective gravity
-(centrifugal term inside it) unless a function says otherwise; ``omega`` is the rotation
-rate in rad/s (``rotframe.earth.OMEGA_EARTH`` for the Earth).
+(centrifugal term inside it) unless a function says otherwise. ``rotation_rate`` is the
+scalar rotation rate Omega in rad/s (``rotframe.earth.OMEGA_EARTH`` for the Earth); a
+rotation *vector* is named ``omega_vec``, as ``omega`` is a vector elsewhere in rotframe.
 """
 
 from __future__ import annotations
@@ -65,7 +66,7 @@ class ProjectileFlat(NamedTuple):
 # --------------------------------------------------------------------------------------
 
 
-def drop_east_deflection_first_order(height, latitude, g, omega):
+def drop_east_deflection_first_order(height, latitude, g, rotation_rate):
     """Eastward deflection of a body dropped from rest, to first order in Omega, m.
 
     ``d = (1/3) Omega g t^3 cos(lat)``, ``t = sqrt(2 h / g)``.
@@ -84,8 +85,8 @@ def drop_east_deflection_first_order(height, latitude, g, omega):
         Latitude, rad.
     g : float
         Effective gravity, m/s^2.
-    omega : float
-        Rotation rate, rad/s.
+    rotation_rate : float
+        Rotation rate Omega (a scalar, rad/s; ``rotframe.earth.OMEGA_EARTH`` for the Earth).
 
     Returns
     -------
@@ -93,11 +94,11 @@ def drop_east_deflection_first_order(height, latitude, g, omega):
         East deflection, m (positive east).
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
-    d = omega * g * t**3 * np.cos(latitude) / 3.0
+    d = rotation_rate * g * t**3 * np.cos(latitude) / 3.0
     return float(d) if np.ndim(d) == 0 else d
 
 
-def drop_north_deflection_second_order(height, latitude, g, omega):
+def drop_north_deflection_second_order(height, latitude, g, rotation_rate):
     """Northward deflection of a body dropped from rest, to second order in Omega, m.
 
     ``d_north = -(1/6) Omega^2 g t^4 sin(lat) cos(lat)``, ``t = sqrt(2 h / g)``:
@@ -111,11 +112,11 @@ def drop_north_deflection_second_order(height, latitude, g, omega):
     Parameters and units as in :func:`drop_east_deflection_first_order`.
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
-    d = -(omega**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 6.0
+    d = -(rotation_rate**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 6.0
     return float(d) if np.ndim(d) == 0 else d
 
 
-def drop_north_deflection_centrifugal_second_order(height, latitude, g, omega):
+def drop_north_deflection_centrifugal_second_order(height, latitude, g, rotation_rate):
     """Northward deflection from the variation of the centrifugal force along the fall, m.
 
     With effective gravity ``g`` measured at the foot, the explicit centrifugal term
@@ -131,7 +132,7 @@ def drop_north_deflection_centrifugal_second_order(height, latitude, g, omega):
     relative order Omega T. Parameters as in :func:`drop_east_deflection_first_order`.
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
-    d = -5.0 * (omega**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 24.0
+    d = -5.0 * (rotation_rate**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 24.0
     return float(d) if np.ndim(d) == 0 else d
 
 
@@ -212,7 +213,7 @@ def linear_rotating_propagator(
     return s[..., 0:3], s[..., 3:6]
 
 
-def drop_exact_linear(height, latitude, g, omega) -> DropResult:
+def drop_exact_linear(height, latitude, g, rotation_rate) -> DropResult:
     """Fall time and landing deflection of a body dropped from rest, exact linear solution.
 
     Solves ``r'' = (0, 0, -g) - 2 omega x v`` in ENU with ``omega = Omega (0, cos lat,
@@ -231,8 +232,8 @@ def drop_exact_linear(height, latitude, g, omega) -> DropResult:
         Latitude, rad.
     g : float
         Effective gravity, m/s^2 (> 0).
-    omega : float
-        Rotation rate, rad/s.
+    rotation_rate : float
+        Rotation rate Omega (a scalar, rad/s; ``rotframe.earth.OMEGA_EARTH`` for the Earth).
 
     Returns
     -------
@@ -242,7 +243,7 @@ def drop_exact_linear(height, latitude, g, omega) -> DropResult:
     height, g = float(height), float(g)
     if not (height > 0.0 and g > 0.0):
         raise ScenarioError(f"drop needs height > 0 and g > 0; got height={height}, g={g}")
-    w = omega * np.array([0.0, math.cos(latitude), math.sin(latitude)])
+    w = rotation_rate * np.array([0.0, math.cos(latitude), math.sin(latitude)])
     gv = np.array([0.0, 0.0, -g])
     r0 = np.array([0.0, 0.0, height])
     v0 = np.zeros(3)
@@ -256,8 +257,8 @@ def drop_exact_linear(height, latitude, g, omega) -> DropResult:
         if z(hi) < 0.0:
             break
         lo, hi = hi, 2.0 * hi
-    else:  # pragma: no cover - only for absurd omega
-        raise ScenarioError(f"no landing found for height={height}, omega={omega}")
+    else:  # pragma: no cover - only for absurd rotation_rate
+        raise ScenarioError(f"no landing found for height={height}, rotation_rate={rotation_rate}")
     tf = brentq(z, lo, hi, xtol=1e-15 * t0, rtol=4.0 * np.finfo(float).eps)
     r, _ = linear_rotating_propagator(w, gv, tf, r0, v0)
     return DropResult(float(tf), float(r[0]), float(r[1]))
@@ -268,7 +269,7 @@ def drop_exact_linear(height, latitude, g, omega) -> DropResult:
 # --------------------------------------------------------------------------------------
 
 
-def foucault_precession_rate(latitude, omega):
+def foucault_precession_rate(latitude, rotation_rate):
     """Rate at which the swing plane of a Foucault pendulum turns, rad/s.
 
     ``rate = Omega sin(lat)``: positive means clockwise seen from above, so it is positive
@@ -276,7 +277,7 @@ def foucault_precession_rate(latitude, omega):
     11.3 deg per hour. Small-amplitude limit; add :func:`airy_precession` for a finite
     elliptical swing.
     """
-    r = omega * np.sin(latitude)
+    r = rotation_rate * np.sin(latitude)
     return float(r) if np.ndim(r) == 0 else r
 
 
@@ -330,7 +331,7 @@ def airy_precession(length, g, a, b):
     return float(r) if np.ndim(r) == 0 else r
 
 
-def inertial_oscillation(latitude, speed, omega) -> InertialOscillation:
+def inertial_oscillation(latitude, speed, rotation_rate) -> InertialOscillation:
     """Period and radius of an inertial oscillation on the f-plane.
 
     Horizontal motion under the Coriolis force alone, ``f = 2 Omega sin(lat)``: the body
@@ -344,15 +345,15 @@ def inertial_oscillation(latitude, speed, omega) -> InertialOscillation:
         Latitude, rad.
     speed : float or array_like
         Horizontal speed, m/s.
-    omega : float
-        Rotation rate, rad/s.
+    rotation_rate : float
+        Rotation rate Omega (a scalar, rad/s; ``rotframe.earth.OMEGA_EARTH`` for the Earth).
 
     Returns
     -------
     InertialOscillation
         ``(period [s], radius [m])``; floats for scalar input, arrays otherwise.
     """
-    f = np.abs(2.0 * omega * np.sin(np.asarray(latitude, dtype=float)))
+    f = np.abs(2.0 * rotation_rate * np.sin(np.asarray(latitude, dtype=float)))
     v = np.abs(np.asarray(speed, dtype=float))
     f, v = np.broadcast_arrays(f, v)
     zero = f == 0.0
@@ -396,7 +397,7 @@ def projectile_flat_vacuum(speed, elevation, g) -> ProjectileFlat:
     return ProjectileFlat(rng, tf)
 
 
-def projectile_lateral_deflection_first_order(speed, elevation, azimuth, latitude, g, omega):
+def projectile_lateral_deflection_first_order(speed, elevation, azimuth, latitude, g, rotation_rate):
     """Coriolis deflection of a projectile across its line of fire, first order in Omega, m.
 
     Flat Earth, vacuum, uniform effective gravity ``g`` (centrifugal inside it), launched
@@ -435,8 +436,8 @@ def projectile_lateral_deflection_first_order(speed, elevation, azimuth, latitud
         Latitude, rad.
     g : float
         Effective gravity, m/s^2.
-    omega : float
-        Rotation rate, rad/s.
+    rotation_rate : float
+        Rotation rate Omega (a scalar, rad/s; ``rotframe.earth.OMEGA_EARTH`` for the Earth).
 
     Returns
     -------
@@ -446,7 +447,7 @@ def projectile_lateral_deflection_first_order(speed, elevation, azimuth, latitud
     u_h = speed * np.cos(elevation)
     w_v = speed * np.sin(elevation)
     tf = 2.0 * w_v / g
-    d = omega * tf**2 * (
+    d = rotation_rate * tf**2 * (
         u_h * np.sin(latitude) - (w_v / 3.0) * np.cos(latitude) * np.cos(azimuth)
     )
     return float(d) if np.ndim(d) == 0 else d

@@ -171,7 +171,11 @@ class Recording:
             self.rec.log(entity, rr.Arrows3D.from_fields(colors=[color]), static=True)
 
     def body(self, entity, times, quaternions_xyzw, translation=None, axis_length=1.0):
-        """A rigid body: Transform3D per sample (scalar-last quaternions, body -> space)."""
+        """A rigid body: Transform3D per sample (scalar-last quaternions, body -> space).
+
+        Its axes e1, e2, e3 are drawn at ``<entity>/axes``, ``axis_length`` long;
+        ``axis_length=None`` draws none (a moving frame whose arrows are logged apart).
+        """
         import rerun as rr
 
         q = np.asarray(quaternions_xyzw, dtype=np.float64)
@@ -179,6 +183,8 @@ class Recording:
         if translation is not None:
             kwargs["translation"] = np.asarray(translation, dtype=np.float32)
         self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Transform3D.columns(**kwargs))
+        if axis_length is None:
+            return
         L = float(axis_length)
         self.rec.log(f"{entity}/axes", rr.Arrows3D(
             vectors=[[L, 0, 0], [0, L, 0], [0, 0, L]],
@@ -230,6 +236,22 @@ class Recording:
                 self.rec.log(f"{entity}/omega", rr.Arrows3D(vectors=[(1.2 * L * w / norm).astype(np.float32)],
                                                             colors=[[250, 200, 40]],
                                                             labels=[f"omega ({norm:.4g} rad/s)"]), static=True)
+
+    def static(self, entity, archetype: str, **fields):
+        """A static rerun archetype at ``entity``, named (``"Boxes3D"``, ``"Arrows3D"``), from plain fields.
+
+        For what the other methods do not cover, so that scenes log through the
+        Recording and never import rerun: ``fields`` are the archetype's
+        ``from_fields`` arguments as lists or numpy arrays (``half_sizes``,
+        ``vectors``, ``colors``, ``labels``, ``show_labels``...). Logged on an
+        entity that has time-varying data, they add to it (a label on a moving arrow).
+        """
+        import rerun as rr
+
+        kind = getattr(rr, archetype, None)
+        if not archetype[:1].isupper() or not hasattr(kind, "from_fields"):
+            raise ValueError(f"Recording.static: {archetype!r} is not a rerun archetype")
+        self.rec.log(entity, kind.from_fields(**fields), static=True)
 
     def exact_values(self, entity, **arrays):
         """Static float64 arrays (exact state that tests may read back) via AnyValues."""

@@ -457,20 +457,26 @@ def _check_bounds(p: Parameter, value: float, raw, where: str):
         raise ScenarioError(f"{where}{p.name} = {shown}: out of range; allowed {bad}{unit}")
 
 
-#: Methods by kind of scene (the scene modules check their own list again when they run).
-_PARTICLE_METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
-_FREE_BODY_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
-_HEAVY_TOP_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
-_SCENE_METHODS = {"free-top": _FREE_BODY_METHODS, "dzhanibekov": _FREE_BODY_METHODS,
-                  "heavy-top": _HEAVY_TOP_METHODS}
 _RUN_EXAMPLES = {"step": 1e-3, "rtol": 1e-10, "samples": 2000}
 
 
 def methods_for(scene: str | None) -> tuple:
-    """Integrator names a ``[run] method`` or ``--set method=`` may take for ``scene``."""
+    """Integrator names a ``[run] method`` or ``--set method=`` may take for ``scene``.
+
+    One source: the scene module's ``METHODS`` (a
+    :class:`rotframe.scenes.base.MethodNames`, whose ``in`` accepts the old names
+    too), else every particle integrator; for ``scene=None`` every name of the
+    built-in scenes. The scene module is imported here (a run imports it anyway).
+    """
+    from rotframe import scenes
+    from rotframe.scenes.base import MethodNames, particle_methods
+
     if scene is None:
-        return tuple(dict.fromkeys(_PARTICLE_METHODS + _FREE_BODY_METHODS + _HEAVY_TOP_METHODS))
-    return _SCENE_METHODS.get(scene, _PARTICLE_METHODS)
+        found = [methods_for(name) for name, target in scenes.SCENES.items() if isinstance(target, str)]
+        return MethodNames(tuple(dict.fromkeys(m for names in found for m in names)),
+                           {a: c for names in found for a, c in getattr(names, "aliases", {}).items()})
+    methods = getattr(scenes.get(scene), "METHODS", None) if scene in scenes.SCENES else None
+    return methods if methods is not None else particle_methods()
 
 
 def _parse_run_value(key, raw, source, scene=None):

@@ -10,6 +10,7 @@ The scene protocol
 A scene is a module (or any object) with::
 
     METHODS = ("rk4", ...)                                  # optional: allowed method names
+    PARAMETERS = SomeParameters                             # optional: a frozen dataclass of the parameters
     simulate(values, terms, method, run, progress) -> SceneResult
     analyse(values, result) -> {"metrics": {...}, "theory": {...}, "diagnostics": {...}, "notes": [...]}
     record(recording, values, result) -> None
@@ -20,7 +21,14 @@ None (choose a default), ``run`` the run settings (``step``, ``rtol``,
 ``samples``), ``progress`` None or a callable taking the fraction done.
 :class:`~rotframe.scenes.base.SceneResult` wraps a trajectory with ``times``
 and either ``r``, ``v`` (n, N, 3) for particles or ``L`` (n, 3), ``q`` (n, 4)
-for a rigid body. ``record`` logs to a :class:`rotframe.app.record.Recording`.
+for a rigid body. ``record`` logs to a :class:`rotframe.app.record.Recording`
+(passed in: scenes never import rerun nor anything from ``rotframe.app``).
+
+``METHODS`` may be a :class:`~rotframe.scenes.base.MethodNames` (canonical names
+plus old names still accepted; a run reports the canonical one). The built-in
+scenes declare ``PARAMETERS``, a frozen dataclass, and read ``values`` through
+:func:`~rotframe.scenes.base.with_parameters`, which builds it once per call
+and refuses a key the dataclass does not have (exit 2).
 
 Your own scene is registered with :func:`rotframe.register_scene` (which calls
 :func:`register`). The command line imports the modules listed in the

@@ -1,15 +1,160 @@
-"""What scenes share: the result type and the particle run."""
+"""What scenes share: typed parameters, the result type and the particle run."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 import sys
+import typing
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
+
+
+__all__ = ["SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
+           "landing",
+           "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
+           "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
+           "unresolved_note", "method_rel_error", "reject_subnormal"]
+
+
+# ---------------------------------------------------------------------------
+# parameters: a frozen dataclass per scene, built once from the validated values
+# ---------------------------------------------------------------------------
+
+_KINDS = {float: "a number", int: "a whole number", bool: "true or false", str: "a string"}
+
+
+def _convert(cls, name, kind, value):
+    """``value`` as the field's type (float, int, bool, str or tuple of floats); ScenarioError otherwise."""
+    origin = typing.get_origin(kind)
+    if origin is tuple:
+        try:
+            return tuple(float(x) for x in value)
+        except (TypeError, ValueError):
+            raise ScenarioError(f"{name} = {value!r}: expected numbers (a vector) for {cls.__name__}") from None
+    if kind is bool:
+        if isinstance(value, bool):
+            return value
+    elif kind is str:
+        if isinstance(value, str):
+            return value
+    elif kind is int:
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and value == int(value):
+            return int(value)
+    elif kind is float:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+    else:
+        raise TypeError(f"{cls.__name__}.{name}: field type {kind!r} is not float, int, bool, str or tuple")
+    raise ScenarioError(f"{name} = {value!r}: expected {_KINDS[kind]}")
+
+
+@functools.cache
+def _fields(cls):
+    hints = typing.get_type_hints(cls)
+    return {f.name: (hints[f.name], f) for f in dataclasses.fields(cls)}
+
+
+def scene_parameters(cls, values):
+    """An instance of the scene's frozen parameter dataclass ``cls`` from the validated ``values``.
+
+    ``values`` maps parameter names to values in their documented units (what
+    :meth:`rotframe.app.scenario.Scenario.with_values` resolves; a ``"run"`` key,
+    the run settings, is not a parameter and is skipped). Each field is
+    converted to its declared type (``float``, ``int``, ``bool``, ``str`` or
+    ``tuple[float, ...]``); a field missing from ``values`` takes its default.
+    An instance of ``cls`` is returned as it is.
+
+    Raises
+    ------
+    ScenarioError
+        For a key that is not a field of ``cls`` (a misspelt or foreign parameter
+        in a scenario file: one line naming it and the allowed names), a field
+        without a value and without a default, or a value of the wrong kind.
+    """
+    if isinstance(values, cls):
+        return values
+    fields = _fields(cls)
+    unknown = [k for k in values if k not in fields and k != "run"]
+    if unknown:
+        key = unknown[0]
+        raise ScenarioError(f"parameter {key} = {values[key]!r}: not a parameter of this scene "
+                            f"({cls.__name__}); allowed: {', '.join(fields)}")
+    kwargs = {}
+    for name, (kind, f) in fields.items():
+        if name in values:
+            kwargs[name] = _convert(cls, name, kind, values[name])
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise ScenarioError(f"parameter {name}: missing; {cls.__name__} needs {', '.join(fields)}")
+    return cls(**kwargs)
+
+
+def with_parameters(cls, position=0):
+    """Decorate a scene function whose argument ``position`` is a ``cls``: it then takes the values mapping too.
+
+    The scene protocol passes ``values`` (a mapping; ``record(rec, values,
+    result)`` has it at position 1); the decorated function receives
+    ``scene_parameters(cls, values)`` in its place, so that scene code reads
+    ``p.latitude`` (a misspelt name is an AttributeError, not a silent default)
+    and callers that pass a dict, as the scene protocol does, keep working.
+    """
+    def decorate(func):
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            args = list(args)
+            args[position] = scene_parameters(cls, args[position])
+            return func(*args, **kwargs)
+
+        wrapper.parameters = cls
+        return wrapper
+
+    return decorate
+
+
+# ---------------------------------------------------------------------------
+# method names: canonical names in order, and the old names still accepted
+# ---------------------------------------------------------------------------
+
+
+class MethodNames(tuple):
+    """A scene's method names: the canonical ones in order, plus old names (aliases) that it still accepts.
+
+    A tuple of the canonical names (iterating, printing and ``len`` see only
+    those, so messages and ``rotframe show`` list them), whose ``in`` also
+    accepts an alias; :meth:`canonical` maps an alias to its name, which is the
+    name a run reports (the JSON ``method``).
+    """
+
+    def __new__(cls, names, aliases=None):
+        self = super().__new__(cls, names)
+        self.aliases = dict(aliases or {})
+        unknown = [a for a, target in self.aliases.items() if not tuple.__contains__(self, target)]
+        if unknown:
+            raise ValueError(f"MethodNames: aliases {unknown} point to no method of {tuple(self)}")
+        return self
+
+    def __contains__(self, name) -> bool:
+        return tuple.__contains__(self, name) or (isinstance(name, str) and name in self.aliases)
+
+    def canonical(self, name):
+        """The canonical name of ``name`` (itself when it is one; None stays None)."""
+        return self.aliases.get(name, name) if isinstance(name, str) else name
+
+
+def particle_methods() -> MethodNames:
+    """The particle integrators' names, from their registry (``rotframe.particles.integrators``).
+
+    Canonical names are the keys of ``integrators.METHODS``; old names are its
+    ``ALIASES`` ({old: canonical}) where the registry has them.
+    """
+    from rotframe.particles import integrators
+
+    return MethodNames(tuple(integrators.METHODS), getattr(integrators, "ALIASES", {}))
 
 
 @dataclass
@@ -40,6 +185,7 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
     re-raises with a SceneResult in ``exc.partial`` that can be analysed and
     recorded like a complete one.
     """
+    method = particle_methods().canonical(method)
     try:
         traj = integrate_particles(model, r0, v0, duration, method=method, step=step or run.get("step"),
                                    rtol=run.get("rtol") or 1e-10, samples=int(run.get("samples") or 2000),
@@ -74,6 +220,12 @@ def until_event(traj, name, particle=0):
     keep = traj.times < t_ev
     return (np.append(traj.times[keep], t_ev), np.vstack([traj.r[keep, particle], state[:3]]),
             np.vstack([traj.v[keep, particle], state[3:]]))
+
+
+def landing(traj, name="ground", particle=0):
+    """``(times, r, v, landed)``: :func:`until_event` of the ``name`` event, and whether it happened."""
+    times, r, v = until_event(traj, name, particle)
+    return times, r, v, len(traj.event_times[name][particle]) > 0
 
 
 def resolve_terms(terms, drag=0.0):
@@ -216,13 +368,17 @@ def method_rel_error(traj, time_scale):
     """A bound on the relative error of a run's metrics from its method, for a motion of ``time_scale`` s.
 
     ``exact``: 1e-9 (round-off). The adaptive ``dop853`` (rtol <= 1e-10 in the
-    scenes): 1e-8, its local tolerance grown over many steps. Fixed-step methods: 10 (h / T)^p with p = 2 for
-    ``splitting`` and 4 for ``splitting4`` and ``rk4`` (their global error over a
+    scenes): 1e-8, its local tolerance grown over many steps. Fixed-step methods: 10 (h / T)^p with p their
+    order in the particle registry (``rotframe.particles.integrators.METHODS``: 2 for the rotation
+    splitting, 4 for its fourth-order composition and for ``rk4``; their global error over a
     motion of time scale T), a factor 10 of margin over the leading term.
     """
+    from rotframe.particles.integrators import METHODS
+
     h = traj.extras.get("step") or 0.0
-    order = {"splitting": 2, "splitting4": 4, "rk4": 4}.get(traj.method)
-    if traj.method == "dop853":
+    info = METHODS.get(particle_methods().canonical(traj.method))
+    order = info.order if info is not None and info.kind == "fixed" else None
+    if info is not None and info.kind == "adaptive":
         return 1e-8
     if order is None or not h or not time_scale > 0:
         return 1e-9
@@ -237,6 +393,8 @@ def reject_subnormal(values):
     to its stated accuracy, so the input is refused (exit 2) rather than run.
     """
     tiny = sys.float_info.min
+    if dataclasses.is_dataclass(values):
+        values = dataclasses.asdict(values)
     for key, value in values.items():
         items = value if isinstance(value, (list, tuple, np.ndarray)) else [value]
         for x in items:

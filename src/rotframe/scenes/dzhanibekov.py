@@ -10,38 +10,56 @@ half the period 4 K(m) / lambda; energy and |L| are conserved.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from rotframe.errors import ScenarioError
-from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note
-from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
+from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
+from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
+                                       simulate_free_body)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DzhanibekovParameters:
+    """Parameters of the dzhanibekov effect scene, in the units of its scenario file."""
+
+    i1: float  # kg m^2
+    i2: float  # kg m^2
+    i3: float  # kg m^2
+    omega: tuple[float, ...]  # rad/s, body frame (3 numbers)
+    duration: float  # s
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = DzhanibekovParameters
+
 
 METHODS = FREE_METHODS
 
 
-def build(values):
-    from rotframe.rigid import mass_properties
-    inertia = np.array([values["i1"], values["i2"], values["i3"]], dtype=float)
-    mass_properties.check_moments(inertia)
-    omega = np.asarray(values["omega"], dtype=float)
-    if not np.any(omega):
+@with_parameters(DzhanibekovParameters)
+def build(p):
+    """``(inertia, L0, q0)``: the body in the identity attitude, spinning at ``omega`` (body axes)."""
+    body = free_body_state([p.i1, p.i2, p.i3], p.omega)
+    if not np.any(p.omega):
         raise ScenarioError("omega = 0,0,0: the body must spin (give 3 numbers in rad/s, body axes)")
-    return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
+    return body
 
 
 #: Samples per period of omega(t): omega_mid changes sign twice a period, so 32 per flip.
 SAMPLES_PER_OMEGA_PERIOD = 64
 
 
-def simulate(values, terms, method, run, progress):
+@with_parameters(DzhanibekovParameters)
+def simulate(p, terms, method, run, progress):
     from rotframe.rigid import dynamics as rigid
-    reject_subnormal(values)
-    body = build(values)
+    reject_subnormal(p)
+    body = build(p)
     period = rigid.elliptic_period(body[0], body[1])
-    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000,
+    samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000,
                                     per_period=SAMPLES_PER_OMEGA_PERIOD)
-    result = simulate_free_body(body, values["duration"], method, dict(run, samples=samples), progress)
+    result = simulate_free_body(body, p.duration, method, dict(run, samples=samples), progress)
     result.extras.update(resolved=resolved, omega_period=period)
     return result
 
@@ -74,7 +92,8 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
     return tol
 
 
-def analyse(values, result):
+@with_parameters(DzhanibekovParameters)
+def analyse(p, result):
     from rotframe.rigid import dynamics as rigid
     traj, inertia = result.trajectory, result.extras["inertia"]
     mid = int(np.argsort(inertia)[1])
@@ -125,7 +144,8 @@ def analyse(values, result):
             "diagnostics": {"flips": len(flips), "omega_period_s": period}, "notes": notes}
 
 
-def record(rec, values, result):
+@with_parameters(DzhanibekovParameters, position=1)
+def record(rec, p, result):
     traj, inertia = result.trajectory, result.extras["inertia"]
     idx = record_body(rec, traj, inertia)
     _, _, E, M = invariant_drifts(inertia, traj)

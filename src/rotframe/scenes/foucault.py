@@ -19,6 +19,7 @@ angle, unwrapped and fitted against time, gives the rate.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -26,22 +27,43 @@ from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scen
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
-                                  potential_energy, reject_subnormal, run_particles, unresolved_note)
+                                  particle_methods, potential_energy, reject_subnormal, run_particles,
+                                  unresolved_note, with_parameters)
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+
+@dataclass(frozen=True, kw_only=True)
+class FoucaultParameters:
+    """Parameters of the foucault pendulum scene, in the units of its scenario file."""
+
+    length: float  # m
+    latitude: float  # deg
+    amplitude: float  # m
+    duration: float  # s
+    small_angle: bool  # the linearised model
+    g_model: str = "wgs84"  # "wgs84" or "standard"
+    record_samples: int = 20000  # samples kept in the recording
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = FoucaultParameters
+
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 SAMPLES_PER_PERIOD = 32
 #: Samples kept at most (memory: 48 bytes each); beyond, the period is not measured.
 MAX_SAMPLES = 2_000_000
 
 
-def build(values, terms):
-    Omega, w, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
-    L, a = values["length"], values["amplitude"]
+@with_parameters(FoucaultParameters)
+def build(p, terms):
+    Omega, w, g = earth_model_constants(p.latitude, p.g_model)
+    L, a = p.length, p.amplitude
     if a >= L:
         from rotframe.errors import ScenarioError
 
         raise ScenarioError(f"amplitude = {a:g} m: must be smaller than length = {L:g} m")
-    if values["small_angle"]:
+    if p.small_angle:
         w_vertical = np.array([0.0, 0.0, w[2]])
         model = ParticleModel(("spring", "coriolis"), omega=OmegaSchedule.constant(w_vertical), spring=g / L)
         r0 = np.array([a, 0.0, 0.0])
@@ -53,11 +75,12 @@ def build(values, terms):
     return model, r0, np.zeros(3), g, Omega
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    model, r0, v0, g, Omega = build(values, terms)
-    T = values["duration"]
-    period = 2 * math.pi * math.sqrt(values["length"] / g)
+@with_parameters(FoucaultParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    model, r0, v0, g, Omega = build(p, terms)
+    T = p.duration
+    period = 2 * math.pi * math.sqrt(p.length / g)
     need = int(SAMPLES_PER_PERIOD * T / period)
     resolved = need <= MAX_SAMPLES
     samples = max(int(run.get("samples") or 0), min(need, MAX_SAMPLES))
@@ -114,22 +137,23 @@ def measured_rates(times, r, v, length, g, with_error=False):
     return (-slope, period, slope_error) if with_error else (-slope, period)
 
 
-def analyse(values, result):
+@with_parameters(FoucaultParameters)
+def analyse(p, result):
     traj = result.trajectory
     g = result.extras["g"]
     model = result.extras["model"]
     r, v = traj.r[:, 0], traj.v[:, 0]
-    L, a = values["length"], values["amplitude"]
+    L, a = p.length, p.amplitude
     rate, period, rate_error = measured_rates(traj.times, r, v, L, g, with_error=True)
     Omega = result.extras["Omega"]
-    lat = math.radians(values["latitude"])
+    lat = math.radians(p.latitude)
     foucault_rate = analytic.foucault_precession_rate(lat, Omega)
     w0 = math.sqrt(g / L)
     T_swing = 2 * math.pi / w0
     duration = float(traj.times[-1])
     notes, warnings = [], []
     per_hour = math.degrees(1.0) * 3600
-    if values["small_angle"]:
+    if p.small_angle:
         theory_rate, airy = foucault_rate, 0.0
         rate_label = "exact for the linearised model: Omega sin(latitude)"
         period_theory = float(analytic.pendulum_period(L, g, 0.0))
@@ -149,13 +173,13 @@ def analyse(values, result):
     theory_notes = {"precession_rate_deg_per_hour": rate_label, "period_s": period_label}
     diagnostics = {"simulated_hours": duration / 3600,
                    "omega_sin_latitude_deg_per_hour": foucault_rate * per_hour}
-    if not values["small_angle"]:
+    if not p.small_angle:
         diagnostics["airy_precession_deg_per_hour"] = -airy * per_hour
     if not result.extras.get("resolved", True):
         metrics["period_s"] = math.nan
         notes.append(unresolved_note("period_s", "swing", T_swing, duration, per_period=SAMPLES_PER_PERIOD,
                                      bound=MAX_SAMPLES) + " (the precession rate needs no such resolution)")
-    if not values["small_angle"] and a < 1e4 * np.finfo(float).eps * L:
+    if not p.small_angle and a < 1e4 * np.finfo(float).eps * L:
         # the string is kept to round-off of its length, eps L: a swing not far above that is noise
         metrics = {"precession_rate_deg_per_hour": math.nan, "period_s": math.nan}
         notes.append(f"amplitude {a:.3g} m is within 1e4 round-offs of the string length ({L:g} m): the full "
@@ -189,26 +213,27 @@ def analyse(values, result):
             "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
 
 
-def record(rec, values, result):
+@with_parameters(FoucaultParameters, position=1)
+def record(rec, p, result):
     """The bob with a trail that grows with time, the swing plane and its angle beside Omega sin(lat) t,
     the local frame with Earth's rotation vector, the string's length error."""
     from rotframe.numerics.sampling import decimate
 
     traj = result.trajectory
-    idx = decimate(len(traj.times), int(values.get("record_samples", 20000)))
+    idx = decimate(len(traj.times), int(p.record_samples))
     t, r = traj.times[idx], traj.r[idx, 0]
-    L = values["length"]
+    L = p.length
     rec.points("world/bob", t, r, radius=0.15, color=[230, 90, 40])
     g = result.extras["g"]
     angle = swing_angle(traj.r[:, 0], traj.v[:, 0], math.sqrt(g / L))[idx]
-    a = values["amplitude"]
+    a = p.amplitude
     d = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=1) * a
     rec.segments("world/swing_plane", t, -d, d, color=[40, 160, 230])
     rec.line("world/string_at_rest", [[0, 0, 0], [0, 0, L]], color=[150, 150, 150])
     model = result.extras["model"]
-    rec.frame_axes("world/frame", a, omega=model.omega.vector() if not values["small_angle"] else None)
+    rec.frame_axes("world/frame", a, omega=model.omega.vector() if not p.small_angle else None)
     rec.scalars("diagnostics/swing_angle_deg", t, np.degrees(angle), label="swing plane (measured)")
-    rate = analytic.foucault_precession_rate(math.radians(values["latitude"]), result.extras["Omega"])
+    rate = analytic.foucault_precession_rate(math.radians(p.latitude), result.extras["Omega"])
     rec.reference("diagnostics/swing_angle_deg", t, np.degrees(angle[0] - rate * t),
                   label="-Omega sin(lat) t (clockwise in the north)")
     if model.has("pendulum"):

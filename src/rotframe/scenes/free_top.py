@@ -12,46 +12,64 @@ rates are measured from the motion.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note
-from rotframe.scenes.rigid_base import FREE_METHODS, invariant_drifts, record_body, simulate_free_body
+from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
+from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
+                                       simulate_free_body)
+
+
+@dataclass(frozen=True, kw_only=True)
+class FreeTopParameters:
+    """Parameters of the free symmetric top scene, in the units of its scenario file."""
+
+    i1: float  # kg m^2
+    i3: float  # kg m^2
+    omega3: float  # rad/s
+    omega_perp: float  # rad/s
+    duration: float  # s
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = FreeTopParameters
+
 
 METHODS = FREE_METHODS
 
 
-def build(values):
-    from rotframe.rigid import mass_properties
-    inertia = np.array([values["i1"], values["i1"], values["i3"]], dtype=float)
-    mass_properties.check_moments(inertia)
-    omega = np.array([values["omega_perp"], 0.0, values["omega3"]])
-    return inertia, inertia * omega, np.array([0.0, 0.0, 0.0, 1.0])
+@with_parameters(FreeTopParameters)
+def build(p):
+    """``(inertia, L0, q0)``: the symmetric top spinning at (omega_perp, 0, omega3) in body axes."""
+    return free_body_state([p.i1, p.i1, p.i3], [p.omega_perp, 0.0, p.omega3])
 
 
-def time_scales(values):
+@with_parameters(FreeTopParameters)
+def time_scales(p):
     """(body precession rate k, space precession rate |L| / I1), rad/s, from the parameters.
 
     k = omega3 (I3 - I1) / I1 (signed, about +e3); the symmetry axis circles L at |L| / I1.
     """
-    i1, i3 = values["i1"], values["i3"]
-    k = values["omega3"] * (i3 - i1) / i1
-    space = math.hypot(i1 * values["omega_perp"], i3 * values["omega3"]) / i1
+    i1, i3 = p.i1, p.i3
+    k = p.omega3 * (i3 - i1) / i1
+    space = math.hypot(i1 * p.omega_perp, i3 * p.omega3) / i1
     return k, space
 
 
-def _periods(values):
+def _periods(p):
     """The periods (s) the metrics must resolve: of the rates that are not zero."""
-    k, space = time_scales(values)
+    k, space = time_scales(p)
     return [2 * math.pi / abs(r) for r in (k, space) if r != 0.0 and math.isfinite(2 * math.pi / abs(r))]
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    periods = _periods(values)
+@with_parameters(FreeTopParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    periods = _periods(p)
     shortest = min(periods) if periods else math.inf
-    samples, resolved = samples_for(values["duration"], shortest, run.get("samples") or 2000)
-    result = simulate_free_body(build(values), values["duration"], method, dict(run, samples=samples), progress)
+    samples, resolved = samples_for(p.duration, shortest, run.get("samples") or 2000)
+    result = simulate_free_body(build(p), p.duration, method, dict(run, samples=samples), progress)
     result.extras["resolved"] = resolved
     result.extras["shortest_period"] = shortest
     return result
@@ -90,10 +108,11 @@ def _tolerance(method, rate, traj):
     return tol
 
 
-def analyse(values, result):
+@with_parameters(FreeTopParameters)
+def analyse(p, result):
     traj, inertia = result.trajectory, result.extras["inertia"]
-    omega3, omega_perp = values["omega3"], values["omega_perp"]
-    k, space_theory = time_scales(values)
+    omega3, omega_perp = p.omega3, p.omega_perp
+    k, space_theory = time_scales(p)
     duration = float(traj.times[-1])
     e_drift, m_drift, _, _ = invariant_drifts(inertia, traj)
     notes, theory, tolerance = [], {}, {}
@@ -146,7 +165,8 @@ def analyse(values, result):
             "diagnostics": diagnostics, "notes": notes}
 
 
-def record(rec, values, result):
+@with_parameters(FreeTopParameters, position=1)
+def record(rec, p, result):
     traj, inertia = result.trajectory, result.extras["inertia"]
     idx = record_body(rec, traj, inertia)
     w = traj.L[idx] / inertia

@@ -11,63 +11,92 @@ is stable when I3^2 w3^2 > 4 I1 m g l (I1 about the fixed point).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe.scenes.base import SceneResult, reject_subnormal, samples_for, unresolved_note
+from rotframe.scenes.base import SceneResult, reject_subnormal, samples_for, unresolved_note, with_parameters
 from rotframe.scenes.rigid_base import HEAVY_METHODS, guarded, initial_attitude_zxz, integrate_body
 
+
+@dataclass(frozen=True, kw_only=True)
+class HeavyTopParameters:
+    """Parameters of the heavy symmetric top scene, in the units of its scenario file."""
+
+    i1: float  # kg m^2, about the fixed point
+    i3: float  # kg m^2
+    mass: float  # kg
+    length: float  # m, pivot to centre of mass
+    g: float  # m/s^2
+    theta0: float  # deg
+    phidot0: float  # rad/s
+    psidot0: float  # rad/s
+    wobble: float  # rad/s, initial thetadot
+    duration: float  # s
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = HeavyTopParameters
+
+
+#: ``top-splitting``, ``top-splitting4``, ``top-splitting6``, ``rk4`` (the old ``splitting[4|6]`` accepted).
 METHODS = HEAVY_METHODS
 
 
-def build(values):
+@with_parameters(HeavyTopParameters)
+def build(p):
     from rotframe import frames
     from rotframe.rigid import mass_properties
-    i1, i3 = values["i1"], values["i3"]
+    i1, i3 = p.i1, p.i3
     inertia = np.array([i1, i1, i3])
     mass_properties.check_moments(inertia)
-    theta0 = math.radians(values["theta0"])
+    theta0 = math.radians(p.theta0)
     angles = [0.0, theta0, 0.0]
-    rates = [values["phidot0"], values["wobble"], values["psidot0"]]
+    rates = [p.phidot0, p.wobble, p.psidot0]
     omega = frames.euler_rates_to_omega(angles, rates, seq="ZXZ", frame="body")
     return inertia, inertia * omega, initial_attitude_zxz(*angles)
 
 
-def _theory(values):
-    """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket."""
+@with_parameters(HeavyTopParameters)
+def turning_points(p):
+    """(theta_min, theta_max, nutation period) from Goldstein's cubic, or None where it has no bracket.
+
+    None too for a top started upright without a nod (theta0 = 0, wobble = 0): it has no turning points.
+    """
     from rotframe.rigid import dynamics as rigid
-    if not (values["theta0"] > 0 or values["wobble"] != 0):
+    if not (p.theta0 > 0 or p.wobble != 0):
         return None
     try:
-        return rigid.heavy_top_turning_points(values["i1"], values["i3"], values["mass"], values["length"],
-                                              values["g"], math.radians(values["theta0"]), values["wobble"],
-                                              values["phidot0"], values["psidot0"])
+        return rigid.heavy_top_turning_points(p.i1, p.i3, p.mass, p.length,
+                                              p.g, math.radians(p.theta0), p.wobble,
+                                              p.phidot0, p.psidot0)
     except Exception:  # the cubic has no bracket (e.g. exactly steady precession)
         return None
 
 
-def _nutation_period_estimate(values):
+def _nutation_period_estimate(p):
     """A nutation period (s) to size the sampling: the cubic's, else the fast top's 2 pi I1 / (I3 |omega3|)."""
-    tp = _theory(values)
+    tp = turning_points(p)
     if tp is not None and len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0:
         return float(tp[2])
-    w3 = values["psidot0"] + values["phidot0"] * math.cos(math.radians(values["theta0"]))
-    return 2 * math.pi * values["i1"] / (values["i3"] * abs(w3)) if w3 else math.inf
+    w3 = p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
+    return 2 * math.pi * p.i1 / (p.i3 * abs(w3)) if w3 else math.inf
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    inertia, L0, q0 = build(values)
-    method = method or run.get("method") or "splitting"
-    top = (values["mass"], values["length"], values["g"])
-    period = _nutation_period_estimate(values)
-    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000)
+@with_parameters(HeavyTopParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    inertia, L0, q0 = build(p)
+    method = HEAVY_METHODS.canonical(method or run.get("method") or "top-splitting")
+    top = (p.mass, p.length, p.g)
+    period = _nutation_period_estimate(p)
+    samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000)
 
     def finish(traj):
         return SceneResult(traj, ["free-rigid-body", "gravity-torque"], traj.method, traj.steps,
                            extras={"inertia": inertia, "resolved": resolved, "nutation_period": period})
 
-    return guarded(finish, integrate_body, method, inertia, L0, q0, values["duration"], dict(run, samples=samples),
+    return guarded(finish, integrate_body, method, inertia, L0, q0, p.duration, dict(run, samples=samples),
                    progress, top=top)
 
 
@@ -121,13 +150,14 @@ def _peak_times(times, theta, k):
     return np.clip(tv, t1 - 0.5 * (t1 - t0), t1 + 0.5 * (t2 - t1))
 
 
-def analyse(values, result):
+@with_parameters(HeavyTopParameters)
+def analyse(p, result):
     from rotframe.rigid import dynamics as rigid
     traj = result.trajectory
     theta = tilt(traj)
-    args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])
+    args = (p.i1, p.i3, p.mass, p.length, p.g)
     threshold = rigid.sleeping_top_threshold(*args)
-    w3 = values["psidot0"] + values["phidot0"] * math.cos(math.radians(values["theta0"]))
+    w3 = p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
     dt = float(traj.times[1] - traj.times[0]) if len(traj.times) > 1 else math.inf
     h = traj.extras.get("step") or dt
     amplitude = float(theta.max() - theta.min())
@@ -161,8 +191,8 @@ def analyse(values, result):
     exact = "exact: roots of Goldstein's cubic f(u) of the same top"
     theory_notes = {"theta_min_deg": exact, "theta_max_deg": exact,
                     "nutation_period_s": "exact: 2 int du / sqrt(f(u)) between the roots (elliptic integral)"}
-    tp = _theory(values)
-    if values["theta0"] > 0 or values["wobble"] != 0:
+    tp = turning_points(p)
+    if p.theta0 > 0 or p.wobble != 0:
         if tp is None:
             notes.append("no turning-point theory: the cubic f(u) has no bracketing roots (steady precession)")
         else:
@@ -175,7 +205,7 @@ def analyse(values, result):
             # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin;
             # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
             T = float(tp[2]) if len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0 else math.inf
-            w_fast = max(abs(w3), abs(values["phidot0"]), 2 * math.pi / T)
+            w_fast = max(abs(w3), abs(p.phidot0), 2 * math.pi / T)
             method_rel = 10 * (w_fast * h) ** 2 if traj.method != "exact" else 1e-9
             amp_deg = math.degrees(tp[1] - tp[0])
             for key, i in (("theta_min_deg", int(np.argmin(theta))), ("theta_max_deg", int(np.argmax(theta)))):
@@ -190,27 +220,28 @@ def analyse(values, result):
                 tolerance["nutation_period_s"] = 2 * dt / (len(k) - 1) + method_rel * T
     diagnostics = {"sleeping_threshold_omega3_rad_s": threshold, "omega3_rad_s": w3,
                    "sleeping_top_stable": bool(abs(w3) > threshold)}
-    if values["theta0"] == 0:
+    if p.theta0 == 0:
         notes.append(f"sleeping top: stable above omega3 = {threshold:.4g} rad/s; this one spins at {w3:.4g}"
                      + (" (stays up)" if abs(w3) > threshold else " (falls)"))
     return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
             "diagnostics": diagnostics, "notes": notes}
 
 
-def record(rec, values, result):
+@with_parameters(HeavyTopParameters, position=1)
+def record(rec, p, result):
     """The top, L in space per sample (its horizontal part turns under the gravity torque), theta and its
     turning-angle theory, the Euler angles, the energy error; each kind in its own time-series view."""
     from rotframe.rigid import dynamics as rigid
     from rotframe.scenes.rigid_base import record_body
 
     traj = result.trajectory
-    idx = record_body(rec, traj, result.extras["inertia"], axis_length=values["length"] * 1.5, mass=values["mass"],
+    idx = record_body(rec, traj, result.extras["inertia"], axis_length=p.length * 1.5, mass=p.mass,
                       L_label="L in space (its vertical part is conserved; the horizontal part turns "
                               "with the gravity torque)")
     t = traj.times[idx]
     theta = tilt(traj)
     rec.scalars("diagnostics/theta_deg", t, np.degrees(theta[idx]), kind="tilt theta (deg)", label="theta (simulated)")
-    theory = analyse_theory(values)
+    theory = turning_points(p)
     if theory is not None:
         rec.reference("diagnostics/theta_deg", t, math.degrees(theory[0]), label="theta_min (Goldstein cubic)",
                       name="theory_min")
@@ -220,21 +251,22 @@ def record(rec, values, result):
     for k, name in enumerate(("phi", "theta", "psi")):
         kind = "Euler angle theta (deg)" if name == "theta" else f"Euler angle {name} (deg, unwrapped)"
         rec.scalars(f"diagnostics/euler_zxz/{name}_deg", t, np.degrees(angles[:, k]), kind=kind)
-    tip = rigid.body_to_space(traj.q[idx], np.array([0.0, 0.0, 1.5 * values["length"]]))
+    tip = rigid.body_to_space(traj.q[idx], np.array([0.0, 0.0, 1.5 * p.length]))
     rec.trail("world/tip_path", t, tip, color=[60, 200, 120])
-    rec.frame_axes("world/frame", values["length"], labels=("x", "y", "z (up)"))
-    E = rigid.energy(result.extras["inertia"], traj.L) + values["mass"] * values["g"] * values["length"] * np.cos(theta)
+    rec.frame_axes("world/frame", p.length, labels=("x", "y", "z (up)"))
+    E = rigid.energy(result.extras["inertia"], traj.L) + p.mass * p.g * p.length * np.cos(theta)
     rec.scalars("diagnostics/energy_rel_error", t, (E[idx] - E[0]) / abs(E[0]))
 
 
-def analyse_theory(values):
+@with_parameters(HeavyTopParameters)
+def analyse_theory(p):
     """(theta_min, theta_max, period) from Goldstein's cubic, or None where it has no bracket."""
     from rotframe.rigid import dynamics as rigid
-    if not (values["theta0"] > 0 or values["wobble"] != 0):
+    if not (p.theta0 > 0 or p.wobble != 0):
         return None
-    args = (values["i1"], values["i3"], values["mass"], values["length"], values["g"])
+    args = (p.i1, p.i3, p.mass, p.length, p.g)
     try:
-        return rigid.heavy_top_turning_points(*args, math.radians(values["theta0"]), values["wobble"],
-                                              values["phidot0"], values["psidot0"])
+        return rigid.heavy_top_turning_points(*args, math.radians(p.theta0), p.wobble,
+                                              p.phidot0, p.psidot0)
     except Exception:  # the cubic has no bracket (e.g. exactly steady precession)
         return None

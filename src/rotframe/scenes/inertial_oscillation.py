@@ -11,40 +11,60 @@ The model is linear, so the exact propagator is the default.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, reject_subnormal, rel_drift,
-                                  run_particles, samples_for, unresolved_note)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, particle_methods,
+                                  reject_subnormal, rel_drift, run_particles, samples_for, unresolved_note,
+                                  with_parameters)
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+
+@dataclass(frozen=True, kw_only=True)
+class InertialOscillationParameters:
+    """Parameters of the inertial oscillation scene, in the units of its scenario file."""
+
+    latitude: float  # deg
+    speed: float  # m/s
+    heading: float  # deg from north, clockwise
+    duration: float  # s
 
 
-def build(values, terms):
-    Omega, w, g = earth_model_constants(values["latitude"])
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = InertialOscillationParameters
+
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
+
+
+@with_parameters(InertialOscillationParameters)
+def build(p, terms):
+    Omega, w, g = earth_model_constants(p.latitude)
     f_plane = np.array([0.0, 0.0, w[2]])
     model = ParticleModel(tuple(terms), omega=OmegaSchedule.constant(f_plane))
-    az = math.radians(values["heading"])
-    v0 = values["speed"] * np.array([math.sin(az), math.cos(az), 0.0])
+    az = math.radians(p.heading)
+    v0 = p.speed * np.array([math.sin(az), math.cos(az), 0.0])
     return model, np.zeros(3), v0, Omega
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    model, r0, v0, Omega = build(values, terms)
+@with_parameters(InertialOscillationParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    model, r0, v0, Omega = build(p, terms)
     method = method or default_method(model)
-    f = abs(2 * Omega * math.sin(math.radians(values["latitude"])))
+    f = abs(2 * Omega * math.sin(math.radians(p.latitude)))
     period = 2 * math.pi / f if f > 0 else math.inf
-    samples, resolved = samples_for(values["duration"], period, run.get("samples") or 2000)
+    samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000)
 
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
                            extras={"Omega": Omega, "resolved": resolved, "period": period})
 
-    return run_particles(model, r0, v0, values["duration"], method, dict(run, samples=samples), progress, finish)
+    return run_particles(model, r0, v0, p.duration, method, dict(run, samples=samples), progress, finish)
 
 
 #: A heading that turns by less than this (rad) over the run is round-off, not rotation.
@@ -75,15 +95,16 @@ def measured(times, r, v):
     return 2 * math.pi / abs(rate), radius, math.copysign(1.0, rate)
 
 
-def analyse(values, result):
+@with_parameters(InertialOscillationParameters)
+def analyse(p, result):
     traj = result.trajectory
     r, v = traj.r[:, 0], traj.v[:, 0]
-    lat = math.radians(values["latitude"])
-    theory = analytic.inertial_oscillation(lat, values["speed"], result.extras["Omega"])
+    lat = math.radians(p.latitude)
+    theory = analytic.inertial_oscillation(lat, p.speed, result.extras["Omega"])
     notes = []
     metrics = {"period_s": math.nan, "radius_m": math.nan}
     sense = 0.0
-    if values["speed"] == 0:
+    if p.speed == 0:
         metrics["radius_m"] = float(np.max(np.linalg.norm(r, axis=1)))
         notes.append("speed = 0: the puck stays at rest; nothing circles, so there is no period")
     elif not result.extras.get("resolved", True):
@@ -106,9 +127,9 @@ def analyse(values, result):
     turned = 2 * math.pi * float(traj.times[-1]) / metrics["period_s"] if math.isfinite(metrics["period_s"]) else 0
     method_rel = method_rel_error(traj, result.extras["period"]) + (1e-15 / turned if turned else 0.0)
     tolerance = {k: method_rel * abs(t) for k, t in theory_vals.items()
-                 if math.isfinite(t) and (k != "period_s" or values["speed"] > 0)}
-    expected = -math.copysign(1.0, lat) if lat != 0 and values["speed"] > 0 else 0.0
-    diagnostics = {"speed_rel_drift": rel_drift(np.linalg.norm(v, axis=1)) if values["speed"] > 0 else 0.0,
+                 if math.isfinite(t) and (k != "period_s" or p.speed > 0)}
+    expected = -math.copysign(1.0, lat) if lat != 0 and p.speed > 0 else 0.0
+    diagnostics = {"speed_rel_drift": rel_drift(np.linalg.norm(v, axis=1)) if p.speed > 0 else 0.0,
                    "sense": "clockwise" if sense < 0 else "counter-clockwise" if sense > 0 else "none"}
     warnings = []
     if math.isfinite(metrics["period_s"]) and sense != expected:
@@ -118,16 +139,17 @@ def analyse(values, result):
             "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
 
 
-def record(rec, values, result):
+@with_parameters(InertialOscillationParameters, position=1)
+def record(rec, p, result):
     traj = result.trajectory
     rec.points("world/puck", traj.times, traj.r[:, 0] / 1000.0, radius=0.5, color=[230, 90, 40])
-    f = 2 * result.extras["Omega"] * math.sin(math.radians(values["latitude"]))
+    f = 2 * result.extras["Omega"] * math.sin(math.radians(p.latitude))
     omega = np.array([0.0, 0.0, f / 2])  # the f-plane: only the vertical part of Omega acts
     rec.frame_axes("world/frame", max(float(np.max(np.abs(traj.r[:, 0]))) / 1000.0, 1.0) / 2, omega=omega)
     rec.scalars("diagnostics/speed_rel_error", traj.times,
-                np.linalg.norm(traj.v[:, 0], axis=1) / values["speed"] - 1 if values["speed"] else 0 * traj.times)
+                np.linalg.norm(traj.v[:, 0], axis=1) / p.speed - 1 if p.speed else 0 * traj.times)
     v = traj.v[:, 0]
-    if values["speed"]:
+    if p.speed:
         direction = np.degrees(np.unwrap(np.arctan2(v[:, 1], v[:, 0])))
         rec.scalars("diagnostics/velocity_direction_deg", traj.times, direction, label="direction of v (from east)")
         rec.reference("diagnostics/velocity_direction_deg", traj.times, direction[0] - np.degrees(f * traj.times),

@@ -17,42 +17,71 @@ its stated accuracy (:func:`theory_and_accuracy`).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import Event
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, reject_subnormal,
-                                  rel_drift, resolve_terms, run_particles, samples_for, until_event)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
+                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
+                                  samples_for, with_parameters)
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+
+@dataclass(frozen=True, kw_only=True)
+class ProjectileParameters:
+    """Parameters of the projectile scene, in the units of its scenario file."""
+
+    latitude: float  # deg
+    azimuth: float  # deg from north, clockwise
+    elevation: float  # deg
+    speed: float  # m/s
+    drag: float  # 1/m, quadratic drag coefficient (0 = vacuum)
+    scale_height: float  # m, of the isothermal atmosphere
+    magnify: float = 20.0  # display factor of the lateral deflection
 
 
-def build(values, terms):
-    Omega, w, g = earth_model_constants(values["latitude"])
-    terms = resolve_terms(terms, values["drag"])
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = ProjectileParameters
+
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
+
+
+def aim_axes(azimuth_deg):
+    """Horizontal unit vectors (ENU) along the aim and to its right, for an azimuth in degrees from north."""
+    az = math.radians(azimuth_deg)
+    return np.array([math.sin(az), math.cos(az), 0.0]), np.array([math.cos(az), -math.sin(az), 0.0])
+
+
+@with_parameters(ProjectileParameters)
+def build(p, terms):
+    Omega, w, g = earth_model_constants(p.latitude)
+    terms = resolve_terms(terms, p.drag)
     R = earth.R_EARTH
     # GM chosen so that central gravity equals the effective g at the gun (same g at the start)
     model = ParticleModel(terms, omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
-                          k_quadratic=values["drag"], scale_height=values["scale_height"], radius=R,
+                          k_quadratic=p.drag, scale_height=p.scale_height, radius=R,
                           gm=g * R * R, g0=g)
-    az, el = math.radians(values["azimuth"]), math.radians(values["elevation"])
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
-    v0 = values["speed"] * (math.cos(el) * aim + math.sin(el) * np.array([0.0, 0.0, 1.0]))
+    el = math.radians(p.elevation)
+    aim, _ = aim_axes(p.azimuth)
+    v0 = p.speed * (math.cos(el) * aim + math.sin(el) * np.array([0.0, 0.0, 1.0]))
     ground = Event("ground", "altitude" if "curvature" in terms else "r", 2, 0.0, -1, True)
-    flight = 2 * values["speed"] * max(math.sin(el), 1e-3) / g
+    flight = 2 * p.speed * max(math.sin(el), 1e-3) / g
     # room to land, from the shot's own time scale (an absolute margin would swamp a short flight)
     return model, np.zeros(3), v0, ground, 3.0 * flight + min(10.0, 3.0 * flight), g
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    model, r0, v0, ground, duration, g = build(values, terms)
+@with_parameters(ProjectileParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    model, r0, v0, ground, duration, g = build(p, terms)
     method = method or run.get("method") or "dop853"
 
     # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
-    flight = 2 * values["speed"] * math.sin(math.radians(values["elevation"])) / g
+    flight = 2 * p.speed * math.sin(math.radians(p.elevation)) / g
     samples, resolved = samples_for(duration, flight, run.get("samples") or 2000)
 
     def finish(traj):
@@ -85,11 +114,10 @@ def apex_height(times, r):
     return float(max(z1, z0 + d1 * (tv - t0) + d2 * (tv - t0) * (tv - t1)))
 
 
-def ground_track(values, r, model):
+@with_parameters(ProjectileParameters)
+def ground_track(p, r, model):
     """(range along the ground, lateral deflection right of the aim) of positions r (n, 3)."""
-    az = math.radians(values["azimuth"])
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
-    right = np.array([math.cos(az), -math.sin(az), 0.0])
+    aim, right = aim_axes(p.azimuth)
     if model.has("curvature"):
         R = model.radius
         c = np.array([0.0, 0.0, -R])
@@ -101,7 +129,8 @@ def ground_track(values, r, model):
     return r @ aim, r @ right
 
 
-def theory_and_accuracy(values, g, Omega, model):
+@with_parameters(ProjectileParameters)
+def theory_and_accuracy(p, g, Omega, model):
     """Flat-vacuum closed forms, their labels and the absolute accuracy each one claims.
 
     The expansion parameter is eps = 2 Omega v / g (Omega times the longest time
@@ -116,8 +145,8 @@ def theory_and_accuracy(values, g, Omega, model):
     no accuracy is claimed (a difference there is the physics of the extra
     terms, which ``--audit`` measures, not an error of the run).
     """
-    el, az, lat = (math.radians(values[k]) for k in ("elevation", "azimuth", "latitude"))
-    v = values["speed"]
+    el, az, lat = (math.radians(x) for x in (p.elevation, p.azimuth, p.latitude))
+    v = p.speed
     flat = analytic.projectile_flat_vacuum(v, el, g)
     theory = {"range_m": float(flat.range), "flight_time_s": float(flat.flight_time),
               "lateral_deflection_m": float(analytic.projectile_lateral_deflection_first_order(v, el, az, lat, g, Omega))}
@@ -136,15 +165,15 @@ def theory_and_accuracy(values, g, Omega, model):
                               for k, lab in labels.items()}
 
 
-def analyse(values, result):
+@with_parameters(ProjectileParameters)
+def analyse(p, result):
     traj = result.trajectory
     model = result.extras["model"]
     g = result.extras["g"]
-    times, r, v = until_event(traj, "ground")
-    landed = len(traj.event_times["ground"][0]) > 0
-    rng, lateral = ground_track(values, r, model)
+    times, r, v, landed = landing(traj)
+    rng, lateral = ground_track(p, r, model)
     Omega = float(np.linalg.norm(model.omega.vector()))
-    theory, accuracy, theory_notes = theory_and_accuracy(values, g, Omega, model)
+    theory, accuracy, theory_notes = theory_and_accuracy(p, g, Omega, model)
     metrics = {"range_m": float(rng[-1]), "lateral_deflection_m": float(lateral[-1]),
                "flight_time_s": float(times[-1]) if landed else math.nan}
     diagnostics = {"apex_m": apex_height(times, r)}
@@ -171,18 +200,17 @@ def analyse(values, result):
             "diagnostics": diagnostics, "notes": notes}
 
 
-def record(rec, values, result):
+@with_parameters(ProjectileParameters, position=1)
+def record(rec, p, result):
     traj = result.trajectory
-    times, r, v = until_event(traj, "ground")
+    times, r, v, _ = landing(traj)
     rec.points("world/shell", times, r / 1000.0, radius=0.5, color=[230, 90, 40])
     rec.frame_axes("world/frame", 20.0, omega=result.extras["model"].omega.vector())  # km
-    rng, lateral = ground_track(values, r, result.extras["model"])
+    rng, lateral = ground_track(p, r, result.extras["model"])
     rec.scalars("diagnostics/altitude_km", times, r[:, 2] / 1000.0)
     rec.scalars("diagnostics/lateral_deflection_m", times, lateral)
-    magnify = float(values.get("magnify", 20.0))
-    az = math.radians(values["azimuth"])
-    aim = np.array([math.sin(az), math.cos(az), 0.0])
-    right = np.array([math.cos(az), -math.sin(az), 0.0])
+    magnify = float(p.magnify)
+    aim, right = aim_axes(p.azimuth)
     shown = (np.outer(rng, aim) + magnify * np.outer(lateral, right)) / 1000.0
     shown[:, 2] = r[:, 2] / 1000.0
     rec.points("world/deflection_magnified", times, shown, radius=0.4, color=[40, 160, 230])

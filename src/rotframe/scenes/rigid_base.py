@@ -10,11 +10,16 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
+from rotframe.scenes.base import MethodNames
 
-#: Methods of the free body; ``exact`` is the elliptic-function flow.
-FREE_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
-#: Methods of the heavy top.
-HEAVY_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
+#: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
+#: Lie-Poisson splitting of orders 2, 4, 6.
+FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4"))
+#: Methods of the heavy top: ``top-splitting[4|6]`` (exact free symmetric-top flow and gravity kick, orders
+#: 2, 4, 6) and ``rk4``; the old names ``splitting``, ``splitting4``, ``splitting6`` are still accepted.
+HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "rk4"),
+                            {"splitting": "top-splitting", "splitting4": "top-splitting4",
+                             "splitting6": "top-splitting6"})
 
 
 @dataclass
@@ -38,6 +43,8 @@ class BodyTrajectory:
 def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """Integrate a free body, or a heavy symmetric top (``top = (mass, length, g)``), by a named method.
 
+    ``method`` is a name of :data:`FREE_METHODS`, or of :data:`HEAVY_METHODS`
+    (an old name too, run and reported under its canonical name) with ``top``.
     Fixed-step methods use ``run["step"]`` and keep ``run["samples"]`` samples;
     the work is done in chunks so that progress shows, Ctrl-C interrupts and a
     non-finite state stops the run with everything before it kept.
@@ -45,6 +52,8 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     from rotframe.rigid import dynamics as rigid
     from rotframe import limits
 
+    if top is not None:
+        method = HEAVY_METHODS.canonical(method)
     duration = float(duration)
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
@@ -134,6 +143,19 @@ def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
     return L, q
 
 
+def free_body_state(inertia, omega_body):
+    """``(inertia, L0, q0)`` of a free body: principal moments (checked), L = I omega in body axes, q0 identity.
+
+    Raises ScenarioError for moments that no body has (see
+    :func:`rotframe.rigid.mass_properties.check_moments`).
+    """
+    from rotframe.rigid import mass_properties
+
+    inertia = np.asarray(inertia, dtype=float)
+    mass_properties.check_moments(inertia)
+    return inertia, inertia * np.asarray(omega_body, dtype=float), np.array([0.0, 0.0, 0.0, 1.0])
+
+
 def simulate_free_body(body, duration, method, run, progress):
     """Run a free body ``body = (inertia, L0, q0)``; the default method is the exact flow."""
     from rotframe.scenes.base import SceneResult
@@ -154,7 +176,7 @@ def _stepper(method, inertia, top):
     if method == "rk4":
         return lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)
     order = {"": 2, "4": 4, "6": 6}
-    for prefix in ("lie-poisson", "splitting"):
+    for prefix in ("lie-poisson", "top-splitting"):
         if method.startswith(prefix) and method[len(prefix):] in order:
             k = order[method[len(prefix):]]
             if top is not None:
@@ -214,14 +236,14 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
                 L_label="L in space (fixed: no torque acts)"):
     """Body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
 
+    Logged to ``rec``, the :class:`rotframe.app.record.Recording` passed in.
+
     ``world/angular_momentum`` is an arrow along L (space frame) at each
     sample, scaled to 1.5 ``axis_length``: fixed for a free body, turning for
     a torqued one (``L_label`` says which).
     """
-    import rerun as rr
-
-    from rotframe.rigid import dynamics as rigid
     from rotframe.numerics.sampling import decimate
+    from rotframe.rigid import dynamics as rigid
 
     idx = decimate(len(traj.times), 5000)
     t = traj.times[idx]
@@ -231,11 +253,11 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
     s = 6.0 / mass * (np.array([I[1] + I[2] - I[0], I[0] + I[2] - I[1], I[0] + I[1] - I[2]]))
     half = 0.5 * np.sqrt(np.clip(s, 1e-12 * s.max(), None))
     half *= axis_length * 0.6 / half.max()
-    rec.rec.log(f"world/{name}/shape", rr.Boxes3D(half_sizes=[half], colors=[[200, 170, 90, 160]]), static=True)
+    rec.static(f"world/{name}/shape", "Boxes3D", half_sizes=[half], colors=[[200, 170, 90, 160]])
     Ls = rigid.angular_momentum_space(traj.q[idx], traj.L[idx])
     scale = 1.5 * axis_length / max(float(np.linalg.norm(Ls[0])), 1e-300)
     rec.segments("world/angular_momentum", t, np.zeros_like(Ls), scale * Ls, color=[250, 250, 250])
-    rec.rec.log("world/angular_momentum", rr.Arrows3D.from_fields(labels=[L_label], show_labels=True), static=True)
+    rec.static("world/angular_momentum", "Arrows3D", labels=[L_label], show_labels=True)
     Lb = traj.L[idx] / np.maximum(np.linalg.norm(traj.L[idx], axis=1), 1e-300)[:, None]
     rec.line(f"world/{name}/polhode", 1.2 * axis_length * Lb, color=[250, 200, 60])
     rec.scalars("diagnostics/omega_body/1", t, traj.L[idx, 0] / I[0] if I[0] else 0 * t)

@@ -12,36 +12,56 @@ equatorward (southward in the north) part is second order,
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, rel_drift,
-                                  reject_subnormal,
-                                  resolve_terms, run_particles, until_event)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
+                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
+                                  with_parameters)
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+
+@dataclass(frozen=True, kw_only=True)
+class TowerDropParameters:
+    """Parameters of the tower drop scene, in the units of its scenario file."""
+
+    height: float  # m
+    latitude: float  # deg
+    drag: float  # 1/m, quadratic drag coefficient (0 = vacuum)
+    g_model: str = "wgs84"  # "wgs84" or "standard"
+    magnify: float = 1000.0  # display factor of the deflection
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = TowerDropParameters
+
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
 
 
-def build(values, terms):
+@with_parameters(TowerDropParameters)
+def build(p, terms):
     """(model, r0, v0, duration) for the parameters; drag > 0 adds quadratic drag."""
-    Omega, w, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
-    model = ParticleModel(resolve_terms(terms, values["drag"]), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
-                          k_quadratic=values["drag"], g0=g, radius=earth.R_EARTH, gm=earth.GM_EARTH)
-    h = values["height"]
+    Omega, w, g = earth_model_constants(p.latitude, p.g_model)
+    model = ParticleModel(resolve_terms(terms, p.drag), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
+                          k_quadratic=p.drag, g0=g, radius=earth.R_EARTH, gm=earth.GM_EARTH)
+    h = p.height
     t_vac = math.sqrt(2 * h / g)
-    t_drag = h * math.sqrt(values["drag"] / g) if values["drag"] > 0 else 0.0
+    t_drag = h * math.sqrt(p.drag / g) if p.drag > 0 else 0.0
     # room to land from the problem's own time scale (an absolute margin would swamp a short fall)
     duration = 1.5 * (t_vac + t_drag) + min(1.0, 1.5 * (t_vac + t_drag))
     return model, np.array([0.0, 0.0, h]), np.zeros(3), duration, g
 
 
-def simulate(values, terms, method, run, progress):
-    reject_subnormal(values)
-    model, r0, v0, duration, g = build(values, terms)
+@with_parameters(TowerDropParameters)
+def simulate(p, terms, method, run, progress):
+    reject_subnormal(p)
+    model, r0, v0, duration, g = build(p, terms)
     method = method or default_method(model)
 
     def finish(traj):
@@ -55,7 +75,8 @@ def simulate(values, terms, method, run, progress):
 UNDERFLOW = 1e-290
 
 
-def theory_and_accuracy(values, model, g, Omega):
+@with_parameters(TowerDropParameters)
+def theory_and_accuracy(p, model, g, Omega):
     """Closed forms for the drop and the relative accuracy each one claims, for this model.
 
     East: (1/3) Omega g t^3 cos(lat), first order in Omega (neglected: relative
@@ -66,7 +87,7 @@ def theory_and_accuracy(values, model, g, Omega):
     along the fall, which moves every value by a relative h / R at most. With
     drag the vacuum forms are indicative only (accuracy None).
     """
-    h, lat = values["height"], math.radians(values["latitude"])
+    h, lat = p.height, math.radians(p.latitude)
     t = math.sqrt(2 * h / g)
     north = analytic.drop_north_deflection_second_order(h, lat, g, Omega)
     label = "second order in Omega, uniform gravity, vacuum"
@@ -81,23 +102,23 @@ def theory_and_accuracy(values, model, g, Omega):
                 "fall_time_s": 2 * wt**2 + 2 * extra}
     labels = {"east_deflection_m": "first order in Omega, uniform gravity, vacuum",
               "north_deflection_m": label, "fall_time_s": "no rotation, uniform gravity, vacuum"}
-    if values["drag"] > 0:
+    if p.drag > 0:
         return theory, {k: None for k in theory}, {k: v + ": indicative only (the model has drag)"
                                                    for k, v in labels.items()}
     notes = {k: f"{labels[k]} (+-{accuracy[k]:.2g} relative)" for k in theory}
     return theory, accuracy, notes
 
 
-def analyse(values, result):
+@with_parameters(TowerDropParameters)
+def analyse(p, result):
     traj = result.trajectory
     g = result.extras["g"]
     model = result.extras["model"]
-    times, r, v = until_event(traj, "ground")
-    landed = len(traj.event_times["ground"][0]) > 0
+    times, r, v, landed = landing(traj)
     Omega = float(np.linalg.norm(model.omega.vector()))
     metrics = {"east_deflection_m": float(r[-1, 0]), "north_deflection_m": float(r[-1, 1]),
                "fall_time_s": float(times[-1]) if landed else math.nan}
-    theory, accuracy, theory_notes = theory_and_accuracy(values, model, g, Omega)
+    theory, accuracy, theory_notes = theory_and_accuracy(p, model, g, Omega)
     diagnostics = {}
     notes = []
     e = jacobi_energy(model, r, v)
@@ -108,11 +129,11 @@ def analyse(values, result):
                      "air both prolongs the Coriolis push and damps the eastward drift (no energy invariant either)")
     if model.has("altitude-gravity") or model.has("central-gravity"):
         notes.append("theory assumes uniform gravity; weaker gravity aloft changes every value by up to a "
-                     f"relative h / R = {values['height'] / earth.R_EARTH:.2g}")
+                     f"relative h / R = {p.height / earth.R_EARTH:.2g}")
     if not landed:
         notes.append("the body did not reach the ground in the simulated time")
     # a deflection below float64's normal range has no significant digits left: null, not a number
-    log_east = math.log10(Omega / 3) + math.log10(g) + 1.5 * math.log10(2 * values["height"] / g)
+    log_east = math.log10(Omega / 3) + math.log10(g) + 1.5 * math.log10(2 * p.height / g)
     if log_east < math.log10(UNDERFLOW):
         for key in ("east_deflection_m", "north_deflection_m"):
             metrics[key] = theory[key] = math.nan
@@ -130,12 +151,13 @@ def analyse(values, result):
             "diagnostics": diagnostics, "notes": notes}
 
 
-def record(rec, values, result):
+@with_parameters(TowerDropParameters, position=1)
+def record(rec, p, result):
     traj = result.trajectory
-    times, r, v = until_event(traj, "ground")
-    h = values["height"]
+    times, r, v, _ = landing(traj)
+    h = p.height
     rec.points("world/body", times, r, radius=0.5, color=[230, 90, 40])
-    magnify = float(values.get("magnify", 1000.0))
+    magnify = float(p.magnify)
     shown = r.copy()
     shown[:, :2] *= magnify
     rec.points("world/deflection_magnified", times, shown, radius=0.5, color=[40, 160, 230])
@@ -147,7 +169,7 @@ def record(rec, values, result):
     # first order in Omega: x(t) = (1/3) Omega g t^3 cos(lat), the vertical component of g only
     Omega, g = float(np.linalg.norm(w)), result.extras["g"]
     rec.reference("diagnostics/east_deflection_mm", times,
-                  1e3 * Omega * g * times ** 3 * math.cos(math.radians(values["latitude"])) / 3,
+                  1e3 * Omega * g * times ** 3 * math.cos(math.radians(p.latitude)) / 3,
                   label="(1/3) Omega g t^3 cos(lat)")
     rec.scalars("diagnostics/north_deflection_mm", times, 1e3 * r[:, 1], label="north (simulated)")
     e = jacobi_energy(model, r, v)
@@ -191,7 +213,8 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
         r0[:, 2] = heights
         keep = [k for k, i in enumerate(members) if tracks is not None and i in tracks]
         ens = integrate_ensemble(model, r0, np.zeros_like(r0), duration, GROUND,
-                                 method=method or run.get("method") or default_method(model), run=run, keep=keep)
+                                 method=METHODS.canonical(method or run.get("method") or default_method(model)),
+                                 run=run, keep=keep)
         for k, i in enumerate(members):
             metrics[i] = {"east_deflection_m": float(ens.state[k, 0]), "north_deflection_m": float(ens.state[k, 1]),
                           "fall_time_s": float(ens.t_event[k])}
@@ -200,15 +223,16 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     return metrics
 
 
-def ensemble_theory(values):
+@with_parameters(TowerDropParameters)
+def ensemble_theory(p):
     """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
     t = sqrt(2 h / g).
     """
-    Omega, _, g = earth_model_constants(values["latitude"], values.get("g_model", "wgs84"))
-    lat = math.radians(values["latitude"])
-    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(values["height"], lat, g, Omega)),
-            "north_deflection_m": float(analytic.drop_north_deflection_second_order(values["height"], lat, g, Omega)),
-            "fall_time_s": math.sqrt(2 * values["height"] / g)}
+    Omega, _, g = earth_model_constants(p.latitude, p.g_model)
+    lat = math.radians(p.latitude)
+    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(p.height, lat, g, Omega)),
+            "north_deflection_m": float(analytic.drop_north_deflection_second_order(p.height, lat, g, Omega)),
+            "fall_time_s": math.sqrt(2 * p.height / g)}

@@ -4,7 +4,8 @@ The turntable spins about the vertical z axis at w(t) = omega0 + alpha t. The
 puck starts at (start_radius, 0, 0) on the turntable, shoved towards the centre
 at ``speed`` relative to the turntable. In inertial space it moves on a straight
 line; seen from the turntable it feels Coriolis, centrifugal and (while the
-turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md): the inertial
+turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md,
+:func:`rotframe.analytic.turntable_inertial_line`): the inertial
 line mapped into the rotating frame, r_rot(t) = R_z(-theta(t)) (r0 + v_in t),
 theta(t) = integral of w.
 """
@@ -12,22 +13,45 @@ theta(t) = integral of w.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe import analytic
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import SceneResult, method_rel_error, reject_subnormal, rel_drift, run_particles
+from rotframe.scenes.base import (SceneResult, method_rel_error, particle_methods, reject_subnormal, rel_drift,
+                                  run_particles, with_parameters)
+
+
+@dataclass(frozen=True, kw_only=True)
+class TurntableParameters:
+    """Parameters of the turntable scene, in the units of its scenario file."""
+
+    omega0: float  # rad/s, spin rate at t = 0
+    alpha: float  # rad/s^2, spin-up rate
+    speed: float  # m/s, shove towards the centre
+    duration: float  # s
+    start_radius: float  # m
+    table_radius: float  # m, drawn only
+
+
+#: The scene's parameters (the scene protocol's optional ``PARAMETERS``).
+PARAMETERS = TurntableParameters
+
+
+#: Every particle integrator (the registry's names; its old names accepted too).
+METHODS = particle_methods()
 
 Z = np.array([0.0, 0.0, 1.0])
 
 
-def _setup(values, terms):
-    w0, alpha, T = values["omega0"], values["alpha"], values["duration"]
+def _setup(p, terms):
+    w0, alpha, T = p.omega0, p.alpha, p.duration
     omega = OmegaSchedule.ramp(Z, w0, alpha, T)
     terms = [t for t in terms if not (t == "euler" and alpha == 0.0)]
     model = ParticleModel(tuple(terms), omega=omega)
-    r0 = np.array([values["start_radius"], 0.0, 0.0])
-    v0 = np.array([-values["speed"], 0.0, 0.0])
+    r0 = np.array([p.start_radius, 0.0, 0.0])
+    v0 = np.array([-p.speed, 0.0, 0.0])
     return model, omega, r0, v0, T
 
 
@@ -35,11 +59,12 @@ def _setup(values, terms):
 DIVERGED = 0.1
 
 
-def simulate(values, terms, method, run, progress):
+@with_parameters(TurntableParameters)
+def simulate(p, terms, method, run, progress):
     from rotframe.errors import IntegrationError
 
-    reject_subnormal(values)
-    model, omega, r0, v0, T = _setup(values, terms)
+    reject_subnormal(p)
+    model, omega, r0, v0, T = _setup(p, terms)
 
     def finish(traj):
         oracle = inertial_line(omega, r0, v0, traj.times)
@@ -50,7 +75,7 @@ def simulate(values, terms, method, run, progress):
     # a numerical instability that stays finite is still a failure: stop where the path left the exact line
     traj = result.trajectory
     err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
-    size = motion_size(values, traj.times)
+    size = motion_size(p, traj.times)
     bad = np.nonzero(~(err <= DIVERGED * size))[0]
     if len(bad):
         good = max(int(bad[0]), 1)
@@ -62,19 +87,24 @@ def simulate(values, terms, method, run, progress):
     return result
 
 
-def motion_size(values, times):
+@with_parameters(TurntableParameters)
+def motion_size(p, times):
     """Size of the motion (m) up to each time: start radius plus the inertial distance travelled."""
-    v_in = math.hypot(values["speed"], values["omega0"] * values["start_radius"])
-    return values["start_radius"] + v_in * np.asarray(times) + 1e-300
+    v_in = math.hypot(p.speed, p.omega0 * p.start_radius)
+    return p.start_radius + v_in * np.asarray(times) + 1e-300
 
 
 def inertial_line(omega, r0, v0, times):
-    """Rotating-frame positions of the inertial straight line (the oracle)."""
+    """Rotating-frame positions (n, 3) of the inertial straight line (the oracle), for the schedule ``omega``.
+
+    ``r0``, ``v0`` are the puck's position and velocity in the turntable's frame
+    at t = 0; its inertial velocity is ``v0 + w(0) x r0``, and the line is
+    :func:`rotframe.analytic.turntable_inertial_line` turned by the schedule's
+    exact angle.
+    """
+    times = np.asarray(times, dtype=float)
     v_in = v0 + np.cross(omega.vector(0.0), r0)
-    theta = omega.angle(times)
-    p = r0[None, :] + v_in[None, :] * np.asarray(times)[:, None]
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1], p[:, 2]], axis=1)
+    return analytic.turntable_inertial_line(r0, v_in, omega.angle(times), times)
 
 
 def _inertial_speed(result):
@@ -84,22 +114,23 @@ def _inertial_speed(result):
     return np.linalg.norm(v + np.cross(w, r), axis=1)
 
 
-def analyse(values, result):
+@with_parameters(TurntableParameters)
+def analyse(p, result):
     traj = result.trajectory
     err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
     turns = float(result.extras["omega"].angle(traj.times[-1])[0] / (2 * math.pi))
     T = float(traj.times[-1])
-    w_max = max(abs(values["omega0"]), abs(values["omega0"] + values["alpha"] * T))
+    w_max = max(abs(p.omega0), abs(p.omega0 + p.alpha * T))
     # the method's error over the path: relative to the motion's size, on the spin's time scale 1 / w_max
-    size = float(motion_size(values, [T])[0])
+    size = float(motion_size(p, [T])[0])
     tol = method_rel_error(traj, 1.0 / w_max if w_max > 0 else T) * size
     notes = []
-    if values["alpha"] != 0 and values["omega0"] * (values["omega0"] + values["alpha"] * T) < 0:
+    if p.alpha != 0 and p.omega0 * (p.omega0 + p.alpha * T) < 0:
         notes.append("the spin reverses during the run: turns counts the net angle (the two senses cancel)")
     return {
         "metrics": {"position_error_m": float(err[-1]), "turns": turns},
         "theory": {"position_error_m": 0.0,
-                   "turns": (values["omega0"] * T + 0.5 * values["alpha"] * T**2) / (2 * math.pi)},
+                   "turns": (p.omega0 * T + 0.5 * p.alpha * T**2) / (2 * math.pi)},
         "theory_notes": {"position_error_m": "exact: the inertial straight line seen from the turntable",
                          "turns": "exact: (omega0 T + alpha T^2 / 2) / 2 pi"},
         "tolerance": {"position_error_m": tol, "turns": 1e-12 * max(abs(turns), 1.0)},
@@ -109,12 +140,13 @@ def analyse(values, result):
     }
 
 
-def record(rec, values, result):
+@with_parameters(TurntableParameters, position=1)
+def record(rec, p, result):
     traj = result.trajectory
     rec.points("world/puck", traj.times, traj.r[:, 0], radius=0.03, color=[240, 120, 40])
     rec.points("world/oracle", traj.times, result.extras["oracle"], radius=0.015, color=[80, 80, 80], trail=False)
     phi = np.linspace(0, 2 * np.pi, 181)
-    R = values["table_radius"]
+    R = p.table_radius
     rec.line("world/turntable", np.stack([R * np.cos(phi), R * np.sin(phi), 0 * phi], axis=1), color=[120, 120, 200])
     rec.frame_axes("world/frame", 0.5 * R, labels=("x (turntable)", "y (turntable)", "z (spin axis)"))
     _record_inertial_axes(rec, traj.times, result.extras["omega"], 0.8 * R)
@@ -125,16 +157,11 @@ def record(rec, values, result):
 
 def _record_inertial_axes(rec, times, omega, length):
     """The inertial (lab) axes as seen from the turntable: they turn by -theta(t) about z."""
-    import rerun as rr
-
     from rotframe.numerics.sampling import decimate
 
     idx = decimate(len(times), 2000)
     half = -0.5 * np.asarray(omega.angle(times[idx]), dtype=float).reshape(-1)
-    quat = np.stack([0 * half, 0 * half, np.sin(half), np.cos(half)], axis=1).astype(np.float32)
-    rec.rec.send_columns("world/inertial_axes", indexes=[rr.TimeColumn(
-        "sim_time", duration=np.round(times[idx] * 1e9).astype(np.int64).astype("timedelta64[ns]"))],
-        columns=rr.Transform3D.columns(quaternion=quat))
-    rec.rec.log("world/inertial_axes/arrows", rr.Arrows3D(
-        vectors=[[length, 0, 0], [0, length, 0]], colors=[[120, 120, 120], [120, 120, 120]],
-        labels=["X (inertial)", "Y (inertial)"]), static=True)
+    quat = np.stack([0 * half, 0 * half, np.sin(half), np.cos(half)], axis=1)
+    rec.body("world/inertial_axes", times[idx], quat, axis_length=None)
+    rec.static("world/inertial_axes/arrows", "Arrows3D", vectors=[[length, 0, 0], [0, length, 0]],
+               colors=[[120, 120, 120], [120, 120, 120]], labels=["X (inertial)", "Y (inertial)"])

@@ -331,7 +331,7 @@ def _heavy_top(quick):
     from rotframe.scenes.heavy_top import build
 
     values = {"i1": 1.9e-4, "i3": 2.5e-5, "mass": 0.1, "length": 0.04, "g": 9.81, "theta0": 20.0,
-              "phidot0": 0.0, "psidot0": 300.0, "wobble": 0.0}
+              "phidot0": 0.0, "psidot0": 300.0, "wobble": 0.0, "duration": 2.0}
     inertia, L0, q0 = build(values)
     mgl = values["mass"] * values["g"] * values["length"]
     spec = {"kind": "rigid", "inertia": tuple(inertia), "mgl": mgl}
