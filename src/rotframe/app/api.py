@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from rotframe.app.choices import did_you_mean
 from rotframe.errors import ScenarioError
 
 __all__ = ["scenarios", "load", "run", "Result", "TrajectoryArrays", "register_scene"]
@@ -194,7 +195,7 @@ def resolve_values(scn, params: Mapping[str, Any]) -> dict:
             run_settings[key] = sc._parse_run_value(key, _plain(raw, unit, key, scn.name), source=scn.name)
         else:
             allowed = list(scn.parameters) + [k for k in sc.RUN_KEYS if k != "method"]
-            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{sc._did_you_mean(key, allowed)}; "
+            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{did_you_mean(key, allowed)}; "
                                 f"allowed: {', '.join(allowed)}")
     values["run"] = run_settings
     return values

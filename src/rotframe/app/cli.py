@@ -27,7 +27,11 @@ import sys
 import time
 import warnings
 
-EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERNAL = 0, 2, 3, 1
+from rotframe.app.messages import EXIT_INPUT, EXIT_INTERNAL, EXIT_NUMERICAL, EXIT_OK  # noqa: F401  (public here too)
+from rotframe.app.messages import error as _error
+from rotframe.app.messages import one_line as _one_line
+from rotframe.app.options import jsonable as _jsonable
+from rotframe.app.options import parse_sets as _parse_sets
 
 
 class _UsageError(Exception):
@@ -112,9 +116,6 @@ def _dispatch(args) -> int:
                "and please report it")
         return EXIT_INTERNAL
 
-
-def _one_line(exc) -> str:
-    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 class _JsonStdout:
@@ -549,16 +550,6 @@ def cmd_section(args) -> int:
 # ---------------------------------------------------------------------------
 
 
-def _parse_sets(items):
-    sets = {}
-    for item in items:
-        if "=" not in item:
-            raise _input_error(f"--set {item!r}: expected KEY=VALUE")
-        key, value = item.split("=", 1)
-        sets[key.strip()] = value.strip()
-    return sets
-
-
 def _default_recording(name):
     from pathlib import Path
 
@@ -619,20 +610,6 @@ def _input_error(message):
     return ScenarioError(message)
 
 
-def _error(message):
-    print(f"rotframe: error: {message}", file=sys.stderr)
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "item") and callable(obj.item):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None  # JSON has no inf or nan: an infinite period (no rotation) or a missing value
-    return obj
 
 
 def _format_summary(scn, s) -> str:

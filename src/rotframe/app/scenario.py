@@ -32,13 +32,13 @@ listing scenarios stays instant.
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from rotframe.app.choices import did_you_mean as _did_you_mean
 from rotframe.errors import ScenarioError
 
 __all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS"]
@@ -518,11 +518,6 @@ def _check_keys(data: dict, allowed, src: str, where: str):
         if key not in allowed:
             raise ScenarioError(f"{src}: unknown key {key!r} in {where}{_did_you_mean(key, list(allowed))}; "
                                 f"allowed: {', '.join(allowed)}")
-
-
-def _did_you_mean(word: str, options) -> str:
-    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def _first_line(exc) -> str:

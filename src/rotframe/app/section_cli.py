@@ -25,13 +25,13 @@ naming the key, the value and what is allowed.
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import sys
 
 import numpy as np
 
+from rotframe.app.choices import did_you_mean
 from rotframe.rigid.sections import (
     PROPERTY_UNITS,
     SectionError,
@@ -350,8 +350,8 @@ def _parse_points(key: str, text: str, scale: float) -> list[list[float]]:
 
 
 def _did_you_mean(word: str, choices) -> str:
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.5)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+    """Shape and key names are short: a looser match (0.5) than scenario keys' default (0.6)."""
+    return did_you_mean(word, choices, cutoff=0.5)
 
 
 def _params_text(params: dict) -> str:

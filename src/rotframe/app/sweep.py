@@ -48,6 +48,7 @@ import numpy as np
 from rotframe.numerics.sampling import decimate
 
 from rotframe.particles.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (moved; kept importable)
+from rotframe.app.messages import one_line as _one_line
 from rotframe.errors import RotframeError, ScenarioError
 
 __all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "EnsembleRun", "parse_spec",
@@ -201,11 +202,12 @@ def main(args) -> int:
     ScenarioError
         Bad input (the command line turns it into exit code 2 and one line).
     """
-    from rotframe.app import cli
+    from rotframe.app import messages
+    from rotframe.app.options import jsonable, parse_sets
     from rotframe.app.progress import Progress
     from rotframe.app.signals import InterruptScope
 
-    spec = parse_spec(args.name, sets=cli._parse_sets(args.sets), grid=args.grid, log_grid=args.log_grid,
+    spec = parse_spec(args.name, sets=parse_sets(args.sets), grid=args.grid, log_grid=args.log_grid,
                       samples=args.samples, vary=args.vary, seed=args.seed, method=args.method)
     if args.workers is not None and args.workers < 1:
         raise ScenarioError(f"--workers {args.workers}: must be >= 1")
@@ -224,19 +226,19 @@ def main(args) -> int:
     except SweepInterrupted as exc:
         progress.close()
         scope.interrupted = True
-        cli._error(f"{scope.verb}: {exc.saved} of {exc.total} rows are saved in {exc.parts}; "
+        messages.error(f"{scope.verb}: {exc.saved} of {exc.total} rows are saved in {exc.parts}; "
                    "run the same command with --resume to compute the rest")
         return scope.exit_code
     except KeyboardInterrupt as exc:  # while merging, plotting or recording: the parts are still there
         progress.close()
         scope.note(exc)
-        cli._error(f"{scope.verb} while writing the results; every computed row is kept in "
+        messages.error(f"{scope.verb} while writing the results; every computed row is kept in "
                    f"{_Files.for_spec(spec, args.out).parts}; run the same command with --resume to finish")
         return scope.exit_code
     finally:
         progress.close()
     if args.json:
-        print(json.dumps(cli._jsonable(result.as_json())))
+        print(json.dumps(jsonable(result.as_json())))
     else:
         print(format_result(result, spec))
     if result.rows and result.failed == result.rows:
@@ -244,12 +246,12 @@ def main(args) -> int:
                       if e.startswith(("ScenarioError", "LimitError", "OutputError")))
         if invalid == result.rows:
             first = result.table.column("error")[0].as_py()
-            cli._error(f"every row was invalid input ({first}); the messages are in the error column of "
+            messages.error(f"every row was invalid input ({first}); the messages are in the error column of "
                        f"{result.out}")
-            return cli.EXIT_INPUT
-        cli._error(f"every run failed; the messages are in the error column of {result.out}")
-        return cli.EXIT_NUMERICAL
-    return cli.EXIT_OK
+            return messages.EXIT_INPUT
+        messages.error(f"every run failed; the messages are in the error column of {result.out}")
+        return messages.EXIT_NUMERICAL
+    return messages.EXIT_OK
 
 
 def check_outputs(spec, out, resume=False):
@@ -765,7 +767,7 @@ def _check_method(scn, method):
 
 
 def _did_you_mean(word, options):
-    from rotframe.app.scenario import _did_you_mean as suggest
+    from rotframe.app.choices import did_you_mean as suggest
 
     plain = [o.split("[")[0] for o in options]
     return suggest(word, plain) or suggest(word, list(options))
@@ -1257,10 +1259,6 @@ def _float(v):
 def _error_text(exc):
     text = " ".join(str(exc).split())
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-
-
-def _one_line(exc):
-    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 def _track(result):
