@@ -376,12 +376,13 @@ def _run(args) -> int:
     from rotframe.particles.integrators import RunInterrupted
     from rotframe.errors import IntegrationError
     from rotframe.app.progress import Progress
+    from rotframe.app.record import default_path
 
     scope = args._scope
     sets = _parse_sets(args.sets)
     scn = sc.load(args.name)
     values = scn.with_values(sets)
-    out = None if args.no_record else (args.out or str(_default_recording(scn.name)))
+    out = None if args.no_record else (args.out or str(default_path(scn.name)))
     if out is not None:
         _check_writable(out)
     _check_outputs(args)
@@ -548,12 +549,6 @@ def cmd_section(args) -> int:
 # ---------------------------------------------------------------------------
 # helpers
 # ---------------------------------------------------------------------------
-
-
-def _default_recording(name):
-    from pathlib import Path
-
-    return Path("recordings") / f"{name}.rrd"
 
 
 def _check_writable(out):

@@ -6,6 +6,7 @@ Standard library only, so that importing it keeps ``rotframe --help`` instant.
 from __future__ import annotations
 
 import math
+from pathlib import PurePath
 
 __all__ = ["split_set", "parse_sets", "jsonable"]
 
@@ -41,16 +42,19 @@ def parse_sets(items, *, on_error=None) -> dict:
 
 
 def jsonable(obj):
-    """``obj`` with numpy scalars as Python numbers and every non-finite float as ``None`` (JSON's null).
+    """``obj`` with numpy scalars as Python numbers, every non-finite float as ``None`` (JSON's null),
+    dictionary keys and paths as strings.
 
     JSON has no inf or nan: an infinite period (no rotation) or a missing value is written as null.
     """
     if isinstance(obj, dict):
-        return {k: jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [jsonable(v) for v in obj]
     if hasattr(obj, "item") and callable(obj.item):
         obj = obj.item()
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
+    if isinstance(obj, PurePath):
+        return str(obj)
     return obj

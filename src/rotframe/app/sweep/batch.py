@@ -17,11 +17,9 @@ import numpy as np
 
 from rotframe.app.sweep.spec import apply_row, key_of
 from rotframe.errors import RotframeError, ScenarioError
+from rotframe.particles.ensemble import MAX_TRACK_SAMPLES  # at most this many samples per recorded path
 
 __all__ = ["MAX_TRACK_SAMPLES", "BatchTask", "BatchOutput", "run_batch"]
-
-
-MAX_TRACK_SAMPLES = 500  # the same as rotframe.particles.ensemble.MAX_TRACK_SAMPLES
 
 
 @dataclass

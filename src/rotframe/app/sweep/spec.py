@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from rotframe.app.options import split_set
 from rotframe.errors import ScenarioError
 
 __all__ = ["Axis", "Vary", "SweepSpec", "SweptKey", "DISTRIBUTIONS", "parse_spec", "sweep_points", "points_of",
@@ -254,10 +255,10 @@ def _parse_vary(scn, base, text):
 
 
 def _split_assignment(option, text, form):
-    if "=" not in text:
+    pair = split_set(text)
+    if pair is None:
         raise ScenarioError(f"{option} {text!r}: expected {form}")
-    key, value = text.split("=", 1)
-    return key.strip(), value.strip()
+    return pair
 
 
 def _parse_count(option, text, raw):
