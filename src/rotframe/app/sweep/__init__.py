@@ -89,7 +89,7 @@ def main(args) -> int:
     check_outputs(spec, args.out, args.resume)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
-    scope = getattr(args, "_scope", None) or InterruptScope()
+    scope = getattr(args, "scope", None) or InterruptScope()
     progress = Progress("sweep", "rows", enabled=not args.json)
     try:
         result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
