@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-DRIVER = ("import sys; from rotframe.app import sweep; sweep.CONNECT_TIMEOUT_S = 1.0; from rotframe.app.cli import main; "
+DRIVER = ("import sys; from rotframe.app.sweep import execute; execute.CONNECT_TIMEOUT_S = 1.0; from rotframe.app.cli import main; "
           "sys.exit(main(sys.argv[1:]))")
 
 

@@ -98,11 +98,11 @@ def test_a_signal_in_every_phase_of_a_run(tmp_path, module, attr, nth, argv, par
 
 
 @pytest.mark.parametrize("attr,nth,sig", [("run_batch", 2, "SIGTERM"), ("write_plots", 1, "SIGINT"),
-                                          ("_write_recording", 1, "SIGTERM")])
+                                          ("write_recording", 1, "SIGTERM")])
 def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
     # foucault runs row by row: the first two rows are timed alone, so run_batch is called more than once
     argv = ["sweep", "foucault", "--grid", "latitude=0:90:6", "--set", "duration=20", "--out", "s.parquet"]
-    res = drive(tmp_path, "rotframe.app.sweep", attr, nth, sig, *argv)
+    res = drive(tmp_path, "rotframe.app.sweep.execute", attr, nth, sig, *argv)
     line = check(res, sig)
     assert "--resume" in line
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))

@@ -80,7 +80,7 @@ def test_a_planted_sign_error_in_the_foucault_theory_gives_a_warning(monkeypatch
 
 
 def test_text_table_names_the_theory_and_prints_each_warning(monkeypatch):
-    from rotframe.app import cli
+    from rotframe.app import summary_text
     from rotframe.app import scenario as sc
     scn = sc.load("free-top")
     summary = {"params": {}, "model": ["m"], "method": "exact", "steps": 1,
@@ -88,7 +88,7 @@ def test_text_table_names_the_theory_and_prints_each_warning(monkeypatch):
                "theory_notes": {"x": "exact: a closed form"}, "diagnostics": {}, "notes": ["n"],
                "warnings": ["x: first", "y: second"], "timing": {"simulate_s": 0, "record_s": 0, "total_s": 0},
                "recording": None}
-    text = cli._format_summary(scn, summary)
+    text = summary_text.format_summary(scn, summary)
     assert "theory of x: exact: a closed form" in text
     assert "  warning: x: first" in text and "  warning: y: second" in text
     assert " null " in text

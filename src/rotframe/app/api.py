@@ -38,13 +38,14 @@ True
 from __future__ import annotations
 
 import json
-import math
 import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from rotframe.app.choices import did_you_mean
+from rotframe.app.options import jsonable
 from rotframe.errors import ScenarioError
 
 __all__ = ["scenarios", "load", "run", "Result", "TrajectoryArrays", "register_scene"]
@@ -191,10 +192,10 @@ def resolve_values(scn, params: Mapping[str, Any]) -> dict:
             values[key] = sc.parse_value(p, _plain(raw, p.unit, key, scn.name), source=scn.name)
         elif key in sc.RUN_KEYS and key != "method":
             unit = "s" if key == "step" else ""
-            run_settings[key] = sc._parse_run_value(key, _plain(raw, unit, key, scn.name), source=scn.name)
+            run_settings[key] = sc.parse_run_value(key, _plain(raw, unit, key, scn.name), source=scn.name)
         else:
             allowed = list(scn.parameters) + [k for k in sc.RUN_KEYS if k != "method"]
-            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{sc._did_you_mean(key, allowed)}; "
+            raise ScenarioError(f"{scn.name}: unknown parameter {key!r}{did_you_mean(key, allowed)}; "
                                 f"allowed: {', '.join(allowed)}")
     values["run"] = run_settings
     return values
@@ -361,7 +362,7 @@ class Result:
 
     def to_dict(self) -> dict:
         """The summary as a JSON-ready dict, with the keys of ``rotframe run --json`` (NaN -> None)."""
-        return _jsonable(self._summary)
+        return jsonable(self._summary)
 
     def to_json(self, **kwargs: Any) -> str:
         """The summary as one JSON object, as ``rotframe run --json`` prints it."""
@@ -453,20 +454,6 @@ def _python_scalars(obj):
         return [_python_scalars(v) for v in obj]
     if type(obj).__module__ == "numpy" and getattr(obj, "ndim", None) == 0:
         return obj.item()
-    return obj
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "item") and callable(obj.item):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, Path):
-        return str(obj)
     return obj
 
 

@@ -27,7 +27,11 @@ import sys
 import time
 import warnings
 
-EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERNAL = 0, 2, 3, 1
+from rotframe.app.messages import EXIT_INPUT, EXIT_INTERNAL, EXIT_NUMERICAL, EXIT_OK  # noqa: F401  (public here too)
+from rotframe.app.messages import error as _error
+from rotframe.app.messages import one_line as _one_line
+from rotframe.app.options import jsonable as _jsonable
+from rotframe.app.options import parse_sets as _parse_sets
 
 
 class _UsageError(Exception):
@@ -54,7 +58,7 @@ def main(argv=None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_OK
-    args._t_start = t_start
+    args.t_start = t_start
     code = EXIT_OK
     # from the command line (argv None) a signal after the work ends the process with the
     # command's own exit code, never a traceback from the interpreter's shutdown
@@ -64,7 +68,7 @@ def main(argv=None) -> int:
             # on the command line numpy's overflow warnings are not messages for the user: an
             # overflow that matters is caught as a non-finite value and reported in one line
             warnings.simplefilter("ignore", RuntimeWarning)
-        args._scope = scope
+        args.scope = scope
         try:
             code = _dispatch(args)
         except KeyboardInterrupt as exc:
@@ -112,9 +116,6 @@ def _dispatch(args) -> int:
                "and please report it")
         return EXIT_INTERNAL
 
-
-def _one_line(exc) -> str:
-    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 class _JsonStdout:
@@ -375,12 +376,14 @@ def _run(args) -> int:
     from rotframe.particles.integrators import RunInterrupted
     from rotframe.errors import IntegrationError
     from rotframe.app.progress import Progress
+    from rotframe.app.record import default_path
+    from rotframe.app.summary_text import format_summary
 
-    scope = args._scope
+    scope = args.scope
     sets = _parse_sets(args.sets)
     scn = sc.load(args.name)
     values = scn.with_values(sets)
-    out = None if args.no_record else (args.out or str(_default_recording(scn.name)))
+    out = None if args.no_record else (args.out or str(default_path(scn.name)))
     if out is not None:
         _check_writable(out)
     _check_outputs(args)
@@ -438,7 +441,7 @@ def _run(args) -> int:
         summary["recording"] = str(final)
     compile_s = float(getattr(result.trajectory, "extras", {}).get("compile_s", 0.0))
     summary["timing"].update({"compile_s": compile_s, "simulate_s": simulate_s - compile_s,
-                              "record_s": record_s, "total_s": time.perf_counter() - args._t_start})
+                              "record_s": record_s, "total_s": time.perf_counter() - args.t_start})
     summary["units"] = _units(scn, summary)
     _write_outputs(args, scn, values, result, summary)
     if args.audit and status == EXIT_OK:
@@ -453,7 +456,7 @@ def _run(args) -> int:
     if args.json:
         print(json.dumps(_jsonable(summary)))
     else:
-        print(_format_summary(scn, summary))
+        print(format_summary(scn, summary))
     if message:
         where = f"; the recording up to then is in {summary['recording']}" if summary.get("recording") else ""
         _error(message + where)
@@ -549,22 +552,6 @@ def cmd_section(args) -> int:
 # ---------------------------------------------------------------------------
 
 
-def _parse_sets(items):
-    sets = {}
-    for item in items:
-        if "=" not in item:
-            raise _input_error(f"--set {item!r}: expected KEY=VALUE")
-        key, value = item.split("=", 1)
-        sets[key.strip()] = value.strip()
-    return sets
-
-
-def _default_recording(name):
-    from pathlib import Path
-
-    return Path("recordings") / f"{name}.rrd"
-
-
 def _check_writable(out):
     """The recording (and its partial) can be written: checked before any computing starts."""
     from rotframe.app.outputs import check_output_file
@@ -617,70 +604,3 @@ def _input_error(message):
     from rotframe.errors import ScenarioError
 
     return ScenarioError(message)
-
-
-def _error(message):
-    print(f"rotframe: error: {message}", file=sys.stderr)
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "item") and callable(obj.item):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None  # JSON has no inf or nan: an infinite period (no rotation) or a missing value
-    return obj
-
-
-def _format_summary(scn, s) -> str:
-    """The run summary as a text table; each theory is named and each warning has its own line."""
-    lines = [f"{scn.name}: {scn.title}"]
-    params = ", ".join(f"{k}={_short(v)}{(' ' + scn.parameters[k].unit) if k in scn.parameters and scn.parameters[k].unit else ''}"
-                       for k, v in s["params"].items())
-    lines.append(f"  parameters  {params}")
-    lines.append(f"  model       {', '.join(s['model'])}")
-    lines.append(f"  method      {s['method']} ({s['steps']} steps)")
-    lines.append("  metric                          simulated        theory    rel. diff")
-    for key, value in s["metrics"].items():
-        theory = s["theory"].get(key)
-        shown = _short(value) if _is_number(value) else "null"
-        if _is_number(theory) and _is_number(value):
-            diff = abs(value - theory) / abs(theory) if theory else abs(value - theory)
-            lines.append(f"  {key:<30} {value:>11.6g}  {theory:>12.6g}  {diff:>10.2g}")
-        elif _is_number(theory):
-            lines.append(f"  {key:<30} {shown:>11}  {theory:>12.6g}")
-        else:
-            lines.append(f"  {key:<30} {shown:>11}")
-    for key, value in s["diagnostics"].items():
-        unresolved = value is None or (isinstance(value, float) and value != value)  # None or NaN: JSON's null
-        lines.append(f"  {key:<30} {'null' if unresolved else _short(value):>11}")
-    for key, what in s.get("theory_notes", {}).items():
-        if key in s["theory"]:
-            lines.append(f"  theory of {key}: {what}")
-    for note in s.get("notes", []):
-        lines.append(f"  note: {note}")
-    for warning in s.get("warnings", []):
-        lines.append(f"  warning: {warning}")
-    if "audit" in s:
-        lines.append(s["audit"]["text"])
-    t = s["timing"]
-    lines.append(f"  timing      simulate {t['simulate_s']:.3f} s (+ {t.get('compile_s', 0):.3f} s loading or "
-                 f"compiling kernels), record {t['record_s']:.3f} s, total {t['total_s']:.3f} s")
-    lines.append(f"  recording   {s['recording'] or '(none)'}")
-    return "\n".join(lines)
-
-
-def _is_number(v) -> bool:
-    """A finite int or float (not a bool): what the table prints as a number."""
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _short(v):
-    if isinstance(v, float):
-        return f"{v:.6g}"
-    if isinstance(v, list):
-        return ",".join(_short(x) for x in v)
-    return str(v)

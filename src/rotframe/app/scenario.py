@@ -32,21 +32,26 @@ listing scenarios stays instant.
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from rotframe.app.choices import did_you_mean as _did_you_mean
+from rotframe.app.quantities import NotAQuantity, WrongDimension, first_line, value_in
 from rotframe.errors import ScenarioError
 
-__all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS"]
+__all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS", "RUN_DEFAULTS",
+           "parse_run_value"]
 
 _TOP_KEYS = ("name", "title", "description", "scene", "model", "optional_terms", "parameters", "run")
 _PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusive_max", "shape", "choices", "type")
 #: Settings under ``[run]`` that ``--set`` may change too.
 RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
+#: Run settings of a scenario whose ``[run]`` table leaves them out: the one table of run defaults
+#: (``method`` None: the scene's default method; ``step`` None: the scene's own step rule).
+RUN_DEFAULTS = {"method": None, "step": None, "rtol": 1e-10, "samples": 2000}
 #: Model terms of rigid-body scenes (particle terms are in rotframe.particles.model.TERMS).
 RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 
@@ -88,7 +93,7 @@ def find(name_or_path: str) -> Path:
             found = path.is_file()
         except (OSError, ValueError) as exc:  # a name too long, a NUL byte
             raise ScenarioError(f"scenario file {text[:80]!r}{'...' if len(text) > 80 else ''}: cannot be "
-                                f"read ({_first_line(exc)[:80]}); allowed: a path to a .toml file") from None
+                                f"read ({first_line(exc)[:80]}); allowed: a path to a .toml file") from None
         if not found:
             raise ScenarioError(f"scenario file {text!r} does not exist")
         return path
@@ -171,7 +176,7 @@ class Scenario:
             if key in self.parameters:
                 values[key] = parse_value(self.parameters[key], raw, source="--set")
             elif key in RUN_KEYS:
-                run[key] = _parse_run_value(key, raw, source="--set", scene=self.scene)
+                run[key] = parse_run_value(key, raw, source="--set", scene=self.scene)
             else:
                 allowed = list(self.parameters) + list(RUN_KEYS)
                 raise ScenarioError(f"--set: unknown key {key!r} for scenario {self.name!r}"
@@ -329,13 +334,13 @@ def load(name_or_path: str) -> Scenario:
     clash = set(params) & set(RUN_KEYS)
     if clash:
         raise ScenarioError(f"{src}: parameter names {sorted(clash)} are reserved for [run]")
-    run = {"method": None, "step": None, "rtol": 1e-10, "samples": 2000}
+    run = dict(RUN_DEFAULTS)
     run_data = data["run"] if "run" in data else builtin.get("run", {})
     for key, raw in run_data.items():
         if key not in RUN_KEYS:
             raise ScenarioError(f"{src}: unknown key 'run.{key}'{_did_you_mean(key, list(RUN_KEYS))}; "
                                 f"allowed: {', '.join(RUN_KEYS)}")
-        run[key] = _parse_run_value(key, raw, source=src, scene=scene)
+        run[key] = parse_run_value(key, raw, source=src, scene=scene)
     model = list(data["model"] if "model" in data else builtin.get("model", []))
     optional = list(data["optional_terms"] if "optional_terms" in data else builtin.get("optional_terms", []))
     from rotframe.particles.model import TERMS
@@ -413,36 +418,40 @@ def _to_float(p: Parameter, raw, where: str) -> float:
 
 
 def _parse_quantity(p: Parameter, text: str, where: str) -> float:
+    unit = p.unit or ""
+    try:
+        return _angle_value(p, text, unit) if unit in ("deg", "rad") else value_in(text, unit)
+    except ScenarioError as exc:  # an angle with a letter it does not take, or a sign and a letter
+        raise ScenarioError(f"{where}{exc}") from None
+    except WrongDimension as exc:
+        raise ScenarioError(f"{where}{p.name} = {text!r}: wrong dimension; expected a value in "
+                            f"{unit or 'no unit'} ({exc})") from None
+    except NotAQuantity as exc:
+        example = p.default if isinstance(p.default, (int, float)) and not isinstance(p.default, bool) else 1
+        raise ScenarioError(f"{where}{p.name} = {text!r}: not a number or quantity; expected e.g. "
+                            f"'{_fmt(example)}{(' ' + unit) if unit else ''}' ({exc})") from None
+
+
+def _angle_value(p: Parameter, text: str, unit: str) -> float:
+    """An angle in ``unit`` (deg or rad): a number, or what :func:`rotframe.earth.read_angle_text` reads."""
     try:
         return float(text)
     except ValueError:
         pass
-    unit = p.unit or ""
     import astropy.units as u
     from astropy.units import imperial
 
-    with imperial.enable():  # "520 ft", "4 inch", "30 mi/h", only for this parse
-        return _parse_quantity_enabled(p, text, where, unit, u)
-
-
-def _parse_quantity_enabled(p: Parameter, text: str, where: str, unit: str, u) -> float:
-    try:
-        if unit in ("deg", "rad"):
+    with imperial.enable():
+        try:
             from rotframe.earth import angle_kind, read_angle_text
 
             return float(read_angle_text(text, p.name, angle_kind(p.name)).to_value(unit))
-        q = u.Quantity(text)
-        target = u.Unit(unit) if unit else u.dimensionless_unscaled
-        return float(q.to_value(target))
-    except ScenarioError as exc:  # an angle with a letter it does not take, or a sign and a letter
-        raise ScenarioError(f"{where}{exc}") from None
-    except (u.UnitConversionError, u.UnitTypeError) as exc:
-        raise ScenarioError(f"{where}{p.name} = {text!r}: wrong dimension; expected a value in "
-                            f"{unit or 'no unit'} ({_first_line(exc)})") from None
-    except (ValueError, TypeError, ArithmeticError) as exc:
-        example = p.default if isinstance(p.default, (int, float)) and not isinstance(p.default, bool) else 1
-        raise ScenarioError(f"{where}{p.name} = {text!r}: not a number or quantity; expected e.g. "
-                            f"'{_fmt(example)}{(' ' + unit) if unit else ''}' ({_first_line(exc)})") from None
+        except ScenarioError:
+            raise
+        except (u.UnitConversionError, u.UnitTypeError) as exc:
+            raise WrongDimension(first_line(exc), None) from None
+        except (ValueError, TypeError, ArithmeticError) as exc:
+            raise NotAQuantity(first_line(exc)) from None
 
 
 def _check_bounds(p: Parameter, value: float, raw, where: str):
@@ -479,7 +488,12 @@ def methods_for(scene: str | None) -> tuple:
     return methods if methods is not None else particle_methods()
 
 
-def _parse_run_value(key, raw, source, scene=None):
+def parse_run_value(key, raw, source, scene=None):
+    """Parse and check one run setting (a :data:`RUN_KEYS` key) from a file, ``--set`` or the Python API.
+
+    ``method`` must be one of :func:`methods_for` ``(scene)``; ``step`` (s), ``rtol`` and ``samples``
+    (a whole number) must be finite and > 0.
+    """
     kind = RUN_KEYS[key]
     where = f"{source}: " if source else ""
     if kind is str:
@@ -524,17 +538,6 @@ def _check_keys(data: dict, allowed, src: str, where: str):
         if key not in allowed:
             raise ScenarioError(f"{src}: unknown key {key!r} in {where}{_did_you_mean(key, list(allowed))}; "
                                 f"allowed: {', '.join(allowed)}")
-
-
-def _did_you_mean(word: str, options) -> str:
-    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
-def _first_line(exc) -> str:
-    """The first sentence of an exception's message (astropy's run to several lines of advice)."""
-    text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-    return text.split(". ")[0].rstrip(".")
 
 
 def _fmt(value) -> str:

@@ -25,13 +25,15 @@ naming the key, the value and what is allowed.
 
 from __future__ import annotations
 
-import difflib
 import json
 import math
 import sys
 
 import numpy as np
 
+from rotframe.app.choices import did_you_mean
+from rotframe.app.options import split_set
+from rotframe.app.quantities import NotAQuantity, WrongDimension, value_in
 from rotframe.rigid.sections import (
     PROPERTY_UNITS,
     SectionError,
@@ -224,9 +226,9 @@ def _parse_sets(shape: str, sets) -> dict[str, str]:
     raw = {key: default for key, (default, _) in spec.items()}
     seen = set()
     for item in sets or []:
-        key, sep, value = str(item).partition("=")
-        key = key.strip().replace("-", "_")
-        if not sep or not key:
+        key, value = split_set(item) or ("", "")
+        key = key.replace("-", "_")
+        if not key:
             raise _InputError(f"--set {item!r} is not KEY=VALUE; allowed keys for {shape}: {', '.join(spec)}")
         if key not in spec:
             raise _InputError(
@@ -284,22 +286,17 @@ def _parse_length(shape: str, key: str, text: str) -> float:
 
 
 def _quantity_to_metres(shape: str, key: str, text: str) -> float:
-    import astropy.units as u
-    from astropy.units import imperial
-
-    with imperial.enable():
-        try:
-            q = u.Quantity(text)
-        except (TypeError, ValueError):
-            raise _InputError(
-                f"{shape}: {key} = {text!r} is neither a number nor a quantity; allowed: {_LENGTH_ALLOWED}"
-            ) from None
-        if not q.unit.is_equivalent(u.m):
-            raise _InputError(
-                f"{shape}: {key} = {text!r} has unit {q.unit.to_string()!r} ({q.unit.physical_type}), "
-                f"not a length; allowed: {_LENGTH_ALLOWED}"
-            )
-        return float(q.to_value(u.m))
+    try:
+        return value_in(text, "m")
+    except NotAQuantity:
+        raise _InputError(
+            f"{shape}: {key} = {text!r} is neither a number nor a quantity; allowed: {_LENGTH_ALLOWED}"
+        ) from None
+    except WrongDimension as exc:
+        raise _InputError(
+            f"{shape}: {key} = {text!r} has unit {exc.unit.to_string()!r} ({exc.unit.physical_type}), "
+            f"not a length; allowed: {_LENGTH_ALLOWED}"
+        ) from None
 
 
 def _parse_unit(text: str) -> float:
@@ -350,8 +347,8 @@ def _parse_points(key: str, text: str, scale: float) -> list[list[float]]:
 
 
 def _did_you_mean(word: str, choices) -> str:
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.5)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+    """Shape and key names are short: a looser match (0.5) than scenario keys' default (0.6)."""
+    return did_you_mean(word, choices, cutoff=0.5)
 
 
 def _params_text(params: dict) -> str:

@@ -1,0 +1,330 @@
+"""The benchmark problems: each scenario's equations, initial state, horizon, reference and method ladders.
+
+A :class:`Problem` carries the equations for scipy (``rhs``, ``y0``), the exact or
+reference final state, the error and invariant measures, and for every rotframe
+method a ladder of step sizes or tolerances (short ones with ``quick``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Problem", "problems", "EXTRAS", "PREPARED", "attitude_error"]
+
+
+@dataclass
+class Problem:
+    """One benchmark problem.
+
+    ``rhs(t, y)`` and ``y0`` are the equations for scipy; ``exact`` the final
+    state to compare with; ``error(y)`` the final-state error (and its unit in
+    ``error_kind``); ``invariant(Y)`` the worst invariant error over states
+    ``Y`` (n, dim); ``runs`` maps a rotframe method to a list of settings and
+    ``run(method, setting) -> (y_end, nfev, invariant_error)``, the invariant
+    error as a function to call after the timing (or None).
+    """
+
+    scenario: str
+    horizon: str
+    t_end: float
+    y0: np.ndarray
+    rhs: object
+    error: object
+    error_kind: str
+    invariant: object
+    runs: dict
+    run: object
+    atol: float = 1e-12
+    scipy_budget_s: float = 20.0
+    scipy_rtols: tuple = tuple(10.0 ** -k for k in range(3, 14))
+    notes: list = field(default_factory=list)
+    spec: dict = None  # the equations for the peers (rotframe.app.bench.peers)
+    ref_error: float = 0.0  # accuracy of the reference itself: smaller errors are not resolved
+
+
+def problems(names=None, quick=False):
+    """The benchmark problems (for ``names``, or all)."""
+    makers = {"turntable": _turntable, "tower-drop": _tower_drop, "foucault": _foucault,
+              "dzhanibekov": _dzhanibekov, "heavy-top": _heavy_top}
+    names = list(names or makers)
+    unknown = [n for n in names if n not in makers and n not in EXTRAS]
+    if unknown:
+        from rotframe.errors import ScenarioError
+
+        raise ScenarioError(f"bench: no benchmark for {unknown[0]!r}; available: "
+                            f"{', '.join(list(makers) + list(EXTRAS))}")
+    out = []
+    for n in names:
+        if n in makers:
+            out.extend(makers[n](quick))
+    return out
+
+
+#: benchmarks that are not problems
+EXTRAS = ("ensemble", "sweep", "startup", "record")
+
+
+def _ladder(quick, full, short):
+    return short if quick else full
+
+
+#: suffix of a rotframe method run through rotframe.particles.prepared.PreparedRun (prepared once, untimed)
+PREPARED = " prepared"
+
+
+def _particle_runner(model, r0, v0, t_end, invariant_fn):
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.prepared import PreparedRun
+
+    prepared = {}
+    times = np.array([0.0, t_end])
+
+    def run(method, setting):
+        base = method.removesuffix(PREPARED)
+        kw = {"rtol": setting} if base == "dop853" else {"step": setting}
+        if method.endswith(PREPARED):
+            pr = prepared.get((base, setting))
+            if pr is None:
+                pr = prepared[(base, setting)] = PreparedRun(model, base, t_end, **kw)
+            r, v = pr(r0, v0)
+            Y = np.concatenate([r[:, 0], v[:, 0]], axis=1)
+            return Y[-1], pr.nfev, lambda: invariant_fn(times, Y)
+        traj = integrate_particles(model, r0, v0, t_end, method=method, samples=1, **kw)
+        Y = np.concatenate([traj.r[:, 0], traj.v[:, 0]], axis=1)
+        return Y[-1], traj.nfev, lambda: invariant_fn(traj.times, Y)
+
+    return run
+
+
+def _with_prepared(runs, quick):
+    """Add prepared-run ladders (the same settings) for dop853 and the first fixed-step method."""
+    out = dict(runs)
+    for m in ("dop853", "rk4") if not quick else ("dop853",):
+        if m in runs:
+            out[m + PREPARED] = runs[m]
+    return out
+
+
+def _turntable(quick):
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.scenes.turntable import inertial_line
+
+    w0, alpha, T = 1.0, 0.2, 4.0
+    omega = OmegaSchedule.ramp([0, 0, 1], w0, alpha, T)
+    model = ParticleModel(("coriolis", "centrifugal", "euler"), omega=omega)
+    r0, v0 = np.array([2.0, 0.0, 0.0]), np.array([-1.0, 0.0, 0.0])
+    r_end = inertial_line(omega, r0, v0, np.array([T]))[0]
+    spec = {"kind": "particle", "w": (0.0, 0.0, 0.0), "g": (0.0, 0.0, 0.0), "ramp": (w0, alpha), "pendulum": None}
+
+    def inertial_speed(t, Y):
+        # the inertial speed |v + w x r| is constant on the exact solution
+        w = (w0 + alpha * t)[:, None] * np.array([0.0, 0.0, 1.0])
+        s = np.linalg.norm(Y[:, 3:] + np.cross(w, Y[:, :3]), axis=1)
+        return float(np.max(np.abs(s / s[0] - 1)))
+
+    steps = _ladder(quick, [4e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4], [1e-3])
+    runs = _with_prepared({"splitting": steps, "splitting4": steps, "rk4": steps,
+                           "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
+    y0 = np.concatenate([r0, v0])
+    from rotframe.app.bench.peers import python_rhs
+
+    return [Problem("turntable", "4 s, 0.9 turns", T, y0, python_rhs(spec),
+                    lambda y: float(np.linalg.norm(y[:3] - r_end)), "analytic: final position error (m)",
+                    inertial_speed, runs, _particle_runner(model, r0, v0, T, inertial_speed), spec=spec)]
+
+
+def _tower_drop(quick):
+    from rotframe import earth
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    lat = math.radians(50 + 53 / 60)
+    g = float(earth.normal_gravity(lat))
+    w = earth.omega_enu(lat)
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=np.array([0, 0, -g]))
+    T = 5.0
+    r0, v0 = np.array([0, 0, 158.5]), np.zeros(3)
+    exact = integrate_particles(model, r0, v0, T, method="exact", samples=1)
+    y_exact = np.concatenate([exact.r[-1, 0], exact.v[-1, 0]])
+    spec = {"kind": "particle", "w": tuple(w), "g": (0.0, 0.0, -g), "ramp": None, "pendulum": None}
+
+    def energy(t, Y):
+        e = 0.5 * np.sum(Y[:, 3:] ** 2, axis=1) + g * Y[:, 2]
+        return float(np.max(np.abs(e - e[0])) / abs(e[0]))
+
+    steps = _ladder(quick, [1e-1, 1e-2, 1e-3, 1e-4], [1e-2])
+    runs = _with_prepared({"exact": [None], "splitting": steps, "rk4": steps,
+                           "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
+    base = _particle_runner(model, r0, v0, T, energy)
+
+    def run(method, setting):
+        if method == "exact":
+            traj = integrate_particles(model, r0, v0, T, method="exact", samples=1)
+            Y = np.concatenate([traj.r[:, 0], traj.v[:, 0]], axis=1)
+            return Y[-1], 0, lambda: energy(traj.times, Y)
+        return base(method, setting)
+
+    return [Problem("tower-drop", "5 s fall", T, np.concatenate([r0, v0]), python_rhs(spec),
+                    lambda y: float(np.linalg.norm(y[:3] - y_exact[:3])),
+                    "analytic (exact propagator): final position error (m)", energy, runs, run, spec=spec)]
+
+
+def _foucault(quick):
+    from rotframe import earth
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    lat = math.radians(48.846)
+    g = float(earth.normal_gravity(lat))
+    w = earth.omega_enu(lat)
+    L, a = 67.0, 3.0
+    T = 600.0 if quick else 3600.0
+    pivot = np.array([0.0, 0.0, L])
+    model = ParticleModel(("gravity", "coriolis", "pendulum"), omega=OmegaSchedule.constant(w),
+                          g=np.array([0, 0, -g]), pendulum_length=L, pivot=pivot)
+    r0, v0 = np.array([a, 0, L - math.sqrt(L * L - a * a)]), np.zeros(3)
+    spec = {"kind": "particle", "w": tuple(w), "g": (0.0, 0.0, -g), "ramp": None, "pendulum": (L, tuple(pivot))}
+    # reference: the 4th-order splitting at h = 2e-4 s. After 1 h it differs from the same at 4e-4 and
+    # 1e-4 s, from rotframe's DOP853 at rtol 1e-13 and from scipy's DOP853 at rtol 1e-13 by 0.5 to 2.7e-9 m
+    # (round-off over 1.8e7 steps and 2.2e5 periods): errors below 3e-9 m are not resolved. The quick
+    # bench's 10 min at 1e-3 s has a smaller truncation error (splitting4 at 5e-3 s over 1 h is within
+    # 1.4e-9 m of the fine reference) and is given the same floor
+    ref = integrate_particles(model, r0, v0, T, method="splitting4", step=2e-4 if not quick else 1e-3, samples=1)
+    y_ref = np.concatenate([ref.r[-1, 0], ref.v[-1, 0]])
+
+    def constraint(t, Y):
+        return float(np.max(np.abs(np.linalg.norm(Y[:, :3] - pivot, axis=1) - L)))
+
+    steps = _ladder(quick, [5e-2, 2e-2, 1e-2, 5e-3, 2e-3], [1e-2])
+    runs = _with_prepared({"splitting": steps, "splitting4": steps, "rk4": steps,
+                           "dop853": _ladder(quick, [1e-5, 1e-7, 1e-9, 1e-11, 1e-13], [1e-9])}, quick)
+    ref_kind = "splitting4, h = 2e-4 s" if not quick else "splitting4, h = 1e-3 s (quick)"
+    return [Problem("foucault", f"{T / 3600:g} h, {T / 16.42:.0f} periods", T, np.concatenate([r0, v0]),
+                    python_rhs(spec), lambda y: float(np.linalg.norm(y[:3] - y_ref[:3])),
+                    f"reference ({ref_kind}): final position error (m)", constraint, runs,
+                    _particle_runner(model, r0, v0, T, constraint), atol=1e-10,
+                    scipy_rtols=tuple(10.0 ** -k for k in range(3, 12)), spec=spec,
+                    ref_error=3e-9)]
+
+
+def _rigid_runner(inertia, L0, q0, T, top=None, invariant=None):
+    from rotframe.rigid.adaptive import rigid_dop853
+    from rotframe.scenes.rigid_base import integrate_body
+
+    mgl = 0.0 if top is None else top[0] * top[1] * top[2]
+    ends = np.array([0.0, T])
+
+    def run(method, setting):
+        if method == "dop853":
+            res = rigid_dop853(inertia, L0, q0, ends, rtol=setting, mgl=mgl)
+            Y = np.concatenate([res.L, res.q], axis=1)
+            return Y[-1], res.nfev, None if invariant is None else (lambda: invariant(ends, Y))
+        rs = {"samples": 1, "step": setting}
+        traj = integrate_body(method, inertia, L0, q0, T, rs, None, top=top)
+        Y = np.concatenate([traj.L, traj.q], axis=1)
+        return Y[-1], traj.steps, None if invariant is None else (lambda: invariant(traj.times, Y))
+
+    return run
+
+
+def attitude_error(q, q_ref):
+    """Rotation angle (rad) between two attitudes given as quaternions (any norm, either sign).
+
+    ``|q - q_ref| = 2 sin(angle / 4)`` for unit quaternions of the closer sign;
+    the arccos of their dot product would lose half the digits (a floor near 1e-8).
+    """
+    q = np.asarray(q, float) / np.linalg.norm(q)
+    q_ref = np.asarray(q_ref, float) / np.linalg.norm(q_ref)
+    if q @ q_ref < 0:
+        q_ref = -q_ref
+    return 4 * math.asin(min(1.0, 0.5 * float(np.linalg.norm(q - q_ref))))
+
+
+def _dzhanibekov(quick):
+    from rotframe.rigid import dynamics as rigid
+    from rotframe.app.bench.peers import python_rhs
+    from rotframe.rigid.exact_flow import free_body_flow
+
+    inertia = np.array([1.0, 2.0, 3.0])
+    L0 = inertia * np.array([0.01, 1.0, 0.01])
+    q0 = np.array([0.0, 0.0, 0.0, 1.0])
+    spec = {"kind": "rigid", "inertia": tuple(inertia), "mgl": 0.0}
+    out = []
+    for T, label in [(100.0, "100 s, 2.6 periods")] + ([] if quick else [(4e4, "4e4 s, 1000 periods")]):
+        Lx, qx = rigid.free_body_exact(inertia, L0, q0, np.array([T]))
+        M = np.linalg.norm(L0)
+
+        def err(y, Lx=Lx, qx=qx):
+            return max(float(np.linalg.norm(y[:3] - Lx[0]) / M), attitude_error(y[3:], qx[0]))
+
+        def invariant(t, Y):
+            E = 0.5 * np.sum(Y[:, :3] ** 2 / inertia, axis=1)
+            Mm = np.linalg.norm(Y[:, :3], axis=1)
+            return float(max(np.max(np.abs(E / E[0] - 1)), np.max(np.abs(Mm / Mm[0] - 1))))
+
+        long = T > 1000
+        steps = _ladder(quick, [1e-1, 3e-2, 1e-2, 3e-3, 1e-3] if not long else [1e-1, 3e-2, 1e-2], [3e-3])
+        rtols = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13]
+        runs = {"exact": [None], "dop853": _ladder(quick, rtols, [1e-8]), "lie-poisson": steps,
+                "lie-poisson4": steps, "rk4": steps}
+        if long:
+            runs = {"exact": [None], "dop853": rtols[2::2], "lie-poisson4": steps}
+        base = _rigid_runner(inertia, L0, q0, T, invariant=invariant)
+
+        def run(method, setting, base=base, T=T):
+            if method == "exact":  # the closed form, compiled (rigid_exact.free_body_flow)
+                times = np.array([0.0, T])
+                Ls, qs = free_body_flow(inertia, L0, q0, times)
+                Y = np.concatenate([Ls, qs], axis=1)
+                return Y[-1], 0, lambda: invariant(times, Y)
+            return base(method, setting)
+
+        p = Problem("dzhanibekov", label, T, np.concatenate([L0, q0]), python_rhs(spec), err,
+                    "analytic (elliptic functions): max(|dL|/|L|, attitude angle)", invariant, runs, run,
+                    atol=1e-13, scipy_budget_s=10.0 if long else 20.0,
+                    scipy_rtols=tuple(10.0 ** -k for k in range(3, 14)) if not long else (1e-3, 1e-5, 1e-7),
+                    spec=spec)
+        out.append(p)
+    return out
+
+
+def _heavy_top(quick):
+    from scipy.integrate import solve_ivp
+
+    from rotframe.app.bench.peers import numba_rhs, python_rhs
+    from rotframe.scenes.heavy_top import build
+
+    values = {"i1": 1.9e-4, "i3": 2.5e-5, "mass": 0.1, "length": 0.04, "g": 9.81, "theta0": 20.0,
+              "phidot0": 0.0, "psidot0": 300.0, "wobble": 0.0, "duration": 2.0}
+    inertia, L0, q0 = build(values)
+    mgl = values["mass"] * values["g"] * values["length"]
+    spec = {"kind": "rigid", "inertia": tuple(inertia), "mgl": mgl}
+    T = 2.0
+    rhs = python_rhs(spec)
+    # reference: scipy DOP853 at rtol 1e-13 (an independent integrator; its own error ~1e-12)
+    ref = solve_ivp(numba_rhs(spec), (0, T), np.concatenate([L0, q0]), method="DOP853", rtol=1e-13,
+                    atol=1e-13 * np.array([np.linalg.norm(L0)] * 3 + [1.0] * 4)).y[:, -1]
+    M = np.linalg.norm(L0)
+
+    def err(y):
+        return max(float(np.linalg.norm(y[:3] - ref[:3]) / M), attitude_error(y[3:], ref[3:]))
+
+    def invariant(t, Y):  # energy, with the potential m g l cos(theta)
+        L, q = Y[:, :3], Y[:, 3:] / np.linalg.norm(Y[:, 3:], axis=1)[:, None]
+        cos_theta = 1 - 2 * (q[:, 0] ** 2 + q[:, 1] ** 2)
+        E = 0.5 * np.sum(L * L / inertia, axis=1) + mgl * cos_theta
+        return float(np.max(np.abs(E / E[0] - 1)))
+
+    steps = _ladder(quick, [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5], [1e-4])
+    runs = {"dop853": _ladder(quick, [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12], [1e-8]),
+            "splitting": steps, "splitting4": steps, "rk4": [s for s in steps if s <= 1e-3]}
+    return [Problem("heavy-top", "2 s, 95 spins", T, np.concatenate([L0, q0]), rhs, err,
+                    "reference (scipy DOP853, rtol 1e-13): max(|dL|/|L|, attitude angle)", invariant, runs,
+                    _rigid_runner(inertia, L0, q0, T, top=(values["mass"], values["length"], values["g"]),
+                                  invariant=invariant),
+                    atol=1e-14, spec=spec)]

@@ -1,0 +1,127 @@
+"""What the bench rows mean: at each error level the fastest rotframe and peer runs, and speed-ups over scipy."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["LEVELS", "is_peer", "problem_keys", "level_summary", "speedups"]
+
+
+#: error levels of the summary
+LEVELS = (1e-3, 1e-6, 1e-9)
+
+
+def is_peer(r):
+    return r.get("family") == "peer" or r["method"].startswith(("scipy", "diffrax"))
+
+
+def problem_keys(rows):
+    """The (scenario, horizon) of each benchmarked problem, in order of first appearance."""
+    keys = []
+    for r in rows:
+        k = (r["scenario"], r.get("horizon"))
+        if r.get("horizon") and r.get("kind") != "summary" and k not in keys:
+            keys.append(k)
+    return keys
+
+
+def level_summary(rows, levels=LEVELS):
+    """Summary rows: per (scenario, horizon) and error level, the fastest rotframe and peer runs and their ratio.
+
+    A run counts for a level when its final error is at most the level. A
+    rotframe row with zero error counts only for the ``exact`` method (the
+    reference is that flow). ``ratio`` = peer time / rotframe time; ``note``
+    says why a level has no ratio.
+    """
+    out = []
+    keys = problem_keys(rows)
+    for scenario, horizon in keys:
+        sel = [r for r in rows if (r["scenario"], r.get("horizon")) == (scenario, horizon)
+               and r.get("kind") != "summary" and r["error"] is not None and np.isfinite(r["error"])]
+        mine = [r for r in sel if not is_peer(r) and (r["error"] > 0 or r["method"] == "exact")]
+        theirs = [r for r in sel if is_peer(r)]
+        ref_error = max((r.get("reference_error") or 0.0 for r in sel), default=0.0)
+        for level in levels:
+            if level < ref_error:
+                out.append({"scenario": scenario, "method": "summary", "setting": level, "wall_s": None,
+                            "error": None, "error_kind": sel[0]["error_kind"], "nfev": 0, "horizon": horizon,
+                            "kind": "summary", "level": level, "rotframe_method": None, "rotframe_setting": None,
+                            "peer": None, "peer_setting": None, "peer_wall_s": None, "peer_error": None,
+                            "peer_compile_s": None, "ratio": None,
+                            "note": f"not measurable: the reference itself is good to {ref_error:.0e} only"})
+                continue
+            m = [r for r in mine if r["error"] <= level]
+            t = [r for r in theirs if r["error"] <= level]
+            best_m = min(m, key=lambda r: r["wall_s"]) if m else None
+            best_t = min(t, key=lambda r: r["wall_s"]) if t else None
+            row = {"scenario": scenario, "method": "summary", "setting": level,
+                   "wall_s": best_m["wall_s"] if best_m else None, "error": best_m["error"] if best_m else None,
+                   "error_kind": sel[0]["error_kind"] if sel else "", "nfev": best_m["nfev"] if best_m else 0,
+                   "horizon": horizon, "kind": "summary", "level": level,
+                   "rotframe_method": best_m["method"] if best_m else None,
+                   "rotframe_setting": best_m["setting"] if best_m else None,
+                   "peer": best_t["method"] if best_t else None, "peer_setting": best_t["setting"] if best_t else None,
+                   "peer_wall_s": best_t["wall_s"] if best_t else None, "peer_error": best_t["error"] if best_t else None,
+                   "peer_compile_s": _compile_of(rows, best_t) if best_t else None,
+                   "ratio": (best_t["wall_s"] / best_m["wall_s"]) if (best_m and best_t) else None}
+            notes = []
+            if not best_m:
+                finest = min((r["error"] for r in mine), default=None)
+                notes.append("no rotframe run reached this error" +
+                             (f" (smallest {finest:.1e})" if finest is not None else ""))
+            if not best_t:
+                finest = min((r["error"] for r in theirs), default=None)
+                notes.append("no peer run reached this error" +
+                             (f" (smallest {finest:.1e})" if finest is not None else " (no peer rows)"))
+            if row["ratio"] is not None and row["ratio"] < 10:
+                notes.append(f"below the 10x goal by a factor {10 / row['ratio']:.1f}")
+            if notes:
+                row["note"] = "; ".join(notes)
+            out.append(row)
+    return out
+
+
+def _compile_of(rows, r):
+    """The compile time reported with the first row of ``r``'s method."""
+    for s in rows:
+        if (s["scenario"], s.get("horizon"), s["method"]) == (r["scenario"], r.get("horizon"), r["method"]) \
+                and "compile_s" in s:
+            return s["compile_s"]
+    return None
+
+
+def speedups(rows, max_error=1e-2):
+    """Per (scenario, horizon): speed ratio of the best rotframe method over the fastest scipy method.
+
+    For each rotframe row, the fastest scipy row whose final error is at least
+    as small is found; the ratio of their wall times is reported at the
+    rotframe row that maximises it, with the error where it holds. Rows with
+    error above ``max_error`` are not accuracy and are left out, and so are rows
+    with zero error (a method compared with itself as the reference).
+    """
+    out = {}
+    keys = {(r["scenario"], r["horizon"]) for r in rows if r.get("horizon") and r.get("kind") != "summary"}
+    for key in sorted(keys):
+        def usable(r):
+            return (r["scenario"], r.get("horizon")) == key and r.get("kind") != "summary" and \
+                r["error"] is not None and np.isfinite(r["error"]) and 0 < r["error"] <= max_error
+
+        mine = [r for r in rows if usable(r) and not is_peer(r)]
+        theirs = [r for r in rows if usable(r) and r["method"].startswith("scipy")]
+        if not mine or not theirs:
+            continue
+        best = None
+        for r in mine:
+            candidates = [s["wall_s"] for s in theirs if s["error"] <= r["error"]]
+            if not candidates:
+                continue
+            ratio = min(candidates) / r["wall_s"]
+            if best is None or ratio > best[0]:
+                fastest = min((s for s in theirs if s["error"] <= r["error"]), key=lambda s: s["wall_s"])
+                best = (ratio, r, fastest)
+        if best:
+            ratio, r, s = best
+            out[f"{key[0]} ({key[1]})"] = {"speedup": ratio, "error": r["error"], "rotframe": r["method"],
+                                           "rotframe_setting": r["setting"], "rotframe_wall_s": r["wall_s"],
+                                           "scipy": s["method"], "scipy_rtol": s["setting"], "scipy_wall_s": s["wall_s"]}
+    return out

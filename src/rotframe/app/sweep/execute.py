@@ -1,0 +1,402 @@
+"""Running a sweep: batches sized from their cost, in this process or on Dask, each part written as it finishes.
+
+Points are cut into batches (about 0.2 s to 30 s of work each, at most about four
+per worker); batches run here, or as Dask tasks on a ``LocalCluster``
+(``--workers N``) or an existing scheduler (``--scheduler ADDRESS``), retried when a
+worker is lost. Dask is imported only when needed.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotframe.app.messages import one_line as _one_line
+from rotframe.app.sweep.batch import BatchTask, run_batch
+from rotframe.app.sweep.plots import write_plots
+from rotframe.app.sweep.recording import write_recording
+from rotframe.app.sweep.spec import SweepSpec, points_of, sweep_points
+from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, require, write_part
+from rotframe.errors import ScenarioError
+
+__all__ = ["SweepResult", "SweepInterrupted", "run_sweep", "check_scheduler", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
+
+
+#: at most this many trajectories and samples per trajectory in the recording
+MAX_TRACKS = 2000
+
+
+#: wall time of one batch of runs (s): long enough that task overhead stays small, short enough to lose little
+MIN_BATCH_S = 0.2
+
+
+MAX_BATCH_S = 30.0
+
+
+BATCHES_PER_WORKER = 4
+
+
+#: rows per vectorised ensemble batch, and the smallest ensemble batch worth a Dask task
+ENSEMBLE_BATCH = 1 << 17
+
+
+MIN_ENSEMBLE_BATCH = 4096
+
+
+#: Dask retries of a task whose worker failed
+RETRIES = 3
+
+
+#: seconds allowed to connect to a scheduler and for the Dask handshake, each
+CONNECT_TIMEOUT_S = 10.0
+
+
+@dataclass
+class SweepResult:
+    """A finished sweep: the merged table and where everything was written."""
+
+    scenario: str
+    table: object
+    out: str
+    plots: list
+    recording: str | None
+    path: str
+    rows: int
+    failed: int
+    computed: int
+    batches: int
+    timing: dict
+
+    def as_json(self) -> dict:
+        """The ``--json`` object."""
+        return {"scenario": self.scenario, "rows": self.rows, "failed": self.failed, "out": self.out,
+                "plots": self.plots, "recording": self.recording, "timing": self.timing, "path": self.path,
+                "computed": self.computed, "batches": self.batches}
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or SIGTERM) during a sweep; every finished batch is kept in ``parts``."""
+
+    def __init__(self, saved: int, total: int, parts: str):
+        super().__init__(f"{saved} of {total} rows saved")
+        self.saved, self.total, self.parts = saved, total, parts
+
+
+def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client=None, resume=False,
+              batch_rows=None, on_batch=None, plots=True, recording=True) -> SweepResult:
+    """Run a sweep, writing each batch as it finishes; merge, plot and record at the end.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+    out : path-like, optional
+        Parquet file (default ``sweeps/<name>.parquet``); parts go to ``<out>.parts/``,
+        plots to ``<stem>-<metric>.png`` and the recording to ``<stem>.rrd`` beside it.
+    workers : int, optional
+        Run batches on a ``distributed.LocalCluster`` of this many single-threaded processes.
+    scheduler : str, optional
+        Address of an existing Dask scheduler.
+    client : distributed.Client, optional
+        Use this client (not closed here) instead of ``workers`` / ``scheduler``.
+    resume : bool
+        Keep the rows already in ``out`` and its parts; compute only the missing ones.
+    batch_rows : int, optional
+        Rows per batch (default: sized from the time of the first runs).
+    on_batch : callable(done, total), optional
+        Called after each batch is written (progress; tests use it to interrupt).
+    plots, recording : bool
+        Write the PNGs and the rerun recording.
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    SweepInterrupted
+        On Ctrl-C / SIGTERM; the finished batches stay in ``<out>.parts/``.
+    ScenarioError
+        ``out`` not ending in ``.parquet``; ``--resume`` of a different sweep; an unreachable scheduler.
+    """
+    t_start = time.perf_counter()
+    require("pyarrow", "rotframe sweep")
+    files = SweepFiles.for_spec(spec, out)
+    with exclusive(files):
+        return _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                                 recording)
+
+
+def _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
+                      recording):
+    meta = spec.describe()
+    done = prepare(files, meta, resume)
+    pending = np.setdiff1d(np.arange(spec.n_rows), np.fromiter(done, dtype=np.int64, count=len(done)))
+    ctx = _Context.create(spec, files, meta)
+    t0 = time.perf_counter()
+    computed, batches = _compute(ctx, pending, len(done), workers, scheduler, client, batch_rows, on_batch)
+    timing = {"compute_s": time.perf_counter() - t0}
+    t0 = time.perf_counter()
+    table = merge(files, meta, spec, include_out=resume)
+    timing["merge_s"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    pngs = write_plots(table, spec, files.plot_stem) if plots else []
+    timing["plot_s"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    rrd = write_recording(ctx, table) if recording else None
+    timing["record_s"] = time.perf_counter() - t0
+    shutil.rmtree(files.parts, ignore_errors=True)
+    timing["total_s"] = time.perf_counter() - t_start
+    failed = int(sum(1 for e in table.column("error").to_pylist() if e))
+    return SweepResult(scenario=spec.name, table=table, out=str(files.out), plots=[str(p) for p in pngs],
+                       recording=str(rrd) if rrd else None, path=ctx.path, rows=table.num_rows, failed=failed,
+                       computed=computed, batches=batches, timing=timing)
+
+
+@dataclass
+class _Context:
+    spec: SweepSpec
+    files: SweepFiles
+    meta: dict
+    scenario_path: str
+    path: str
+    points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
+    track_rows: frozenset
+
+    @classmethod
+    def create(cls, spec, files, meta):
+        from rotframe import scenes
+        from rotframe.app import scenario as sc
+        from rotframe.numerics.sampling import decimate
+
+        scn = sc.load(spec.scenario)
+        path = "ensemble" if hasattr(scenes.get(scn.scene), "simulate_ensemble") else "runs"
+        track_rows = frozenset(int(i) for i in decimate(spec.n_rows, MAX_TRACKS))
+        points = None if spec.axes else sweep_points(spec)  # a grid is computed row by row, lazily
+        return cls(spec, files, meta, str(scn.path.resolve()), path, points, track_rows)
+
+    def task(self, index, rows):
+        rows = np.asarray(rows, dtype=np.int64)
+        values = points_of(self.spec, rows) if self.points is None else self.points[rows]
+        return BatchTask(index=index, scenario=self.scenario_path, sets=dict(self.spec.sets), keys=self.spec.keys,
+                         rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
+                         track_rows=self.track_rows.intersection(rows.tolist()))
+
+
+def _limits_now():
+    from rotframe import limits
+
+    return limits.current()
+
+
+def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_batch):
+    """Run the pending rows batch by batch, writing each part as it finishes; (rows, batches) computed."""
+    if len(pending) == 0:
+        return 0, 0
+    state = {"done": n_done, "computed": 0, "batches": 0}
+
+    def finished(output):
+        write_part(ctx.files, output, ctx.spec.keys, ctx.meta)
+        state["done"] += len(output.rows)
+        state["computed"] += len(output.rows)
+        state["batches"] += 1
+        if on_batch is not None:
+            on_batch(state["done"], ctx.spec.n_rows)
+
+    try:
+        _execute(ctx, pending, workers, scheduler, client, batch_rows, finished)
+    except KeyboardInterrupt:
+        raise SweepInterrupted(state["done"], ctx.spec.n_rows, str(ctx.files.parts)) from None
+    return state["computed"], state["batches"]
+
+
+def _execute(ctx, pending, workers, scheduler, client, batch_rows, finished):
+    own = None
+    if client is None and (workers or scheduler):
+        own = client = _connect(workers, scheduler)
+    try:
+        n_workers = max(1, sum(client.nthreads().values())) if client is not None else 1
+        if ctx.path == "ensemble":
+            size = batch_rows or _ensemble_batch_size(len(pending), n_workers, client is not None)
+        else:
+            if batch_rows is None:
+                pending, batch_rows = _probe(ctx, pending, n_workers, finished)
+            size = batch_rows
+        tasks = (ctx.task(i, pending[s:s + size]) for i, s in enumerate(range(0, len(pending), size)))
+        if client is None:  # one batch generated at a time
+            for task in tasks:
+                finished(run_batch(task))
+        else:
+            _execute_dask(client, list(tasks), finished)
+    finally:
+        if own is not None:
+            _close(own)
+
+
+def _probe(ctx, pending, n_workers, finished):
+    """Run the first two rows here to time them; returns the rest and the rows per batch."""
+    output = run_batch(ctx.task(0, pending[:2]))
+    finished(output)
+    rest = pending[2:]
+    per_row = max(min(output.seconds) if output.seconds else 0.0, 1e-4)
+    total = per_row * len(rest)
+    target = min(max(total / (BATCHES_PER_WORKER * n_workers), MIN_BATCH_S), MAX_BATCH_S)
+    return rest, max(1, int(math.ceil(target / per_row)))
+
+
+def _ensemble_batch_size(n, n_workers, distributed):
+    if not distributed:
+        return ENSEMBLE_BATCH
+    size = int(math.ceil(n / (BATCHES_PER_WORKER * n_workers)))
+    return int(min(max(size, MIN_ENSEMBLE_BATCH), ENSEMBLE_BATCH))
+
+
+def check_scheduler(address, timeout=None):
+    """A Dask scheduler address: ``tcp://HOST:PORT`` (or ``tls://``), reachable within ``timeout`` seconds.
+
+    Only the TCP connection is tried here; the Dask handshake itself is bounded in
+    :func:`_connect`. Raises ScenarioError in one line.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    allowed = "allowed: tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786"
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
+    text = str(address).strip()
+    if "://" not in text:
+        text_full = "tcp://" + text
+    else:
+        text_full = text
+    try:
+        parts = urlsplit(text_full)
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise ScenarioError(f"--scheduler {address!r}: not an address ({exc}); {allowed}") from None
+    if parts.scheme not in ("tcp", "tls") or not host or port is None or parts.path not in ("", "/"):
+        raise ScenarioError(f"--scheduler {address!r}: not a scheduler address; {allowed}")
+    try:
+        with socket.create_connection((host, port), timeout=timeout):
+            pass
+    except OSError as exc:
+        why = "timed out" if isinstance(exc, (TimeoutError, socket.timeout)) else (exc.strerror or str(exc))
+        raise ScenarioError(f"--scheduler {address!r}: cannot connect to {host}:{port} ({why})") from None
+    return f"{parts.scheme}://{host}:{port}"
+
+
+def _connect(workers, scheduler):
+    import logging
+
+    require("distributed", "--scheduler" if scheduler else "--workers")
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        return _client_bounded(Client, check_scheduler(scheduler), scheduler)
+    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    return Client(cluster)
+
+
+def _client_bounded(Client, address, given, timeout=None):
+    """A Dask client of ``address``, or ScenarioError within ``timeout`` s whatever answers there.
+
+    Dask's own connect timeout does not bound the handshake: a listener that is not a
+    scheduler can keep it waiting for ever (or send a frame header announcing exabytes).
+    The client is made in a daemon thread that this one waits for at most ``timeout``.
+    """
+    import threading
+
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
+    box = {}
+
+    def make():
+        try:
+            box["client"] = Client(address, timeout=f"{timeout}s", set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 -- reported below
+            box["error"] = exc
+
+    with _quiet_dask_logs():
+        worker = threading.Thread(target=make, daemon=True, name="rotframe-dask-connect")
+        worker.start()
+        worker.join(timeout + 2.0)
+    if "client" in box:
+        return box["client"]
+    _quiet_dask_unraisable()
+    why = _one_line(box["error"])[:200] if "error" in box else f"no Dask handshake within {timeout:g} s"
+    raise ScenarioError(f"--scheduler {given!r}: not a Dask scheduler or not answering ({why})")
+
+
+def _quiet_dask_unraisable():
+    """A half-made Dask client prints a traceback from its ``__del__`` (at exit): keep that one quiet."""
+    import sys
+
+    previous = sys.unraisablehook
+    if getattr(previous, "_rotframe_quiet", False):
+        return
+
+    def hook(unraisable):
+        obj = unraisable.object
+        module = getattr(obj, "__module__", "") or getattr(type(obj), "__module__", "") or ""
+        if str(module).startswith(("distributed", "tornado")):
+            return
+        previous(unraisable)
+
+    hook._rotframe_quiet = True
+    sys.unraisablehook = hook
+
+
+def _quiet_dask_logs():
+    import contextlib
+    import logging
+
+    @contextlib.contextmanager
+    def quiet():
+        loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
+                                                  "distributed.client", "tornado")]
+        levels = [lg.level for lg in loggers]
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+        try:
+            yield
+        finally:
+            for lg, level in zip(loggers, levels):
+                lg.setLevel(level)
+
+    return quiet()
+
+
+def _close(client):
+    cluster = client.cluster if hasattr(client, "cluster") else None
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def _execute_dask(client, tasks, finished):
+    """Submit every batch (with ``retries``); write each as it completes.
+
+    Dask reschedules the tasks of a lost worker and retries a failed task; a batch that
+    still fails is submitted again, and finally computed here, so no row is lost.
+    """
+    from distributed import as_completed
+
+    futures = {client.submit(run_batch, t, retries=RETRIES, pure=False): (t, 0) for t in tasks}
+    queue = as_completed(list(futures))
+    try:
+        for future in queue:
+            task, attempt = futures.pop(future)
+            try:
+                output = future.result()
+            except Exception:  # noqa: BLE001 -- KilledWorker, CommClosedError, a worker's MemoryError ...
+                if attempt >= RETRIES:
+                    finished(run_batch(task))
+                    continue
+                again = client.submit(run_batch, task, retries=RETRIES, pure=False)
+                futures[again] = (task, attempt + 1)
+                queue.add(again)
+                continue
+            finished(output)
+    finally:
+        client.cancel(list(futures))

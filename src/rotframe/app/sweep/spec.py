@@ -1,0 +1,355 @@
+"""What a sweep runs: the spec from the command line's pieces, and its rows of swept values.
+
+A swept key is a numeric parameter or one component of a vector parameter
+(``omega[0]``). Grid rows are the Cartesian product of ``--grid`` / ``--log-grid``
+axes (last axis fastest); Monte Carlo rows are drawn from
+``numpy.random.default_rng(seed)``, one ``--vary`` distribution after the other.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from rotframe.app.options import split_set
+from rotframe.errors import ScenarioError
+
+__all__ = ["Axis", "Vary", "SweepSpec", "SweptKey", "DISTRIBUTIONS", "parse_spec", "sweep_points", "points_of",
+           "key_of", "apply_row"]
+
+
+DISTRIBUTIONS = {"normal": ("MEAN", "SD"), "uniform": ("LO", "HI")}
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One grid axis: ``key`` swept over ``values`` (documented unit); ``log`` for a log-spaced grid."""
+
+    key: str
+    values: tuple
+    log: bool = False
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One Monte Carlo distribution: ``normal(a=mean, b=sd)`` or ``uniform(a=lo, b=hi)``."""
+
+    key: str
+    dist: str
+    a: float
+    b: float
+
+
+@dataclass
+class SweepSpec:
+    """What to sweep: validated by :func:`parse_spec`, turned into rows by :func:`sweep_points`.
+
+    Attributes
+    ----------
+    scenario : str
+        Scenario name or ``.toml`` path, as given.
+    name : str
+        The scenario's name (default output names).
+    sets : dict
+        ``--set`` values fixed for every row.
+    axes : list of Axis
+        Grid axes (empty for a Monte Carlo sweep).
+    samples : int or None
+        Monte Carlo sample count.
+    vary : list of Vary
+    seed : int
+    method : str or None
+    """
+
+    scenario: str
+    name: str
+    sets: dict
+    axes: list = field(default_factory=list)
+    samples: int | None = None
+    vary: list = field(default_factory=list)
+    seed: int = 0
+    method: str | None = None
+
+    @property
+    def keys(self) -> list:
+        """Swept keys, in column order."""
+        return [a.key for a in self.axes] + [v.key for v in self.vary]
+
+    @property
+    def log_keys(self) -> set:
+        """Keys on a log-spaced grid (plotted on a log axis)."""
+        return {a.key for a in self.axes if a.log}
+
+    @property
+    def n_rows(self) -> int:
+        """Number of points."""
+        if self.axes:
+            return int(np.prod([len(a.values) for a in self.axes]))
+        return int(self.samples or 0)
+
+    def describe(self) -> dict:
+        """A JSON-able description, stored in every Parquet file of the sweep."""
+        return {"scenario": self.name, "sets": dict(self.sets),
+                "axes": [[a.key, list(a.values), a.log] for a in self.axes], "samples": self.samples,
+                "vary": [asdict(v) for v in self.vary], "seed": self.seed, "method": self.method,
+                "keys": self.keys, "rows": self.n_rows}
+
+
+def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=(), seed=0, method=None):
+    """Validate the sweep's command-line pieces into a :class:`SweepSpec`.
+
+    Parameters
+    ----------
+    scenario : str
+        Scenario name or ``.toml`` path.
+    sets : dict, optional
+        ``{key: value}`` fixed for every row (validated as ``rotframe run --set``).
+    grid, log_grid : sequence of str
+        ``KEY=START:STOP:N``: N linearly (logarithmically, both bounds > 0) spaced values, inclusive.
+    samples : int, optional
+        Monte Carlo sample count (with ``vary``).
+    vary : sequence of str
+        ``KEY=normal(MEAN,SD)`` or ``KEY=uniform(LO,HI)``.
+    seed : int
+    method : str, optional
+        Integrator, checked against the scene's methods.
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the option, key and value and what is allowed.
+    """
+    from rotframe.app import scenario as sc
+    scn = sc.load(scenario)
+    sets = dict(sets or {})
+    base = scn.with_values(sets)
+    _check_method(scn, method)
+    axes = [_parse_axis(scn, base, text, log=False) for text in grid]
+    axes += [_parse_axis(scn, base, text, log=True) for text in log_grid]
+    varies = [_parse_vary(scn, base, text) for text in vary]
+    _check_shape(axes, varies, samples)
+    from rotframe import limits
+
+    rows = math.prod(len(a.values) for a in axes) if axes else int(samples or 0)
+    limits.check_rows(rows, what="sweep")
+    spec = SweepSpec(scenario=str(scenario), name=scn.name, sets=sets, axes=axes, samples=samples,
+                     vary=varies, seed=int(seed), method=method)
+    _check_keys_once(spec)
+    return spec
+
+
+def sweep_points(spec: SweepSpec) -> np.ndarray:
+    """The swept values, one row per point: a (rows, keys) float array in :attr:`SweepSpec.keys` order.
+
+    Grid rows are the Cartesian product of the axes (last axis fastest); Monte Carlo
+    rows are drawn from ``default_rng(seed)``, one distribution after the other, so the
+    same spec always gives the same rows.
+    """
+    if spec.axes:
+        grid = list(itertools.product(*[a.values for a in spec.axes]))
+        return np.array(grid, dtype=np.float64).reshape(len(grid), len(spec.axes))
+    rng = np.random.default_rng(spec.seed)
+    cols = [rng.normal(v.a, v.b, spec.samples) if v.dist == "normal" else rng.uniform(v.a, v.b, spec.samples)
+            for v in spec.vary]
+    return np.stack(cols, axis=1).astype(np.float64)
+
+
+def points_of(spec: SweepSpec, rows) -> np.ndarray:
+    """The swept values of the given ``rows`` only (as :func:`sweep_points` would give them).
+
+    Grid points are computed from their row index, so a large grid is never held
+    whole; Monte Carlo rows are drawn in order from the seed.
+    """
+    rows = np.asarray(rows, dtype=np.int64)
+    if spec.axes:
+        shape = tuple(len(a.values) for a in spec.axes)
+        idx = np.unravel_index(rows, shape) if len(rows) else [np.zeros(0, np.int64)] * len(shape)
+        cols = [np.asarray(a.values, dtype=np.float64)[i] for a, i in zip(spec.axes, idx)]
+        return np.stack(cols, axis=1) if cols else np.zeros((len(rows), 0))
+    return sweep_points(spec)[rows]
+
+
+@dataclass(frozen=True)
+class SweptKey:
+    """A swept key: a parameter, or one component of a vector parameter (``omega[0]``)."""
+
+    text: str
+    param: str
+    index: int | None = None
+
+
+def _parse_key(scn, option, text):
+    m = re.fullmatch(r"\s*([A-Za-z_][\w-]*)\s*(?:\[\s*(\d+)\s*\])?\s*", text)
+    allowed = _sweepable(scn)
+    if not m or m.group(1) not in scn.parameters:
+        word = m.group(1) if m else text
+        raise ScenarioError(f"{option}: unknown key {text!r} for scenario {scn.name!r}"
+                            f"{_did_you_mean(word, allowed)}; sweepable: {', '.join(allowed)}")
+    p = scn.parameters[m.group(1)]
+    if p.type == "vector":
+        size = p.shape or len(p.default)
+        if m.group(2) is None or int(m.group(2)) >= size:
+            raise ScenarioError(f"{option}: {text!r} is a vector of {size}; sweep one component, "
+                                f"{m.group(1)}[0] to {m.group(1)}[{size - 1}]")
+        return SweptKey(f"{m.group(1)}[{int(m.group(2))}]", m.group(1), int(m.group(2)))
+    if p.type not in ("float", "int") or m.group(2) is not None:
+        raise ScenarioError(f"{option}: {text!r} is not a numeric parameter ({p.type}); "
+                            f"sweepable: {', '.join(allowed)}")
+    return SweptKey(m.group(1), m.group(1))
+
+
+def _sweepable(scn):
+    out = []
+    for name, p in scn.parameters.items():
+        if p.type in ("float", "int"):
+            out.append(name)
+        elif p.type == "vector":
+            out.append(f"{name}[i]")
+    return out
+
+
+def _parse_axis(scn, base, text, log):
+    option = "--log-grid" if log else "--grid"
+    key_text, spec = _split_assignment(option, text, "KEY=START:STOP:N")
+    key = _parse_key(scn, option, key_text)
+    parts = spec.split(":")
+    if len(parts) != 3:
+        raise ScenarioError(f"{option} {text!r}: expected KEY=START:STOP:N (N values from START to STOP)")
+    n = _parse_count(option, text, parts[2])
+    from rotframe import limits
+
+    limits.check_rows(n, what=f"{option} {text!r}")
+    lo, hi = (_parse_number(scn, key, option, text, s) for s in parts[:2])
+    if log and not (lo > 0 and hi > 0):
+        raise ScenarioError(f"{option} {text!r}: START and STOP must both be > 0 for a logarithmic grid")
+    values = np.geomspace(lo, hi, n) if log else np.linspace(lo, hi, n)
+    if key.index is None and scn.parameters[key.param].type == "int":
+        values = np.unique(np.round(values))
+    _check_value(scn, base, key, option, text, values)
+    return Axis(key.text, tuple(float(x) for x in values), log)
+
+
+def _parse_vary(scn, base, text):
+    key_text, spec = _split_assignment("--vary", text, "KEY=normal(MEAN,SD) or KEY=uniform(LO,HI)")
+    key = _parse_key(scn, "--vary", key_text)
+    m = re.fullmatch(r"\s*([A-Za-z_]\w*)\s*\(\s*([^,()]+?)\s*,\s*([^,()]+?)\s*\)\s*", spec)
+    allowed = "normal(MEAN,SD), uniform(LO,HI)"
+    if not m:
+        raise ScenarioError(f"--vary {text!r}: expected KEY=normal(MEAN,SD) or KEY=uniform(LO,HI)")
+    dist = m.group(1)
+    if dist not in DISTRIBUTIONS:
+        raise ScenarioError(f"--vary {text!r}: unknown distribution {dist!r}"
+                            f"{_did_you_mean(dist, list(DISTRIBUTIONS))}; allowed: {allowed}")
+    a, b = (_parse_number(scn, key, "--vary", text, s) for s in m.groups()[1:])
+    if dist == "normal" and b < 0:
+        raise ScenarioError(f"--vary {text!r}: SD = {b:g} must be >= 0")
+    if dist == "uniform" and b < a:
+        raise ScenarioError(f"--vary {text!r}: LO = {a:g} must not exceed HI = {b:g}")
+    centre = np.array([a if dist == "normal" else 0.5 * (a + b)])
+    _check_value(scn, base, key, "--vary", text, centre)
+    return Vary(key.text, dist, a, b)
+
+
+def _split_assignment(option, text, form):
+    pair = split_set(text)
+    if pair is None:
+        raise ScenarioError(f"{option} {text!r}: expected {form}")
+    return pair
+
+
+def _parse_count(option, text, raw):
+    try:
+        n = int(raw.strip())
+    except ValueError:
+        raise ScenarioError(f"{option} {text!r}: N = {raw.strip()!r} must be a whole number >= 1") from None
+    if n < 1:
+        raise ScenarioError(f"{option} {text!r}: N = {n} must be >= 1")
+    return n
+
+
+def _parse_number(scn, key, option, text, raw):
+    """A number (or quantity string) in the parameter's unit; bounds are checked later."""
+    from rotframe.app.scenario import Parameter, parse_value
+
+    p = Parameter(name=key.text, default=0.0, unit=scn.parameters[key.param].unit)
+    try:
+        return float(parse_value(p, raw.strip(), source=f"{option} {text!r}"))
+    except ScenarioError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+def _check_value(scn, base, key, option, text, values):
+    """The extreme grid values (or the distribution's centre) must be valid values of the parameter."""
+    for x in {float(np.min(values)), float(np.max(values))}:
+        try:
+            apply_row(scn, dict(base), [key], [x])
+        except ScenarioError as exc:
+            raise ScenarioError(f"{option} {text!r}: {exc}") from None
+
+
+def _check_shape(axes, varies, samples):
+    if axes and (varies or samples is not None):
+        raise ScenarioError("sweep: give either --grid/--log-grid or --samples with --vary, not both")
+    if samples is not None and samples < 1:
+        raise ScenarioError(f"--samples {samples}: must be >= 1")
+    if varies and samples is None:
+        raise ScenarioError("--vary needs --samples N (the number of Monte Carlo samples)")
+    if samples is not None and not varies:
+        raise ScenarioError(f"--samples {samples}: give at least one --vary KEY=normal(MEAN,SD)|uniform(LO,HI)")
+    if not axes and not varies:
+        raise ScenarioError("sweep: nothing to sweep; give --grid KEY=START:STOP:N, --log-grid or --samples N "
+                            "with --vary")
+
+
+def _check_keys_once(spec):
+    seen = set()
+    for key in spec.keys:
+        if key in seen:
+            raise ScenarioError(f"sweep: key {key!r} is swept twice")
+        seen.add(key)
+        param = key.split("[")[0]
+        if param in spec.sets and "[" not in key:
+            raise ScenarioError(f"sweep: key {key!r} is both fixed by --set and swept")
+
+
+def _check_method(scn, method):
+    if method is None:
+        return
+    from rotframe import scenes
+    from rotframe.particles.integrators import METHODS
+
+    allowed = getattr(scenes.get(scn.scene), "METHODS", None) or list(METHODS)
+    if method not in allowed:
+        raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}"
+                            f"{_did_you_mean(method, list(allowed))}")
+
+
+def _did_you_mean(word, options):
+    from rotframe.app.choices import did_you_mean as suggest
+
+    plain = [o.split("[")[0] for o in options]
+    return suggest(word, plain) or suggest(word, list(options))
+
+
+def key_of(text):
+    m = re.fullmatch(r"(.+)\[(\d+)\]", text)
+    return SweptKey(text, m.group(1), int(m.group(2))) if m else SweptKey(text, text)
+
+
+def apply_row(scn, values, keys, row):
+    """``values`` with the swept keys set to ``row`` (validated); vector components replace one entry."""
+    from rotframe.app.scenario import parse_value
+
+    for key, x in zip(keys, row):
+        p = scn.parameters[key.param]
+        if key.index is None:
+            values[key.param] = parse_value(p, float(x))
+        else:
+            vec = list(values[key.param])
+            vec[key.index] = float(x)
+            values[key.param] = parse_value(p, vec)
+    return values
