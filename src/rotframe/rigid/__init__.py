@@ -12,7 +12,13 @@ from typing import Any
 
 #: Modules whose public names (``__all__``) are also reachable as ``rotframe.rigid.NAME``,
 #: as they were when the rigid-body API was one module. Loaded on first access.
-_PUBLIC_FROM = ("rotframe.rigid.dynamics",)
+_PUBLIC_FROM = (
+    "rotframe.rigid.checks",
+    "rotframe.rigid.free_body",
+    "rotframe.rigid.torqued",
+    "rotframe.rigid.heavy_top",
+    "rotframe.rigid.observables",
+)
 
 
 def __getattr__(name: str) -> Any:
