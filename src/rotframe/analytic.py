@@ -18,6 +18,7 @@ from scipy.optimize import brentq
 from scipy.special import ellipk
 
 from rotframe.errors import ScenarioError
+from rotframe.numerics.rotation import skew
 
 __all__ = [
     "DropResult",
@@ -194,7 +195,7 @@ def linear_rotating_propagator(
     w = _vec3(omega_vec, "omega_vec")
     g = _vec3(g_vec, "g_vec")
     s0 = np.concatenate([_vec3(r0, "r0"), _vec3(v0, "v0"), [1.0]])
-    W = _skew(w)
+    W = skew(w)
     a_r = np.zeros((3, 3))
     if centrifugal:
         a_r -= W @ W
@@ -512,11 +513,6 @@ def _vec3(x, name):
     if a.shape != (3,):
         raise ValueError(f"{name} must have shape (3,), got {a.shape}")
     return a
-
-
-def _skew(w):
-    """Skew matrix W with W @ v = w x v."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 def _spring_matrix(spring):

@@ -56,6 +56,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.rotation import rodrigues_rotate
+
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
 I_KLIN, I_KQUAD, I_GMODE, I_GM, I_R, I_PLEN, I_PIVOT, I_G0, I_SPRING, I_SCALE_H = 9, 10, 11, 12, 13, 14, 15, 18, 19, 20
@@ -360,18 +362,6 @@ def acceleration(r, v, t, P, wt, wv, out):
 
 
 @_jit
-def _rotate(vx, vy, vz, ax, ay, az, c, s):
-    """v rotated about the unit axis (ax, ay, az) by the angle with cos c, sin s."""
-    d = ax * vx + ay * vy + az * vz
-    cx = ay * vz - az * vy
-    cy = az * vx - ax * vz
-    cz = ax * vy - ay * vx
-    one_c = 1.0 - c
-    return (vx * c + cx * s + ax * d * one_c, vy * c + cy * s + ay * d * one_c,
-            vz * c + cz * s + az * d * one_c)
-
-
-@_jit
 def _air(z, m):
     """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
     H = m.scale_h
@@ -446,7 +436,7 @@ def _free_steps(state, n, method, h, m, plan):
                 k2 = m.k2 * air
                 vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
             if m.coriolis:
-                vx, vy, vz = _rotate(vx, vy, vz, ux, uy, uz, c, s)
+                vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
             if m.drag:
                 vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
             vx += hh * ax
@@ -496,7 +486,7 @@ def _sphere_step(state, h, m, sub):
     if m.coriolis:
         wn = m.axis[0] * nx + m.axis[1] * ny + m.axis[2] * nz
         angle = -2.0 * wn * sub[2]
-        vx, vy, vz = _rotate(vx, vy, vz, nx, ny, nz, np.cos(angle), np.sin(angle))
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, np.cos(angle), np.sin(angle))
     if m.drag:
         vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
     vx += hh * ax

@@ -20,19 +20,13 @@ import math
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.rotation import quat_mul
 from rotframe.rigid.elliptic import carlson_rf, carlson_rj, ellipk_agm, incomplete_pi, jacobi_reduced
 from rotframe.rigid.free_body import free_body_exact
 
 __all__ = ["free_body_flow", "carlson_rf", "carlson_rj", "ellipk_agm"]
 
 _jit = njit(cache=True, error_model="numpy", nogil=True)
-
-
-@_jit
-def _qmul(a0, a1, a2, a3, b0, b1, b2, b3):
-    """Hamilton product of scalar-last quaternions given as scalars."""
-    return (a3 * b0 + b3 * a0 + a1 * b2 - a2 * b1, a3 * b1 + b3 * a1 + a2 * b0 - a0 * b2,
-            a3 * b2 + b3 * a2 + a0 * b1 - a1 * b0, a3 * b3 - a0 * b0 - a1 * b1 - a2 * b2)
 
 
 @_jit
@@ -156,16 +150,16 @@ def _flow(moments, L0, q0, t, out_L, out_q):
         if i == 0:
             Pi0 = Pi
             # S0 = q0 P^-1 Rz(phi0) Ry(theta0)
-            a = _qmul(q0[0], q0[1], q0[2], q0[3], -pq0, -pq1, -pq2, pq3)
-            a = _qmul(a[0], a[1], a[2], a[3], 0.0, 0.0, math.sin(0.5 * phi), math.cos(0.5 * phi))
-            S0 = _qmul(a[0], a[1], a[2], a[3], 0.0, math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
+            a = quat_mul(q0[0], q0[1], q0[2], q0[3], -pq0, -pq1, -pq2, pq3)
+            a = quat_mul(a[0], a[1], a[2], a[3], 0.0, 0.0, math.sin(0.5 * phi), math.cos(0.5 * phi))
+            S0 = quat_mul(a[0], a[1], a[2], a[3], 0.0, math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
             continue
         k = i - 1
         psi = norm_L / J[2] * (t[k] + (J[2] - J[0]) / (J[0] * lam) * (Pi - Pi0))
-        a = _qmul(S0[0], S0[1], S0[2], S0[3], 0.0, 0.0, math.sin(0.5 * psi), math.cos(0.5 * psi))
-        a = _qmul(a[0], a[1], a[2], a[3], 0.0, -math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
-        a = _qmul(a[0], a[1], a[2], a[3], 0.0, 0.0, -math.sin(0.5 * phi), math.cos(0.5 * phi))
-        a = _qmul(a[0], a[1], a[2], a[3], pq0, pq1, pq2, pq3)
+        a = quat_mul(S0[0], S0[1], S0[2], S0[3], 0.0, 0.0, math.sin(0.5 * psi), math.cos(0.5 * psi))
+        a = quat_mul(a[0], a[1], a[2], a[3], 0.0, -math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
+        a = quat_mul(a[0], a[1], a[2], a[3], 0.0, 0.0, -math.sin(0.5 * phi), math.cos(0.5 * phi))
+        a = quat_mul(a[0], a[1], a[2], a[3], pq0, pq1, pq2, pq3)
         for j in range(4):
             out_q[k, j] = a[j]
         for j in range(3):  # ordered -> body: P^T L

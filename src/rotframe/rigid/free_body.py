@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike
 from scipy import special
 from scipy.spatial.transform import Rotation
 
+from rotframe.numerics.rotation import quat_about_axis, quat_mul_arrays, rotate_about
 from rotframe.rigid.checks import (
     InvalidStateError,
     check_axis_momentum,
@@ -135,7 +136,7 @@ def free_body_exact(
     if frame is None:  # steady rotation about the middle axis
         middle = int(np.argsort(inertia)[1])
         angle = norm_L * inv_i[middle] * t
-        q = _qmul(q0, _qaxis(L0 / norm_L, angle))
+        q = quat_mul_arrays(q0, quat_about_axis(L0 / norm_L, angle))
         return np.tile(L0, (t.size, 1)), q
     return _free_asymmetric(frame, L0, q0, t)
 
@@ -183,8 +184,8 @@ def _free_symmetric(inv_i, s, L0, q0, t):
     inv_p = inv_i[(s + 1) % 3]
     gamma = L0[s] * (inv_i[s] - inv_p)  # body rate of the second flow, = -k
     e_s = np.eye(3)[s]
-    q = _qmul(_qmul(q0, _qaxis(L0 / norm_L, norm_L * inv_p * t)), _qaxis(e_s, gamma * t))
-    L = _rotate_about(e_s, -gamma * t, L0)
+    q = quat_mul_arrays(quat_mul_arrays(q0, quat_about_axis(L0 / norm_L, norm_L * inv_p * t)), quat_about_axis(e_s, gamma * t))
+    L = rotate_about(e_s, -gamma * t, L0)
     return L, q
 
 
@@ -267,9 +268,9 @@ def _free_asymmetric(fr, L0, q0, t):
     ez, ey = np.eye(3)[2], np.eye(3)[1]
     qP = Rotation.from_matrix(fr["P"]).as_quat()
     qP_inv = qP * np.array([-1.0, -1.0, -1.0, 1.0])
-    S0 = _qmul(_qmul(_qmul(q0, qP_inv), _qaxis(ez, phi[0])), _qaxis(ey, theta[0]))
-    q = _qmul(_qmul(_qmul(_qmul(S0, _qaxis(ez, psi)), _qaxis(ey, -theta[1:])),
-                    _qaxis(ez, -phi[1:])), qP)
+    S0 = quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(q0, qP_inv), quat_about_axis(ez, phi[0])), quat_about_axis(ey, theta[0]))
+    q = quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(S0, quat_about_axis(ez, psi)), quat_about_axis(ey, -theta[1:])),
+                    quat_about_axis(ez, -phi[1:])), qP)
     L = L_ord[1:] @ fr["P"]  # ordered -> body: P^T @ L
     return L, q
 
@@ -308,29 +309,6 @@ def _jacobi_with_pi(u, fr):
 def _wrap(x):
     """Angle wrapped to [-pi, pi)."""
     return (x + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def _qmul(a, b):
-    """Hamilton product of scalar-last quaternions, broadcasting over leading axes."""
-    av, aw = a[..., :3], a[..., 3:]
-    bv, bw = b[..., :3], b[..., 3:]
-    v = aw * bv + bw * av + np.cross(av, bv)
-    w = aw * bw - np.sum(av * bv, axis=-1, keepdims=True)
-    return np.concatenate([v, w], axis=-1)
-
-
-def _qaxis(axis, angle):
-    """Quaternions (..., 4) of rotations by ``angle`` (...) about unit ``axis`` (3,)."""
-    half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
-    return np.concatenate([np.sin(half) * axis, np.cos(half)], axis=-1)
-
-
-def _rotate_about(axis, angle, v):
-    """Rotate ``v`` (3,) by ``angle`` (n,) about unit ``axis`` (Rodrigues): shape (n, 3)."""
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    return v * c + np.cross(axis, v) * s + axis * (axis @ v) * (1.0 - c)
-
-
 
 
 # text, complex and object input to the public functions: a InvalidStateError, not a numpy TypeError

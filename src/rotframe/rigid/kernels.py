@@ -20,18 +20,9 @@ import math
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.rotation import quat_mul
+
 __all__ = ["free_step", "split_run", "euler_rhs", "rk4_run"]
-
-
-@njit(cache=True)
-def _qmul_nb(a, b):
-    """Hamilton product of scalar-last quaternions (4,)."""
-    return np.array([
-        a[3] * b[0] + b[3] * a[0] + a[1] * b[2] - a[2] * b[1],
-        a[3] * b[1] + b[3] * a[1] + a[2] * b[0] - a[0] * b[2],
-        a[3] * b[2] + b[3] * a[2] + a[0] * b[1] - a[1] * b[0],
-        a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
-    ])
 
 
 @njit(cache=True)
@@ -60,7 +51,7 @@ def _turn_about_axis(L, q, i, angle):
     r = np.zeros(4)
     r[i] = math.sin(0.5 * angle)
     r[3] = math.cos(0.5 * angle)
-    q[:] = _qmul_nb(q, r)
+    q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
 
 
 @njit(cache=True)
@@ -74,7 +65,7 @@ def free_step(L, q, tau, inv_i, sym):
             r = np.empty(4)
             r[:3] = math.sin(half) * L / norm_L
             r[3] = math.cos(half)
-            q[:] = _qmul_nb(q, r)
+            q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
         _turn_about_axis(L, q, sym, tau * L[sym] * (inv_i[sym] - inv_p))
     else:
         _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
@@ -140,8 +131,11 @@ def euler_rhs(y, inv_i, mgl, torque_body, torque_space):
     dy[1] = L[2] * om[0] - L[0] * om[2]
     dy[2] = L[0] * om[1] - L[1] * om[0]
     dy[:3] += _torque_body(q, mgl, torque_body, torque_space)
-    wq = np.array([om[0], om[1], om[2], 0.0])
-    dy[3:] = 0.5 * _qmul_nb(q, wq)
+    dq = quat_mul(q[0], q[1], q[2], q[3], om[0], om[1], om[2], 0.0)
+    dy[3] = 0.5 * dq[0]
+    dy[4] = 0.5 * dq[1]
+    dy[5] = 0.5 * dq[2]
+    dy[6] = 0.5 * dq[3]
     return dy
 
 
