@@ -22,7 +22,10 @@ from numba import njit
 
 from rotframe.numerics.rotation import quat_mul
 
-__all__ = ["free_step", "split_run", "euler_rhs", "rk4_run"]
+__all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "rk4_run"]
+
+# error_model="numpy": a zero quaternion gives NaN, caught by the callers' finiteness checks
+_jit_nan = njit(cache=True, error_model="numpy", nogil=True)
 
 
 @njit(cache=True)
@@ -75,24 +78,50 @@ def free_step(L, q, tau, inv_i, sym):
         _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
 
 
-@njit(cache=True)
-def _torque_body(q, mgl, torque_body, torque_space):
-    """Body torque: constant body part, ``R(q)^T`` times the space part, and gravity.
+@_jit_nan
+def body_torque(x, y, z, w, mgl, nb0, nb1, nb2, ns0, ns1, ns2):
+    """Body torque (3-tuple): constant body part ``nb``, ``R(q)^T ns`` and gravity.
 
-    Gravity: ``mgl (z_b[1], -z_b[0], 0) = l e3 x (-m g z_b)`` with
-    ``z_b = R(q)^T (0, 0, 1)``, the third row of ``R(q)``.
+    ``q = (x, y, z, w)`` is normalised here. Gravity: ``mgl (z_b[1], -z_b[0], 0)
+    = l e3 x (-m g z_b)`` with ``z_b = R(q)^T (0, 0, 1)``, the third row of ``R(q)``
+    (docs/physics/rigid-bodies.md). Without a space torque or gravity the rotation is skipped.
     """
-    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    x, y, z, w = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    if mgl == 0.0 and ns0 == 0.0 and ns1 == 0.0 and ns2 == 0.0:
+        return nb0, nb1, nb2
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / n, y / n, z / n, w / n
     # rows of R(q): R^T v = (col_0 . v, col_1 . v, col_2 . v)
     r00, r01, r02 = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
     r10, r11, r12 = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
     r20, r21, r22 = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
-    ts = torque_space
-    out = torque_body.copy()
-    out[0] += r00 * ts[0] + r10 * ts[1] + r20 * ts[2] + mgl * r21
-    out[1] += r01 * ts[0] + r11 * ts[1] + r21 * ts[2] - mgl * r20
-    out[2] += r02 * ts[0] + r12 * ts[1] + r22 * ts[2]
+    return (nb0 + (r00 * ns0 + r10 * ns1 + r20 * ns2 + mgl * r21),
+            nb1 + (r01 * ns0 + r11 * ns1 + r21 * ns2 - mgl * r20),
+            nb2 + (r02 * ns0 + r12 * ns1 + r22 * ns2))
+
+
+@_jit_nan
+def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1, ns2):
+    """Euler's equations and quaternion kinematics, the one right-hand side of the rigid layer.
+
+    ``dL/dt = L x omega + N_body``, ``omega = L / I`` (``i0, i1, i2 = 1/I``, 0 for a
+    zero moment), ``dq/dt = q * (omega, 0) / 2`` (Hamilton product, scalar-last,
+    ``q`` not normalised), ``N_body`` from :func:`body_torque`. Returns the 7-tuple
+    ``(dL0, dL1, dL2, dx, dy, dz, dw)``. Used by :func:`euler_rhs` (RK4,
+    ``rigid_rhs``) and by the adaptive DOP853 of :mod:`rotframe.rigid.adaptive`.
+    """
+    o0, o1, o2 = L0 * i0, L1 * i1, L2 * i2
+    t0, t1, t2 = body_torque(x, y, z, w, mgl, nb0, nb1, nb2, ns0, ns1, ns2)
+    d0, d1, d2, d3 = quat_mul(x, y, z, w, o0, o1, o2, 0.0)
+    return (L1 * o2 - L2 * o1 + t0, L2 * o0 - L0 * o2 + t1, L0 * o1 - L1 * o0 + t2,
+            0.5 * d0, 0.5 * d1, 0.5 * d2, 0.5 * d3)
+
+
+@njit(cache=True)
+def _torque_body(q, mgl, torque_body, torque_space):
+    """:func:`body_torque` of the state's ``q`` as an array (3,)."""
+    tb, ts = torque_body, torque_space
+    out = np.empty(3)
+    out[0], out[1], out[2] = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
     return out
 
 
@@ -123,19 +152,12 @@ def split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, we
 
 @njit(cache=True)
 def euler_rhs(y, inv_i, mgl, torque_body, torque_space):
-    """Euler's equations plus quaternion kinematics (see rigid_rhs)."""
-    L, q = y[:3], y[3:]
-    om = L * inv_i
+    """:func:`euler_rates` on the state ``y = (L_body, q)`` (7,); see ``rigid_rhs``."""
+    tb, ts = torque_body, torque_space
     dy = np.empty(7)
-    dy[0] = L[1] * om[2] - L[2] * om[1]
-    dy[1] = L[2] * om[0] - L[0] * om[2]
-    dy[2] = L[0] * om[1] - L[1] * om[0]
-    dy[:3] += _torque_body(q, mgl, torque_body, torque_space)
-    dq = quat_mul(q[0], q[1], q[2], q[3], om[0], om[1], om[2], 0.0)
-    dy[3] = 0.5 * dq[0]
-    dy[4] = 0.5 * dq[1]
-    dy[5] = 0.5 * dq[2]
-    dy[6] = 0.5 * dq[3]
+    dy[0], dy[1], dy[2], dy[3], dy[4], dy[5], dy[6] = euler_rates(
+        y[0], y[1], y[2], y[3], y[4], y[5], y[6], inv_i[0], inv_i[1], inv_i[2], mgl,
+        tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
     return dy
 
 
