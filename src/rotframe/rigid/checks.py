@@ -15,12 +15,12 @@ import numpy as np
 
 from rotframe.errors import RotframeError
 from rotframe.rigid.mass_properties import InvalidBodyError, check_mass, check_moments
+from rotframe.validation import check_vector3
 
 __all__ = [
     "InvalidStateError",
     "check_inertia",
     "check_axis_momentum",
-    "check_vector",
     "check_quaternion",
     "check_torque",
     "check_steps",
@@ -57,14 +57,6 @@ def check_axis_momentum(moments, L, name="L_body"):
             )
 
 
-def check_vector(v, name):
-    """A finite 3-vector as float64."""
-    a = np.asarray(v, dtype=np.float64)
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
-        raise InvalidStateError(f"{name} = {np.asarray(v).tolist()} must be 3 finite numbers")
-    return a
-
-
 def check_quaternion(q):
     """A finite non-zero quaternion (x, y, z, w), normalised."""
     a = np.asarray(q, dtype=np.float64)
@@ -83,7 +75,7 @@ def check_torque(moments, torque, frame):
         raise InvalidStateError(f"torque_frame = {frame!r}; allowed: 'body' or 'space'")
     if torque is None:
         return zero, zero
-    n = check_vector(torque, "torque")
+    n = check_vector3(torque, "torque", InvalidStateError)
     if frame == "body":
         check_axis_momentum(moments, n, "torque")
         return n, zero

@@ -46,11 +46,10 @@ from rotframe.rigid.checks import (
     check_axis_momentum,
     check_inertia,
     check_quaternion,
-    check_vector,
     symmetry_axis,
 )
 from rotframe.rigid.elliptic import incomplete_pi_arrays, jacobi_reduced
-from rotframe.validation import guard_public
+from rotframe.validation import check_vector3, guard_public
 
 __all__ = ["free_body_exact", "elliptic_period"]
 
@@ -119,7 +118,7 @@ def free_body_exact(
         (no sign jumps) and equal to ``q0`` at ``t = 0``.
     """
     inertia, inv_i = check_inertia(inertia)
-    L0 = check_vector(L0_body, "L0_body")
+    L0 = check_vector3(L0_body, "L0_body", InvalidStateError)
     check_axis_momentum(inertia, L0)
     q0 = check_quaternion(q0)
     t = np.atleast_1d(np.asarray(times, dtype=np.float64))
@@ -164,7 +163,7 @@ def elliptic_period(inertia: ArrayLike, L0_body: ArrayLike) -> float:
         Period (s).
     """
     inertia, inv_i = check_inertia(inertia)
-    L0 = check_vector(L0_body, "L0_body")
+    L0 = check_vector3(L0_body, "L0_body", InvalidStateError)
     check_axis_momentum(inertia, L0)
     if not np.any(L0):
         return math.inf

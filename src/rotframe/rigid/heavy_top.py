@@ -33,11 +33,10 @@ from rotframe.rigid.checks import (
     InvalidStateError,
     check_axis_momentum,
     check_inertia,
-    check_vector,
     heavy_top_mgl,
 )
 from rotframe.rigid.drivers import run_splitting
-from rotframe.validation import guard_public
+from rotframe.validation import check_vector3, guard_public
 
 __all__ = [
     "heavy_top_splitting",
@@ -100,7 +99,7 @@ def heavy_top_splitting(
     """
     inertia, inv_i = check_inertia((i1, i1, i3))
     mgl = heavy_top_mgl(mass, length, g)
-    L0 = check_vector(L0_body, "L0_body")
+    L0 = check_vector3(L0_body, "L0_body", InvalidStateError)
     check_axis_momentum(inertia, L0)
     zero = np.zeros(3)
     return run_splitting(inv_i, 2, mgl, zero, zero, L0, q0, h, n_steps, order, sample_every)

@@ -34,13 +34,12 @@ from rotframe.rigid.checks import (
     check_quaternion,
     check_steps,
     check_torque,
-    check_vector,
     symmetry_axis,
 )
 from rotframe.rigid.drivers import allocate_samples, composition_weights, finish_samples, run_splitting
 from rotframe.rigid.kernels import euler_rhs, free_step, rk4_run
 from rotframe.rigid.observables import body_to_space
-from rotframe.validation import guard_public
+from rotframe.validation import check_vector3, guard_public
 
 __all__ = ["lie_poisson", "torqued_splitting", "rigid_rhs", "rigid_rk4"]
 
@@ -101,7 +100,7 @@ def lie_poisson(
         Times (s) of the kept steps.
     """
     inertia, inv_i = check_inertia(inertia)
-    L0 = check_vector(L0_body, "L0_body")
+    L0 = check_vector3(L0_body, "L0_body", InvalidStateError)
     check_axis_momentum(inertia, L0)
     torque_body, torque_space = check_torque(inertia, torque, torque_frame)
     sym = symmetry_axis(inertia)
@@ -147,7 +146,7 @@ def torqued_splitting(
         As in :func:`lie_poisson`.
     """
     inertia, inv_i = check_inertia(inertia)
-    L = check_vector(L0_body, "L0_body").copy()
+    L = check_vector3(L0_body, "L0_body", InvalidStateError).copy()
     check_axis_momentum(inertia, L)
     q = check_quaternion(q0).copy()
     if torque_frame not in ("body", "space"):
@@ -261,7 +260,7 @@ def rigid_rk4(
         As in :func:`lie_poisson`.
     """
     inertia, inv_i = check_inertia(inertia)
-    L0 = check_vector(L0_body, "L0_body")
+    L0 = check_vector3(L0_body, "L0_body", InvalidStateError)
     check_axis_momentum(inertia, L0)
     q0 = check_quaternion(q0)
     torque_body, torque_space = check_torque(inertia, torque, torque_frame)
