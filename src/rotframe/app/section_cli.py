@@ -32,6 +32,7 @@ import sys
 
 import numpy as np
 
+from rotframe.app.section_plot import plot_section
 from rotframe.rigid.sections import (
     PROPERTY_UNITS,
     SectionError,
@@ -39,7 +40,6 @@ from rotframe.rigid.sections import (
     channel,
     circle,
     i_beam,
-    plot_section,
     polygon,
     rectangle,
     tube,
