@@ -56,6 +56,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.error_norm import dop853_error_norm
 from rotframe.numerics.rotation import rodrigues_rotate
 
 # Parameter-vector indices (kept in one place; model.pack writes them).
@@ -915,30 +916,6 @@ def _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp):
         y_new[j] = y[j] + h * acc
     w, wd = _rates(t + h, m.steady, m.w, wt, wv)
     K[12, 0], K[12, 1], K[12, 2], K[12, 3], K[12, 4], K[12, 5] = _deriv(_as_state(y_new), m, w, wd)
-
-
-@_jit
-def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
-    """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
-
-    ``atol`` holds one absolute tolerance per component of ``y`` (the particle and
-    rigid-body kernels share this function; docs/physics/dop853.md).
-    """
-    n = y.shape[0]
-    e5 = 0.0
-    e3 = 0.0
-    for j in range(n):
-        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
-        s5 = 0.0
-        s3 = 0.0
-        for q in range(13):
-            s5 += E5[q] * K[q, j]
-            s3 += E3[q] * K[q, j]
-        e5 += (s5 / sc) ** 2
-        e3 += (s3 / sc) ** 2
-    if e5 == 0.0 and e3 == 0.0:
-        return 0.0
-    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
 
 
 @_jit
