@@ -110,29 +110,22 @@ def solid_sphere(mass: float, radius: float) -> np.ndarray:
     ndarray, shape (3, 3)
         Inertia tensor (kg m^2) about the centre of mass.
     """
-    m = check_mass(mass)
-    r = _length(radius, "radius")
-    return np.eye(3) * (0.4 * m * r * r)
+    return _isotropic(mass, radius, 0.4)
 
 
 def spherical_shell(mass: float, radius: float) -> np.ndarray:
     """Thin spherical shell about its centre: ``(2/3) m R^2`` on each axis.
 
-    Parameters
-    ----------
-    mass : float
-        Mass (kg).
-    radius : float
-        Radius (m).
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        Inertia tensor (kg m^2) about the centre of mass.
+    Parameters and result as in :func:`solid_sphere`.
     """
+    return _isotropic(mass, radius, 2.0 / 3.0)
+
+
+def _isotropic(mass, radius, factor):
+    """``factor m R^2`` on each axis (a body with the symmetry of the sphere), after the checks."""
     m = check_mass(mass)
     r = _length(radius, "radius")
-    return np.eye(3) * (2.0 / 3.0 * m * r * r)
+    return np.eye(3) * (factor * m * r * r)
 
 
 def box(mass: float, a: float, b: float, c: float) -> np.ndarray:

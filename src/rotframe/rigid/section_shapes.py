@@ -86,12 +86,7 @@ def i_beam(depth: float, flange_width: float, flange_thickness: float, web_thick
     The bounding box is ``[0, flange_width] x [0, depth]``, web centred.
     Requires ``2 flange_thickness < depth`` and ``web_thickness < flange_width``.
     """
-    d = _positive("i-beam", "depth", depth)
-    b = _positive("i-beam", "flange_width", flange_width)
-    tf = _positive("i-beam", "flange_thickness", flange_thickness)
-    tw = _positive("i-beam", "web_thickness", web_thickness)
-    _less("i-beam", "flange_thickness", tf, "depth/2", d / 2)
-    _less("i-beam", "web_thickness", tw, "flange_width", b)
+    d, b, tf, tw = _flanged("i-beam", depth, flange_width, flange_thickness, web_thickness)
     w0, w1 = 0.5 * (b - tw), 0.5 * (b + tw)
     return polygon(
         [
@@ -124,12 +119,7 @@ def channel(depth: float, flange_width: float, flange_thickness: float, web_thic
     towards +x, out to ``flange_width``. Requires ``2 flange_thickness <
     depth`` and ``web_thickness < flange_width``.
     """
-    d = _positive("channel", "depth", depth)
-    b = _positive("channel", "flange_width", flange_width)
-    tf = _positive("channel", "flange_thickness", flange_thickness)
-    tw = _positive("channel", "web_thickness", web_thickness)
-    _less("channel", "flange_thickness", tf, "depth/2", d / 2)
-    _less("channel", "web_thickness", tw, "flange_width", b)
+    d, b, tf, tw = _flanged("channel", depth, flange_width, flange_thickness, web_thickness)
     return polygon(
         [(0.0, 0.0), (b, 0.0), (b, tf), (tw, tf), (tw, d - tf), (b, d - tf), (b, d), (0.0, d)]
     )
@@ -148,3 +138,17 @@ def _positive(shape: str, key: str, value) -> float:
 def _less(shape: str, key: str, value: float, limit_name: str, limit: float) -> None:
     if not value < limit:
         raise SectionError(f"{shape}: {key} = {value:g} m must be less than {limit_name} = {limit:g} m")
+
+
+def _flanged(shape: str, depth, flange_width, flange_thickness, web_thickness) -> tuple[float, ...]:
+    """Checked ``(depth, flange_width, flange_thickness, web_thickness)`` of a flanged shape.
+
+    All positive, ``2 flange_thickness < depth`` and ``web_thickness < flange_width``.
+    """
+    d = _positive(shape, "depth", depth)
+    b = _positive(shape, "flange_width", flange_width)
+    tf = _positive(shape, "flange_thickness", flange_thickness)
+    tw = _positive(shape, "web_thickness", web_thickness)
+    _less(shape, "flange_thickness", tf, "depth/2", d / 2)
+    _less(shape, "web_thickness", tw, "flange_width", b)
+    return d, b, tf, tw
