@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.numerics.rotation import quat_mul
+from rotframe.numerics.rotation import quat_mul, rodrigues_rotate
 
 __all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "rk4_run"]
 
@@ -42,8 +42,10 @@ def _turn_about_axis(L, q, i, angle):
     c, s = math.cos(angle), math.sin(angle)
     Lj, Lk = L[j], L[k]
     before = Lj * Lj + Lk * Lk
-    nj = c * Lj + s * Lk
-    nk = -s * Lj + c * Lk
+    # Rodrigues about the unit axis e_i by -angle: (nj, nk) = (c Lj + s Lk, -s Lj + c Lk)
+    turned = rodrigues_rotate(L[0], L[1], L[2], 1.0 if i == 0 else 0.0, 1.0 if i == 1 else 0.0,
+                              1.0 if i == 2 else 0.0, c, -s)
+    nj, nk = turned[j], turned[k]
     after = nj * nj + nk * nk
     # first-order correction n (1 + (before - after) / (2 after)), applied as a small
     # increment: a factor near 1 would round with a bias (the doubles below 1 are
