@@ -102,10 +102,11 @@ def _quat_mul_rows(a, b, out):
 
 def quat_mul_arrays(a, b) -> np.ndarray:
     """Hamilton product of scalar-last quaternions ``(..., 4)``, broadcasting over leading axes."""
-    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
-    shape = a.shape
-    out = np.empty((int(np.prod(shape[:-1], dtype=np.int64)), 4))
-    _quat_mul_rows(np.ascontiguousarray(a.reshape(-1, 4)), np.ascontiguousarray(b.reshape(-1, 4)), out)
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    shape = np.broadcast_shapes(a.shape, b.shape)
+    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4)) for x in (a, b)]  # writeable copies
+    out = np.empty_like(rows[0])
+    _quat_mul_rows(rows[0], rows[1], out)
     return out.reshape(shape)
 
 
