@@ -106,6 +106,7 @@ class Section:
 
     Examples
     --------
+    >>> from rotframe.rigid.section_shapes import rectangle
     >>> s = rectangle(0.1, 0.2)
     >>> round(s.ixx / (0.1 * 0.2**3 / 12), 12)
     1.0
