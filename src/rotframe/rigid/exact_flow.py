@@ -7,8 +7,8 @@ many time points, but a few hundred microseconds of setup and small-array calls
 for one. :func:`free_body_flow` computes the same formulas, setup included, in
 one numba function: the ordered frame, ``K(m)`` by the arithmetic-geometric
 mean (A&S 17.6), ``R_F``, ``R_J``, ``R_C`` by Carlson's duplication algorithm
-(Carlson 1995, Numer. Algorithms 10, 13), ``sn, cn, dn`` by descending Landen
-transformations (:func:`rotframe.rigid.elliptic.jacobi_reduced`), and the attitude as the product
+(Carlson 1995, Numer. Algorithms 10, 13) and ``sn, cn, dn`` by descending Landen
+transformations, all from :mod:`rotframe.rigid.elliptic`, and the attitude as the product
 ``q = S0 Rz(psi) Ry(-theta) Rz(-phi) P``. Symmetric bodies, the separatrix,
 rotation about the middle axis and ``L = 0`` go to ``free_body_exact``.
 """
@@ -21,10 +21,10 @@ import numpy as np
 from numba import njit
 
 from rotframe.numerics.rotation import quat_mul
-from rotframe.rigid.elliptic import carlson_rf, carlson_rj, ellipk_agm, incomplete_pi, jacobi_reduced
+from rotframe.rigid.elliptic import carlson_rf, ellipk_agm, incomplete_pi, jacobi_reduced
 from rotframe.rigid.free_body import free_body_exact
 
-__all__ = ["free_body_flow", "carlson_rf", "carlson_rj", "ellipk_agm"]
+__all__ = ["free_body_flow"]
 
 _jit = njit(cache=True, error_model="numpy", nogil=True)
 
