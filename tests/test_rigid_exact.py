@@ -12,7 +12,8 @@ from scipy import special
 
 from rotframe.rigid import dynamics as rigid
 from rotframe.rigid.adaptive import rigid_dop853
-from rotframe.rigid.exact_flow import carlson_rf, carlson_rj, ellipk_agm, free_body_flow
+from rotframe.rigid.elliptic import carlson_rf, carlson_rj, ellipk_agm
+from rotframe.rigid.exact_flow import free_body_flow
 
 
 def _body(rng):

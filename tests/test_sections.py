@@ -20,6 +20,7 @@ from matplotlib.path import Path as MplPath
 
 from rotframe.errors import RotframeError
 from rotframe.app.section_cli import SHAPES, run_section, shapes_help
+from rotframe.app.section_plot import plot_section
 from rotframe.rigid.sections import (
     CircleRegion,
     PolygonRegion,
@@ -29,7 +30,6 @@ from rotframe.rigid.sections import (
     channel,
     circle,
     i_beam,
-    plot_section,
     polygon,
     rectangle,
     tube,

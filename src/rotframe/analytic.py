@@ -19,6 +19,8 @@ from scipy.optimize import brentq
 from scipy.special import ellipk
 
 from rotframe.errors import ScenarioError
+from rotframe.numerics.rotation import skew
+from rotframe.validation import check_vector3
 
 __all__ = [
     "DropResult",
@@ -192,10 +194,10 @@ def linear_rotating_propagator(
     r, v : ndarray, shape t.shape + (3,)
         Position (m) and rotating-frame velocity (m/s) at the times ``t``.
     """
-    w = _vec3(omega_vec, "omega_vec")
-    g = _vec3(g_vec, "g_vec")
-    s0 = np.concatenate([_vec3(r0, "r0"), _vec3(v0, "v0"), [1.0]])
-    W = _skew(w)
+    w = check_vector3(omega_vec, "omega_vec", finite=False)
+    g = check_vector3(g_vec, "g_vec", finite=False)
+    s0 = np.concatenate([check_vector3(r0, "r0", finite=False), check_vector3(v0, "v0", finite=False), [1.0]])
+    W = skew(w)
     a_r = np.zeros((3, 3))
     if centrifugal:
         a_r -= W @ W
@@ -489,8 +491,8 @@ def turntable_inertial_line(r0, v0_inertial, theta_of_t, t):
     ndarray, shape (N, 3)
         Rotating-frame positions, m.
     """
-    r0 = _vec3(r0, "r0")
-    v = _vec3(v0_inertial, "v0_inertial")
+    r0 = check_vector3(r0, "r0", finite=False)
+    v = check_vector3(v0_inertial, "v0_inertial", finite=False)
     theta = np.asarray(theta_of_t, dtype=float)
     t = np.asarray(t, dtype=float)
     theta, t = np.broadcast_arrays(theta, t)
@@ -506,18 +508,6 @@ def turntable_inertial_line(r0, v0_inertial, theta_of_t, t):
 # --------------------------------------------------------------------------------------
 # Helpers
 # --------------------------------------------------------------------------------------
-
-
-def _vec3(x, name):
-    a = np.asarray(x, dtype=float)
-    if a.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,), got {a.shape}")
-    return a
-
-
-def _skew(w):
-    """Skew matrix W with W @ v = w x v."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 def _spring_matrix(spring):

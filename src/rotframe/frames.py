@@ -105,7 +105,7 @@ def direction_cosines(v: ArrayLike) -> np.ndarray:
     ValueError (RotframeError)
         For a zero or non-finite vector (no direction) or a last axis not of length 3.
     """
-    v = _vectors(v, "direction_cosines", "v")
+    v = check_vector3(v, "v", _InputError, stack=True, finite=False, caller="direction_cosines")
     scale = np.abs(v).max(axis=-1, keepdims=True)  # scaled first: no overflow for huge |v|
     bad = ~(np.isfinite(scale[..., 0]) & (scale[..., 0] > 0))
     if bad.any():
@@ -391,7 +391,7 @@ def euler_rates_to_omega(
     array([0.652704, 0.171663, 1.962121])
     """
     J, _ = _rate_matrix(angles, seq, frame, degrees, "euler_rates_to_omega")
-    rates = _vectors(rates, "euler_rates_to_omega", "rates")
+    rates = check_vector3(rates, "rates", _InputError, stack=True, finite=False, caller="euler_rates_to_omega")
     _common_shape("euler_rates_to_omega", angles=J[..., 0], rates=rates)
     return (J @ rates[..., None])[..., 0]
 
@@ -435,7 +435,7 @@ def omega_to_euler_rates(
         and the middle angle; rates there are not finite, and none are returned.
     """
     J, middle = _rate_matrix(angles, seq, frame, degrees, "omega_to_euler_rates")
-    omega = _vectors(omega, "omega_to_euler_rates", "omega")
+    omega = check_vector3(omega, "omega", _InputError, stack=True, finite=False, caller="omega_to_euler_rates")
     _common_shape("omega_to_euler_rates", angles=J[..., 0], omega=omega)
     g = np.abs(np.sin(middle)) if _is_proper(seq) else np.abs(np.cos(middle))
     locked = g < gimbal_atol
@@ -471,9 +471,9 @@ def space_derivative(d_body: ArrayLike, omega: ArrayLike, vec: ArrayLike) -> np.
     ndarray, shape (..., 3)
         ``d_body + omega x vec``.
     """
-    d_body = _vectors(d_body, "space_derivative", "d_body")
-    omega = _vectors(omega, "space_derivative", "omega")
-    vec = _vectors(vec, "space_derivative", "vec")
+    d_body = check_vector3(d_body, "d_body", _InputError, stack=True, finite=False, caller="space_derivative")
+    omega = check_vector3(omega, "omega", _InputError, stack=True, finite=False, caller="space_derivative")
+    vec = check_vector3(vec, "vec", _InputError, stack=True, finite=False, caller="space_derivative")
     _common_shape("space_derivative", d_body=d_body, omega=omega, vec=vec)
     return d_body + np.cross(omega, vec)
 
@@ -514,12 +514,12 @@ def fictitious_accelerations(
     >>> np.round(a["coriolis"] * 1e3, 4) + 0.0  # mm/s^2: 2 Omega sin(45 deg) 10 m/s, east (to the right)
     array([1.0313, 0.    , 0.    ])
     """
-    r = _vectors(r, "fictitious_accelerations", "r")
-    v = _vectors(v, "fictitious_accelerations", "v")
-    omega = _vectors(omega, "fictitious_accelerations", "omega")
+    r = check_vector3(r, "r", _InputError, stack=True, finite=False, caller="fictitious_accelerations")
+    v = check_vector3(v, "v", _InputError, stack=True, finite=False, caller="fictitious_accelerations")
+    omega = check_vector3(omega, "omega", _InputError, stack=True, finite=False, caller="fictitious_accelerations")
     if omega_dot is None:
         omega_dot = np.zeros(3)
-    omega_dot = _vectors(omega_dot, "fictitious_accelerations", "omega_dot")
+    omega_dot = check_vector3(omega_dot, "omega_dot", _InputError, stack=True, finite=False, caller="fictitious_accelerations")
     shape = _common_shape("fictitious_accelerations", r=r, v=v, omega=omega, omega_dot=omega_dot)
     coriolis = -2.0 * np.cross(omega, v)
     centrifugal = -np.cross(omega, np.cross(omega, r))
@@ -693,15 +693,8 @@ def _rate_matrix(angles, seq, frame, degrees, caller):
 
 
 def _angles(angles, caller, name, degrees):
-    a = _vectors(angles, caller, name)
+    a = check_vector3(angles, name, _InputError, stack=True, finite=False, caller=caller)
     return np.radians(a) if degrees else a
-
-
-def _vectors(x, caller, name):
-    x = np.asarray(x, dtype=np.float64)
-    if x.ndim == 0 or x.shape[-1] != 3:
-        raise _InputError(f"{caller}: {name} has shape {x.shape}; it must be (..., 3)")
-    return x
 
 
 def _matrices(A, caller):
@@ -755,6 +748,6 @@ def _angle_text(angle):
 
 
 # text, complex and object input to the public functions: a _InputError, not a numpy TypeError
-from rotframe.validation import guard_public  # noqa: E402
+from rotframe.validation import check_vector3, guard_public  # noqa: E402
 
 guard_public(globals(), __all__, _InputError, error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "dcm_to_euler", "from_scipy", "to_scipy")})

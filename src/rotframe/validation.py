@@ -1,4 +1,10 @@
-"""Public functions refuse text, complex and object input with a RotframeError.
+"""Input validation shared by every layer: 3-vectors, and the guard of public functions.
+
+:func:`check_vector3` is the one check of a 3-vector (or a stack of them) for
+every module; its error names the caller, the argument, the value and what is
+allowed, in the error class the caller gives.
+
+Public functions refuse text, complex and object input with a RotframeError.
 
 :func:`guard_public` wraps the plain-Python functions a module exports so that
 
@@ -27,7 +33,7 @@ import numpy as np
 
 from rotframe.errors import RotframeError
 
-__all__ = ["guard_public"]
+__all__ = ["guard_public", "check_vector3"]
 
 
 def _has_complex(value) -> bool:
@@ -96,3 +102,51 @@ def guard_public(namespace: dict, names, error_cls, error_for=None) -> None:
         func = namespace.get(name)
         if isinstance(func, types.FunctionType) and not getattr(func, "__wrapped_public__", False):
             namespace[name] = _guard(func, error_cls, error_for)
+
+
+def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, stack: bool = False,
+                  finite: bool = True, unit: str = "", caller: str = "") -> np.ndarray:
+    """``value`` as a float64 3-vector, shape ``(3,)`` (or ``(..., 3)`` with ``stack=True``).
+
+    Parameters
+    ----------
+    value : array_like
+        The argument as given.
+    name : str
+        Its name, as the caller's signature spells it.
+    error_cls : type
+        Error raised (a :class:`~rotframe.errors.RotframeError` subclass in the
+        public API, so that the CLI exits with code 2).
+    stack : bool
+        Accept any leading shape ``(..., 3)`` instead of exactly ``(3,)``.
+    finite : bool
+        Also refuse NaN and infinite components.
+    unit : str
+        Unit named in the message (e.g. ``"m"``).
+    caller : str
+        Function named at the start of the message.
+
+    Returns
+    -------
+    ndarray
+        ``np.asarray(value, dtype=float64)``.
+
+    Raises
+    ------
+    error_cls
+        One line: ``[caller: ]name = VALUE has shape S; it must be ...`` (e.g.
+        ``(..., 3)``, ``3 finite numbers (m)``).
+    """
+    a = np.asarray(value, dtype=np.float64)
+    shape_ok = (a.ndim >= 1 and a.shape[-1] == 3) if stack else a.shape == (3,)
+    if shape_ok and (not finite or np.all(np.isfinite(a))):
+        return a
+    shown = np.asarray(value).ravel()[:6].tolist()
+    if np.asarray(value).size > 6:
+        shown = str(shown)[:-1] + ", ...]"
+    allowed = "(..., 3)" if stack else "3 numbers"
+    if finite:
+        allowed = ("finite, " if stack else "3 finite numbers") + (allowed if stack else "")
+    where = f"{caller}: " if caller else ""
+    units = f" ({unit})" if unit else ""
+    raise error_cls(f"{where}{name} = {shown} has shape {a.shape}; it must be {allowed}{units}")

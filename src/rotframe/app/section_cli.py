@@ -34,6 +34,7 @@ import numpy as np
 from rotframe.app.choices import did_you_mean
 from rotframe.app.options import split_set
 from rotframe.app.quantities import NotAQuantity, WrongDimension, value_in
+from rotframe.app.section_plot import plot_section
 from rotframe.rigid.sections import (
     PROPERTY_UNITS,
     SectionError,
@@ -41,7 +42,6 @@ from rotframe.rigid.sections import (
     channel,
     circle,
     i_beam,
-    plot_section,
     polygon,
     rectangle,
     tube,

@@ -56,6 +56,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.error_norm import dop853_error_norm
+from rotframe.numerics.rotation import rodrigues_rotate
+
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
 I_KLIN, I_KQUAD, I_GMODE, I_GM, I_R, I_PLEN, I_PIVOT, I_G0, I_SPRING, I_SCALE_H = 9, 10, 11, 12, 13, 14, 15, 18, 19, 20
@@ -360,18 +363,6 @@ def acceleration(r, v, t, P, wt, wv, out):
 
 
 @_jit
-def _rotate(vx, vy, vz, ax, ay, az, c, s):
-    """v rotated about the unit axis (ax, ay, az) by the angle with cos c, sin s."""
-    d = ax * vx + ay * vy + az * vz
-    cx = ay * vz - az * vy
-    cy = az * vx - ax * vz
-    cz = ax * vy - ay * vx
-    one_c = 1.0 - c
-    return (vx * c + cx * s + ax * d * one_c, vy * c + cy * s + ay * d * one_c,
-            vz * c + cz * s + az * d * one_c)
-
-
-@_jit
 def _air(z, m):
     """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
     H = m.scale_h
@@ -446,7 +437,7 @@ def _free_steps(state, n, method, h, m, plan):
                 k2 = m.k2 * air
                 vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
             if m.coriolis:
-                vx, vy, vz = _rotate(vx, vy, vz, ux, uy, uz, c, s)
+                vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
             if m.drag:
                 vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
             vx += hh * ax
@@ -496,7 +487,7 @@ def _sphere_step(state, h, m, sub):
     if m.coriolis:
         wn = m.axis[0] * nx + m.axis[1] * ny + m.axis[2] * nz
         angle = -2.0 * wn * sub[2]
-        vx, vy, vz = _rotate(vx, vy, vz, nx, ny, nz, np.cos(angle), np.sin(angle))
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, np.cos(angle), np.sin(angle))
     if m.drag:
         vx, vy, vz = _drag_flow(vx, vy, vz, k1, k2, hh)
     vx += hh * ax
@@ -925,30 +916,6 @@ def _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp):
         y_new[j] = y[j] + h * acc
     w, wd = _rates(t + h, m.steady, m.w, wt, wv)
     K[12, 0], K[12, 1], K[12, 2], K[12, 3], K[12, 4], K[12, 5] = _deriv(_as_state(y_new), m, w, wd)
-
-
-@_jit
-def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
-    """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
-
-    ``atol`` holds one absolute tolerance per component of ``y`` (the particle and
-    rigid-body kernels share this function; docs/physics/dop853.md).
-    """
-    n = y.shape[0]
-    e5 = 0.0
-    e3 = 0.0
-    for j in range(n):
-        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
-        s5 = 0.0
-        s3 = 0.0
-        for q in range(13):
-            s5 += E5[q] * K[q, j]
-            s3 += E3[q] * K[q, j]
-        e5 += (s5 / sc) ** 2
-        e3 += (s3 / sc) ** 2
-    if e5 == 0.0 and e3 == 0.0:
-        return 0.0
-    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
 
 
 @_jit

@@ -238,8 +238,10 @@ class ParticleModel:
 
     def linear_matrices(self):
         """(K, C, b) with r'' = K r + C v + b, for a linear model (see :attr:`is_linear`)."""
+        from rotframe.numerics.rotation import skew  # numba-free callers stay cheap to import
+
         w = self.omega.vector(0.0)
-        W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+        W = skew(w)
         K = np.zeros((3, 3))
         C = np.zeros((3, 3))
         b = np.zeros(3)

@@ -2,7 +2,7 @@
 
 The state is ``y = (L_body, q)``: angular momentum in principal body axes
 (kg m^2/s) and the body -> space orientation quaternion, scalar-last. The
-equations are those of :func:`rotframe.rigid.dynamics.rigid_rhs` (docs/physics.md,
+equations are those of :func:`rotframe.rigid.torqued.rigid_rhs` (docs/physics.md,
 rigid bodies): Euler's equations ``dL/dt = L x omega + N_body``,
 ``omega = L / I``, and the kinematics ``dq/dt = q * (omega, 0) / 2``, with the
 torque of a heavy symmetric top ``mgl (z_b[1], -z_b[0], 0)``, a constant body
@@ -31,7 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.particles.kernels import dop853_error_norm
+from rotframe.numerics.error_norm import dop853_error_norm
+from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
@@ -63,28 +64,10 @@ def _tableau():
 
 @_jit
 def _f(y, p, K, row):
-    """Right-hand side into K[row]; p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))."""
-    L0, L1, L2 = y[0], y[1], y[2]
-    x, yq, z, w = y[3], y[4], y[5], y[6]
-    o0, o1, o2 = L0 * p[0], L1 * p[1], L2 * p[2]
-    n0 = p[4]
-    n1 = p[5]
-    n2 = p[6]
-    if p[3] != 0.0 or p[7] != 0.0 or p[8] != 0.0 or p[9] != 0.0:
-        s = 1.0 / (x * x + yq * yq + z * z + w * w)  # the rotation of q/|q|
-        r00, r01, r02 = 1 - 2 * s * (yq * yq + z * z), 2 * s * (x * yq - z * w), 2 * s * (x * z + yq * w)
-        r10, r11, r12 = 2 * s * (x * yq + z * w), 1 - 2 * s * (x * x + z * z), 2 * s * (yq * z - x * w)
-        r20, r21, r22 = 2 * s * (x * z - yq * w), 2 * s * (yq * z + x * w), 1 - 2 * s * (x * x + yq * yq)
-        n0 += r00 * p[7] + r10 * p[8] + r20 * p[9] + p[3] * r21
-        n1 += r01 * p[7] + r11 * p[8] + r21 * p[9] - p[3] * r20
-        n2 += r02 * p[7] + r12 * p[8] + r22 * p[9]
-    K[row, 0] = L1 * o2 - L2 * o1 + n0
-    K[row, 1] = L2 * o0 - L0 * o2 + n1
-    K[row, 2] = L0 * o1 - L1 * o0 + n2
-    K[row, 3] = 0.5 * (w * o0 + yq * o2 - z * o1)
-    K[row, 4] = 0.5 * (w * o1 + z * o0 - x * o2)
-    K[row, 5] = 0.5 * (w * o2 + x * o1 - yq * o0)
-    K[row, 6] = -0.5 * (x * o0 + yq * o1 + z * o2)
+    """Right-hand side (:func:`rotframe.rigid.kernels.euler_rates`) into K[row];
+    p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))."""
+    (K[row, 0], K[row, 1], K[row, 2], K[row, 3], K[row, 4], K[row, 5], K[row, 6]) = euler_rates(
+        y[0], y[1], y[2], y[3], y[4], y[5], y[6], p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
 
 @_jit
 def _stages(y, h, p, A, K, tmp, first, last):

@@ -1,14 +1,14 @@
 """The exact free asymmetric rigid body in one compiled call (a fast path of ``rigid.free_body_exact``).
 
-:func:`rotframe.rigid.dynamics.free_body_exact` evaluates the closed-form motion (Jacobi
+:func:`rotframe.rigid.free_body.free_body_exact` evaluates the closed-form motion (Jacobi
 elliptic functions for the momentum, Carlson's integrals for the angle about
 ``L``; docs/physics.md, rigid bodies) with numpy and scipy on arrays: right for
 many time points, but a few hundred microseconds of setup and small-array calls
 for one. :func:`free_body_flow` computes the same formulas, setup included, in
 one numba function: the ordered frame, ``K(m)`` by the arithmetic-geometric
 mean (A&S 17.6), ``R_F``, ``R_J``, ``R_C`` by Carlson's duplication algorithm
-(Carlson 1995, Numer. Algorithms 10, 13), ``sn, cn, dn`` by descending Landen
-transformations (``rigid._jacobi_reduced``), and the attitude as the product
+(Carlson 1995, Numer. Algorithms 10, 13) and ``sn, cn, dn`` by descending Landen
+transformations, all from :mod:`rotframe.rigid.elliptic`, and the attitude as the product
 ``q = S0 Rz(psi) Ry(-theta) Rz(-phi) P``. Symmetric bodies, the separatrix,
 rotation about the middle axis and ``L = 0`` go to ``free_body_exact``.
 """
@@ -20,97 +20,13 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.rigid.dynamics import _jacobi_reduced
+from rotframe.numerics.rotation import quat_mul
+from rotframe.rigid.elliptic import carlson_rf, ellipk_agm, incomplete_pi, jacobi_reduced
+from rotframe.rigid.free_body import free_body_exact
 
-__all__ = ["free_body_flow", "carlson_rf", "carlson_rj", "ellipk_agm"]
+__all__ = ["free_body_flow"]
 
 _jit = njit(cache=True, error_model="numpy", nogil=True)
-# duplication stops when every relative deviation is below this: the truncated series then errs
-# by about ERRTOL^6 / 4 ~ 1e-19 relative (Carlson 1995, eq. 2.2)
-_ERRTOL = 0.0008
-
-
-@_jit
-def carlson_rf(x, y, z):
-    """Carlson's R_F(x, y, z), x, y, z >= 0, at most one zero (DLMF 19.16.1)."""
-    for _ in range(100):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * (sy + sz) + sy * sz
-        x, y, z = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
-        ave = (x + y + z) / 3.0
-        dx, dy, dz = (ave - x) / ave, (ave - y) / ave, (ave - z) / ave
-        if max(abs(dx), abs(dy), abs(dz)) <= _ERRTOL:
-            break
-    e2 = dx * dy - dz * dz
-    e3 = dx * dy * dz
-    return (1.0 + (e2 / 24.0 - 0.1 - 3.0 / 44.0 * e3) * e2 + e3 / 14.0) / math.sqrt(ave)
-
-
-@_jit
-def _carlson_rc(x, y):
-    """Carlson's R_C(x, y), x >= 0, y > 0 (DLMF 19.2.17)."""
-    w = 1.0
-    for _ in range(100):
-        lam = 2.0 * math.sqrt(x) * math.sqrt(y) + y
-        x, y = 0.25 * (x + lam), 0.25 * (y + lam)
-        ave = (x + y + y) / 3.0
-        s = (y - ave) / ave
-        if abs(s) <= _ERRTOL:
-            break
-    return w * (1.0 + s * s * (0.3 + s * (1.0 / 7.0 + s * (0.375 + s * 9.0 / 22.0)))) / math.sqrt(ave)
-
-
-@_jit
-def carlson_rj(x, y, z, p):
-    """Carlson's R_J(x, y, z, p), x, y, z >= 0 (at most one zero), p > 0 (DLMF 19.16.2)."""
-    c1, c2, c3, c4 = 3.0 / 14.0, 1.0 / 3.0, 3.0 / 22.0, 3.0 / 26.0
-    c5, c6, c7, c8 = 0.75 * c3, 1.5 * c4, 0.5 * c2, c3 + c3
-    total = 0.0
-    fac = 1.0
-    for _ in range(100):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * (sy + sz) + sy * sz
-        alpha = (p * (sx + sy + sz) + sx * sy * sz) ** 2
-        beta = p * (p + lam) ** 2
-        total += fac * _carlson_rc(alpha, beta)
-        fac *= 0.25
-        x, y, z, p = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (p + lam)
-        ave = 0.2 * (x + y + z + p + p)
-        dx, dy, dz, dp = (ave - x) / ave, (ave - y) / ave, (ave - z) / ave, (ave - p) / ave
-        if max(abs(dx), abs(dy), abs(dz), abs(dp)) <= _ERRTOL:
-            break
-    ea = dx * (dy + dz) + dy * dz
-    eb = dx * dy * dz
-    ec = dp * dp
-    ed = ea - 3.0 * ec
-    ee = eb + 2.0 * dp * (ea - ec)
-    return 3.0 * total + fac * (1.0 + ed * (-c1 + c5 * ed - c6 * ee) + eb * (c7 + dp * (-c8 + dp * c4))
-                                + dp * ea * (c2 - dp * c3) - c2 * dp * ec) / (ave * math.sqrt(ave))
-
-
-@_jit
-def ellipk_agm(m1):
-    """Complete K(m) from the complementary parameter m1 = 1 - m > 0: pi / (2 AGM(1, sqrt(m1)))."""
-    a, b = 1.0, math.sqrt(m1)
-    for _ in range(64):
-        if abs(a - b) <= 1e-16 * a:
-            break
-        a, b = 0.5 * (a + b), math.sqrt(a * b)
-    return math.pi / (a + b)
-
-
-@_jit
-def _pi_carlson(s, c, d, nu):
-    """Incomplete Pi(nu; am | m) from s = sin am, c = |cos am|, d = dn (A&S 17.2; DLMF 19.25.14)."""
-    s2 = s * s
-    return s * carlson_rf(c * c, d * d, 1.0) + nu / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - nu * s2)
-
-
-@_jit
-def _qmul(a0, a1, a2, a3, b0, b1, b2, b3):
-    """Hamilton product of scalar-last quaternions given as scalars."""
-    return (a3 * b0 + b3 * a0 + a1 * b2 - a2 * b1, a3 * b1 + b3 * a1 + a2 * b0 - a0 * b2,
-            a3 * b2 + b3 * a2 + a0 * b1 - a1 * b0, a3 * b3 - a0 * b0 - a1 * b1 - a2 * b2)
 
 
 @_jit
@@ -155,7 +71,7 @@ def _flow(moments, L0, q0, t, out_L, out_q):
     if not (nq > 0.0 and np.isfinite(nq)):
         return False
     q0 = q0 / nq
-    # ordered frame (rigid._elliptic_frame)
+    # ordered frame (free_body._elliptic_frame)
     order = np.argsort(moments, kind="mergesort")
     P = np.zeros((3, 3))
     for i in range(3):
@@ -198,10 +114,10 @@ def _flow(moments, L0, q0, t, out_L, out_q):
     m1 = max((J3 - J1) * D_s * s * s / ((J3 - J2) * B), 1e-300)
     nu = -J3 * (J2 - J1) / (J1 * (J3 - J2))
     K = ellipk_agm(m1)
-    Pic = _pi_carlson(1.0, 0.0, math.sqrt(m1), nu)
+    Pic = incomplete_pi(1.0, 0.0, math.sqrt(m1), nu)
     sigma = 1.0 if J3 > J1 else -1.0
     ratio = math.sqrt(J2 * (J3 - J1) / (J1 * (J3 - J2)))
-    # u0 from the initial state (rigid._free_asymmetric)
+    # u0 from the initial state (free_body._free_asymmetric)
     s0, c0 = sigma * L[1] / ratio, L[0]
     hyp = math.hypot(s0, c0)
     if hyp > 0.0:
@@ -215,12 +131,12 @@ def _flow(moments, L0, q0, t, out_L, out_q):
     u[0] = u0
     for i in range(nt):
         u[i + 1] = u0 + lam * t[i]
-    sn_w, cn_w, dn_w, sgn, refl, jj = _jacobi_reduced(u, m, m1, K)
+    sn_w, cn_w, dn_w, sgn, refl, jj = jacobi_reduced(u, m, m1, K)
     pq0, pq1, pq2, pq3 = _matrix_quat(P)
     S0 = (0.0, 0.0, 0.0, 1.0)
     Pi0 = 0.0
     for i in range(nt + 1):
-        G = _pi_carlson(sn_w[i], cn_w[i], dn_w[i], nu)
+        G = incomplete_pi(sn_w[i], cn_w[i], dn_w[i], nu)
         sn = sgn[i] * sn_w[i]
         cn = -cn_w[i] if refl[i] else cn_w[i]
         dn = dn_w[i]
@@ -234,16 +150,16 @@ def _flow(moments, L0, q0, t, out_L, out_q):
         if i == 0:
             Pi0 = Pi
             # S0 = q0 P^-1 Rz(phi0) Ry(theta0)
-            a = _qmul(q0[0], q0[1], q0[2], q0[3], -pq0, -pq1, -pq2, pq3)
-            a = _qmul(a[0], a[1], a[2], a[3], 0.0, 0.0, math.sin(0.5 * phi), math.cos(0.5 * phi))
-            S0 = _qmul(a[0], a[1], a[2], a[3], 0.0, math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
+            a = quat_mul(q0[0], q0[1], q0[2], q0[3], -pq0, -pq1, -pq2, pq3)
+            a = quat_mul(a[0], a[1], a[2], a[3], 0.0, 0.0, math.sin(0.5 * phi), math.cos(0.5 * phi))
+            S0 = quat_mul(a[0], a[1], a[2], a[3], 0.0, math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
             continue
         k = i - 1
         psi = norm_L / J[2] * (t[k] + (J[2] - J[0]) / (J[0] * lam) * (Pi - Pi0))
-        a = _qmul(S0[0], S0[1], S0[2], S0[3], 0.0, 0.0, math.sin(0.5 * psi), math.cos(0.5 * psi))
-        a = _qmul(a[0], a[1], a[2], a[3], 0.0, -math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
-        a = _qmul(a[0], a[1], a[2], a[3], 0.0, 0.0, -math.sin(0.5 * phi), math.cos(0.5 * phi))
-        a = _qmul(a[0], a[1], a[2], a[3], pq0, pq1, pq2, pq3)
+        a = quat_mul(S0[0], S0[1], S0[2], S0[3], 0.0, 0.0, math.sin(0.5 * psi), math.cos(0.5 * psi))
+        a = quat_mul(a[0], a[1], a[2], a[3], 0.0, -math.sin(0.5 * theta), 0.0, math.cos(0.5 * theta))
+        a = quat_mul(a[0], a[1], a[2], a[3], 0.0, 0.0, -math.sin(0.5 * phi), math.cos(0.5 * phi))
+        a = quat_mul(a[0], a[1], a[2], a[3], pq0, pq1, pq2, pq3)
         for j in range(4):
             out_q[k, j] = a[j]
         for j in range(3):  # ordered -> body: P^T L
@@ -252,12 +168,12 @@ def _flow(moments, L0, q0, t, out_L, out_q):
 
 
 def free_body_flow(inertia, L0_body, q0, times):
-    """The exact torque-free motion at ``times``, as :func:`rotframe.rigid.dynamics.free_body_exact` returns it.
+    """The exact torque-free motion at ``times``, as :func:`rotframe.rigid.free_body.free_body_exact` returns it.
 
     The same closed form, evaluated in one compiled call for the asymmetric
     body (a few microseconds for a few time points); other cases (two equal
     moments, the separatrix, rotation about the middle axis, ``L = 0``) and
-    invalid input are passed to :func:`rotframe.rigid.dynamics.free_body_exact`.
+    invalid input are passed to :func:`rotframe.rigid.free_body.free_body_exact`.
 
     Returns
     -------
@@ -273,6 +189,4 @@ def free_body_flow(inertia, L0_body, q0, times):
         out_q = np.empty((t.size, 4))
         if _flow(moments, L0, q, t, out_L, out_q):
             return out_L, out_q
-    from rotframe.rigid.dynamics import free_body_exact
-
     return free_body_exact(inertia, L0_body, q0, times)

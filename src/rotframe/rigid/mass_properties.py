@@ -81,7 +81,7 @@ def point_masses(masses: ArrayLike, positions: ArrayLike, about: ArrayLike = (0.
         Inertia tensor (kg m^2) about ``about`` in the reference axes.
     """
     m = np.atleast_1d(np.asarray(masses, dtype=np.float64))
-    r = np.asarray(positions, dtype=np.float64).reshape(-1, 3) - _vector(about, "about")
+    r = np.asarray(positions, dtype=np.float64).reshape(-1, 3) - check_vector3(about, "about", InvalidBodyError, unit="m")
     if m.ndim != 1 or m.shape[0] != r.shape[0]:
         raise InvalidBodyError(
             f"masses (shape {m.shape}) and positions (shape {r.shape}) must pair each mass "
@@ -110,29 +110,22 @@ def solid_sphere(mass: float, radius: float) -> np.ndarray:
     ndarray, shape (3, 3)
         Inertia tensor (kg m^2) about the centre of mass.
     """
-    m = check_mass(mass)
-    r = _length(radius, "radius")
-    return np.eye(3) * (0.4 * m * r * r)
+    return _isotropic(mass, radius, 0.4)
 
 
 def spherical_shell(mass: float, radius: float) -> np.ndarray:
     """Thin spherical shell about its centre: ``(2/3) m R^2`` on each axis.
 
-    Parameters
-    ----------
-    mass : float
-        Mass (kg).
-    radius : float
-        Radius (m).
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        Inertia tensor (kg m^2) about the centre of mass.
+    Parameters and result as in :func:`solid_sphere`.
     """
+    return _isotropic(mass, radius, 2.0 / 3.0)
+
+
+def _isotropic(mass, radius, factor):
+    """``factor m R^2`` on each axis (a body with the symmetry of the sphere), after the checks."""
     m = check_mass(mass)
     r = _length(radius, "radius")
-    return np.eye(3) * (2.0 / 3.0 * m * r * r)
+    return np.eye(3) * (factor * m * r * r)
 
 
 def box(mass: float, a: float, b: float, c: float) -> np.ndarray:
@@ -236,7 +229,7 @@ def shift_from_com(tensor_com: ArrayLike, mass: float, com: ArrayLike, point: Ar
     """
     t = check_tensor(tensor_com)
     m = check_mass(mass)
-    return t + _steiner(m, _vector(com, "com") - _vector(point, "point"))
+    return t + _steiner(m, check_vector3(com, "com", InvalidBodyError, unit="m") - check_vector3(point, "point", InvalidBodyError, unit="m"))
 
 
 def shift_to_com(tensor_point: ArrayLike, mass: float, com: ArrayLike, point: ArrayLike) -> np.ndarray:
@@ -262,7 +255,7 @@ def shift_to_com(tensor_point: ArrayLike, mass: float, com: ArrayLike, point: Ar
     """
     t = check_tensor(tensor_point)
     m = check_mass(mass)
-    return check_tensor(t - _steiner(m, _vector(com, "com") - _vector(point, "point")))
+    return check_tensor(t - _steiner(m, check_vector3(com, "com", InvalidBodyError, unit="m") - check_vector3(point, "point", InvalidBodyError, unit="m")))
 
 
 def combine(parts: Iterable) -> tuple[float, np.ndarray, np.ndarray]:
@@ -291,7 +284,7 @@ def combine(parts: Iterable) -> tuple[float, np.ndarray, np.ndarray]:
     if not parts:
         raise InvalidBodyError("combine() needs at least one part (mass, com, tensor)")
     masses = np.array([check_mass(p[0], name=f"parts[{k}] mass") for k, p in enumerate(parts)])
-    coms = np.array([_vector(p[1], f"parts[{k}] com") for k, p in enumerate(parts)])
+    coms = np.array([check_vector3(p[1], f"parts[{k}] com", InvalidBodyError, unit="m") for k, p in enumerate(parts)])
     total = masses.sum()
     com = masses @ coms / total
     tensor = np.zeros((3, 3))
@@ -455,14 +448,6 @@ def _steiner(mass, d):
     return mass * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
 
 
-def _vector(v, name):
-    """A finite 3-vector as float64, or :class:`InvalidBodyError` naming it."""
-    a = np.asarray(v, dtype=np.float64)
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
-        raise InvalidBodyError(f"{name} = {np.asarray(v).tolist()} must be 3 finite numbers (m)")
-    return a
-
-
 def _length(v, name):
     """A finite length >= 0 as float, or :class:`InvalidBodyError` naming it."""
     x = float(v)
@@ -472,6 +457,6 @@ def _length(v, name):
 
 
 # text, complex and object input to the public functions: a InvalidBodyError, not a numpy TypeError
-from rotframe.validation import guard_public  # noqa: E402
+from rotframe.validation import check_vector3, guard_public  # noqa: E402
 
 guard_public(globals(), __all__, InvalidBodyError)

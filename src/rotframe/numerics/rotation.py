@@ -1,0 +1,116 @@
+"""Rotation primitives, one source each: the skew (hat) matrix, Rodrigues' rotation, quaternions.
+
+Conventions
+-----------
+* ``skew(w) @ v == np.cross(w, v)`` (the hat map of ``so(3)``).
+* Rodrigues' formula for the ACTIVE rotation of ``v`` by ``angle`` about the unit
+  axis ``a`` (right-hand rule): ``v c + (a x v) s + a (a . v)(1 - c)`` with
+  ``c = cos(angle)``, ``s = sin(angle)``; it is ``exp(angle skew(a)) @ v``.
+* Quaternions are SCALAR-LAST ``(x, y, z, w)``, as in scipy's ``Rotation``;
+  :func:`quat_mul` is Hamilton's product, so ``R(a * b) = R(a) @ R(b)``, and
+  :func:`quat_about_axis` is the quaternion of Rodrigues' rotation,
+  ``(sin(angle/2) a, cos(angle/2))``.
+
+The compiled kernels (:func:`rodrigues_rotate`, :func:`quat_mul`) take scalar
+components so that numba callers pay no array allocation; the array forms
+(:func:`rotate_about`, :func:`quat_mul_arrays`) loop over the same kernels, so
+every caller evaluates the same formula in the same operation order. The
+formulas are in ``docs/physics/rigid-bodies.md`` (quaternion kinematics) and
+``docs/physics/splitting.md`` (exact Coriolis rotation).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    "skew",
+    "rodrigues_rotate",
+    "rotate_about",
+    "quat_mul",
+    "quat_mul_arrays",
+    "quat_about_axis",
+]
+
+_jit = njit(cache=True, error_model="numpy", nogil=True)
+
+
+def skew(w) -> np.ndarray:
+    """The skew (hat) matrix ``W`` of a 3-vector: ``W @ v = w x v``.
+
+    Parameters
+    ----------
+    w : array_like, shape (3,)
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+    """
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+@_jit
+def rodrigues_rotate(vx, vy, vz, ax, ay, az, c, s):
+    """``v`` rotated about the unit axis ``(ax, ay, az)`` by the angle with cosine ``c``, sine ``s``.
+
+    Rodrigues: ``v c + (a x v) s + a (a . v)(1 - c)``; returns the three components.
+    """
+    d = ax * vx + ay * vy + az * vz
+    cx = ay * vz - az * vy
+    cy = az * vx - ax * vz
+    cz = ax * vy - ay * vx
+    one_c = 1.0 - c
+    return (vx * c + cx * s + ax * d * one_c, vy * c + cy * s + ay * d * one_c,
+            vz * c + cz * s + az * d * one_c)
+
+
+@_jit
+def _rotate_rows(axis, c, s, v, out):
+    for i in range(c.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = rodrigues_rotate(v[0], v[1], v[2], axis[0], axis[1], axis[2],
+                                                           c[i], s[i])
+
+
+def rotate_about(axis, angle, v) -> np.ndarray:
+    """Rotate ``v`` (3,) by each of ``angle`` (n,) about the unit ``axis`` (3,) (Rodrigues).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+    """
+    angle = np.asarray(angle, dtype=np.float64)
+    out = np.empty((angle.shape[0], 3))
+    _rotate_rows(np.asarray(axis, dtype=np.float64), np.cos(angle), np.sin(angle),
+                 np.asarray(v, dtype=np.float64), out)
+    return out
+
+
+@_jit
+def quat_mul(a0, a1, a2, a3, b0, b1, b2, b3):
+    """Hamilton product ``a * b`` of scalar-last quaternions given as components; a 4-tuple."""
+    return (a3 * b0 + b3 * a0 + a1 * b2 - a2 * b1, a3 * b1 + b3 * a1 + a2 * b0 - a0 * b2,
+            a3 * b2 + b3 * a2 + a0 * b1 - a1 * b0, a3 * b3 - a0 * b0 - a1 * b1 - a2 * b2)
+
+
+@_jit
+def _quat_mul_rows(a, b, out):
+    for i in range(out.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = quat_mul(a[i, 0], a[i, 1], a[i, 2], a[i, 3],
+                                                              b[i, 0], b[i, 1], b[i, 2], b[i, 3])
+
+
+def quat_mul_arrays(a, b) -> np.ndarray:
+    """Hamilton product of scalar-last quaternions ``(..., 4)``, broadcasting over leading axes."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    shape = np.broadcast_shapes(a.shape, b.shape)
+    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4)) for x in (a, b)]  # writeable copies
+    out = np.empty_like(rows[0])
+    _quat_mul_rows(rows[0], rows[1], out)
+    return out.reshape(shape)
+
+
+def quat_about_axis(axis, angle) -> np.ndarray:
+    """Quaternions ``(..., 4)`` of rotations by ``angle`` (...) about the unit ``axis`` (3,)."""
+    half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
+    return np.concatenate([np.sin(half) * axis, np.cos(half)], axis=-1)

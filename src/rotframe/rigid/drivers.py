@@ -1,0 +1,58 @@
+"""Python drivers shared by the fixed-step rigid-body integrators.
+
+Output arrays and sample times (steps ``0, s, 2s, ...`` and always the last), the
+triple-jump weights (:func:`rotframe.numerics.composition.triple_jump_weights`,
+refused orders as :class:`~rotframe.rigid.checks.InvalidStateError`), the end of
+a run (an :class:`~rotframe.errors.IntegrationError` that keeps the finite
+samples), and the driver of the compiled splitting :func:`run_splitting`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.errors import IntegrationError
+from rotframe.numerics.composition import triple_jump_weights
+from rotframe.rigid.checks import InvalidStateError, check_quaternion, check_steps
+from rotframe.rigid.kernels import split_run
+
+__all__ = ["composition_weights", "allocate_samples", "finish_samples", "run_splitting"]
+
+
+def composition_weights(order):
+    """Weights of the order-2 step in Yoshida's triple-jump composition (Yoshida 1990)."""
+    if order not in (2, 4, 6):
+        raise InvalidStateError(f"order = {order!r}; allowed: 2, 4 or 6")
+    return triple_jump_weights(order)
+
+
+def allocate_samples(h, n_steps, sample_every):
+    """Output arrays and sample times: steps 0, s, 2s, ... and always the last."""
+    steps = np.arange(0, n_steps + 1, sample_every)
+    if steps[-1] != n_steps:
+        steps = np.append(steps, n_steps)
+    return np.empty((steps.size, 3)), np.empty((steps.size, 4)), steps * h
+
+
+def finish_samples(out_L, out_q, times, kept, name):
+    """Return the samples, or raise IntegrationError keeping the finite ones."""
+    if kept == times.size:
+        return out_L, out_q, times
+    t_reached = float(times[kept - 1])
+    raise IntegrationError(
+        f"{name}: state became non-finite after t = {t_reached:.6g} s (last finite sample); "
+        "reduce the step",
+        t_reached=t_reached, partial=(out_L[:kept], out_q[:kept], times[:kept]),
+    )
+
+
+def run_splitting(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, order,
+                   sample_every):
+    """Shared driver of lie_poisson and heavy_top_splitting."""
+    q0 = check_quaternion(q0)
+    weights = composition_weights(order)
+    h, n_steps, sample_every = check_steps(h, n_steps, sample_every)
+    out_L, out_q, times = allocate_samples(h, n_steps, sample_every)
+    kept = split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, weights,
+                      sample_every, out_L, out_q)
+    return finish_samples(out_L, out_q, times, kept, "splitting")

@@ -1,0 +1,185 @@
+"""Compiled steps of the rigid-body integrators (numba, ``cache=True``).
+
+State: ``L`` (3,) angular momentum in principal body axes (kg m^2/s) and ``q``
+(4,) the body -> space quaternion, scalar-last. ``inv_i`` holds ``1/I_i`` (0 for
+a zero moment). A torque is a constant body part, a constant space part turned
+into body axes by ``R(q)^T``, and the gravity torque ``mgl (z_b[1], -z_b[0], 0)``
+of a heavy symmetric top (see :func:`rotframe.rigid.torqued.rigid_rhs`).
+
+* :func:`free_step`: the exact free flow of a symmetric body, or the 1,2,3,2,1
+  Lie-Poisson splitting (McLachlan 1993).
+* :func:`split_run`: the Strang composition kick / free / kick over many steps.
+* :func:`euler_rhs`: Euler's equations plus quaternion kinematics.
+* :func:`rk4_run`: classical RK4 on :func:`euler_rhs`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rotframe.numerics.rotation import quat_mul, rodrigues_rotate
+
+__all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "rk4_run"]
+
+# error_model="numpy": a zero quaternion gives NaN, caught by the callers' finiteness checks
+_jit_nan = njit(cache=True, error_model="numpy", nogil=True)
+
+
+@njit(cache=True)
+def _turn_about_axis(L, q, i, angle):
+    """Exact rotation about body axis ``i``: ``L`` turns by ``-angle``, ``q <- q rot_i(angle)``.
+
+    The rounded (cos, sin) pair has cos^2 + sin^2 = 1 + delta with a delta that
+    is the same at every step when the angle is (a symmetric body at a fixed
+    step), which would make |L| and the energy drift linearly in the number of
+    steps. Rescaling the turned pair to its length before the turn (as a small
+    increment, see below) leaves an error of random sign per step, so round-off grows like sqrt(N) (Brouwer's law).
+    """
+    j, k = (i + 1) % 3, (i + 2) % 3
+    c, s = math.cos(angle), math.sin(angle)
+    Lj, Lk = L[j], L[k]
+    before = Lj * Lj + Lk * Lk
+    # Rodrigues about the unit axis e_i by -angle: (nj, nk) = (c Lj + s Lk, -s Lj + c Lk)
+    turned = rodrigues_rotate(L[0], L[1], L[2], 1.0 if i == 0 else 0.0, 1.0 if i == 1 else 0.0,
+                              1.0 if i == 2 else 0.0, c, -s)
+    nj, nk = turned[j], turned[k]
+    after = nj * nj + nk * nk
+    # first-order correction n (1 + (before - after) / (2 after)), applied as a small
+    # increment: a factor near 1 would round with a bias (the doubles below 1 are
+    # twice as dense as those above)
+    corr = 0.5 * (before - after) / after if after > 0.0 else 0.0
+    L[j] = nj + nj * corr
+    L[k] = nk + nk * corr
+    r = np.zeros(4)
+    r[i] = math.sin(0.5 * angle)
+    r[3] = math.cos(0.5 * angle)
+    q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
+
+
+@njit(cache=True)
+def free_step(L, q, tau, inv_i, sym):
+    """Free flow over ``tau``: exact for a symmetric body, else the 1,2,3,2,1 splitting."""
+    if sym >= 0:
+        inv_p = inv_i[(sym + 1) % 3]
+        norm_L = math.sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2])
+        if norm_L > 0.0:  # |L|^2 / (2 Ip): rotation about L, L_body unchanged
+            half = 0.5 * tau * norm_L * inv_p
+            r = np.empty(4)
+            r[:3] = math.sin(half) * L / norm_L
+            r[3] = math.cos(half)
+            q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
+        _turn_about_axis(L, q, sym, tau * L[sym] * (inv_i[sym] - inv_p))
+    else:
+        _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
+        _turn_about_axis(L, q, 1, 0.5 * tau * L[1] * inv_i[1])
+        _turn_about_axis(L, q, 2, tau * L[2] * inv_i[2])
+        _turn_about_axis(L, q, 1, 0.5 * tau * L[1] * inv_i[1])
+        _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
+
+
+@_jit_nan
+def body_torque(x, y, z, w, mgl, nb0, nb1, nb2, ns0, ns1, ns2):
+    """Body torque (3-tuple): constant body part ``nb``, ``R(q)^T ns`` and gravity.
+
+    ``q = (x, y, z, w)`` is normalised here. Gravity: ``mgl (z_b[1], -z_b[0], 0)
+    = l e3 x (-m g z_b)`` with ``z_b = R(q)^T (0, 0, 1)``, the third row of ``R(q)``
+    (docs/physics/rigid-bodies.md). Without a space torque or gravity the rotation is skipped.
+    """
+    if mgl == 0.0 and ns0 == 0.0 and ns1 == 0.0 and ns2 == 0.0:
+        return nb0, nb1, nb2
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / n, y / n, z / n, w / n
+    # rows of R(q): R^T v = (col_0 . v, col_1 . v, col_2 . v)
+    r00, r01, r02 = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
+    r10, r11, r12 = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
+    r20, r21, r22 = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
+    return (nb0 + (r00 * ns0 + r10 * ns1 + r20 * ns2 + mgl * r21),
+            nb1 + (r01 * ns0 + r11 * ns1 + r21 * ns2 - mgl * r20),
+            nb2 + (r02 * ns0 + r12 * ns1 + r22 * ns2))
+
+
+@_jit_nan
+def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1, ns2):
+    """Euler's equations and quaternion kinematics, the one right-hand side of the rigid layer.
+
+    ``dL/dt = L x omega + N_body``, ``omega = L / I`` (``i0, i1, i2 = 1/I``, 0 for a
+    zero moment), ``dq/dt = q * (omega, 0) / 2`` (Hamilton product, scalar-last,
+    ``q`` not normalised), ``N_body`` from :func:`body_torque`. Returns the 7-tuple
+    ``(dL0, dL1, dL2, dx, dy, dz, dw)``. Used by :func:`euler_rhs` (RK4,
+    ``rigid_rhs``) and by the adaptive DOP853 of :mod:`rotframe.rigid.adaptive`.
+    """
+    o0, o1, o2 = L0 * i0, L1 * i1, L2 * i2
+    t0, t1, t2 = body_torque(x, y, z, w, mgl, nb0, nb1, nb2, ns0, ns1, ns2)
+    d0, d1, d2, d3 = quat_mul(x, y, z, w, o0, o1, o2, 0.0)
+    return (L1 * o2 - L2 * o1 + t0, L2 * o0 - L0 * o2 + t1, L0 * o1 - L1 * o0 + t2,
+            0.5 * d0, 0.5 * d1, 0.5 * d2, 0.5 * d3)
+
+
+@njit(cache=True)
+def _torque_body(q, mgl, torque_body, torque_space):
+    """:func:`body_torque` of the state's ``q`` as an array (3,)."""
+    tb, ts = torque_body, torque_space
+    out = np.empty(3)
+    out[0], out[1], out[2] = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
+    return out
+
+
+@njit(cache=True)
+def split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, weights,
+               sample_every, out_L, out_q):
+    """Composition of Strang steps kick(tau/2) free(tau) kick(tau/2); returns samples kept."""
+    L, q = L0.copy(), q0.copy()
+    kick = mgl != 0.0 or np.any(torque_body != 0.0) or np.any(torque_space != 0.0)
+    out_L[0], out_q[0] = L, q
+    kept = 1
+    for step in range(1, n_steps + 1):
+        for w in weights:
+            tau = w * h
+            if kick:
+                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
+            free_step(L, q, tau, inv_i, sym)
+            if kick:
+                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
+        q /= math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        if step % sample_every == 0 or step == n_steps:
+            out_L[kept], out_q[kept] = L, q
+            kept += 1
+            if not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
+                return kept - 1
+    return kept
+
+
+@njit(cache=True)
+def euler_rhs(y, inv_i, mgl, torque_body, torque_space):
+    """:func:`euler_rates` on the state ``y = (L_body, q)`` (7,); see ``rigid_rhs``."""
+    tb, ts = torque_body, torque_space
+    dy = np.empty(7)
+    dy[0], dy[1], dy[2], dy[3], dy[4], dy[5], dy[6] = euler_rates(
+        y[0], y[1], y[2], y[3], y[4], y[5], y[6], inv_i[0], inv_i[1], inv_i[2], mgl,
+        tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
+    return dy
+
+
+@njit(cache=True)
+def rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_every, out_L,
+             out_q):
+    """Classical RK4 on euler_rhs; returns samples kept."""
+    y = np.empty(7)
+    y[:3], y[3:] = L0, q0
+    out_L[0], out_q[0] = L0, q0
+    kept = 1
+    for step in range(1, n_steps + 1):
+        k1 = euler_rhs(y, inv_i, mgl, torque_body, torque_space)
+        k2 = euler_rhs(y + 0.5 * h * k1, inv_i, mgl, torque_body, torque_space)
+        k3 = euler_rhs(y + 0.5 * h * k2, inv_i, mgl, torque_body, torque_space)
+        k4 = euler_rhs(y + h * k3, inv_i, mgl, torque_body, torque_space)
+        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if step % sample_every == 0 or step == n_steps:
+            out_L[kept], out_q[kept] = y[:3], y[3:]
+            kept += 1
+            if not np.all(np.isfinite(y)):
+                return kept - 1
+    return kept
