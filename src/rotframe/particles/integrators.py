@@ -202,8 +202,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     _check_work(info, duration, step, samples, r0.shape[0])
     if info.kind == "exact":
         if not model.is_linear:
-            nonlinear = [t for t in model.terms if t in ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum")]
-            why = f"terms {nonlinear} are nonlinear" if nonlinear else "omega varies in time"
+            why = "; ".join(model.nonlinear_reasons())
             raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}); "
                                 "use splitting, splitting4, rk4 or dop853")
         return _integrate_exact(model, r0, v0, duration, samples, events, progress)

@@ -18,7 +18,7 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["OmegaSchedule", "ParticleModel", "TERMS"]
+__all__ = ["OmegaSchedule", "ParticleModel", "TERMS", "NONLINEAR_TERMS"]
 
 #: Force terms a particle scene can name.
 TERMS = (
@@ -34,6 +34,10 @@ TERMS = (
     "spring",
     "curvature",
 )
+
+#: Terms that make r'' nonlinear in (r, v): a model naming one has no exact linear flow
+#: (:attr:`ParticleModel.is_linear`). ``curvature`` makes the ground a sphere (events on altitude).
+NONLINEAR_TERMS = ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature")
 
 
 @dataclass(frozen=True)
@@ -191,13 +195,24 @@ class ParticleModel:
 
         Then the exact propagator (matrix exponential) applies.
         """
-        nonlinear = {"altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature"}
+        return not self.nonlinear_reasons()
+
+    def nonlinear_reasons(self) -> list:
+        """Why the model is not linear with constant coefficients (empty when it is).
+
+        One phrase per cause, for error messages: the :data:`NONLINEAR_TERMS` it
+        names, linear drag in a stratified atmosphere, a rotation rate that varies.
+        """
+        reasons = []
+        nonlinear = [t for t in self.terms if t in NONLINEAR_TERMS]
+        if nonlinear:
+            reasons.append(f"terms {nonlinear} are nonlinear")
         if self.scale_height > 0 and "linear-drag" in self.terms:
-            return False
-        if nonlinear & set(self.terms):
-            return False
+            reasons.append("linear drag in air of varying density (scale_height > 0) is nonlinear")
         uses_omega = {"coriolis", "centrifugal", "euler"} & set(self.terms)
-        return not uses_omega or self.omega.is_constant
+        if uses_omega and not self.omega.is_constant:
+            reasons.append("omega varies in time")
+        return reasons
 
     def pack(self) -> np.ndarray:
         """The flat parameter vector of :mod:`rotframe.particles.kernels` (made once per model, returned as a copy)."""
