@@ -56,6 +56,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
+from rotframe.numerics.dop853 import dop853_error_norm
+
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
 I_KLIN, I_KQUAD, I_GMODE, I_GM, I_R, I_PLEN, I_PIVOT, I_G0, I_SPRING, I_SCALE_H = 9, 10, 11, 12, 13, 14, 15, 18, 19, 20
@@ -215,11 +218,6 @@ def _sub(looked_up, m):
         c = np.cos(angle)
         s = np.sin(angle)
     return w, wd, turn, c, s
-
-
-# Yoshida (1990) triple jump: w1 = 1 / (2 - 2^(1/3)), w0 = 1 - 2 w1.
-_YOSHIDA_W1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
-_YOSHIDA_W0 = 1.0 - 2.0 * _YOSHIDA_W1
 
 
 @_jit
@@ -407,8 +405,8 @@ def _drag_flow(vx, vy, vz, k1, k2, h):
 def _sub_steps(method, h):
     """Number and lengths of the splitting sub-steps of a step h: one of h, or Yoshida's h1, h0, h1."""
     if method == 1:
-        h1 = _YOSHIDA_W1 * h
-        return 3, (h1, _YOSHIDA_W0 * h, h1)
+        h1 = YOSHIDA4_OUTER * h
+        return 3, (h1, YOSHIDA4_INNER * h, h1)
     return 1, (h, h, h)
 
 
@@ -925,30 +923,6 @@ def _dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp):
         y_new[j] = y[j] + h * acc
     w, wd = _rates(t + h, m.steady, m.w, wt, wv)
     K[12, 0], K[12, 1], K[12, 2], K[12, 3], K[12, 4], K[12, 5] = _deriv(_as_state(y_new), m, w, wd)
-
-
-@_jit
-def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
-    """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
-
-    ``atol`` holds one absolute tolerance per component of ``y`` (the particle and
-    rigid-body kernels share this function; docs/physics/dop853.md).
-    """
-    n = y.shape[0]
-    e5 = 0.0
-    e3 = 0.0
-    for j in range(n):
-        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
-        s5 = 0.0
-        s3 = 0.0
-        for q in range(13):
-            s5 += E5[q] * K[q, j]
-            s3 += E3[q] * K[q, j]
-        e5 += (s5 / sc) ** 2
-        e3 += (s3 / sc) ** 2
-    if e5 == 0.0 and e3 == 0.0:
-        return 0.0
-    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
 
 
 @_jit

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.particles.kernels import dop853_error_norm
+from rotframe.numerics.dop853 import dop853_error_norm
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
