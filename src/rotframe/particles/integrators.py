@@ -276,7 +276,7 @@ class _EventBuffers:
 
 def _integrate_kernel(model, info, r0, v0, duration, step, rtol, atol, samples, events, progress,
                       max_events):
-    from rotframe.particles import kernels
+    from rotframe.particles import drivers as kernels
     n = r0.shape[0]
     P = model.pack()
     wt, wv = model.omega.times, model.omega.values

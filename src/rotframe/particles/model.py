@@ -125,7 +125,7 @@ class OmegaSchedule:
 
     def angle(self, t):
         """Angle turned since the first node, exact for the schedule (rad); vectorised."""
-        from rotframe.particles.kernels import omega_angle
+        from rotframe.particles.schedule import omega_angle
 
         wint = self.cumulative()
         return np.array([omega_angle(float(x), self.times, self.values, wint) for x in np.atleast_1d(t)])
@@ -215,7 +215,7 @@ class ParticleModel:
         return reasons
 
     def pack(self) -> np.ndarray:
-        """The flat parameter vector of :mod:`rotframe.particles.kernels` (made once per model, returned as a copy)."""
+        """The flat parameter vector of :mod:`rotframe.particles.packed` (made once per model, returned as a copy)."""
         cached = self.__dict__.get("_packed")
         if cached is None:
             cached = self._pack()
@@ -223,7 +223,7 @@ class ParticleModel:
         return cached.copy()
 
     def _pack(self) -> np.ndarray:
-        from rotframe.particles import kernels as k
+        from rotframe.particles import packed as k
         P = np.zeros(k.N_PARAMS)
         P[k.I_AXIS : k.I_AXIS + 3] = self.omega.axis
         P[k.I_CORIOLIS] = float(self.has("coriolis"))

@@ -5,7 +5,7 @@ model, allocates output and event buffers and loads the kernel on every call:
 some 70 microseconds, more than the integration of a short run costs. A
 :class:`PreparedRun` does that once for a model, method, duration and sample
 count, and each call then only copies the initial state in and calls the
-compiled kernel (``kernels.run_fixed`` or ``kernels.run_dop853``, the same
+compiled kernel (``drivers.run_fixed`` or ``drivers.run_dop853``, the same
 kernels with the same arguments, so the results are bitwise those of
 ``integrate_particles``). For optimisation loops, shooting, Monte Carlo over
 single particles and the bench. No events; a non-finite state raises
@@ -87,7 +87,7 @@ class PreparedRun:
 
     def run(self, r0, v0):
         """(r, v) samples (samples + 1, n, 3) from initial positions and velocities (n, 3) or (3,)."""
-        from rotframe.particles import kernels
+        from rotframe.particles import drivers as kernels
         n, samples = self.n, self.samples
         out_r = np.empty((samples + 1, n, 3))
         out_v = np.empty((samples + 1, n, 3))
