@@ -458,7 +458,7 @@ def _check_bounds(p: Parameter, value: float, raw, where: str):
 
 
 #: Methods by kind of scene (the scene modules check their own list again when they run).
-_PARTICLE_METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+_PARTICLE_METHODS = ("rotation-splitting", "rotation-splitting4", "splitting", "splitting4", "rk4", "dop853", "exact")
 _FREE_BODY_METHODS = ("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4")
 _HEAVY_TOP_METHODS = ("splitting", "splitting4", "splitting6", "rk4")
 _SCENE_METHODS = {"free-top": _FREE_BODY_METHODS, "dzhanibekov": _FREE_BODY_METHODS,

@@ -10,13 +10,13 @@ everything computed before it.
 
 Methods
 -------
-``splitting``
+``rotation-splitting`` (alias ``splitting``)
     Exact-rotation splitting (drift, kick, exact Coriolis rotation, kick,
     drift). Order 2, explicit, time-reversible, volume-preserving; keeps |v|
     exactly under pure Coriolis motion; for a pendulum keeps the string length
     to round-off. One force evaluation per step. The default for particles.
-``splitting4``
-    Yoshida's symmetric composition of three ``splitting`` steps. Order 4,
+``rotation-splitting4`` (alias ``splitting4``)
+    Yoshida's symmetric composition of three ``rotation-splitting`` steps. Order 4,
     same conservation properties, three force evaluations per step.
 ``rk4``
     Classical Runge-Kutta. Order 4, four evaluations per step, conserves
@@ -53,7 +53,7 @@ if TYPE_CHECKING:  # names used only in annotations
 
     from rotframe.particles.model import ParticleModel
 
-__all__ = ["METHODS", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
+__all__ = ["METHODS", "ALIASES", "METHOD_NAMES", "canonical_method", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
 
 
 @dataclass(frozen=True)
@@ -66,17 +66,44 @@ class MethodInfo:
 
 
 METHODS = {
-    "splitting": MethodInfo("splitting", 2, "fixed", "|v| under Coriolis, pendulum constraint; time-reversible", 0),
-    "splitting4": MethodInfo("splitting4", 4, "fixed", "as splitting", 1),
+    "rotation-splitting": MethodInfo("rotation-splitting", 2, "fixed",
+                                     "|v| under Coriolis, pendulum constraint; time-reversible", 0),
+    "rotation-splitting4": MethodInfo("rotation-splitting4", 4, "fixed", "as rotation-splitting", 1),
     "rk4": MethodInfo("rk4", 4, "fixed", "nothing exactly", 2),
     "dop853": MethodInfo("dop853", 8, "adaptive", "nothing exactly; error per step below rtol"),
     "exact": MethodInfo("exact", 0, "exact", "everything (exact solution of the linear model)"),
 }
 
+#: Former names of particle methods, still accepted everywhere a particle method is named:
+#: alias -> the :data:`METHODS` key. (The heavy top's ``splitting``/``splitting4`` are other methods.)
+ALIASES = {"splitting": "rotation-splitting", "splitting4": "rotation-splitting4"}
+
+#: Every name a particle method may be given by: the :data:`METHODS` keys, then the :data:`ALIASES`.
+METHOD_NAMES = tuple(METHODS) + tuple(ALIASES)
+
+
+def canonical_method(name: str) -> str:
+    """The :data:`METHODS` key of a particle method given by its name or an alias (:data:`ALIASES`).
+
+    Raises
+    ------
+    ScenarioError
+        A name that is neither.
+
+    Examples
+    --------
+    >>> canonical_method("splitting4"), canonical_method("dop853")
+    ('rotation-splitting4', 'dop853')
+    """
+    name = ALIASES.get(name, name)
+    if name not in METHODS:
+        raise ScenarioError(f"method: unknown {name!r}; allowed: {', '.join(METHOD_NAMES)}")
+    return name
+
 
 def default_method(model: ParticleModel) -> str:
-    """``exact`` for linear constant-coefficient models, else ``splitting``."""
-    return "exact" if model.is_linear else "splitting"
+    """``exact`` for linear constant-coefficient models, else ``rotation-splitting``."""
+    return "exact" if model.is_linear else "rotation-splitting"
 
 
 def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,
@@ -93,7 +120,8 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     duration : float
         Simulated time (s), > 0.
     method : str, optional
-        A key of :data:`METHODS`; default :func:`default_method`.
+        A key of :data:`METHODS` or an alias (:data:`ALIASES`); default :func:`default_method`.
+        The trajectory's ``method`` is the canonical name (the :data:`METHODS` key).
     step : float, optional
         Step size (s) for fixed-step methods (the step used divides the output
         interval exactly and is never larger). Default: 1/20 of the output interval.
@@ -118,9 +146,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     RunInterrupted
         KeyboardInterrupt during the run; ``partial`` holds the samples before it.
     """
-    method = method or default_method(model)
-    if method not in METHODS:
-        raise ScenarioError(f"method: unknown {method!r}; allowed: {', '.join(METHODS)}")
+    method = canonical_method(method or default_method(model))
     info = METHODS[method]
     r0 = np.atleast_2d(np.asarray(r0, dtype=np.float64)).copy()
     v0 = np.atleast_2d(np.asarray(v0, dtype=np.float64)).copy()
@@ -138,7 +164,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         if not model.is_linear:
             why = "; ".join(model.nonlinear_reasons())
             raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}); "
-                                "use splitting, splitting4, rk4 or dop853")
+                                "use rotation-splitting, rotation-splitting4, rk4 or dop853")
         return _integrate_exact(model, r0, v0, duration, samples, events, progress)
     setup = KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events)
     return run_chunked(setup, model, r0, v0, progress, max_events)

@@ -26,7 +26,8 @@ class PreparedRun:
     ----------
     model : ParticleModel
     method : str
-        ``splitting``, ``splitting4``, ``rk4`` or ``dop853``.
+        ``rotation-splitting``, ``rotation-splitting4``, ``rk4`` or ``dop853`` (or an alias,
+        :data:`rotframe.particles.integrators.ALIASES`).
     duration : float
         Simulated time (s), > 0.
     step : float, optional
@@ -48,11 +49,13 @@ class PreparedRun:
     def __init__(self, model, method, duration, *, step=None, rtol=1e-10, atol=None, samples=1, n=1):
         from rotframe.errors import ScenarioError
         from rotframe.particles.chunked import KernelSetup
-        from rotframe.particles.integrators import METHODS
+        from rotframe.particles.integrators import METHODS, canonical_method
         from rotframe.particles.trajectory import EventBuffers
 
-        if method not in METHODS or METHODS[method].kind not in ("fixed", "adaptive"):
-            raise ScenarioError(f"method: {method!r}; allowed: splitting, splitting4, rk4, dop853")
+        method = canonical_method(method)
+        if METHODS[method].kind not in ("fixed", "adaptive"):
+            raise ScenarioError(f"method: {method!r}; allowed: rotation-splitting (splitting), "
+                                "rotation-splitting4 (splitting4), rk4, dop853")
         duration = float(duration)
         if not duration > 0:
             raise ScenarioError(f"duration: {duration} s; must be > 0")

@@ -221,7 +221,7 @@ def method_rel_error(traj, time_scale):
     motion of time scale T), a factor 10 of margin over the leading term.
     """
     h = traj.extras.get("step") or 0.0
-    order = {"splitting": 2, "splitting4": 4, "rk4": 4}.get(traj.method)
+    order = {"rotation-splitting": 2, "rotation-splitting4": 4, "rk4": 4}.get(traj.method)
     if traj.method == "dop853":
         return 1e-8
     if order is None or not h or not time_scale > 0:

@@ -28,7 +28,7 @@ from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
                                   potential_energy, reject_subnormal, run_particles, unresolved_note)
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+METHODS = ("rotation-splitting", "rotation-splitting4", "splitting", "splitting4", "rk4", "dop853", "exact")
 SAMPLES_PER_PERIOD = 32
 #: Samples kept at most (memory: 48 bytes each); beyond, the period is not measured.
 MAX_SAMPLES = 2_000_000

@@ -20,7 +20,7 @@ from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, reject_subnormal, rel_drift,
                                   run_particles, samples_for, unresolved_note)
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+METHODS = ("exact", "rotation-splitting", "rotation-splitting4", "splitting", "splitting4", "rk4", "dop853")
 
 
 def build(values, terms):

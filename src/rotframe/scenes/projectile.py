@@ -26,7 +26,7 @@ from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error, reject_subnormal,
                                   rel_drift, resolve_terms, run_particles, samples_for, until_event)
 
-METHODS = ("splitting", "splitting4", "rk4", "dop853", "exact")
+METHODS = ("rotation-splitting", "rotation-splitting4", "splitting", "splitting4", "rk4", "dop853", "exact")
 
 
 def build(values, terms):

@@ -22,7 +22,7 @@ from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_ene
                                   reject_subnormal,
                                   resolve_terms, run_particles, until_event)
 
-METHODS = ("exact", "splitting", "splitting4", "rk4", "dop853")
+METHODS = ("exact", "rotation-splitting", "rotation-splitting4", "splitting", "splitting4", "rk4", "dop853")
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
 
 
