@@ -30,7 +30,7 @@ __all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_spher
 # A compiled function that passes an array on to another one that is not inlined
 # increfs and decrefs it at every call (atomic operations, tens of ns in all). So what
 # runs for every sub-step or stage passes no array on: the step kernels take none (the
-# state is a tuple, the model a _Model), the schedule readers below only read theirs,
+# state is a tuple, the model a PackedModel), the schedule readers below only read theirs,
 # and the functions that pass arrays on (make_plan, dop853_step, the drivers) run at most
 # once per step.
 
