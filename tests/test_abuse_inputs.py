@@ -156,10 +156,10 @@ def test_rigid_method_from_file_or_set_is_accepted(tmp_path, capsys):
 def test_scenario_methods_match_the_scene_modules():
     from rotframe import scenes
     from rotframe.app import scenario
-    from rotframe.particles.integrators import METHODS
+    from rotframe.particles.integrators import METHOD_NAMES
 
     for name in scenes.SCENES:
-        assert set(scenario.methods_for(name)) == set(getattr(scenes.get(name), "METHODS", METHODS)), name
+        assert set(scenario.methods_for(name)) == set(getattr(scenes.get(name), "METHODS", METHOD_NAMES)), name
 
 
 def test_file_recording_goes_under_recordings(tmp_path, capsys, monkeypatch):

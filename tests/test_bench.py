@@ -17,7 +17,7 @@ def test_bench_quick_json_rows_follow_the_contract(tmp_path):
         assert {"scenario", "method", "setting", "wall_s", "error", "error_kind", "nfev"} <= set(row)
     methods = {r["method"] for r in rows}
     assert {"scipy-RK45", "scipy-DOP853", "scipy-Radau", "scipy-LSODA"} <= methods
-    assert {"exact", "splitting", "rk4", "dop853"} <= methods
+    assert {"exact", "rotation-splitting", "rk4", "dop853"} <= methods
     exact = [r for r in rows if r["method"] == "exact"][0]
     assert exact["error"] < 1e-9 and exact["error_kind"].startswith("analytic")
     timed = [r for r in rows if r.get("kind") is None]

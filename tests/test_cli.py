@@ -140,3 +140,19 @@ def test_quantity_strings_convert(tmp_path):
     params = json.loads(res.stdout)["params"]
     assert params["height"] == pytest.approx(520 * 0.3048)
     assert params["latitude"] == pytest.approx(50 + 53 / 60)
+
+
+def test_exact_refused_on_curvature_names_curvature(tmp_path):
+    # 'curvature' makes the model nonlinear (the ground is a sphere): the one-line error must say so,
+    # not blame a varying omega (the projectile's omega is constant)
+    toml = (REPO / "scenarios" / "projectile.toml").read_text()
+    toml = toml.replace('model = ["gravity", "coriolis"]', 'model = ["gravity", "coriolis", "curvature"]')
+    assert "curvature\"]" in toml
+    path = tmp_path / "curved.toml"
+    path.write_text(toml)
+    res = rotframe("run", str(path), "--method", "exact", "--no-record", cwd=tmp_path)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1, res.stderr
+    assert "curvature" in lines[0] and "exact" in lines[0]
+    assert "omega varies" not in lines[0]

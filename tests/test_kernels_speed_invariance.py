@@ -11,6 +11,9 @@ import numpy as np
 import pytest
 
 from rotframe.particles import kernels
+from rotframe.particles.drivers import run_fixed
+from rotframe.particles.forces import acceleration
+from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 from rotframe.errors import IntegrationError
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
@@ -52,7 +55,7 @@ def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samp
     out_v = np.empty((n_samples, n, 3))
     records = (np.full((n, 4), np.nan), np.zeros((n, 4, 3)), np.zeros((n, 4, 3)), np.zeros(n, np.int64),
                np.zeros((n, 4), np.int64), 4)
-    result = kernels.run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
+    result = run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
                                model.omega.times, model.omega.values, model.omega.cumulative(), events,
                                out_r, out_v, *records)
     return result, out_r, out_v, r, v
@@ -90,7 +93,7 @@ def _reference_splitting(model, r, v, t0, h, steps):
         t = t0 + k * h
         r = r + 0.5 * h * v
         v = v + 0.5 * h * model.g
-        angle = -2.0 * (kernels.omega_angle(t + h, wt, wv, wint) - kernels.omega_angle(t, wt, wv, wint))
+        angle = -2.0 * (omega_angle(t + h, wt, wv, wint) - omega_angle(t, wt, wv, wint))
         c, s = np.cos(angle), np.sin(angle)
         v = v * c + np.cross(axis, v) * s + axis * (axis @ v) * (1.0 - c)
         v = v + 0.5 * h * model.g
@@ -146,9 +149,9 @@ def test_acceleration_is_the_rk4_force():
     P, wt, wv = model.pack(), model.omega.times, model.omega.values
     r, v, t = np.array([1.0, -2.0, 30.0]), np.array([0.5, 0.2, -1.0]), 0.7
     out = np.empty(3)
-    kernels.acceleration(r, v, t, P, wt, wv, out)
-    w = kernels.omega_magnitude(t, wt, wv) * model.omega.axis
-    wd = kernels.omega_rate(t, wt, wv) * model.omega.axis
+    acceleration(r, v, t, P, wt, wv, out)
+    w = omega_magnitude(t, wt, wv) * model.omega.axis
+    wd = omega_rate(t, wt, wv) * model.omega.axis
     expected = (model.g - 2 * np.cross(w, v) - np.cross(w, np.cross(w, r)) - np.cross(wd, r)
                 - model.k_linear * v)
     assert np.allclose(out, expected, rtol=1e-14, atol=1e-14)

@@ -72,7 +72,6 @@ def test_method_names_tuple_lists_canonical_names_only():
         MethodNames(("a",), {"x": "nowhere"})
 
 
-@pytest.mark.skipif(not getattr(integrators, "ALIASES", None), reason="the particle registry has no ALIASES yet")
 def test_particle_aliases_run_and_report_the_canonical_name():
     methods = particle_methods()
     for old, new in integrators.ALIASES.items():

@@ -26,6 +26,9 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from numba import njit
+
+__all__ = ["N_STAGES", "coefficients", "exact_tables", "dop853_error_norm"]
 
 N_STAGES = 12
 
@@ -118,3 +121,29 @@ def coefficients():
     for i, b in _BHH.items():
         E3[i - 1] -= float(b)
     return tuple(np.ascontiguousarray(x, dtype=np.float64) for x in (A, B, C, E3, E5))
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
+    """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
+
+    ``K`` (13, n) holds the stages of the step (the last one f(t + h, y_new),
+    weighted zero), ``atol`` (n,) one absolute tolerance per component of ``y``;
+    the scale of component j is ``atol[j] + rtol max(|y[j]|, |y_new[j]|)``. The
+    particle and rigid-body kernels share this function (docs/physics/dop853.md).
+    """
+    n = y.shape[0]
+    e5 = 0.0
+    e3 = 0.0
+    for j in range(n):
+        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
+        s5 = 0.0
+        s3 = 0.0
+        for q in range(13):
+            s5 += E5[q] * K[q, j]
+            s3 += E3[q] * K[q, j]
+        e5 += (s5 / sc) ** 2
+        e3 += (s3 / sc) ** 2
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)

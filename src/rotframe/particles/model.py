@@ -18,7 +18,7 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["OmegaSchedule", "ParticleModel", "TERMS"]
+__all__ = ["OmegaSchedule", "ParticleModel", "TERMS", "NONLINEAR_TERMS"]
 
 #: Force terms a particle scene can name.
 TERMS = (
@@ -34,6 +34,10 @@ TERMS = (
     "spring",
     "curvature",
 )
+
+#: Terms that make r'' nonlinear in (r, v): a model naming one has no exact linear flow
+#: (:attr:`ParticleModel.is_linear`). ``curvature`` makes the ground a sphere (events on altitude).
+NONLINEAR_TERMS = ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature")
 
 
 @dataclass(frozen=True)
@@ -121,7 +125,7 @@ class OmegaSchedule:
 
     def angle(self, t):
         """Angle turned since the first node, exact for the schedule (rad); vectorised."""
-        from rotframe.particles.kernels import omega_angle
+        from rotframe.particles.schedule import omega_angle
 
         wint = self.cumulative()
         return np.array([omega_angle(float(x), self.times, self.values, wint) for x in np.atleast_1d(t)])
@@ -191,16 +195,27 @@ class ParticleModel:
 
         Then the exact propagator (matrix exponential) applies.
         """
-        nonlinear = {"altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature"}
+        return not self.nonlinear_reasons()
+
+    def nonlinear_reasons(self) -> list:
+        """Why the model is not linear with constant coefficients (empty when it is).
+
+        One phrase per cause, for error messages: the :data:`NONLINEAR_TERMS` it
+        names, linear drag in a stratified atmosphere, a rotation rate that varies.
+        """
+        reasons = []
+        nonlinear = [t for t in self.terms if t in NONLINEAR_TERMS]
+        if nonlinear:
+            reasons.append(f"terms {nonlinear} are nonlinear")
         if self.scale_height > 0 and "linear-drag" in self.terms:
-            return False
-        if nonlinear & set(self.terms):
-            return False
+            reasons.append("linear drag in air of varying density (scale_height > 0) is nonlinear")
         uses_omega = {"coriolis", "centrifugal", "euler"} & set(self.terms)
-        return not uses_omega or self.omega.is_constant
+        if uses_omega and not self.omega.is_constant:
+            reasons.append("omega varies in time")
+        return reasons
 
     def pack(self) -> np.ndarray:
-        """The flat parameter vector of :mod:`rotframe.particles.kernels` (made once per model, returned as a copy)."""
+        """The flat parameter vector of :mod:`rotframe.particles.packed` (made once per model, returned as a copy)."""
         cached = self.__dict__.get("_packed")
         if cached is None:
             cached = self._pack()
@@ -208,7 +223,7 @@ class ParticleModel:
         return cached.copy()
 
     def _pack(self) -> np.ndarray:
-        from rotframe.particles import kernels as k
+        from rotframe.particles import packed as k
         P = np.zeros(k.N_PARAMS)
         P[k.I_AXIS : k.I_AXIS + 3] = self.omega.axis
         P[k.I_CORIOLIS] = float(self.has("coriolis"))

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rotframe.numerics.error_norm import dop853_error_norm
+from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]

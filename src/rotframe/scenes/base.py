@@ -154,7 +154,7 @@ def particle_methods() -> MethodNames:
     """
     from rotframe.particles import integrators
 
-    return MethodNames(tuple(integrators.METHODS), getattr(integrators, "ALIASES", {}))
+    return MethodNames(tuple(integrators.METHODS), integrators.ALIASES)
 
 
 @dataclass

@@ -126,7 +126,7 @@ def _turntable(quick):
         return float(np.max(np.abs(s / s[0] - 1)))
 
     steps = _ladder(quick, [4e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4], [1e-3])
-    runs = _with_prepared({"splitting": steps, "splitting4": steps, "rk4": steps,
+    runs = _with_prepared({"rotation-splitting": steps, "rotation-splitting4": steps, "rk4": steps,
                            "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
     y0 = np.concatenate([r0, v0])
     from rotframe.app.bench.peers import python_rhs
@@ -157,7 +157,7 @@ def _tower_drop(quick):
         return float(np.max(np.abs(e - e[0])) / abs(e[0]))
 
     steps = _ladder(quick, [1e-1, 1e-2, 1e-3, 1e-4], [1e-2])
-    runs = _with_prepared({"exact": [None], "splitting": steps, "rk4": steps,
+    runs = _with_prepared({"exact": [None], "rotation-splitting": steps, "rk4": steps,
                            "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
     base = _particle_runner(model, r0, v0, T, energy)
 
@@ -194,16 +194,16 @@ def _foucault(quick):
     # (round-off over 1.8e7 steps and 2.2e5 periods): errors below 3e-9 m are not resolved. The quick
     # bench's 10 min at 1e-3 s has a smaller truncation error (splitting4 at 5e-3 s over 1 h is within
     # 1.4e-9 m of the fine reference) and is given the same floor
-    ref = integrate_particles(model, r0, v0, T, method="splitting4", step=2e-4 if not quick else 1e-3, samples=1)
+    ref = integrate_particles(model, r0, v0, T, method="rotation-splitting4", step=2e-4 if not quick else 1e-3, samples=1)
     y_ref = np.concatenate([ref.r[-1, 0], ref.v[-1, 0]])
 
     def constraint(t, Y):
         return float(np.max(np.abs(np.linalg.norm(Y[:, :3] - pivot, axis=1) - L)))
 
     steps = _ladder(quick, [5e-2, 2e-2, 1e-2, 5e-3, 2e-3], [1e-2])
-    runs = _with_prepared({"splitting": steps, "splitting4": steps, "rk4": steps,
+    runs = _with_prepared({"rotation-splitting": steps, "rotation-splitting4": steps, "rk4": steps,
                            "dop853": _ladder(quick, [1e-5, 1e-7, 1e-9, 1e-11, 1e-13], [1e-9])}, quick)
-    ref_kind = "splitting4, h = 2e-4 s" if not quick else "splitting4, h = 1e-3 s (quick)"
+    ref_kind = "rotation-splitting4, h = 2e-4 s" if not quick else "rotation-splitting4, h = 1e-3 s (quick)"
     return [Problem("foucault", f"{T / 3600:g} h, {T / 16.42:.0f} periods", T, np.concatenate([r0, v0]),
                     python_rhs(spec), lambda y: float(np.linalg.norm(y[:3] - y_ref[:3])),
                     f"reference ({ref_kind}): final position error (m)", constraint, runs,
@@ -322,7 +322,7 @@ def _heavy_top(quick):
 
     steps = _ladder(quick, [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5], [1e-4])
     runs = {"dop853": _ladder(quick, [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12], [1e-8]),
-            "splitting": steps, "splitting4": steps, "rk4": [s for s in steps if s <= 1e-3]}
+            "top-splitting": steps, "top-splitting4": steps, "rk4": [s for s in steps if s <= 1e-3]}
     return [Problem("heavy-top", "2 s, 95 spins", T, np.concatenate([L0, q0]), rhs, err,
                     "reference (scipy DOP853, rtol 1e-13): max(|dL|/|L|, attitude angle)", invariant, runs,
                     _rigid_runner(inertia, L0, q0, T, top=(values["mass"], values["length"], values["g"]),

@@ -45,7 +45,7 @@ def ensemble_rows(quick):
     ground = Event("ground", "r", 2, 0.0, -1, True)
 
     def ours(threads):
-        return integrate_ensemble(model, r0, v0, steps * h, ground, method="splitting", run={"step": h, "samples": 1},
+        return integrate_ensemble(model, r0, v0, steps * h, ground, method="rotation-splitting", run={"step": h, "samples": 1},
                                   threads=threads)
 
     c, s = math.cos(-2 * np.linalg.norm(w) * h), math.sin(-2 * np.linalg.norm(w) * h)

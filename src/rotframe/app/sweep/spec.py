@@ -320,9 +320,9 @@ def _check_method(scn, method):
     if method is None:
         return
     from rotframe import scenes
-    from rotframe.particles.integrators import METHODS
+    from rotframe.particles.integrators import METHOD_NAMES
 
-    allowed = getattr(scenes.get(scn.scene), "METHODS", None) or list(METHODS)
+    allowed = getattr(scenes.get(scn.scene), "METHODS", None) or list(METHOD_NAMES)
     if method not in allowed:
         raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}"
                             f"{_did_you_mean(method, list(allowed))}")

@@ -1,0 +1,326 @@
+"""The one driver of the compiled particle kernels: set up once, run in chunks, interruptible.
+
+:class:`KernelSetup` holds what does not change between runs of one model,
+method, duration and sample count (the packed model, the schedule, the sample
+times, the step or the DOP853 tableau, the event table) and makes every call of
+the compiled drivers (:mod:`rotframe.particles.drivers`) with the same
+arguments. :func:`run_chunked` is the run of
+:func:`rotframe.particles.integrators.integrate_particles`: calls of a bounded
+amount of work, so that progress is shown, Ctrl-C and SIGTERM interrupt cleanly
+and a numerical failure returns everything computed before it.
+:class:`rotframe.particles.prepared.PreparedRun` calls the same setup once per
+run, so its results are bitwise those of ``integrate_particles``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
+
+__all__ = ["KernelSetup", "run_chunked", "steps_per_sample", "GROWTH_LIMIT"]
+
+#: Relative growth of the inertial speed beyond which a run of a force-free model is unstable.
+GROWTH_LIMIT = 1e-3
+
+
+def steps_per_sample(dt_sample, step):
+    """Fixed steps per sample interval: the fewest whose length ``dt_sample / n`` is at most ``step``.
+
+    ``step`` None or 0 means 1/20 of the sample interval (20 steps a sample).
+
+    Raises
+    ------
+    ScenarioError
+        A step that is not > 0.
+    """
+    h_req = float(step) if step else dt_sample / 20.0
+    if not h_req > 0:
+        raise ScenarioError(f"step: {step}; must be > 0")
+    return max(1, math.ceil(dt_sample / h_req - 1e-9))
+
+
+class KernelSetup:
+    """The fixed arguments of the compiled drivers for one model, method, duration and sample count.
+
+    Parameters
+    ----------
+    model : ParticleModel
+    info : MethodInfo
+        A fixed-step or adaptive entry of :data:`rotframe.particles.integrators.METHODS`.
+    duration : float
+        Simulated time (s), > 0.
+    samples : int
+        Output samples after t = 0 (uniform in time; the last one at ``duration`` exactly).
+    step : float, optional
+        Fixed-step methods: the requested step (s), default 1/20 of the sample
+        interval; the step used, :attr:`h`, divides the sample interval (``sps``
+        steps a sample) and is never larger.
+    rtol, atol : float
+        DOP853 tolerances; a falsy ``atol`` means ``rtol`` times the initial
+        state's scale (:meth:`abs_tol`).
+    events : sequence of Event
+
+    Raises
+    ------
+    ScenarioError
+        A step that is not > 0.
+    """
+
+    def __init__(self, model, info, duration, samples, *, step=None, rtol=1e-10, atol=None, events=()):
+        self.info = info
+        self.P = model.pack()
+        self.wt, self.wv = model.omega.times, model.omega.values
+        self.wint = model.omega.cumulative()
+        self.events = tuple(events)
+        self.ev_tab = event_table(self.events)
+        self.samples = samples
+        self.duration = duration
+        self.dt_sample = dt = duration / samples
+        self.times = np.arange(samples + 1) * dt
+        self.times[-1] = duration
+        self.rtol = float(rtol)
+        self.atol = atol
+        if info.kind == "fixed":
+            self.sps = steps_per_sample(dt, step)
+            self.h = dt / self.sps
+            self.evals_per_step = (3 if info.code == 1 else 4 if info.code == 2 else 1)
+        else:
+            from rotframe.numerics.dop853 import coefficients
+
+            self.sps = 0
+            self.h = 0.0
+            self.tableau = coefficients()
+            self.h0 = dt / 10.0
+
+    def kernel(self):
+        """The compiled driver of this method."""
+        from rotframe.particles import drivers
+
+        return drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+
+    def abs_tol(self, r0, v0):
+        """DOP853's absolute tolerance: ``atol``, else ``rtol`` times max(1, |r0|, |v0|) (componentwise max)."""
+        if self.atol:
+            return float(self.atol)
+        scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
+        return self.rtol * scale
+
+    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None):
+        """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
+
+        ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` (:class:`EventBuffers`)
+        the events; ``atol``, ``h_state`` (N,) and ``h0`` are DOP853's. Returns
+        ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
+        completed, ``bad`` the first particle with a non-finite state or -1, the cost
+        of particle 0). ``t0`` (default the sample time ``first``) lets a fixed-step
+        call start inside a sample interval (:meth:`one_sample_in_pieces`).
+        """
+        from rotframe.particles import drivers
+
+        start = self.times[first] if t0 is None else t0
+        if self.info.kind == "fixed":
+            n_done, bad, nfev = drivers.run_fixed(
+                self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt,
+                self.wv, self.wint, self.ev_tab, out_r, out_v, *evb.args())
+            return n_done, bad, nfev, self.sps * n_done
+        A, B, C, E3, E5 = self.tableau
+        return drivers.run_dop853(
+            r, v, alive, start, self.times[first + 1:first + 1 + max(count, 1)], self.P, self.wt, self.wv,
+            self.rtol, atol, self.h0 if h0 is None else h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
+            *evb.args(), h_state)
+
+    def warm_up(self):
+        """Load or compile the driver now; the seconds it took, or 0.0 if it was ready.
+
+        An empty call (no particle) makes numba compile the driver, or load it
+        from its disk cache, when this process has not yet used it with these
+        argument types. Whether it did is read from the dispatcher itself (it
+        gained a signature), not from any record of earlier runs, so the
+        result depends on this call only: the time of that empty call when it
+        loaded or compiled, else 0.0 (the empty call itself costs microseconds).
+        """
+        kernel = self.kernel()
+        signatures = lambda: len(getattr(kernel, "signatures", ()))  # noqa: E731  (a wrapped kernel has none)
+        before = signatures()
+        t_load = time.perf_counter()
+        empty = np.empty((0, 3))
+        out = np.empty((0, 0, 3))
+        self.call(empty.copy(), empty.copy(), np.ones(0, dtype=np.bool_), 0, 0, out, out.copy(),
+                  EventBuffers(0, 1), 1.0, np.zeros(0), 1.0)
+        elapsed = time.perf_counter() - t_load
+        return elapsed if signatures() > before else 0.0
+
+    def one_sample_in_pieces(self, r, v, alive, first, out_r, out_v, evb, n):
+        """One sample interval of ``sps`` fixed steps as several calls of about 4e6 step-evaluations.
+
+        Returns ``(n_done, bad, nfev, steps)`` as :meth:`call` for that one sample.
+        """
+        piece = max(1, int(4e6 // (n * self.evals_per_step)))
+        scratch_r, scratch_v = np.empty((1, n, 3)), np.empty((1, n, 3))
+        t0 = self.times[first]
+        sps = self.sps
+        j = 0
+        nfev = 0
+        from rotframe.particles import drivers
+
+        while j < sps:
+            k = min(piece, sps - j)
+            last = j + k == sps
+            n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
+                                                self.wt, self.wv, self.wint, self.ev_tab,
+                                                out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
+                                                *evb.args())
+            nfev += nf
+            if n_done < 1 or bad >= 0:
+                return 0, bad, nfev, 0
+            j += k
+        return 1, -1, nfev, sps
+
+
+def _adaptive_chunk(info, per_sample, samples, n):
+    """Samples per call of an adaptive kernel that took ``per_sample`` steps over its first sample.
+
+    The run's total is projected from that rate and refused (:mod:`rotframe.limits`) when it
+    is over the work limit; a call is kept under about 2e5 particle-steps (a tenth of a
+    second), so that Python regains control (signals, progress) that often.
+    """
+    from rotframe import limits
+
+    per_sample = max(float(per_sample), 1.0)
+    limits.check_run(steps=per_sample * samples, particles=n,
+                     what=f"method {info.name} (projected from its first sample interval)")
+    return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
+
+
+def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
+    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
+
+    ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
+    (:meth:`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
+    driver in this call, 0.0 when it was already loaded).
+
+    Raises
+    ------
+    IntegrationError
+        Non-finite state or an unstable step; ``partial`` holds the samples before it.
+    RunInterrupted
+        KeyboardInterrupt during the run; ``partial`` holds the samples before it.
+    """
+    info = setup.info
+    samples, times, events = setup.samples, setup.times, setup.events
+    n = r0.shape[0]
+    evb = EventBuffers(n, max_events)
+    alive = np.ones(n, dtype=np.bool_)
+    r = r0.copy()
+    v = v0.copy()
+    out_r = np.empty((samples + 1, n, 3))
+    out_v = np.empty((samples + 1, n, 3))
+    out_r[0] = r0
+    out_v[0] = v0
+    if info.kind == "fixed":
+        cost = setup.sps * n * setup.evals_per_step
+        atol = 0.0
+        h_state = None
+    else:
+        atol = setup.abs_tol(r0, v0)
+        h_state = np.zeros(n)
+        cost = n * 200
+    guard = _energy_guard(model, r0, v0)
+    chunk = max(1, int(4e6 // max(cost, 1)))
+    done = 0
+    nfev = 0
+    steps = 0
+    try:
+        compile_s = setup.warm_up()
+        if info.kind != "fixed":
+            # an adaptive method's cost is known only once it ran: a probe of the first sample
+            # interval, on copies (the run itself is untouched), projects the work and sizes the calls
+            probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
+                               EventBuffers(n, max_events), atol, h_state.copy())
+            chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
+        while done < samples:
+            m = min(chunk, samples - done)
+            sl = slice(done + 1, done + 1 + m)
+            if info.kind == "fixed" and cost > 4e6:
+                # one sample interval is more than a chunk of work: advance it in pieces, so that
+                # Python regains control (signals, progress) about every 0.1 s
+                n_done, bad, nf, st = setup.one_sample_in_pieces(r, v, alive, done, out_r[sl], out_v[sl], evb, n)
+            else:
+                n_done, bad, nf, st = setup.call(r, v, alive, done, m, out_r[sl], out_v[sl], evb, atol, h_state)
+            steps += st
+            nfev += nf
+            if n_done < m or bad >= 0:
+                good = done + 1 + n_done
+                partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(good)
+                evb.attach(partial, events)
+                raise IntegrationError(
+                    f"non-finite state of particle {bad} after t = {times[good - 1]:.6g} s "
+                    f"(method {info.name})", t_reached=float(times[good - 1]), partial=partial)
+            bad_k = _energy_growth(model, guard, times, out_r, out_v, done + 1, done + 1 + m)
+            if bad_k is not None:
+                partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(bad_k)
+                evb.attach(partial, events)
+                raise IntegrationError(
+                    f"unstable step: the inertial speed of a particle under no real force grew by more than "
+                    f"{GROWTH_LIMIT:g} (relative) by t = {times[bad_k]:.6g} s (method {info.name}, "
+                    f"step {setup.h:.3g} s); use a smaller step or dop853",
+                    t_reached=float(times[bad_k - 1]), partial=partial)
+            done += m
+            if progress is not None:
+                progress(done / samples)
+            if not alive.any():
+                # every particle stopped at a terminal event: fill the rest and finish
+                out_r[done + 1:] = r
+                out_v[done + 1:] = v
+                done = samples
+    except KeyboardInterrupt:
+        partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(done + 1)
+        evb.attach(partial, events)
+        raise RunInterrupted(partial) from None
+    traj = Trajectory(times, out_r, out_v, info.name, steps, nfev, True, setup.duration)
+    traj.extras["step"] = setup.h
+    traj.extras["compile_s"] = compile_s
+    evb.attach(traj, events)
+    return traj
+
+
+def _inertial_speed(model, t, r, v):
+    """|v + w(t) x r| for positions and velocities (..., N, 3) at times t (...,)."""
+    w = np.interp(t, model.omega.times, model.omega.values)
+    wv = np.asarray(w)[..., None, None] * model.omega.axis
+    return np.linalg.norm(v + np.cross(wv, r), axis=-1)
+
+
+def _energy_guard(model, r0, v0):
+    """The initial inertial speeds when the model's true motion keeps them (else None).
+
+    A particle under the fictitious forces alone (Coriolis, centrifugal, and
+    Euler when the rate varies) moves on a straight line at constant speed in
+    inertial space; drag only slows it. So its inertial speed |v + w x r| never
+    grows, whatever the frame does, and a growth beyond :data:`GROWTH_LIMIT`
+    is the mark of an unstable step (docs/physics/stability.md). Models with a
+    real force that can add energy (gravity, springs, a pendulum) return None.
+    """
+    terms = set(model.terms)
+    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
+    if not fictitious <= terms or not terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}:
+        return None
+    return _inertial_speed(model, 0.0, r0, v0)
+
+
+def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
+    """Index of the first sample in [lo, hi) where the inertial speed grew past the limit, or None."""
+    if guard is None:
+        return None
+    with np.errstate(all="ignore"):
+        speed = _inertial_speed(model, times[lo:hi], out_r[lo:hi], out_v[lo:hi])
+    scale = np.maximum(guard, 1e-300)
+    grown = np.any(speed > (1.0 + GROWTH_LIMIT) * scale + 1e-12, axis=1) | ~np.all(np.isfinite(speed), axis=1)
+    if not grown.any():
+        return None
+    return lo + int(np.argmax(grown))

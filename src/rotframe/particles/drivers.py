@@ -1,0 +1,268 @@
+"""Compiled ensemble drivers: many steps, output samples and events, for many particles.
+
+:func:`run_fixed` runs a fixed-step method (:mod:`rotframe.particles.kernels`),
+:func:`run_dop853` the adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner
+II.10). Both advance ``r, v`` (N, 3) in place, fill output samples, record
+events (:mod:`rotframe.particles.events`) and report a non-finite state instead
+of raising; the Python side (:mod:`rotframe.particles.integrators`) calls them in
+chunks of output samples, so that progress, Ctrl-C and a numerical failure are
+handled between chunks without losing data.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.numerics.dop853 import dop853_error_norm
+from rotframe.particles.dop853_steps import dop853_step
+from rotframe.particles.events import DOP853, crossed, event_value, locate_event, record_event, start_value
+from rotframe.particles.forces import derivative
+from rotframe.particles.kernels import advance, make_plan, method_steps
+from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
+from rotframe.particles.schedule import rates
+
+__all__ = ["run_fixed", "run_dop853"]
+
+
+@jit_kernel
+def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
+              events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
+    """Advance an ensemble with a fixed-step method and store samples.
+
+    Parameters
+    ----------
+    method : int
+        0 splitting, 1 splitting4, 2 rk4.
+    r, v : (N, 3) arrays
+        State at ``t0`` (rotating frame, m and m/s); updated in place.
+    alive : (N,) bool array
+        Particles still moving; a terminal event clears the flag (in place).
+    h : float
+        Step (s). Samples are stored every ``steps_per_sample`` steps.
+    events : (E, 5) array
+        Event table (see module docstring). Crossings are located by
+        re-stepping from the last state before the crossing with a shorter step
+        (bisection to round-off), so an event time is exact for the method's own
+        discrete trajectory.
+    out_r, out_v : (n_samples, N, 3) arrays
+        Filled with the state after each sample interval; a stopped particle
+        keeps its state at the terminal event.
+    ev_t, ev_r, ev_v, ev_count, ev_which : event records per particle (time, state, event index).
+
+    Returns
+    -------
+    n_done : int
+        Samples completed (``n_samples`` unless a state became non-finite).
+    bad : int
+        Index of the first particle with a non-finite state, or -1.
+    nfev : int
+        Force evaluations of particle 0 (the cost of one trajectory).
+    """
+    m = unpack(P, wt, wv)
+    plan = make_plan(method, t0, h, m, wt, wv, wint)
+    nfev_step = NFEV[method]
+    n = r.shape[0]
+    n_ev = events.shape[0]
+    g_old = np.empty(n_ev)
+    nfev0 = 0
+    n_done = n_samples
+    bad = -1
+    # locate_event's DOP853 arguments, unused by a fixed-step method
+    empty = np.empty(0)
+    no_rk = (np.empty((0, 0)), empty, empty, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), np.empty((0, 0)), empty, empty, empty)
+    for p in range(n):
+        state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
+        is_alive = alive[p]
+        k_step = 0
+        if n_ev > 0:
+            w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
+            for e in range(n_ev):
+                g_old[e] = start_value(events, e, state, m, w0, wd0)
+        for s in range(n_samples):
+            if is_alive:
+                if n_ev == 0:
+                    # no event to watch: the whole sample interval in one call
+                    state = advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan)
+                    k_step += steps_per_sample
+                    if p == 0:
+                        nfev0 += nfev_step * steps_per_sample
+                else:
+                    for _ in range(steps_per_sample):
+                        t = t0 + k_step * h
+                        start = state
+                        step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)
+                        state = method_steps(method, state, 1, h, m, step_plan)
+                        if p == 0:
+                            nfev0 += nfev_step
+                        k_step += 1
+                        stop = False
+                        for e in range(n_ev):
+                            g_new = event_value(events, e, state, m.radius)
+                            if crossed(events[e, 3], g_old[e], g_new):
+                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint,
+                                                        no_rk)
+                                record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + tau, hit)
+                                if events[e, 4] != 0.0:
+                                    stop = True
+                                    state = hit
+                            g_old[e] = g_new
+                        if stop:
+                            is_alive = False
+                            break
+                if not is_finite(state):
+                    if s < n_done:
+                        n_done = s
+                    if bad < 0:
+                        bad = p
+                    break
+            store(out_r, out_v, s, p, state)
+        store_particle(r, v, p, state)
+        alive[p] = is_alive
+    return n_done, bad, nfev0
+
+
+@jit_kernel
+def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C, E3, E5,
+               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state):
+    """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
+
+    Error control as in Hairer's DOP853 (5th- and 3rd-order estimates combined).
+    Output at ``sample_times``: the state at a sample time inside an accepted
+    step is computed by one extra DOP853 step of the right length from the
+    step's start (an interpolant of the same order as the method). Events are
+    located the same way, by bisection on the length of that extra step.
+    ``h_state`` (N,) carries each particle's step size between calls.
+
+    Returns (n_done, bad, nfev, steps) like :func:`run_fixed` (cost of particle 0).
+    """
+    m = unpack(P, wt, wv)
+    n = r.shape[0]
+    n_out = sample_times.shape[0]
+    n_ev = events.shape[0]
+    K = np.empty((13, 6))
+    atol_vec = np.full(6, atol)
+    Kt = np.empty((13, 6))
+    y = np.empty(6)
+    y_new = np.empty(6)
+    yt = np.empty(6)
+    tmp = np.empty(6)
+    g_old = np.empty(n_ev)
+    nfev0 = 0
+    steps0 = 0
+    n_done = n_out
+    bad = -1
+    t_end = sample_times[n_out - 1]
+    for p in range(n):
+        for i in range(3):
+            y[i] = r[p, i]
+            y[3 + i] = v[p, i]
+        t = t0
+        h = h_state[p]
+        if h <= 0.0:
+            h = h0
+        is_alive = alive[p]
+        w, wd = rates(t, m.steady, m.w, wt, wv)
+        f0 = derivative(as_state(y), m, w, wd)
+        nf = 1
+        for e in range(n_ev):
+            g_old[e] = start_value(events, e, as_state(y), m, w, wd)
+        k_out = 0
+        while k_out < n_out and sample_times[k_out] <= t:
+            store(out_r, out_v, k_out, p, y)
+            k_out += 1
+        failed = False
+        while is_alive and t < t_end:
+            # one accepted step
+            accepted = False
+            at_end = False
+            truncated = False
+            while not accepted:
+                h_ctrl = h
+                truncated = t + h > t_end
+                if truncated:
+                    h = t_end - t
+                min_h = 10.0 * abs(np.nextafter(t, np.inf) - t)
+                if h < min_h:
+                    if t_end - t < min_h:
+                        # the steps summed to within a few ulp of the end: it is reached (the state
+                        # is off by |f| * 10 ulp(t), far below any tolerance); not a collapsed step
+                        at_end = True
+                        h = h_ctrl  # the next call starts from the controller's step, not from the ulps
+                    else:
+                        failed = True
+                    break
+                dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
+                nf += 12
+                err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
+                if not np.isfinite(err):
+                    h *= 0.2
+                    continue
+                if err < 1.0:
+                    fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
+                    accepted = True
+                else:
+                    fac = max(0.2, 0.9 * err ** (-1.0 / 8.0))
+                h_used = h
+                h = h * fac
+            if failed:
+                break
+            if at_end:
+                t = t_end
+                break
+            # a step cut to land on t_end ends there exactly (t + (t_end - t) may round below it)
+            t_new = t_end if truncated else t + h_used
+            if p == 0:
+                steps0 += 1
+            # events inside (t, t_new]
+            stop = False
+            t_stop = t_new
+            for e in range(n_ev):
+                g_new = event_value(events, e, as_state(y_new), m.radius)
+                if crossed(events[e, 3], g_old[e], g_new):
+                    rk = (A, B, C, f0, Kt, y, tmp, yt)
+                    hi, hit = locate_event(DOP853, events, e, as_state(y), g_old[e], t, h_used, m, wt, wv, wv,
+                                           rk)
+                    record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
+                    if events[e, 4] != 0.0 and t + hi <= t_stop:
+                        stop = True
+                        t_stop = t + hi
+                g_old[e] = g_new
+            # samples inside (t, t_stop]
+            while k_out < n_out and sample_times[k_out] <= t_stop:
+                ts = sample_times[k_out]
+                if ts == t_new:
+                    store(out_r, out_v, k_out, p, y_new)
+                else:
+                    dop853_step(t, y, f0, ts - t, m, wt, wv, A, B, C, Kt, yt, tmp)
+                    nf += 12
+                    store(out_r, out_v, k_out, p, yt)
+                k_out += 1
+            if stop:
+                dop853_step(t, y, f0, t_stop - t, m, wt, wv, A, B, C, Kt, yt, tmp)
+                for j in range(6):
+                    y[j] = yt[j]
+                t = t_stop
+                is_alive = False
+                break
+            for j in range(6):
+                y[j] = y_new[j]
+            f0 = as_state(K[12])
+            t = t_new
+            if not is_finite(as_state(y)):
+                failed = True
+                break
+        if failed:
+            if bad < 0:
+                bad = p
+            if k_out < n_done:
+                n_done = k_out
+        # a stopped particle keeps its final state in the remaining samples
+        while k_out < n_out:
+            store(out_r, out_v, k_out, p, y)
+            k_out += 1
+        store_particle(r, v, p, y)
+        alive[p] = is_alive
+        h_state[p] = h
+        if p == 0:
+            nfev0 = nf
+    return n_done, bad, nfev0, steps0

@@ -1,0 +1,149 @@
+"""Events of the compiled particle drivers: event functions, crossings and their location.
+
+An event row is ``(kind, component, value, direction, terminal)``
+(:data:`rotframe.particles.packed.N_EVENT_FIELDS`; kind 0 position, 1 velocity,
+2 altitude above the curved ground). A crossing found over a step is located by
+bisection on the length of a re-step from the step's start with the method's own
+one-step map (:func:`locate_event`), so the event time is exact for the method's
+discrete trajectory (docs/physics/events.md). Both drivers (fixed-step and
+DOP853) use this one bisection and this one recording.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.particles.dop853_steps import dop853_step
+from rotframe.particles.forces import state_acceleration
+from rotframe.particles.kernels import make_plan, method_steps
+from rotframe.particles.packed import as_state, jit_kernel
+
+__all__ = ["DOP853", "event_value", "start_value", "crossed", "trial_state", "locate_event", "record_event"]
+
+#: Method code of the adaptive DOP853 step in :func:`trial_state` (0, 1, 2: the fixed-step codes).
+DOP853 = 3
+
+
+@jit_kernel
+def event_value(events, e, state, radius):
+    """Event function of row ``e`` of the event table at ``state``."""
+    kind = events[e, 0]
+    c = int(events[e, 1])
+    if kind == 0.0:
+        return state[c] - events[e, 2]
+    if kind == 1.0:
+        return state[3 + c] - events[e, 2]
+    x, y, z = state[0], state[1], state[2]
+    dz = z + radius
+    return np.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
+
+
+@jit_kernel
+def start_value(events, e, state, m, w, wd):
+    """Event function of row ``e`` at the start of a run or chunk, for crossing detection.
+
+    The rule for a function that is exactly zero at the start (a shell fired
+    from the ground, z = 0): it takes the sign it has just after the start,
+    the sign of its first non-zero time derivative (first or second); the
+    start itself is never an event. A shell fired upward from z = 0 thus
+    lands at its first return to z = 0, however soon (even inside the first
+    step), and a ``direction = -1`` ground event is not triggered by the
+    launch. Only the sign of the returned value is meaningful when ``g = 0``
+    (see docs/physics/events.md).
+    """
+    g = event_value(events, e, state, m.radius)
+    if g != 0.0:
+        return g
+    kind = events[e, 0]
+    c = int(events[e, 1])
+    x, y, z, vx, vy, vz = state
+    a = state_acceleration(state, m, w, wd)
+    if kind == 0.0:
+        d1 = state[3 + c]
+        d2 = a[c]
+    elif kind == 1.0:
+        d1 = a[c]
+        d2 = 0.0
+    else:
+        dx, dy, dz = x, y, z + m.radius
+        n = np.sqrt(dx * dx + dy * dy + dz * dz)
+        dv = dx * vx + dy * vy + dz * vz
+        da = dx * a[0] + dy * a[1] + dz * a[2]
+        d1 = dv / n
+        d2 = (vx * vx + vy * vy + vz * vz + da) / n - dv * dv / (n * n * n)
+    if d1 != 0.0:
+        return 1e-300 if d1 > 0.0 else -1e-300
+    if d2 != 0.0:
+        return 1e-300 if d2 > 0.0 else -1e-300
+    return 0.0
+
+
+@jit_kernel
+def crossed(direction, g0, g1):
+    """Whether the event function went from g0 to g1 across zero in the given direction."""
+    if direction > 0.0:
+        return g0 < 0.0 and g1 >= 0.0
+    if direction < 0.0:
+        return g0 > 0.0 and g1 <= 0.0
+    return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
+
+
+@jit_kernel
+def trial_state(method, start, t, tau, m, wt, wv, wint, rk):
+    """The state one step of length ``tau`` after ``start`` (at time t), by the method's own map.
+
+    ``method`` 0, 1, 2: the fixed-step maps (:func:`rotframe.particles.kernels.method_steps`),
+    from the state tuple ``start``. :data:`DOP853`: one DOP853 step from the arrays of
+    ``rk = (A, B, C, f0, K, y, tmp, y_out)`` (the tableau, f(t, y), stage and scratch
+    arrays, the start ``y`` (6,)), written into ``y_out``; ``start`` is then unused.
+    """
+    if method == DOP853:
+        A, B, C, f0, K, y, tmp, y_out = rk
+        dop853_step(t, y, f0, tau, m, wt, wv, A, B, C, K, y_out, tmp)
+        return as_state(y_out)
+    return method_steps(method, start, 1, tau, m, make_plan(method, t, tau, m, wt, wv, wint))
+
+
+@jit_kernel
+def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk):
+    """Sub-step tau in (0, h] at which event ``e`` of the one-step map from ``start`` vanishes.
+
+    Bisection on tau of g(:func:`trial_state` (start, tau)), halving until the
+    bracket cannot shrink (round-off of tau itself, even for a crossing at
+    tau ~ 1e-161 s, which a fixed 60 halvings of h would miss by 1e140).
+    ``g_start`` is the event function at ``start`` as used for the crossing test
+    (its sign just after the start when it is zero there, :func:`start_value`).
+    ``method`` and ``rk`` as in :func:`trial_state`. Returns tau and the state
+    at the event (a 6-tuple).
+    """
+    lo = 0.0
+    hi = h
+    g_lo = g_start
+    for _ in range(2200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        trial = trial_state(method, start, t, mid, m, wt, wv, wint, rk)
+        g_mid = event_value(events, e, trial, m.radius)
+        if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
+            lo = mid
+            g_lo = g_mid
+        else:
+            hi = mid
+    return hi, trial_state(method, start, t, hi, m, wt, wv, wint, rk)
+
+
+@jit_kernel
+def record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t_event, state):
+    """Append event ``e`` of particle p at ``t_event`` with ``state`` (6-tuple) to the records.
+
+    Beyond ``max_events`` records the event is counted (``ev_count``) but not stored.
+    """
+    k = ev_count[p]
+    if k < max_events:
+        ev_t[p, k] = t_event
+        for i in range(3):
+            ev_r[p, k, i] = state[i]
+            ev_v[p, k, i] = state[3 + i]
+        ev_which[p, k] = e
+    ev_count[p] = k + 1

@@ -1,0 +1,159 @@
+"""Accelerations of a particle in a rotating frame, compiled (one source for every method).
+
+Equation of motion (rotating frame, docs/physics/rotating-frames.md)::
+
+    r'' = g(r) - 2 w(t) x v - w x (w x r) - w'(t) x r - k1 v - k2 |v| v  [+ tension]
+
+with ``w(t) = w_hat * w(t)``, a fixed unit axis times a magnitude that is
+piecewise linear in time (a constant is a one-node table). Each term is
+switched by a flag in ``P``; a term that is off costs one branch.
+
+The step kernels (:mod:`rotframe.particles.kernels`), the DOP853 stages
+(:mod:`rotframe.particles.dop853_steps`) and the event rules
+(:mod:`rotframe.particles.events`) all evaluate forces here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.particles.packed import jit_kernel, unpack
+from rotframe.particles.schedule import rates
+
+__all__ = ["position_acceleration", "state_acceleration", "acceleration", "derivative", "air_density",
+           "drag_coefficients", "drag_flow", "string_normal"]
+
+
+@jit_kernel
+def position_acceleration(x, y, z, m, w, wd):
+    """Forces that depend on position and time only: gravity, spring, centrifugal, Euler.
+
+    ``w`` and ``wd`` are the rotation rate and its derivative at the time of evaluation.
+    """
+    mode = m.gmode
+    if mode == 1.0:
+        R = m.radius
+        s = R / (R + z)
+        ax = 0.0
+        ay = 0.0
+        az = -m.g0 * s * s
+    elif mode == 2.0:
+        dz = z + m.radius
+        d2 = x * x + y * y + dz * dz
+        f = -m.gm / (d2 * np.sqrt(d2))
+        ax = f * x
+        ay = f * y
+        az = f * dz
+    else:
+        ax, ay, az = m.g
+    k = m.spring
+    if k != 0.0:
+        ax -= k * x
+        ay -= k * y
+    ux, uy, uz = m.axis
+    if m.centrifugal:
+        # -w x (w x r) = w^2 (r - (w_hat . r) w_hat)
+        d = ux * x + uy * y + uz * z
+        w2 = w * w
+        ax += w2 * (x - d * ux)
+        ay += w2 * (y - d * uy)
+        az += w2 * (z - d * uz)
+    if m.euler:
+        # -w' x r with w' = w'(t) w_hat (fixed axis)
+        ax -= wd * (uy * z - uz * y)
+        ay -= wd * (uz * x - ux * z)
+        az -= wd * (ux * y - uy * x)
+    return ax, ay, az
+
+
+@jit_kernel
+def state_acceleration(state, m, w, wd):
+    """Total acceleration in the rotating frame at ``state``; see :func:`acceleration`."""
+    x, y, z, vx, vy, vz = state
+    ax, ay, az = position_acceleration(x, y, z, m, w, wd)
+    if m.coriolis:
+        w2 = 2.0 * w
+        ux = m.axis[0] * w2
+        uy = m.axis[1] * w2
+        uz = m.axis[2] * w2
+        ax -= uy * vz - uz * vy
+        ay -= uz * vx - ux * vz
+        az -= ux * vy - uy * vx
+    if m.drag:
+        k1, k2 = drag_coefficients(z, m)
+        speed = np.sqrt(vx * vx + vy * vy + vz * vz)
+        k = k1 + k2 * speed
+        ax -= k * vx
+        ay -= k * vy
+        az -= k * vz
+    L = m.length
+    if L > 0.0:
+        nx, ny, nz = string_normal(x, y, z, m)
+        an = ax * nx + ay * ny + az * nz
+        vn = vx * nx + vy * ny + vz * nz
+        v2t = vx * vx + vy * vy + vz * vz - vn * vn
+        c = an + v2t / L
+        ax -= c * nx
+        ay -= c * ny
+        az -= c * nz
+    return ax, ay, az
+
+
+@jit_kernel
+def acceleration(r, v, t, P, wt, wv, out):
+    """Total acceleration in the rotating frame (for Runge-Kutta methods), into ``out``.
+
+    For a pendulum (``P[14] > 0``) the string constraint is kept by the
+    index-1 form: the normal component of the applied acceleration is removed
+    and the centripetal term ``-|v_t|^2 / L n`` added.
+    """
+    m = unpack(P, wt, wv)
+    w, wd = rates(t, m.steady, m.w, wt, wv)
+    out[0], out[1], out[2] = state_acceleration((r[0], r[1], r[2], v[0], v[1], v[2]), m, w, wd)
+
+
+@jit_kernel
+def derivative(state, m, w, wd):
+    """Right-hand side (v, a) of the first-order system at ``state`` for the rates w, w', as a 6-tuple."""
+    ax, ay, az = state_acceleration(state, m, w, wd)
+    return state[3], state[4], state[5], ax, ay, az
+
+
+@jit_kernel
+def air_density(z, m):
+    """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
+    H = m.scale_h
+    if H > 0.0:
+        return np.exp(-z / H)
+    return 1.0
+
+
+@jit_kernel
+def drag_flow(vx, vy, vz, k1, k2, h):
+    """Exact flow of v' = -(k1 + k2 |v|) v over h at fixed position (direction kept, speed decays)."""
+    if k1 == 0.0 and k2 == 0.0:
+        return vx, vy, vz
+    speed = np.sqrt(vx * vx + vy * vy + vz * vz)
+    if speed == 0.0:
+        return vx, vy, vz
+    if k1 == 0.0:
+        new = speed / (1.0 + k2 * speed * h)
+    else:
+        e = np.exp(-k1 * h)
+        new = k1 * speed * e / (k1 + k2 * speed * (1.0 - e))
+    f = new / speed
+    return vx * f, vy * f, vz * f
+
+
+@jit_kernel
+def drag_coefficients(z, m):
+    """Drag coefficients (k1 (1/s), k2 (1/m)) at height z: the sea-level ones times :func:`air_density`."""
+    air = air_density(z, m)
+    return m.k1 * air, m.k2 * air
+
+
+@jit_kernel
+def string_normal(x, y, z, m):
+    """Unit normal (r - pivot) / L of the pendulum's sphere at (x, y, z) (exact only on the sphere)."""
+    L = m.length
+    return (x - m.pivot[0]) / L, (y - m.pivot[1]) / L, (z - m.pivot[2]) / L

@@ -1,0 +1,61 @@
+"""The rotation-rate schedule w(t) as the compiled kernels read it.
+
+The magnitude table is ``wt`` (node times, increasing) and ``wv`` (values,
+rad/s); w(t) is piecewise linear between the nodes and held constant outside
+them. ``wint`` holds the integral of w from ``wt[0]`` to each node, so the
+rotation angle over any interval is exact for the piecewise-linear schedule
+(:meth:`rotframe.particles.model.OmegaSchedule.cumulative`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.particles.packed import jit_kernel
+
+__all__ = ["omega_magnitude", "omega_rate", "omega_angle", "rates"]
+
+
+@jit_kernel
+def omega_magnitude(t, wt, wv):
+    """Magnitude w(t) of the piecewise-linear schedule (rad/s)."""
+    n = wt.shape[0]
+    if n == 1 or t <= wt[0]:
+        return wv[0]
+    if t >= wt[n - 1]:
+        return wv[n - 1]
+    k = np.searchsorted(wt, t) - 1
+    s = (t - wt[k]) / (wt[k + 1] - wt[k])
+    return wv[k] + s * (wv[k + 1] - wv[k])
+
+
+@jit_kernel
+def omega_rate(t, wt, wv):
+    """Time derivative w'(t) of the schedule (rad/s^2); zero outside the table."""
+    n = wt.shape[0]
+    if n == 1 or t < wt[0] or t >= wt[n - 1]:
+        return 0.0
+    k = np.searchsorted(wt, t, side="right") - 1
+    return (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
+
+
+@jit_kernel
+def omega_angle(t, wt, wv, wint):
+    """Integral of w from ``wt[0]`` to t (rad), exact for the piecewise-linear schedule."""
+    n = wt.shape[0]
+    if n == 1 or t <= wt[0]:
+        return wv[0] * (t - wt[0])
+    if t >= wt[n - 1]:
+        return wint[n - 1] + wv[n - 1] * (t - wt[n - 1])
+    k = np.searchsorted(wt, t) - 1
+    dt = t - wt[k]
+    slope = (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
+    return wint[k] + wv[k] * dt + 0.5 * slope * dt * dt
+
+
+@jit_kernel
+def rates(t, steady, w, wt, wv):
+    """Rotation rate w(t) and its derivative (rad/s, rad/s^2): ``(w, 0)`` when ``steady``, else from the table."""
+    if steady:
+        return w, 0.0
+    return omega_magnitude(t, wt, wv), omega_rate(t, wt, wv)

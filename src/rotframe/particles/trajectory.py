@@ -1,0 +1,119 @@
+"""What a particle run returns: samples, events, cost; and the records the kernels fill.
+
+:class:`Trajectory` is the one result type of every particle method (fixed-step,
+adaptive, exact); a run cut short keeps what it computed in
+:class:`RunInterrupted` or :class:`rotframe.errors.IntegrationError`
+(``partial``, a truncated :class:`Trajectory`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Event", "Trajectory", "RunInterrupted", "EventBuffers", "event_table"]
+
+
+@dataclass(frozen=True)
+class Event:
+    """A zero crossing located to round-off on the method's own trajectory.
+
+    ``kind`` "r" or "v": the event function is ``r[component] - value`` or
+    ``v[component] - value``; "altitude": height above the sphere of the
+    model's ``radius`` centred at (0, 0, -radius), minus ``value`` (curved ground); ``direction`` +1 rising, -1 falling, 0 both;
+    a ``terminal`` event stops that particle (ground impact).
+    """
+
+    name: str
+    kind: str
+    component: int
+    value: float = 0.0
+    direction: int = 0
+    terminal: bool = False
+
+    def row(self):
+        kind = {"r": 0.0, "v": 1.0, "altitude": 2.0}[self.kind]
+        return [kind, float(self.component), float(self.value),
+                float(self.direction), float(self.terminal)]
+
+
+@dataclass
+class Trajectory:
+    """Samples of an ensemble trajectory (rotating frame, SI).
+
+    Attributes
+    ----------
+    times : (n,) array, s
+    r, v : (n, N, 3) arrays, m and m/s
+    event_times : dict name -> list (per particle) of arrays of event times
+    event_states : dict name -> list (per particle) of (k, 6) arrays (r, v)
+    method, steps, nfev : what was run and what it cost (one trajectory)
+    complete : False when the run stopped early; ``t_reached`` says where.
+    """
+
+    times: np.ndarray
+    r: np.ndarray
+    v: np.ndarray
+    method: str
+    steps: int = 0
+    nfev: int = 0
+    complete: bool = True
+    t_reached: float = math.nan
+    event_times: dict = field(default_factory=dict)
+    event_states: dict = field(default_factory=dict)
+    extras: dict = field(default_factory=dict)
+
+    def truncated(self, n: int) -> Trajectory:
+        return Trajectory(self.times[:n], self.r[:n], self.v[:n], self.method, self.steps, self.nfev,
+                          False, float(self.times[n - 1]) if n else math.nan,
+                          self.event_times, self.event_states, self.extras)
+
+
+class RunInterrupted(Exception):
+    """Ctrl-C or SIGTERM during a run; ``partial`` holds what was computed."""
+
+    def __init__(self, partial, reason="interrupted"):
+        super().__init__(reason)
+        self.partial = partial
+        self.reason = reason
+
+
+def event_table(events):
+    """The events as the (E, 5) table of the compiled drivers (:mod:`rotframe.particles.events`)."""
+    if not events:
+        return np.zeros((0, 5))
+    return np.array([e.row() for e in events], dtype=np.float64)
+
+
+class EventBuffers:
+    """Per-particle event records filled by the kernels, in order of occurrence."""
+
+    def __init__(self, n, max_events):
+        self.t = np.full((n, max_events), np.nan)
+        self.r = np.zeros((n, max_events, 3))
+        self.v = np.zeros((n, max_events, 3))
+        self.count = np.zeros(n, dtype=np.int64)
+        self.which = np.zeros((n, max_events), dtype=np.int64)
+        self.max_events = max_events
+
+    def args(self):
+        """The record arrays in the order the compiled drivers take them."""
+        return self.t, self.r, self.v, self.count, self.which, self.max_events
+
+    def reset(self):
+        """Forget every record (a new run with the same buffers)."""
+        self.count[:] = 0
+
+    def attach(self, traj, events):
+        """Split the records by event name into ``traj.event_times`` / ``event_states``."""
+        for e_idx, ev in enumerate(events):
+            traj.event_times[ev.name] = []
+            traj.event_states[ev.name] = []
+            for p in range(self.count.shape[0]):
+                k = min(int(self.count[p]), self.max_events)
+                mask = self.which[p, :k] == e_idx
+                traj.event_times[ev.name].append(self.t[p, :k][mask])
+                traj.event_states[ev.name].append(
+                    np.concatenate([self.r[p, :k][mask], self.v[p, :k][mask]], axis=1))
