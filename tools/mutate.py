@@ -18,7 +18,7 @@ A mutant is *killed* when the tests fail (or run past ``--timeout``), *survived*
 they pass. Usage (from the repository root)::
 
     python tools/mutate.py                         # default targets and tests
-    python tools/mutate.py --target src/rotframe/kernels.py:_air,_position_acceleration \\
+    python tools/mutate.py --target src/rotframe/particles/forces.py:air_density,position_acceleration \\
         --tests "tests/test_i11b_forces.py -k 'not projectile'" -j 2
 
 Prints one line per mutant and the score; exits 1 when any mutant survived
@@ -41,7 +41,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-DEFAULT_TARGETS = ["src/rotframe/kernels.py:_position_acceleration,_acceleration,_air"]
+DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:position_acceleration,state_acceleration,air_density,drag_coefficients,string_normal"]
 DEFAULT_TESTS = "tests/test_i11b_forces.py -k 'not projectile'"
 
 
@@ -66,7 +66,6 @@ class _Collector(ast.NodeVisitor):
                 self.sites.append((node, "op", ast.Mult(), f"line {line}: / -> *"))
             elif isinstance(node.op, ast.Pow):
                 self.sites.append((node, "left", None, f"line {line}: a ** b -> a"))
-            del op
         elif isinstance(node, ast.AugAssign):
             if isinstance(node.op, ast.Add):
                 self.sites.append((node, "op", ast.Sub(), f"line {line}: += -> -="))
