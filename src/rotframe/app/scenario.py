@@ -41,6 +41,7 @@ from pathlib import Path
 from rotframe.app.choices import did_you_mean as _did_you_mean
 from rotframe.app.quantities import NotAQuantity, WrongDimension, first_line, value_in
 from rotframe.errors import ScenarioError
+from rotframe.scenes.run_settings import RUN_DEFAULTS
 
 __all__ = ["Scenario", "Parameter", "load", "find", "names", "scenario_dir", "RUN_KEYS", "RUN_DEFAULTS",
            "parse_run_value"]
@@ -51,7 +52,6 @@ _PARAM_KEYS = ("default", "unit", "doc", "min", "max", "exclusive_min", "exclusi
 RUN_KEYS = {"method": str, "step": float, "rtol": float, "samples": int}
 #: Run settings of a scenario whose ``[run]`` table leaves them out: the one table of run defaults
 #: (``method`` None: the scene's default method; ``step`` None: the scene's own step rule).
-RUN_DEFAULTS = {"method": None, "step": None, "rtol": 1e-10, "samples": 2000}
 #: Model terms of rigid-body scenes (particle terms are in rotframe.particles.model.TERMS).
 RIGID_TERMS = ("free-rigid-body", "gravity-torque")
 

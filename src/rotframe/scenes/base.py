@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.scenes.run_settings import RUN_DEFAULTS, run_setting
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
 
-__all__ = ["SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
+__all__ = ["RUN_DEFAULTS", "run_setting", "SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
            "landing",
            "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
            "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
@@ -188,7 +189,7 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
     method = particle_methods().canonical(method)
     try:
         traj = integrate_particles(model, r0, v0, duration, method=method, step=step or run.get("step"),
-                                   rtol=run.get("rtol") or 1e-10, samples=int(run.get("samples") or 2000),
+                                   rtol=run_setting(run, "rtol"), samples=int(run_setting(run, "samples")),
                                    events=events, progress=progress)
     except (IntegrationError, RunInterrupted) as exc:
         if exc.partial is not None and len(exc.partial.times):

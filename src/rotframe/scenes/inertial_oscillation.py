@@ -18,7 +18,7 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, method_rel_error, particle_methods,
+from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, method_rel_error, particle_methods,
                                   reject_subnormal, rel_drift, run_particles, samples_for, unresolved_note,
                                   with_parameters)
 
@@ -58,7 +58,7 @@ def simulate(p, terms, method, run, progress):
     method = method or default_method(model)
     f = abs(2 * Omega * math.sin(math.radians(p.latitude)))
     period = 2 * math.pi / f if f > 0 else math.inf
-    samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000)
+    samples, resolved = samples_for(p.duration, period, run_setting(run, "samples"))
 
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,

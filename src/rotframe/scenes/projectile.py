@@ -24,7 +24,7 @@ import numpy as np
 from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
 from rotframe.particles.integrators import Event
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
+from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
                                   samples_for, with_parameters)
 
@@ -82,7 +82,7 @@ def simulate(p, terms, method, run, progress):
 
     # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
     flight = 2 * p.speed * math.sin(math.radians(p.elevation)) / g
-    samples, resolved = samples_for(duration, flight, run.get("samples") or 2000)
+    samples, resolved = samples_for(duration, flight, run_setting(run, "samples"))
 
     def finish(traj):
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
