@@ -25,7 +25,7 @@ __all__ = [
 ]
 
 #: The public functions of this module (wrapped by :func:`~rotframe.validation.guard_public`).
-GUARDED = ("direction_cosines", "elemental", "check_rotation", "orthonormalize", "from_scipy", "to_scipy")
+_GUARDED = ("direction_cosines", "elemental", "check_rotation", "orthonormalize", "from_scipy", "to_scipy")
 
 
 def direction_cosines(v: ArrayLike) -> np.ndarray:
@@ -261,4 +261,6 @@ def _matrices(A, caller):
     return A
 
 
-guard_public(globals(), GUARDED, FrameInputError, error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "dcm_to_euler", "from_scipy", "to_scipy")})
+# text, complex and object input to the public functions: a FrameInputError, not a numpy TypeError
+guard_public(globals(), _GUARDED, FrameInputError,
+             error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "from_scipy", "to_scipy")})

@@ -230,6 +230,4 @@ def angle_text(angle):
 
 
 # text, complex and object input to the public functions: a FrameInputError, not a numpy TypeError
-
-
-guard_public(globals(), ("euler_to_dcm", "dcm_to_euler"), FrameInputError, error_for={n: NotARotationError for n in ("check_rotation", "orthonormalize", "dcm_to_euler", "from_scipy", "to_scipy")})
+guard_public(globals(), ("euler_to_dcm", "dcm_to_euler"), FrameInputError, error_for={"dcm_to_euler": NotARotationError})

@@ -163,4 +163,5 @@ def _rate_matrix(angles, seq, frame, degrees, caller):
     return J, np.broadcast_to(a2, J.shape[:-2])
 
 
+# text, complex and object input to the public functions: a FrameInputError, not a numpy TypeError
 guard_public(globals(), __all__, FrameInputError)

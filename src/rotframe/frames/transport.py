@@ -94,4 +94,5 @@ def fictitious_accelerations(
     }
 
 
+# text, complex and object input to the public functions: a FrameInputError, not a numpy TypeError
 guard_public(globals(), __all__, FrameInputError)
