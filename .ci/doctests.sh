@@ -3,7 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 python -m pytest -q --doctest-modules -p no:cacheprovider \
-    src/rotframe/errors.py src/rotframe/frames.py src/rotframe/validation.py \
+    src/rotframe/errors.py src/rotframe/frames src/rotframe/validation.py \
     src/rotframe/numerics src/rotframe/rigid src/rotframe/app/api.py src/rotframe/app/units.py \
     src/rotframe/app/record.py src/rotframe/app/export.py src/rotframe/app/section_plot.py \
     src/rotframe/app/choices.py src/rotframe/app/options.py src/rotframe/app/quantities.py \
