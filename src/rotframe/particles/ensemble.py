@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope", "check_threads", "resolve_threads",
+__all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope", "threads_in_force", "check_threads",
+           "resolve_threads",
            "BLOCK", "MAX_TRACK_SAMPLES", "PATH_BUDGET"]
 
 #: at most this many samples per kept path
@@ -63,6 +64,11 @@ def threads_scope(threads):
         yield _THREADS.get()
     finally:
         _THREADS.reset(token)
+
+
+def threads_in_force() -> int | None:
+    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
+    return _THREADS.get()
 
 
 def resolve_threads(threads=None) -> int:
