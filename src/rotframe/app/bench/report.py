@@ -85,7 +85,7 @@ def table(rows, speed) -> str:
         if "rows_per_s" in r:
             extra = f"  {r['rows_per_s']:.3g} rows/s"
             if "scaling" in r:
-                extra += f", {r['scaling']:.2f} x one worker (cluster start {r['cluster_start_s']:.2g} s apart)"
+                extra += f", {r['scaling']:.2f} x one worker (cluster start and warm-up {r['cluster_start_s']:.2g} s apart)"
         if "import_s" in r:
             extra = f"  (imports {r['import_s']:.2f} s)"
         err = r["error"]
