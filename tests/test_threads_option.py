@@ -117,14 +117,14 @@ def _drops(n, steps, h, seed=4):
     return ours, r0, v0, w, g
 
 
-def test_bench_same_work_check_accepts_the_ceiling_and_rejects_other_physics():
+def test_benchsame_work_check_accepts_the_ceiling_and_rejects_other_physics():
     """The check that ``bench ensemble``'s ceiling does our work would catch a ceiling doing other work.
 
     The ceiling with Coriolis matches to round-off; without Coriolis (rotation by 0)
     it differs by about 1e-6 of |v|, far above the check's 1e-12; one step fewer also fails.
     """
     from rotframe.app.bench import ceiling
-    from rotframe.app.bench.throughput import _same_work
+    from rotframe.app.bench.throughput import same_work
 
     n, steps, h = 300, 50, 1e-3
     ours, r0, v0, w, g = _drops(n, steps, h)
@@ -136,11 +136,11 @@ def test_bench_same_work_check_accepts_the_ceiling_and_rejects_other_physics():
         ceiling.serial(r, v, g, axis, c, s, h, k)
         return r, v
 
-    same, rel, note = _same_work(ours, hand(math.cos(angle), math.sin(angle)), n, steps, h)
+    same, rel, note = same_work(ours, hand(math.cos(angle), math.sin(angle)), n, steps, h)
     assert same and rel <= 1e-12 and note.startswith("same")
-    same, rel, note = _same_work(ours, hand(1.0, 0.0), n, steps, h)
+    same, rel, note = same_work(ours, hand(1.0, 0.0), n, steps, h)
     assert not same and rel > 1e-9 and note.startswith("NOT")
-    assert not _same_work(ours, hand(math.cos(angle), math.sin(angle), steps - 1), n, steps, h)[0]
+    assert not same_work(ours, hand(math.cos(angle), math.sin(angle), steps - 1), n, steps, h)[0]
 
 
 def test_bench_ensemble_honours_threads_and_reports_the_ceiling(capsys):

@@ -259,7 +259,7 @@ def _parser():
                         "sample and particle; SI units in the column names)")
     q.add_argument("--png", metavar="FILE", default=None, help="also write a picture of the run (PNG, matplotlib)")
     _add_limits(q)
-    _add_threads(q, "ensembles of particles")
+    _add_threads(q, "ensembles of particles (a scene's run of a few particles uses one)")
     q.set_defaults(func=cmd_run)
 
     q = sub.add_parser("bench", help="speed against error for every method")

@@ -14,7 +14,7 @@ import numpy as np
 
 from rotframe.app.bench.measure import timed
 
-__all__ = ["ensemble_rows", "sweep_rows", "startup_rows", "record_rows"]
+__all__ = ["ensemble_rows", "same_work", "sweep_rows", "startup_rows", "record_rows"]
 
 
 def ensemble_rows(quick):
@@ -73,7 +73,7 @@ def ensemble_rows(quick):
     a = ours(1)
     b = ours(None)
     identical = bool(np.array_equal(a.state, b.state) and np.array_equal(a.t_event, b.t_event, equal_nan=True))
-    same, same_rel, same_note = _same_work(a, hand(ceiling.serial)(), n, steps, h)
+    same, same_rel, same_note = same_work(a, hand(ceiling.serial)(), n, steps, h)
     rows = []
     budget = 1.0 if quick else 3.0
     saved = numba.get_num_threads()
@@ -102,7 +102,7 @@ def ensemble_rows(quick):
     return rows
 
 
-def _same_work(ours, hand, n, steps, h):
+def same_work(ours, hand, n, steps, h):
     """(same, max relative difference, note): do ours and the hand-written loop take the same steps of the same physics?
 
     Both must have integrated every particle for all ``steps`` (ours found no ground
