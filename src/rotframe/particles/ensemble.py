@@ -219,14 +219,21 @@ def _integrate(model, r0, v0, duration, event, method, run, samples):
 
 
 def _first_events(traj, event):
-    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none."""
+    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none.
+
+    Vectorised (C-level loops over the per-particle records), so that little of a
+    block's time is spent holding the GIL.
+    """
     n = traj.r.shape[1]
     state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
     t_event = np.full(n, math.nan)
-    for p, (times, states) in enumerate(zip(traj.event_times[event.name], traj.event_states[event.name])):
-        if len(times):
-            t_event[p] = times[0]
-            state[p] = states[0]
+    times, states = traj.event_times[event.name], traj.event_states[event.name]
+    counts = np.fromiter(map(len, times), dtype=np.int64, count=n)
+    hit = counts > 0
+    if hit.any():
+        first = (np.cumsum(counts) - counts)[hit]  # where each particle's records start in the concatenation
+        t_event[hit] = np.concatenate(times)[first]
+        state[hit] = np.concatenate(states)[first]
     return t_event, state
 
 
