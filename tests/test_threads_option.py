@@ -152,6 +152,6 @@ def test_bench_ensemble_honours_threads_and_reports_the_ceiling(capsys):
     allcore = rows[1]
     assert allcore["bitwise_identical_to_1_thread"] is True
     assert allcore["same_work"] is True and allcore["same_work_max_rel"] <= 1e-12
-    for key in ("parallel_efficiency", "goal_ratio", "of_ceiling", "particle_steps_per_s"):
+    for key in ("parallel_efficiency", "goal_ratio", "scaling_vs_ceiling", "of_ceiling", "particle_steps_per_s"):
         assert math.isfinite(allcore[key]) and allcore[key] > 0
     assert "prange" in rows[3]["method"]
