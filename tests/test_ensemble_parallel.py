@@ -83,5 +83,34 @@ def test_thread_count_validation():
 
     assert ensemble.resolve_threads(2) == 2
     assert ensemble.resolve_threads(None) >= 1
-    with pytest.raises(ScenarioError, match="threads"):
-        ensemble.set_default_threads(0)
+    for bad in (0, -1, 1.5, "two", True):
+        with pytest.raises(ScenarioError, match="threads"):
+            ensemble.threads_scope(bad).__enter__()
+        with pytest.raises(ScenarioError, match="threads"):
+            ensemble.resolve_threads(bad)
+
+
+def test_threads_scope_is_per_block_and_restored():
+    import os
+
+    every = os.cpu_count() or 1
+    assert ensemble.resolve_threads(None) == every
+    with ensemble.threads_scope(3):
+        assert ensemble.resolve_threads(None) == 3
+        assert ensemble.resolve_threads(2) == 2  # an explicit count wins
+        with ensemble.threads_scope(1):
+            assert ensemble.resolve_threads(None) == 1
+        assert ensemble.resolve_threads(None) == 3
+    assert ensemble.resolve_threads(None) == every  # nothing outlives the block
+
+
+def test_threads_scope_is_not_seen_by_other_threads():
+    """A ContextVar: a count set in one thread (one command) does not leak into another."""
+    import threading
+
+    seen = {}
+    with ensemble.threads_scope(5):
+        t = threading.Thread(target=lambda: seen.update(n=ensemble.resolve_threads(None)))
+        t.start()
+        t.join()
+    assert seen["n"] == ensemble.resolve_threads(None)

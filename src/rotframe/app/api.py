@@ -108,7 +108,7 @@ def load(name_or_path: str | Path):
 
 
 def run(name_or_path: str | Path, method: str | None = None, *, progress: ProgressLike = None,
-        **params: Any) -> "Result":
+        threads: int | None = None, **params: Any) -> "Result":
     """Run a scenario; returns a :class:`Result`.
 
     Parameters
@@ -121,6 +121,10 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     progress : callable or bool, optional
         ``progress(fraction)`` is called as the run advances (0 to 1);
         ``True`` draws a bar on stderr.
+    threads : int, optional
+        Threads for ensembles of particles during this run only (default:
+        every core); the results do not depend on it. Not a whole number
+        >= 1: ScenarioError.
     **params
         Parameter values (numbers in the documented unit, astropy quantities or
         strings such as ``"520 ft"``), and the run settings ``step`` (s),
@@ -150,9 +154,11 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     from rotframe import scenes
     from rotframe.app import runner
     from rotframe.errors import IntegrationError
+    from rotframe.particles.ensemble import check_threads, threads_scope
     from rotframe.particles.integrators import RunInterrupted
 
     t_start = time.perf_counter()
+    check_threads(threads)
     scn = load(name_or_path)
     values = resolve_values(scn, params)
     scene = scenes.get(scn.scene)
@@ -162,7 +168,8 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     callback = _progress_callback(progress)
     t0 = time.perf_counter()
     try:
-        scene_result = runner.simulate(scn, values, method=method, progress=callback)
+        with threads_scope(threads):
+            scene_result = runner.simulate(scn, values, method=method, progress=callback)
     except (IntegrationError, RunInterrupted) as exc:
         if exc.partial is not None:
             simulate_s = time.perf_counter() - t0

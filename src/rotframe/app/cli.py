@@ -171,6 +171,22 @@ def _add_limits(q, rows=False):
                        help="refuse a sweep of more rows than N (default 2e6)")
 
 
+def _add_threads(q, what):
+    q.add_argument("--threads", type=_threads_count, default=None, metavar="N",
+                   help=f"threads for {what} (default: every core, {os.cpu_count() or 1} here); the results do not "
+                        "depend on it")
+
+
+def _threads_count(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1") from None
+    if not (math.isfinite(value) and value == int(value) and value >= 1):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a whole number >= 1") from None
+    return int(value)
+
+
 def _positive_count(text):
     try:
         value = float(text)
@@ -243,6 +259,7 @@ def _parser():
                         "sample and particle; SI units in the column names)")
     q.add_argument("--png", metavar="FILE", default=None, help="also write a picture of the run (PNG, matplotlib)")
     _add_limits(q)
+    _add_threads(q, "ensembles of particles (a scene's run of a few particles uses one)")
     q.set_defaults(func=cmd_run)
 
     q = sub.add_parser("bench", help="speed against error for every method")
@@ -250,6 +267,7 @@ def _parser():
     q.add_argument("--json", action="store_true", help="print a JSON list of rows on stdout and nothing else")
     q.add_argument("--quick", action="store_true", help="a short ladder, for a smoke test")
     q.add_argument("--plots", metavar="DIR", default=None, help="write work-precision PNGs to DIR")
+    _add_threads(q, "the all-core ensemble rows")
     q.set_defaults(func=cmd_bench)
 
     q = sub.add_parser("sweep", help="run a scenario over a grid or Monte Carlo samples of parameters")
@@ -274,6 +292,7 @@ def _parser():
     q.add_argument("--resume", action="store_true", help="compute only the rows missing from --out")
     q.add_argument("--json", action="store_true", help="print the result as JSON on stdout and nothing else")
     _add_limits(q, rows=True)
+    _add_threads(q, "vectorised ensemble batches (per batch; a LocalCluster of W workers shares the cores)")
     q.set_defaults(func=cmd_sweep)
 
     q = sub.add_parser("view", help="open a recording in the rerun viewer",
@@ -364,8 +383,15 @@ def _limits(args):
         max_rows=getattr(args, "max_rows", None)))
 
 
+def _threads(args):
+    """The command's ``--threads`` in force for the command only (:func:`rotframe.particles.ensemble.threads_scope`)."""
+    from rotframe.particles.ensemble import threads_scope
+
+    return threads_scope(getattr(args, "threads", None))
+
+
 def cmd_run(args) -> int:
-    with _limits(args):
+    with _limits(args), _threads(args):
         return _run(args)
 
 
@@ -471,13 +497,14 @@ def cmd_bench(args) -> int:
 
         check_output_dir(args.plots, "--plots")
 
-    return bench_main(args)
+    with _threads(args):
+        return bench_main(args)
 
 
 def cmd_sweep(args) -> int:
     from rotframe.app.sweep import main as sweep_main
 
-    with _limits(args):
+    with _limits(args), _threads(args):
         return sweep_main(args)
 
 

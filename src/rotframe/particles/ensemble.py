@@ -8,19 +8,25 @@ The cut does not depend on the number of threads, and every particle is
 integrated on its own inside a block, so the results are bitwise identical
 for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``).
 
-``threads=None`` means every core (``os.cpu_count()``), or the default set by
-:func:`set_default_threads` (the CLI's ``--threads``).
+``threads=None`` means the count in force: the one set by :func:`threads_scope`
+for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
+threads=N)``), else every core (``os.cpu_count()``). The count is held in a
+:class:`contextvars.ContextVar`, like :mod:`rotframe.limits`, so nothing
+outlives the command that set it.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 import os
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "set_default_threads", "resolve_threads",
+__all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope", "threads_in_force", "check_threads",
+           "resolve_threads",
            "BLOCK", "MAX_TRACK_SAMPLES", "PATH_BUDGET"]
 
 #: at most this many samples per kept path
@@ -30,31 +36,48 @@ PATH_BUDGET = 2_000_000
 #: particles per block; fixed, so that the cut never depends on the number of threads
 BLOCK = 4096
 
-_default_threads = None
+#: threads in force (None: every core); set per command by :func:`threads_scope`
+_THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
 
 
-def set_default_threads(threads):
-    """Threads used where ``threads=None`` is passed (None: every core)."""
-    global _default_threads
-    if threads is not None and int(threads) < 1:
-        from rotframe.errors import ScenarioError
+def check_threads(threads, what="threads") -> int | None:
+    """``threads`` as a whole number >= 1 (None stays None); ScenarioError in one line otherwise."""
+    if threads is None:
+        return None
+    from rotframe.errors import ScenarioError
 
-        raise ScenarioError(f"threads: {threads}; must be >= 1")
-    _default_threads = None if threads is None else int(threads)
+    try:
+        ok = not isinstance(threads, bool) and float(threads) == int(threads)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or int(threads) < 1:
+        raise ScenarioError(f"{what}: {threads!r}; must be a whole number >= 1 (default: every core, "
+                            f"{os.cpu_count() or 1} here)")
+    return int(threads)
+
+
+@contextlib.contextmanager
+def threads_scope(threads):
+    """Make ``threads`` (None: every core) the count in force inside the block."""
+    token = _THREADS.set(check_threads(threads))
+    try:
+        yield _THREADS.get()
+    finally:
+        _THREADS.reset(token)
+
+
+def threads_in_force() -> int | None:
+    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
+    return _THREADS.get()
 
 
 def resolve_threads(threads=None) -> int:
-    """The number of threads for ``threads`` (None: the default, else every core)."""
+    """The number of threads for ``threads`` (None: the count in force, else every core)."""
     if threads is None:
-        threads = _default_threads
+        threads = _THREADS.get()
     if threads is None:
         threads = os.cpu_count() or 1
-    threads = int(threads)
-    if threads < 1:
-        from rotframe.errors import ScenarioError
-
-        raise ScenarioError(f"threads: {threads}; must be >= 1")
-    return threads
+    return check_threads(threads)
 
 
 @dataclass
@@ -196,14 +219,21 @@ def _integrate(model, r0, v0, duration, event, method, run, samples):
 
 
 def _first_events(traj, event):
-    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none."""
+    """(t, state) of each particle's first ``event`` found by the kernel; the end state where none.
+
+    Vectorised (C-level loops over the per-particle records), so that little of a
+    block's time is spent holding the GIL.
+    """
     n = traj.r.shape[1]
     state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
     t_event = np.full(n, math.nan)
-    for p, (times, states) in enumerate(zip(traj.event_times[event.name], traj.event_states[event.name])):
-        if len(times):
-            t_event[p] = times[0]
-            state[p] = states[0]
+    times, states = traj.event_times[event.name], traj.event_states[event.name]
+    counts = np.fromiter(map(len, times), dtype=np.int64, count=n)
+    hit = counts > 0
+    if hit.any():
+        first = (np.cumsum(counts) - counts)[hit]  # where each particle's records start in the concatenation
+        t_event[hit] = np.concatenate(times)[first]
+        state[hit] = np.concatenate(states)[first]
     return t_event, state
 
 

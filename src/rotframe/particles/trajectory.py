@@ -107,13 +107,19 @@ class EventBuffers:
         self.count[:] = 0
 
     def attach(self, traj, events):
-        """Split the records by event name into ``traj.event_times`` / ``event_states``."""
+        """Split the records by event name into ``traj.event_times`` / ``event_states``.
+
+        Vectorised: each particle's arrays are slices of one array per event (in
+        particle order, each in record order), so that large ensembles do not
+        spend their time here holding the GIL.
+        """
+        kept = np.minimum(self.count, self.max_events)
+        valid = np.arange(self.max_events)[None, :] < kept[:, None]
         for e_idx, ev in enumerate(events):
-            traj.event_times[ev.name] = []
-            traj.event_states[ev.name] = []
-            for p in range(self.count.shape[0]):
-                k = min(int(self.count[p]), self.max_events)
-                mask = self.which[p, :k] == e_idx
-                traj.event_times[ev.name].append(self.t[p, :k][mask])
-                traj.event_states[ev.name].append(
-                    np.concatenate([self.r[p, :k][mask], self.v[p, :k][mask]], axis=1))
+            sel = valid & (self.which == e_idx)
+            ends = np.cumsum(sel.sum(axis=1)).tolist()
+            starts = [0] + ends[:-1]
+            times = self.t[sel]
+            states = np.concatenate([self.r[sel], self.v[sel]], axis=1)
+            traj.event_times[ev.name] = [times[a:b] for a, b in zip(starts, ends)]
+            traj.event_states[ev.name] = [states[a:b] for a, b in zip(starts, ends)]

@@ -78,10 +78,15 @@ def table(rows, speed) -> str:
             extra = f"  {r['particle_steps_per_s']:.3g} particle-steps/s"
             if "goal_ratio" in r:
                 extra += (f", {r['parallel_efficiency']:.2f} of cores x single-core "
-                          f"({r['goal_ratio']:.2f} of the 0.7 goal), {r['of_ceiling']:.2f} of the ceiling, "
+                          f"({r['goal_ratio']:.2f} of the 0.7 goal; the ceiling's scaling x {r['scaling_vs_ceiling']:.2f}), "
+                          f"{r['of_ceiling']:.2f} of the ceiling, "
                           f"bitwise identical to 1 thread: {r['bitwise_identical_to_1_thread']}")
+            if "same_work" in r and r["method"].startswith("hand-written prange"):
+                extra += f"; {r['same_work_note']}"
         if "rows_per_s" in r:
             extra = f"  {r['rows_per_s']:.3g} rows/s"
+            if "scaling" in r:
+                extra += f", {r['scaling']:.2f} x one worker (cluster start and warm-up {r['cluster_start_s']:.2g} s apart)"
         if "import_s" in r:
             extra = f"  (imports {r['import_s']:.2f} s)"
         err = r["error"]

@@ -36,6 +36,7 @@ class BatchTask:
     path: str
     track_rows: frozenset
     limits: object = None  # the command's rotframe.limits.Limits, applied on the worker too
+    threads: int | None = None  # threads of a vectorised ensemble batch (None: every core of the worker)
 
 
 @dataclass
@@ -56,8 +57,9 @@ def run_batch(task: BatchTask) -> BatchOutput:
     batch falls back to one run per row so the failure lands in that row's ``error``.
     """
     from rotframe import limits
+    from rotframe.particles.ensemble import threads_scope
 
-    with limits.applied(task.limits or limits.current()):
+    with limits.applied(task.limits or limits.current()), threads_scope(task.threads):
         return _run_batch(task)
 
 

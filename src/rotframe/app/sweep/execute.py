@@ -23,7 +23,7 @@ from rotframe.app.sweep.spec import SweepSpec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, require, write_part
 from rotframe.errors import ScenarioError
 
-__all__ = ["SweepResult", "SweepInterrupted", "run_sweep", "check_scheduler", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
+__all__ = ["SweepResult", "SweepInterrupted", "run_sweep", "check_scheduler", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
 
 
 #: at most this many trajectories and samples per trajectory in the recording
@@ -165,6 +165,7 @@ class _Context:
     path: str
     points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
+    threads: int | None = None  # threads of each vectorised batch (:func:`batch_threads`)
 
     @classmethod
     def create(cls, spec, files, meta):
@@ -183,7 +184,27 @@ class _Context:
         values = points_of(self.spec, rows) if self.points is None else self.points[rows]
         return BatchTask(index=index, scenario=self.scenario_path, sets=dict(self.spec.sets), keys=self.spec.keys,
                          rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
-                         track_rows=self.track_rows.intersection(rows.tolist()))
+                         track_rows=self.track_rows.intersection(rows.tolist()), threads=self.threads)
+
+
+def batch_threads(local_workers=None, here=False):
+    """Threads of one vectorised ensemble batch.
+
+    The count in force (``--threads N``) wherever the batch runs. Without one:
+    every core for batches run in this process (``here``); the cores shared out
+    over a ``LocalCluster`` of ``local_workers`` single-threaded processes, so
+    that the workers do not oversubscribe the machine; None (every core of that
+    worker) on an existing scheduler, whose machines this process cannot see.
+    The results do not depend on it (:mod:`rotframe.particles.ensemble`).
+    """
+    from rotframe.particles.ensemble import resolve_threads, threads_in_force
+
+    given = threads_in_force()
+    if given is not None or here:
+        return resolve_threads(given)
+    if local_workers:
+        return max(1, resolve_threads(None) // int(local_workers))
+    return None
 
 
 def _limits_now():
@@ -219,6 +240,8 @@ def _execute(ctx, pending, workers, scheduler, client, batch_rows, finished):
         own = client = _connect(workers, scheduler)
     try:
         n_workers = max(1, sum(client.nthreads().values())) if client is not None else 1
+        local = workers if (own is not None and not scheduler) else None
+        ctx.threads = batch_threads(local_workers=local, here=client is None)
         if ctx.path == "ensemble":
             size = batch_rows or _ensemble_batch_size(len(pending), n_workers, client is not None)
         else:
