@@ -92,8 +92,10 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     if method == "exact":
         if top is not None:
             raise ScenarioError("method 'exact' is the free body's flow; the heavy top has gravity")
+        # the elliptic-function flow of rigid.free_body (not the compiled rigid.exact_flow, which agrees to
+        # round-off only: the scenes' numbers stay those of the reference implementation)
         t0 = time.perf_counter()
-        L, q = rigid.free_body_exact(inertia, L0, q0, times[:1])
+        rigid.free_body_exact(inertia, L0, q0, times[:1])  # check every input once; load the kernels
         compile_s = time.perf_counter() - t0
         out_L = np.empty((samples + 1, 3))
         out_q = np.empty((samples + 1, 4))
@@ -114,9 +116,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     dt_sample = duration / samples
     sps = max(1, math.ceil(dt_sample / step - 1e-9))
     h = dt_sample / sps
-    stepper = _stepper(method, inertia, top)
+    checked, stepper = _stepper(method, inertia, top)
     t0 = time.perf_counter()
-    stepper(L0, q0, h, 1, 1)  # load or compile the kernel
+    checked(L0, q0, h, 1, 1)  # check every input once; load or compile the kernel
     compile_s = time.perf_counter() - t0
     out_L = np.empty((samples + 1, 3))
     out_q = np.empty((samples + 1, 4))
@@ -174,7 +176,7 @@ def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
     out_L[0], out_q[0] = L0, q0
     steps = nfev = 0
     t0 = time.perf_counter()
-    rigid_dop853(inertia, L0, q0, times[:2], rtol=rtol, mgl=mgl)  # load or compile the kernel
+    rigid_dop853(inertia, L0, q0, times[:1], rtol=rtol, mgl=mgl)  # load or compile the kernel (no step taken)
     compile_s = time.perf_counter() - t0
     done = 1  # samples filled
     L, q = L0, q0
@@ -247,20 +249,46 @@ def simulate_free_body(body, duration, method, run, progress):
 
 
 def _stepper(method, inertia, top):
+    """``(checked, fast)`` steppers ``(L, q, h, n, every) -> (L, q, times)`` of a fixed-step method.
+
+    ``checked`` is the public function (every input checked); ``fast`` runs the
+    same compiled driver with the body's constants checked once
+    (:func:`rotframe.rigid.drivers.splitting_stepper`), for the chunks after a
+    first checked call. Both give the same numbers.
+    """
     from rotframe.rigid import dynamics as rigid
+    from rotframe.rigid.checks import check_inertia, heavy_top_mgl, symmetry_axis
+    from rotframe.rigid.drivers import splitting_stepper
+
     i1, i2, i3 = inertia
     mgl = 0.0 if top is None else top[0] * top[1] * top[2]
     if method == "rk4":
-        return lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)
+        rk4 = lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)  # noqa: E731
+        return rk4, rk4
     order = {"": 2, "4": 4, "6": 6}
+    zero = np.zeros(3)
     for prefix in ("lie-poisson", "top-splitting"):
         if method.startswith(prefix) and method[len(prefix):] in order:
             k = order[method[len(prefix):]]
             if top is not None:
                 mass, length, g = top
-                return lambda L, q, h, n, every: rigid.heavy_top_splitting(
-                    i1, i3, mass, length, g, L, q, h, n, order=k, sample_every=every)
-            return lambda L, q, h, n, every: rigid.lie_poisson(inertia, L, q, h, n, order=k, sample_every=every)
+
+                def checked(L, q, h, n, every):
+                    return rigid.heavy_top_splitting(i1, i3, mass, length, g, L, q, h, n, order=k, sample_every=every)
+
+                # the constants exactly as heavy_top_splitting computes them
+                fast = splitting_stepper(check_inertia((i1, i1, i3))[1], 2, heavy_top_mgl(mass, length, g),
+                                         zero, zero, k)
+                return checked, fast
+
+            def checked(L, q, h, n, every):
+                return rigid.lie_poisson(inertia, L, q, h, n, order=k, sample_every=every)
+
+            # the constants exactly as lie_poisson computes them (no torque)
+            moments, inv_i = check_inertia(inertia)
+            sym = symmetry_axis(moments)
+            fast = splitting_stepper(inv_i, -1 if sym is None else sym, 0.0, zero, zero, k)
+            return checked, fast
     raise ScenarioError(f"method {method!r} unknown for a rigid body")
 
 
