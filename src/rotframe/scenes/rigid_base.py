@@ -98,16 +98,17 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     if method == "exact":
         steps = 0.0
     elif method == "dop853":
-        steps = adaptive_steps_estimate(inertia, L0, duration, float(run.get("rtol") or DEFAULT_RTOL),
-                                        0.0 if top is None else top[0] * top[1] * top[2])
+        rtol = float(run.get("rtol") or DEFAULT_RTOL)
+        _check_adaptive(inertia, rtol)
+        steps = adaptive_steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
     else:
         steps = samples * max(1.0, math.ceil(
             (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
     limits.check_run(steps=steps, samples=samples + 1, what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
     if method == "dop853":
-        return _integrate_adaptive(inertia, L0, q0, times, float(run.get("rtol") or DEFAULT_RTOL),
-                                   0.0 if top is None else top[0] * top[1] * top[2], progress)
+        return _integrate_adaptive(inertia, L0, q0, times, rtol, 0.0 if top is None else top[0] * top[1] * top[2],
+                                   progress)
     if method == "exact":
         if top is not None:
             raise ScenarioError("method 'exact' is the free body's flow; the heavy top has gravity")
@@ -184,11 +185,7 @@ def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
     """
     from rotframe.rigid.adaptive import rigid_dop853
 
-    if not (math.isfinite(rtol) and 1e-15 <= rtol < 1.0):
-        raise ScenarioError(f"rtol = {rtol:g}: method dop853 needs 1e-15 <= rtol < 1")
-    if not np.all(np.asarray(inertia) > 0):
-        raise ScenarioError(f"method dop853: principal moments {', '.join(f'{x:g}' for x in inertia)} kg m2; "
-                            "it needs all > 0 (a thin rod has a zero moment: use exact or lie-poisson)")
+    _check_adaptive(inertia, rtol)
     n = len(times)
     out_L = np.empty((n, 3))
     out_q = np.empty((n, 4))
@@ -224,6 +221,15 @@ def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
     traj = BodyTrajectory(times, out_L, out_q, "dop853", steps, True, float(times[-1]))
     traj.extras.update(compile_s=compile_s, rtol=rtol, nfev=nfev)
     return traj
+
+
+def _check_adaptive(inertia, rtol):
+    """ScenarioError unless ``dop853`` can run: 1e-15 <= rtol < 1 and every principal moment > 0."""
+    if not (math.isfinite(rtol) and 1e-15 <= rtol < 1.0):
+        raise ScenarioError(f"rtol = {rtol:g}: method dop853 needs 1e-15 <= rtol < 1")
+    if not np.all(np.asarray(inertia) > 0):
+        raise ScenarioError(f"method dop853: principal moments {', '.join(f'{x:g}' for x in inertia)} kg m2; "
+                            "it needs all > 0 (a thin rod has a zero moment: use exact or lie-poisson)")
 
 
 def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
