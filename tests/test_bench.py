@@ -36,3 +36,21 @@ def test_bench_unknown_name_exits_2(tmp_path):
                          cwd=tmp_path)
     assert res.returncode == 2
     assert "available" in res.stderr
+
+
+def test_free_top_problem_runs_against_the_closed_form():
+    # the Earth over two Euler periods (616 turns): exact is the reference itself (error 0); dop853 at
+    # rtol 1e-8 must stay within the scenes' bound 10 n rtol of the closed form (n = nfev / 12 steps;
+    # measured 1.2e-5 for ~34000 evaluations: bound 2.8e-4); lie-poisson's sub-flows are exact for a
+    # symmetric body, so its error is round-off at any step: at most eps (2.2e-16) times the 3900 rad
+    # turned times sqrt(530 steps), 2e-11, bounded here by 1e-10 (measured 3e-13)
+    from rotframe.app.bench.problems import problems
+
+    (p,) = problems(["free-top"], quick=True)
+    assert p.scenario == "free-top" and set(p.runs) == {"exact", "dop853", "lie-poisson", "rk4"}
+    y, _, _ = p.run("exact", None)
+    assert p.error(y) == 0.0
+    y, nfev, _ = p.run("dop853", 1e-8)
+    assert 0 < p.error(y) < 10 * 1e-8 * nfev / 12
+    y, _, _ = p.run("lie-poisson", 1e5)
+    assert p.error(y) < 1e-10

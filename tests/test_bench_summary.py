@@ -101,3 +101,24 @@ def test_levels_below_the_reference_accuracy_are_not_claimed():
     summ = {r["level"]: r for r in level_summary(rows)}
     assert summ[1e-6]["ratio"] == pytest.approx(100.0)
     assert summ[1e-9]["ratio"] is None and "not measurable" in summ[1e-9]["note"]
+
+
+def test_a_level_below_the_goal_says_by_how_much_and_why():
+    # hand-made rows: at 1e-3 the peer does half the work (1000 vs 2000 nfev) in 4x our time -> ratio 4,
+    # and the reason is the work; at 1e-6 both do 2000 evaluations and the peer's cost 5x ours -> ratio 5,
+    # the reason is the cost per evaluation
+    rows = [dict(_row("dop853", 1e-4, 5e-4, "rotframe"), nfev=2000),
+            dict(_row("diffrax-Tsit5", 4e-4, 8e-4, "peer"), nfev=1000),
+            dict(_row("dop853", 2e-4, 5e-7, "rotframe"), nfev=2000),
+            dict(_row("diffrax-Dopri8", 1e-3, 9e-7, "peer"), nfev=2000)]
+    summ = {r["level"]: r for r in level_summary(rows)}
+    assert summ[1e-3]["ratio"] == pytest.approx(4.0) and summ[1e-3]["shortfall"] == pytest.approx(2.5)
+    assert "needs 2x less work (1000 vs 2000 nfev" in summ[1e-3]["reason"]
+    assert summ[1e-3]["note"].startswith("below the 10x goal by a factor 2.5: ")
+    assert summ[1e-6]["ratio"] == pytest.approx(5.0) and summ[1e-6]["shortfall"] == pytest.approx(2.0)
+    assert "evaluation costs only 5x ours (also compiled" in summ[1e-6]["reason"]
+    assert "it does 1x our work (2000 vs 2000 nfev)" in summ[1e-6]["reason"]
+    # at the goal: no shortfall, no reason (the Tsit5 row made slower, Dopri8's 1e-3 s is the fastest peer)
+    rows[1]["wall_s"] = 2e-3
+    summ = {r["level"]: r for r in level_summary(rows)}
+    assert summ[1e-3]["ratio"] == pytest.approx(10.0) and "reason" not in summ[1e-3] and "note" not in summ[1e-3]

@@ -18,7 +18,7 @@ def test_particle_scenes_take_their_methods_from_the_registry():
 def test_heavy_top_methods_are_renamed_and_the_old_names_are_aliases():
     from rotframe.scenes import heavy_top
 
-    assert tuple(heavy_top.METHODS) == ("top-splitting", "top-splitting4", "top-splitting6", "rk4")
+    assert tuple(heavy_top.METHODS) == ("top-splitting", "top-splitting4", "top-splitting6", "rk4", "dop853")
     for old, new in (("splitting", "top-splitting"), ("splitting4", "top-splitting4"),
                      ("splitting6", "top-splitting6")):
         assert old in heavy_top.METHODS and heavy_top.METHODS.canonical(old) == new
@@ -45,6 +45,10 @@ def test_heavy_top_default_is_the_canonical_name(capsys):
     import json
 
     code, out, err = call(capsys, "run", "heavy-top", "--set", "duration=0.2", "--no-record", "--json")
+    assert_clean(code, out, err, allowed=(0,))
+    assert json.loads(out)["method"] == "dop853"  # the scenario's default since issue 13 (measured cheaper)
+    code, out, err = call(capsys, "run", "heavy-top", "--method", "splitting", "--set", "duration=0.2",
+                          "--no-record", "--json")
     assert_clean(code, out, err, allowed=(0,))
     assert json.loads(out)["method"] == "top-splitting"
 

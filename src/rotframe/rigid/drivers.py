@@ -4,7 +4,8 @@ Output arrays and sample times (steps ``0, s, 2s, ...`` and always the last), th
 triple-jump weights (:func:`rotframe.numerics.composition.triple_jump_weights`,
 refused orders as :class:`~rotframe.rigid.checks.InvalidStateError`), the end of
 a run (an :class:`~rotframe.errors.IntegrationError` that keeps the finite
-samples), and the driver of the compiled splitting :func:`run_splitting`.
+samples), and the drivers of the compiled splitting :func:`run_splitting` and
+:func:`splitting_stepper` (the body checked once, for runs in chunks).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from rotframe.numerics.composition import triple_jump_weights
 from rotframe.rigid.checks import InvalidStateError, check_quaternion, check_steps
 from rotframe.rigid.kernels import split_run
 
-__all__ = ["composition_weights", "allocate_samples", "finish_samples", "run_splitting"]
+__all__ = ["composition_weights", "allocate_samples", "finish_samples", "splitting_stepper", "run_splitting"]
 
 
 def composition_weights(order):
@@ -46,13 +47,29 @@ def finish_samples(out_L, out_q, times, kept, name):
     )
 
 
+def splitting_stepper(inv_i, sym, mgl, torque_body, torque_space, order):
+    """``step(L0, q0, h, n_steps, sample_every) -> (L, q, times)``: the compiled splitting of one body.
+
+    The body's constants (``inv_i``, ``sym``, ``mgl``, the torques, as the public
+    functions check them) and the composition weights of ``order`` are fixed
+    once, so a driver that calls ``step`` again and again (a run in chunks) pays
+    only the checks of the state and the steps (a quaternion normalised, as
+    :func:`run_splitting` does).
+    """
+    weights = composition_weights(order)
+
+    def step(L0, q0, h, n_steps, sample_every):
+        q0 = check_quaternion(q0)
+        h, n_steps, sample_every = check_steps(h, n_steps, sample_every)
+        out_L, out_q, times = allocate_samples(h, n_steps, sample_every)
+        kept = split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, weights,
+                         sample_every, out_L, out_q)
+        return finish_samples(out_L, out_q, times, kept, "splitting")
+
+    return step
+
+
 def run_splitting(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, order,
                    sample_every):
     """Shared driver of lie_poisson and heavy_top_splitting."""
-    q0 = check_quaternion(q0)
-    weights = composition_weights(order)
-    h, n_steps, sample_every = check_steps(h, n_steps, sample_every)
-    out_L, out_q, times = allocate_samples(h, n_steps, sample_every)
-    kept = split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, weights,
-                      sample_every, out_L, out_q)
-    return finish_samples(out_L, out_q, times, kept, "splitting")
+    return splitting_stepper(inv_i, sym, mgl, torque_body, torque_space, order)(L0, q0, h, n_steps, sample_every)

@@ -33,6 +33,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -265,13 +266,25 @@ def _free_asymmetric(fr, L0, q0, t):
     az = np.arctan2(sigma * fr["ratio"] * sn, cn)
     phi = sigma * am + _wrap(az - sigma * am)
     ez, ey = np.eye(3)[2], np.eye(3)[1]
-    qP = Rotation.from_matrix(fr["P"]).as_quat()
+    qP = _permutation_quat(fr["P"].tobytes())
     qP_inv = qP * np.array([-1.0, -1.0, -1.0, 1.0])
     S0 = quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(q0, qP_inv), quat_about_axis(ez, phi[0])), quat_about_axis(ey, theta[0]))
     q = quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(quat_mul_arrays(S0, quat_about_axis(ez, psi)), quat_about_axis(ey, -theta[1:])),
                     quat_about_axis(ez, -phi[1:])), qP)
     L = L_ord[1:] @ fr["P"]  # ordered -> body: P^T @ L
     return L, q
+
+
+@functools.lru_cache(maxsize=64)
+def _permutation_quat(P_bytes):
+    """Quaternion (scalar-last) of a proper signed permutation matrix given as its float64 bytes.
+
+    There are 24 such matrices; scipy's ``from_matrix`` costs more than the rest of a short call, so
+    each is converted once (the same function on the same matrix: the same numbers), read-only.
+    """
+    q = Rotation.from_matrix(np.frombuffer(P_bytes, dtype=np.float64).reshape(3, 3)).as_quat()
+    q.flags.writeable = False
+    return q
 
 
 def _jacobi_with_pi(u, fr):

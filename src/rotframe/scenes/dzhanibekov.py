@@ -16,8 +16,8 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
-                                       simulate_free_body)
+from rotframe.scenes.rigid_base import (FREE_METHODS, adaptive_rel_error, free_body_state,
+                                       invariant_drifts, record_body, simulate_free_body)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -79,7 +79,8 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
     max |L_mid|, the steepness of the flip; taken at dt^3 lambda^2 per crossing.
     The interval is (last - first) / (n - 1), so two crossing errors count. A
     relative 1e-9 covers round-off of the exact flow; fixed-step methods add
-    (lambda h)^2 relative (order 2, factor 10 of margin).
+    (lambda h)^2 relative (order 2, factor 10 of margin), the adaptive ``dop853``
+    :func:`rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
     """
     dt = float(traj.times[1] - traj.times[0])
     w = traj.L / np.where(inertia > 0, inertia, np.inf)
@@ -87,7 +88,9 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
     lam = float(np.max(np.abs(dL)) / max(np.max(np.abs(traj.L[:, mid])), 1e-300))
     tol = 2 * dt**3 * lam**2 / n_intervals + 1e-9 * interval
     h = traj.extras.get("step")
-    if method != "exact" and h:
+    if method == "dop853":
+        tol += adaptive_rel_error(traj) * interval
+    elif method != "exact" and h:
         tol += 10.0 * interval * (lam * h) ** 2
     return tol
 

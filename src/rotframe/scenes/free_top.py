@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import (FREE_METHODS, free_body_state, invariant_drifts, record_body,
-                                       simulate_free_body)
+from rotframe.scenes.rigid_base import (FREE_METHODS, adaptive_rel_error, free_body_state,
+                                       invariant_drifts, record_body, simulate_free_body)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -99,10 +99,13 @@ def _tolerance(method, rate, traj):
     The exact flow and the Lie-Poisson splittings (whose free symmetric sub-flows
     are exact) measure a uniform rotation, fitted over many samples: a relative
     1e-9 covers the round-off of angles of up to 1e7 rad. RK4 adds its truncation
-    error, (rate h)^4 per unit time in relative terms, with a factor 100 of margin.
+    error, (rate h)^4 per unit time in relative terms, with a factor 100 of margin. The adaptive
+    ``dop853`` is good to :func:`rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
     """
     tol = 1e-9 * abs(rate)
     h = traj.extras.get("step")
+    if method == "dop853":
+        tol = adaptive_rel_error(traj) * abs(rate)
     if method == "rk4" and h:
         tol += 100.0 * abs(rate) * (abs(rate) * h) ** 4 * max(1.0, abs(rate) * traj.times[-1])
     return tol

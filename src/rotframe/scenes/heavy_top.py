@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.scenes.base import SceneResult, reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import HEAVY_METHODS, guarded, initial_attitude_zxz, integrate_body
+from rotframe.scenes.rigid_base import (HEAVY_METHODS, adaptive_rel_error, guarded,
+                                       initial_attitude_zxz, integrate_body)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -39,7 +40,8 @@ class HeavyTopParameters:
 PARAMETERS = HeavyTopParameters
 
 
-#: ``top-splitting``, ``top-splitting4``, ``top-splitting6``, ``rk4`` (the old ``splitting[4|6]`` accepted).
+#: ``top-splitting``, ``top-splitting4``, ``top-splitting6``, ``rk4``, ``dop853`` (the old ``splitting[4|6]``
+#: accepted).
 METHODS = HEAVY_METHODS
 
 
@@ -202,11 +204,13 @@ def analyse(p, result):
                 theory["nutation_period_s"] = math.nan
                 notes.append(f"theory: theta stays at {math.degrees(tp[0]):.6g} deg (steady to the resolution of the cubic; the period of "
                              f"small nods about it would be {tp[2]:.6g} s)")
-            # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin;
+            # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin
+            # (dop853: its bound from the tolerance, rigid_base.adaptive_rel_error);
             # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
             T = float(tp[2]) if len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0 else math.inf
             w_fast = max(abs(w3), abs(p.phidot0), 2 * math.pi / T)
-            method_rel = 10 * (w_fast * h) ** 2 if traj.method != "exact" else 1e-9
+            method_rel = (adaptive_rel_error(traj) if traj.method == "dop853"
+                          else 10 * (w_fast * h) ** 2 if traj.method != "exact" else 1e-9)
             amp_deg = math.degrees(tp[1] - tp[0])
             for key, i in (("theta_min_deg", int(np.argmin(theta))), ("theta_max_deg", int(np.argmax(theta)))):
                 # the true extreme lies within a sample of the sampled one, so it differs from it by at most

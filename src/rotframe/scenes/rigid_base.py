@@ -13,13 +13,35 @@ from rotframe.particles.integrators import RunInterrupted
 from rotframe.scenes.base import MethodNames
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
-#: Lie-Poisson splitting of orders 2, 4, 6.
-FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4"))
+#: Lie-Poisson splitting of orders 2, 4, 6, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
+#: (:func:`rotframe.rigid.adaptive.rigid_dop853`, relative tolerance ``rtol`` of the run).
+FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4", "dop853"))
 #: Methods of the heavy top: ``top-splitting[4|6]`` (exact free symmetric-top flow and gravity kick, orders
-#: 2, 4, 6) and ``rk4``; the old names ``splitting``, ``splitting4``, ``splitting6`` are still accepted.
-HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "rk4"),
+#: 2, 4, 6), ``rk4`` and the adaptive ``dop853``; the old names ``splitting``, ``splitting4``,
+#: ``splitting6`` are still accepted.
+HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "rk4", "dop853"),
                             {"splitting": "top-splitting", "splitting4": "top-splitting4",
                              "splitting6": "top-splitting6"})
+
+#: Relative tolerance of ``dop853`` when the run names none (the scenario default of ``rtol``).
+DEFAULT_RTOL = 1e-10
+#: Samples per compiled call of the adaptive and exact runs: between calls progress shows and Ctrl-C is seen.
+SAMPLES_PER_CALL = 4096
+
+
+def adaptive_rel_error(traj):
+    """A bound on the relative global error of a ``dop853`` trajectory, from its ``rtol`` and accepted steps.
+
+    The step-size control keeps each step's local error below ``rtol`` (relative,
+    per component); summed over ``n`` steps without growth that is ``n rtol``,
+    and a factor 10 covers its propagation along the run. Measured: the heavy
+    top over 2 s (1125 steps at rtol 1e-10) is off the scipy DOP853 reference by
+    2e-8 rad in attitude, 0.02 of ``n rtol``; the Dzhanibekov flip over 100 s
+    some 100 ``rtol`` (tests/test_rigid_adaptive.py). Never below 1e-9, the
+    round-off floor of the scenes' metrics.
+    """
+    rtol = traj.extras.get("rtol") or DEFAULT_RTOL
+    return max(1e-9, 10.0 * float(rtol) * max(int(traj.steps), 1))
 
 
 @dataclass
@@ -40,6 +62,20 @@ class BodyTrajectory:
     extras: dict = field(default_factory=dict)
 
 
+def adaptive_steps_estimate(inertia, L0, duration, rtol, mgl=0.0):
+    """Steps ``dop853`` will take, roughly (for the run limits): ``duration w rtol^(-1/8) / 10``.
+
+    ``w`` is the fastest rate, the initial ``|omega|`` plus the gravity rate ``sqrt(|mgl| / I_min)``
+    of a heavy top; an 8th-order step resolves a turn of ``rtol^(1/8)`` rad times a constant. The
+    constant 1/10 is measured: the default heavy top (10 s, 300 rad/s, rtol 1e-9) takes 4222
+    steps, estimated 4529; the Dzhanibekov flip (100 s, 1 rad/s, rtol 1e-10) 189, estimated 180.
+    """
+    moments = [float(x) for x in inertia]  # scalar arithmetic: a short run pays microseconds, not tens
+    w = math.sqrt(sum((float(l) / i) ** 2 for l, i in zip(L0, moments) if i > 0))
+    w += math.sqrt(abs(mgl) / max(min(moments), 1e-300))
+    return duration * w * rtol ** (-1.0 / 8.0) / 10.0
+
+
 def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """Integrate a free body, or a heavy symmetric top (``top = (mass, length, g)``), by a named method.
 
@@ -58,23 +94,34 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
     samples = max(1, int(run.get("samples") or 2000))
-    per_sample = 1.0 if method == "exact" else max(1.0, math.ceil(
-        (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
-    limits.check_run(steps=0.0 if method == "exact" else samples * per_sample, samples=samples + 1,
-                     what=f"method {method}")
+    if method == "exact":
+        steps = 0.0
+    elif method == "dop853":
+        rtol = float(run.get("rtol") or DEFAULT_RTOL)
+        _check_adaptive(inertia, rtol)
+        steps = adaptive_steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
+    else:
+        steps = samples * max(1.0, math.ceil(
+            (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
+    limits.check_run(steps=steps, samples=samples + 1, what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
+    if method == "dop853":
+        return _integrate_adaptive(inertia, L0, q0, times, rtol, 0.0 if top is None else top[0] * top[1] * top[2],
+                                   progress)
     if method == "exact":
         if top is not None:
             raise ScenarioError("method 'exact' is the free body's flow; the heavy top has gravity")
+        # the elliptic-function flow of rigid.free_body (not the compiled rigid.exact_flow, which agrees to
+        # round-off only: the scenes' numbers stay those of the reference implementation)
         t0 = time.perf_counter()
-        L, q = rigid.free_body_exact(inertia, L0, q0, times[:1])
+        rigid.free_body_exact(inertia, L0, q0, times[:1])  # check every input once; load the kernels
         compile_s = time.perf_counter() - t0
         out_L = np.empty((samples + 1, 3))
         out_q = np.empty((samples + 1, 4))
         done = 0
         try:
-            for start in range(0, samples + 1, 4096):
-                stop = min(samples + 1, start + 4096)
+            for start in range(0, samples + 1, SAMPLES_PER_CALL):
+                stop = min(samples + 1, start + SAMPLES_PER_CALL)
                 out_L[start:stop], out_q[start:stop] = rigid.free_body_exact(inertia, L0, q0, times[start:stop])
                 done = stop
                 if progress:
@@ -88,9 +135,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     dt_sample = duration / samples
     sps = max(1, math.ceil(dt_sample / step - 1e-9))
     h = dt_sample / sps
-    stepper = _stepper(method, inertia, top)
+    checked, stepper = _stepper(method, inertia, top)
     t0 = time.perf_counter()
-    stepper(L0, q0, h, 1, 1)  # load or compile the kernel
+    checked(L0, q0, h, 1, 1)  # check every input once; load or compile the kernel
     compile_s = time.perf_counter() - t0
     out_L = np.empty((samples + 1, 3))
     out_q = np.empty((samples + 1, 4))
@@ -126,6 +173,62 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     traj = BodyTrajectory(times, out_L, out_q, method, samples * sps, True, duration)
     traj.extras.update(compile_s=compile_s, step=h)
     return traj
+
+
+def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
+    """The ``dop853`` run at ``times`` (``rtol`` and moments checked by :func:`_check_adaptive`): compiled
+    adaptive DOP853, :data:`SAMPLES_PER_CALL` samples a call.
+
+    Each call starts from the last sample of the one before (its state at a step's end, the
+    quaternion normalised) and chooses its first step afresh. ``steps`` counts accepted steps;
+    ``extras`` holds ``rtol``, ``nfev`` and ``compile_s`` (the first call, which loads the kernel).
+    """
+    from rotframe.rigid.adaptive import rigid_dop853
+
+    n = len(times)
+    out_L = np.empty((n, 3))
+    out_q = np.empty((n, 4))
+    out_L[0], out_q[0] = L0, q0
+    steps = nfev = 0
+    t0 = time.perf_counter()
+    rigid_dop853(inertia, L0, q0, times[:1], rtol=rtol, mgl=mgl)  # load or compile the kernel (no step taken)
+    compile_s = time.perf_counter() - t0
+    done = 1  # samples filled
+    L, q = L0, q0
+    try:
+        while done < n:
+            stop = min(n, done + SAMPLES_PER_CALL)
+            try:
+                res = rigid_dop853(inertia, L, q, times[done - 1:stop], rtol=rtol, mgl=mgl)
+            except IntegrationError as exc:
+                k = len(exc.partial.times)
+                out_L[done:done + k - 1], out_q[done:done + k - 1] = exc.partial.L[1:], exc.partial.q[1:]
+                good = done + k - 1
+                partial = _truncate(BodyTrajectory(times, out_L, out_q, "dop853", steps + exc.partial.steps), good)
+                raise IntegrationError(f"non-finite state or step-size collapse after t = {times[good - 1]:.6g} s "
+                                       f"(method dop853, rtol {rtol:g})", t_reached=float(times[good - 1]),
+                                       partial=partial) from None
+            out_L[done:stop], out_q[done:stop] = res.L[1:], res.q[1:]
+            L, q = res.L[-1], res.q[-1]
+            steps += res.steps
+            nfev += res.nfev
+            done = stop
+            if progress:
+                progress(done / n)
+    except KeyboardInterrupt:
+        raise RunInterrupted(_truncate(BodyTrajectory(times, out_L, out_q, "dop853", steps), done)) from None
+    traj = BodyTrajectory(times, out_L, out_q, "dop853", steps, True, float(times[-1]))
+    traj.extras.update(compile_s=compile_s, rtol=rtol, nfev=nfev)
+    return traj
+
+
+def _check_adaptive(inertia, rtol):
+    """ScenarioError unless ``dop853`` can run: 1e-15 <= rtol < 1 and every principal moment > 0."""
+    if not (math.isfinite(rtol) and 1e-15 <= rtol < 1.0):
+        raise ScenarioError(f"rtol = {rtol:g}: method dop853 needs 1e-15 <= rtol < 1")
+    if not all(float(x) > 0 for x in inertia):
+        raise ScenarioError(f"method dop853: principal moments {', '.join(f'{x:g}' for x in inertia)} kg m2; "
+                            "it needs all > 0 (a thin rod has a zero moment: use exact or lie-poisson)")
 
 
 def _advance_in_pieces(stepper, L, q, h, steps, piece=1_000_000):
@@ -170,20 +273,46 @@ def simulate_free_body(body, duration, method, run, progress):
 
 
 def _stepper(method, inertia, top):
+    """``(checked, fast)`` steppers ``(L, q, h, n, every) -> (L, q, times)`` of a fixed-step method.
+
+    ``checked`` is the public function (every input checked); ``fast`` runs the
+    same compiled driver with the body's constants checked once
+    (:func:`rotframe.rigid.drivers.splitting_stepper`), for the chunks after a
+    first checked call. Both give the same numbers.
+    """
     from rotframe.rigid import dynamics as rigid
+    from rotframe.rigid.checks import check_inertia, heavy_top_mgl, symmetry_axis
+    from rotframe.rigid.drivers import splitting_stepper
+
     i1, i2, i3 = inertia
     mgl = 0.0 if top is None else top[0] * top[1] * top[2]
     if method == "rk4":
-        return lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)
+        rk4 = lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)  # noqa: E731
+        return rk4, rk4
     order = {"": 2, "4": 4, "6": 6}
+    zero = np.zeros(3)
     for prefix in ("lie-poisson", "top-splitting"):
         if method.startswith(prefix) and method[len(prefix):] in order:
             k = order[method[len(prefix):]]
             if top is not None:
                 mass, length, g = top
-                return lambda L, q, h, n, every: rigid.heavy_top_splitting(
-                    i1, i3, mass, length, g, L, q, h, n, order=k, sample_every=every)
-            return lambda L, q, h, n, every: rigid.lie_poisson(inertia, L, q, h, n, order=k, sample_every=every)
+
+                def checked(L, q, h, n, every):
+                    return rigid.heavy_top_splitting(i1, i3, mass, length, g, L, q, h, n, order=k, sample_every=every)
+
+                # the constants exactly as heavy_top_splitting computes them
+                fast = splitting_stepper(check_inertia((i1, i1, i3))[1], 2, heavy_top_mgl(mass, length, g),
+                                         zero, zero, k)
+                return checked, fast
+
+            def checked(L, q, h, n, every):
+                return rigid.lie_poisson(inertia, L, q, h, n, order=k, sample_every=every)
+
+            # the constants exactly as lie_poisson computes them (no torque)
+            moments, inv_i = check_inertia(inertia)
+            sym = symmetry_axis(moments)
+            fast = splitting_stepper(inv_i, -1 if sym is None else sym, 0.0, zero, zero, k)
+            return checked, fast
     raise ScenarioError(f"method {method!r} unknown for a rigid body")
 
 
