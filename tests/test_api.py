@@ -226,12 +226,13 @@ def test_png(tmp_path):
 
 def test_cli_version_and_help_for_every_option(capsys):
     import argparse
+    import collections
 
     from rotframe.app import cli
     with pytest.raises(SystemExit) as info:
         cli.main(["--version"])
     assert info.value.code == 0 and capsys.readouterr().out.strip() == f"rotframe {rotframe.__version__}"
-    parser = cli._parser()
+    parser = cli.build_parser(collections.defaultdict(lambda: None))
     missing = []
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
