@@ -1,0 +1,42 @@
+"""The README's speed table from ``rotframe bench --json`` (summary rows and the environment row).
+
+    rotframe bench --json > /tmp/bench.json
+    python tools/bench_table.py /tmp/bench.json     # Markdown on stdout
+
+One row per problem and error level: the fastest rotframe run that reaches the level, the
+fastest peer run that reaches it, their times and the ratio (peer time / rotframe time), and
+what the bench says where the ratio is under its goal or not measurable.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+
+def _ms(seconds):
+    return "" if seconds is None else f"{seconds * 1e3:.3g} ms"
+
+
+def table(rows) -> str:
+    env = next((r for r in rows if r.get("kind") == "environment"), {})
+    lines = ["| problem | level | rotframe (method, setting) | peer (method, setting) | ratio | note |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        if r.get("kind") != "summary":
+            continue
+        ours = f"{r['rotframe_method']} {r['rotframe_setting']}: {_ms(r['wall_s'])}" if r.get("rotframe_method") else "-"
+        peer = f"{r['peer']} {r['peer_setting']}: {_ms(r['peer_wall_s'])}" if r.get("peer") else "-"
+        ratio = f"x{r['ratio']:.3g}" if r.get("ratio") else "-"
+        note = r.get("note") or ""
+        if r.get("shortfall"):
+            note = f"short of x10 by {r['shortfall']:.2g}x: {r.get('reason', '')}".strip()
+        lines.append(f"| {r['scenario']} ({r.get('horizon', '')}) | {r['level']:.0e} | {ours} | {peer} | {ratio} | {note} |")
+    versions = ", ".join(f"{k} {env[k]}" for k in ("python", "numpy", "scipy", "numba", "jax", "diffrax") if k in env)
+    machine = f"{env.get('cpus', '?')} cores, {env.get('processor', env.get('machine', '?'))}"
+    return "\n".join(lines) + f"\n\nMeasured in one run on {machine}; {versions}.\n"
+
+
+if __name__ == "__main__":
+    with open(sys.argv[1]) as f:
+        print(table(json.load(f)), end="")
