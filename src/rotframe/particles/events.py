@@ -16,7 +16,7 @@ import numpy as np
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
-from rotframe.particles.packed import as_state, jit_kernel
+from rotframe.particles.packed import as_state, jit_inline, jit_kernel
 
 __all__ = ["DOP853", "event_value", "start_value", "crossed", "trial_state", "locate_event", "record_event"]
 
@@ -88,7 +88,7 @@ def crossed(direction, g0, g1):
     return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
 
 
-@jit_kernel
+@jit_inline
 def trial_state(method, start, t, tau, m, wt, wv, wint, rk):
     """The state one step of length ``tau`` after ``start`` (at time t), by the method's own map.
 
@@ -104,7 +104,7 @@ def trial_state(method, start, t, tau, m, wt, wv, wint, rk):
     return method_steps(method, start, 1, tau, m, make_plan(method, t, tau, m, wt, wv, wint))
 
 
-@jit_kernel
+@jit_inline
 def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk):
     """Sub-step tau in (0, h] at which event ``e`` of the one-step map from ``start`` vanishes.
 
