@@ -101,7 +101,7 @@ class KernelSetup:
         """The compiled driver of this method."""
         from rotframe.particles import drivers
 
-        return drivers.fixed_driver(self.info.code) if self.info.kind == "fixed" else drivers.run_dop853
+        return drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
 
     def abs_tol(self, r0, v0):
         """DOP853's absolute tolerance: ``atol``, else ``rtol`` times max(1, |r0|, |v0|) (componentwise max)."""

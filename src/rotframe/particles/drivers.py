@@ -15,44 +15,24 @@ import numpy as np
 
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
-from rotframe.particles.events import DOP853, crossed, event_value, locate_event, record_event, start_value
+from rotframe.particles.events import crossed, event_value, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import derivative
-from rotframe.particles.kernels import RK4, SPLITTING, SPLITTING4, advance, make_plan, method_steps
-from rotframe.particles.packed import NFEV, as_state, is_finite, jit_inline, jit_kernel, store, store_particle, unpack
+from rotframe.particles.kernels import advance, make_plan, method_steps
+from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
-__all__ = ["run_fixed", "fixed_driver", "run_splitting", "run_splitting4", "run_rk4", "run_dop853"]
+__all__ = ["run_fixed", "run_dop853"]
 
 
+@jit_kernel
 def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
-    """Advance an ensemble with the fixed-step method of code ``method``; see :func:`fixed_steps`.
-
-    The compiled driver of each method is its own function (:func:`fixed_driver`),
-    so that a run compiles only the method it uses.
-    """
-    return _FIXED[method](r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                          events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-
-
-def fixed_driver(method):
-    """The compiled driver of the fixed-step method of code ``method``: :func:`run_splitting`, ... ."""
-    return _FIXED[method]
-
-
-@jit_inline
-def fixed_steps(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
     """Advance an ensemble with a fixed-step method and store samples.
-
-    Inlined into one compiled driver per method (:func:`run_splitting`,
-    :func:`run_splitting4`, :func:`run_rk4`) with ``method`` a constant, so that
-    numba compiles only that method's branches.
 
     Parameters
     ----------
     method : int
-        :data:`~rotframe.particles.kernels.SPLITTING`, ``SPLITTING4`` or ``RK4`` (0, 1, 2).
+        0 splitting, 1 splitting4, 2 rk4.
     r, v : (N, 3) arrays
         State at ``t0`` (rotating frame, m and m/s); updated in place.
     alive : (N,) bool array
@@ -116,8 +96,7 @@ def fixed_steps(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, 
                         for e in range(n_ev):
                             g_new = event_value(events, e, state, m.radius)
                             if crossed(events[e, 3], g_old[e], g_new):
-                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint,
-                                                        None)
+                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint)
                                 record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + tau, hit)
                                 if events[e, 4] != 0.0:
                                     stop = True
@@ -139,33 +118,6 @@ def fixed_steps(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, 
 
 
 @jit_kernel
-def run_splitting(r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                  events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
-    """:func:`fixed_steps` of the exact-rotation splitting."""
-    return fixed_steps(SPLITTING, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                       events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-
-
-@jit_kernel
-def run_splitting4(r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                   events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
-    """:func:`fixed_steps` of the Yoshida composition of the splitting."""
-    return fixed_steps(SPLITTING4, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                       events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-
-
-@jit_kernel
-def run_rk4(r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-            events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
-    """:func:`fixed_steps` of classical Runge-Kutta."""
-    return fixed_steps(RK4, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-                       events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-
-
-_FIXED = (run_splitting, run_splitting4, run_rk4)
-
-
-@jit_kernel
 def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C, E3, E5,
                events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state):
     """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
@@ -177,7 +129,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     located the same way, by bisection on the length of that extra step.
     ``h_state`` (N,) carries each particle's step size between calls.
 
-    Returns (n_done, bad, nfev, steps) like :func:`fixed_steps` (cost of particle 0).
+    Returns (n_done, bad, nfev, steps) like :func:`run_fixed` (cost of particle 0).
     """
     m = unpack(P, wt, wv)
     n = r.shape[0]
@@ -263,9 +215,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             for e in range(n_ev):
                 g_new = event_value(events, e, as_state(y_new), m.radius)
                 if crossed(events[e, 3], g_old[e], g_new):
-                    rk = (A, B, C, f0, Kt, y, tmp, yt)
-                    hi, hit = locate_event(DOP853, events, e, as_state(y), g_old[e], t, h_used, m, wt, wv, wv,
-                                           rk)
+                    hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, B, C, f0, Kt, y, tmp,
+                                                  yt)
                     record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
                     if events[e, 4] != 0.0 and t + hi <= t_stop:
                         stop = True

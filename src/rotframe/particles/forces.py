@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.particles.packed import jit_inline, jit_kernel, unpack
+from rotframe.particles.packed import jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
 __all__ = ["position_acceleration", "state_acceleration", "acceleration", "derivative", "air_density",

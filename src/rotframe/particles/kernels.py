@@ -22,14 +22,11 @@ from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
-from rotframe.particles.packed import NFEV, jit_inline, jit_kernel, unpack
+from rotframe.particles.packed import NFEV, jit_kernel, unpack
 from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 
-__all__ = ["SPLITTING", "SPLITTING4", "RK4", "make_plan", "method_steps", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
+__all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
-
-#: Method codes (``MethodInfo.code`` of :data:`rotframe.particles.integrators.METHODS`).
-SPLITTING, SPLITTING4, RK4 = 0, 1, 2
 
 # A compiled function that passes an array on to another one that is not inlined
 # increfs and decrefs it at every call (atomic operations, tens of ns in all). So what
@@ -70,7 +67,7 @@ def _sub(looked_up, m):
     return w, wd, turn, c, s
 
 
-@jit_inline
+@jit_kernel
 def make_plan(method, t, h, m, wt, wv, wint):
     """The rotation data a step [t, t + h] of ``method`` needs: three tuples laid out as :func:`_sub`.
 
@@ -91,7 +88,7 @@ def make_plan(method, t, h, m, wt, wv, wint):
     return sub, sub, sub
 
 
-@jit_inline
+@jit_kernel
 def _steady_plan(method, h, m):
     """:func:`make_plan` at the steady rate ``m.w``."""
     if method == 1:
@@ -274,7 +271,7 @@ def _rk4_steps(state, n, h, m, plan):
     return x, y, z, vx, vy, vz
 
 
-@jit_inline
+@jit_kernel
 def method_steps(method, state, n, h, m, plan):
     """``n`` steps of size h of method 0 splitting, 1 splitting4 or 2 rk4, all with the same ``plan``.
 
@@ -288,7 +285,7 @@ def method_steps(method, state, n, h, m, plan):
     return _free_steps(state, n, method, h, m, plan)
 
 
-@jit_inline
+@jit_kernel
 def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
     """Steps k0 .. k0 + n - 1 of size h from t0 (step k starts at t0 + k h).
 
