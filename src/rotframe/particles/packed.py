@@ -27,8 +27,7 @@ The rotation-rate magnitude table is ``wt`` (node times, increasing) and
 holds the integral of w from ``wt[0]`` to each node, so the rotation angle
 over any interval is exact for the piecewise-linear schedule.
 
-Every kernel of :mod:`rotframe.particles` is compiled with :data:`jit_kernel`, or inlined
-into its callers with :data:`jit_inline`.
+Every kernel of :mod:`rotframe.particles` is compiled with :data:`jit_kernel`.
 """
 
 from __future__ import annotations
@@ -40,7 +39,7 @@ from numba import njit
 
 __all__ = ["I_G", "I_AXIS", "I_CORIOLIS", "I_CENTRIFUGAL", "I_EULER", "I_KLIN", "I_KQUAD", "I_GMODE", "I_GM",
            "I_R", "I_PLEN", "I_PIVOT", "I_G0", "I_SPRING", "I_SCALE_H", "N_PARAMS", "N_EVENT_FIELDS", "NFEV",
-           "jit_kernel", "jit_inline", "PackedModel", "unpack", "as_state", "is_finite", "store", "store_particle"]
+           "jit_kernel", "PackedModel", "unpack", "as_state", "is_finite", "store", "store_particle"]
 
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
@@ -57,15 +56,6 @@ N_EVENT_FIELDS = 5
 #: (caught as a non-finite state) instead of raising, which also lets numba drop the reference
 #: counting of arrays passed to small functions that it inlines; nogil: ensembles run blocks on threads.
 jit_kernel = njit(cache=True, error_model="numpy", nogil=True)
-
-#: The decorator of the small helpers (forces, schedule, events, state packing): as
-#: :data:`jit_kernel`, but numba inlines them into each caller's own IR before typing, so they
-#: are never compiled (nor cached) on their own. What a first run costs is mostly numba's
-#: per-function work (typing, lowering, linking and caching each compiled function), so a
-#: helper that is inlined costs its caller a little typing instead; and a method code passed
-#: as a constant selects its branch before typing (numba prunes the others), so a driver
-#: compiles only the method it runs (:mod:`rotframe.particles.drivers`).
-jit_inline = njit(cache=True, error_model="numpy", nogil=True, inline="always")
 
 #: Force evaluations per step of each fixed-step method code (0 splitting, 1 splitting4, 2 rk4).
 NFEV = (1, 3, 4)
