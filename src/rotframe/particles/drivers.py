@@ -70,7 +70,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     for p in range(n):
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
-        k_step = 0
+        k_step = int(0)  # an int64: a literal 0 would compile advance a second time
         if n_ev > 0:
             w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
             for e in range(n_ev):
@@ -88,7 +88,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         t = t0 + k_step * h
                         start = state
                         step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)
-                        state = method_steps(method, state, 1, h, m, step_plan)
+                        state = method_steps(method, state, int(1), h, m, step_plan)  # int64, not a literal 1
                         if p == 0:
                             nfev0 += nfev_step
                         k_step += 1

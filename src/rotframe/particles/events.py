@@ -117,7 +117,7 @@ def narrow(lo, hi, g_lo, mid, g_mid):
 @jit_kernel
 def fixed_trial(method, start, t, tau, m, wt, wv, wint):
     """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2)."""
-    return method_steps(method, start, 1, tau, m, make_plan(method, t, tau, m, wt, wv, wint))
+    return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint))  # int64 1
 
 
 @jit_kernel

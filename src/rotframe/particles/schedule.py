@@ -17,18 +17,17 @@ __all__ = ["node_index", "omega_magnitude", "omega_rate", "omega_angle", "rates"
 
 
 @jit_kernel
-def node_index(wt, t, right):
-    """``np.searchsorted(wt, t, side="right" if right else "left")`` for increasing ``wt``, by bisection.
+def node_index(wt, t):
+    """``np.searchsorted(wt, t)`` for increasing ``wt``, by bisection: the first index i with ``wt[i] >= t``.
 
-    The first index i with ``wt[i] > t`` (``right``) or ``wt[i] >= t``. Written out
-    because numba's ``np.searchsorted`` compiles a generic version (complex
+    Written out because numba's ``np.searchsorted`` compiles a generic version (complex
     comparisons included) that costs a first run about a second of compiling.
     """
     lo = 0
     hi = wt.shape[0]
     while lo < hi:
         mid = (lo + hi) // 2
-        if wt[mid] < t or (right and wt[mid] == t):
+        if wt[mid] < t:
             lo = mid + 1
         else:
             hi = mid
@@ -43,7 +42,7 @@ def omega_magnitude(t, wt, wv):
         return wv[0]
     if t >= wt[n - 1]:
         return wv[n - 1]
-    k = node_index(wt, t, False) - 1
+    k = node_index(wt, t) - 1
     s = (t - wt[k]) / (wt[k + 1] - wt[k])
     return wv[k] + s * (wv[k + 1] - wv[k])
 
@@ -54,7 +53,8 @@ def omega_rate(t, wt, wv):
     n = wt.shape[0]
     if n == 1 or t < wt[0] or t >= wt[n - 1]:
         return 0.0
-    k = node_index(wt, t, True) - 1
+    i = node_index(wt, t)
+    k = i if wt[i] == t else i - 1  # searchsorted side='right', less 1: the node times increase strictly
     return (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
 
 
@@ -66,7 +66,7 @@ def omega_angle(t, wt, wv, wint):
         return wv[0] * (t - wt[0])
     if t >= wt[n - 1]:
         return wint[n - 1] + wv[n - 1] * (t - wt[n - 1])
-    k = node_index(wt, t, False) - 1
+    k = node_index(wt, t) - 1
     dt = t - wt[k]
     slope = (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
     return wint[k] + wv[k] * dt + 0.5 * slope * dt * dt
