@@ -162,7 +162,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         nf = 1
         for e in range(n_ev):
             g_old[e] = start_value(events, e, as_state(y), m, w, wd)
-        k_out = 0
+        k_out = int(0)  # an int64: a literal 0 would compile store a second time
         while k_out < n_out and sample_times[k_out] <= t:
             store(out_r, out_v, k_out, p, y)
             k_out += 1
