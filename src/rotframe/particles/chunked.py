@@ -140,20 +140,25 @@ class KernelSetup:
         An empty call (no particle) makes numba compile the driver, or load it
         from its disk cache, when this process has not yet used it with these
         argument types. Whether it did is read from the dispatcher itself (it
-        gained a signature), not from any record of earlier runs, so the
-        result depends on this call only: the time of that empty call when it
-        loaded or compiled, else 0.0 (the empty call itself costs microseconds).
+        gained a compiled version), not from any record of earlier runs, so
+        the result depends on this call only: the time of that empty call when
+        it loaded or compiled, else 0.0. A dispatcher that already holds a
+        compiled version is not called (every run's arguments have the same
+        types, so the run's own call only dispatches).
         """
         kernel = self.kernel()
-        signatures = lambda: len(getattr(kernel, "signatures", ()))  # noqa: E731  (a wrapped kernel has none)
-        before = signatures()
+        # the dispatcher's compiled versions (a dict, O(1) to count; a wrapped kernel has none)
+        overloads = getattr(kernel, "overloads", None)
+        if overloads:
+            return 0.0  # loaded or compiled before, in this process: the run's call only dispatches
+        before = 0 if overloads is None else len(overloads)
         t_load = time.perf_counter()
         empty = np.empty((0, 3))
         out = np.empty((0, 0, 3))
         self.call(empty.copy(), empty.copy(), np.ones(0, dtype=np.bool_), 0, 0, out, out.copy(),
                   EventBuffers(0, 1), 1.0, np.zeros(0), 1.0)
         elapsed = time.perf_counter() - t_load
-        return elapsed if signatures() > before else 0.0
+        return elapsed if overloads is not None and len(kernel.overloads) > before else 0.0
 
     def one_sample_in_pieces(self, r, v, alive, first, out_r, out_v, evb, n):
         """One sample interval of ``sps`` fixed steps as several calls of about 4e6 step-evaluations.

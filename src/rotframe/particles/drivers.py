@@ -15,7 +15,7 @@ import numpy as np
 
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
-from rotframe.particles.events import DOP853, crossed, event_value, locate_event, record_event, start_value
+from rotframe.particles.events import crossed, event_value, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import derivative
 from rotframe.particles.kernels import advance, make_plan, method_steps
 from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
@@ -67,13 +67,10 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     nfev0 = 0
     n_done = n_samples
     bad = -1
-    # locate_event's DOP853 arguments, unused by a fixed-step method
-    empty = np.empty(0)
-    no_rk = (np.empty((0, 0)), empty, empty, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), np.empty((0, 0)), empty, empty, empty)
     for p in range(n):
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
-        k_step = 0
+        k_step = int(0)  # an int64: a literal 0 would compile advance a second time
         if n_ev > 0:
             w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
             for e in range(n_ev):
@@ -91,7 +88,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         t = t0 + k_step * h
                         start = state
                         step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)
-                        state = method_steps(method, state, 1, h, m, step_plan)
+                        state = method_steps(method, state, int(1), h, m, step_plan)  # int64, not a literal 1
                         if p == 0:
                             nfev0 += nfev_step
                         k_step += 1
@@ -99,8 +96,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         for e in range(n_ev):
                             g_new = event_value(events, e, state, m.radius)
                             if crossed(events[e, 3], g_old[e], g_new):
-                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint,
-                                                        no_rk)
+                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint)
                                 record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + tau, hit)
                                 if events[e, 4] != 0.0:
                                     stop = True
@@ -166,7 +162,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         nf = 1
         for e in range(n_ev):
             g_old[e] = start_value(events, e, as_state(y), m, w, wd)
-        k_out = 0
+        k_out = int(0)  # an int64: a literal 0 would compile store a second time
         while k_out < n_out and sample_times[k_out] <= t:
             store(out_r, out_v, k_out, p, y)
             k_out += 1
@@ -219,9 +215,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             for e in range(n_ev):
                 g_new = event_value(events, e, as_state(y_new), m.radius)
                 if crossed(events[e, 3], g_old[e], g_new):
-                    rk = (A, B, C, f0, Kt, y, tmp, yt)
-                    hi, hit = locate_event(DOP853, events, e, as_state(y), g_old[e], t, h_used, m, wt, wv, wv,
-                                           rk)
+                    hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, B, C, f0, Kt, y, tmp,
+                                                  yt)
                     record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
                     if events[e, 4] != 0.0 and t + hi <= t_stop:
                         stop = True

@@ -4,9 +4,11 @@ An event row is ``(kind, component, value, direction, terminal)``
 (:data:`rotframe.particles.packed.N_EVENT_FIELDS`; kind 0 position, 1 velocity,
 2 altitude above the curved ground). A crossing found over a step is located by
 bisection on the length of a re-step from the step's start with the method's own
-one-step map (:func:`locate_event`), so the event time is exact for the method's
-discrete trajectory (docs/physics/events.md). Both drivers (fixed-step and
-DOP853) use this one bisection and this one recording.
+one-step map, so the event time is exact for the method's discrete trajectory
+(docs/physics/events.md). The fixed-step drivers re-step with their method
+(:func:`locate_event`), the DOP853 driver with DOP853 (:func:`locate_event_dop853`),
+so that neither compiles the other's steps; both bisect by one rule
+(:func:`bisection_midpoint`, :func:`narrow`) and record by :func:`record_event`.
 """
 
 from __future__ import annotations
@@ -18,10 +20,8 @@ from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import as_state, jit_kernel
 
-__all__ = ["DOP853", "event_value", "start_value", "crossed", "trial_state", "locate_event", "record_event"]
-
-#: Method code of the adaptive DOP853 step in :func:`trial_state` (0, 1, 2: the fixed-step codes).
-DOP853 = 3
+__all__ = ["event_value", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
+           "locate_event", "locate_event_dop853", "record_event"]
 
 
 @jit_kernel
@@ -88,49 +88,80 @@ def crossed(direction, g0, g1):
     return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
 
 
-@jit_kernel
-def trial_state(method, start, t, tau, m, wt, wv, wint, rk):
-    """The state one step of length ``tau`` after ``start`` (at time t), by the method's own map.
+#: Most halvings of a bracket: enough to reach round-off of tau from any step length
+#: (even a crossing at tau ~ 1e-161 s, which a fixed 60 halvings of h would miss by 1e140).
+MAX_HALVINGS = 2200
 
-    ``method`` 0, 1, 2: the fixed-step maps (:func:`rotframe.particles.kernels.method_steps`),
-    from the state tuple ``start``. :data:`DOP853`: one DOP853 step from the arrays of
-    ``rk = (A, B, C, f0, K, y, tmp, y_out)`` (the tableau, f(t, y), stage and scratch
-    arrays, the start ``y`` (6,)), written into ``y_out``; ``start`` is then unused.
+
+@jit_kernel
+def bisection_midpoint(lo, hi):
+    """The midpoint of the bracket [lo, hi] (0 <= lo < hi), or -1.0 when it cannot shrink (round-off)."""
+    mid = 0.5 * (lo + hi)
+    if mid <= lo or mid >= hi:
+        return -1.0
+    return mid
+
+
+@jit_kernel
+def narrow(lo, hi, g_lo, mid, g_mid):
+    """The half of [lo, hi] that keeps the crossing, given g at ``mid``: ``(lo, hi, g_lo)``.
+
+    The crossing is in [mid, hi] when g keeps the sign it has at ``lo`` (a zero
+    counts as crossed), so ``hi`` is always at or past the event.
     """
-    if method == DOP853:
-        A, B, C, f0, K, y, tmp, y_out = rk
-        dop853_step(t, y, f0, tau, m, wt, wv, A, B, C, K, y_out, tmp)
-        return as_state(y_out)
-    return method_steps(method, start, 1, tau, m, make_plan(method, t, tau, m, wt, wv, wint))
+    if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
+        return mid, hi, g_mid
+    return lo, mid, g_lo
 
 
 @jit_kernel
-def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk):
-    """Sub-step tau in (0, h] at which event ``e`` of the one-step map from ``start`` vanishes.
+def fixed_trial(method, start, t, tau, m, wt, wv, wint):
+    """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2)."""
+    return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint))  # int64 1
 
-    Bisection on tau of g(:func:`trial_state` (start, tau)), halving until the
-    bracket cannot shrink (round-off of tau itself, even for a crossing at
-    tau ~ 1e-161 s, which a fixed 60 halvings of h would miss by 1e140).
+
+@jit_kernel
+def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint):
+    """Sub-step tau in (0, h] at which event ``e`` of the fixed-step map from ``start`` vanishes.
+
+    Bisection on tau of g(:func:`fixed_trial` (start, tau)), halving until the
+    bracket cannot shrink (:func:`bisection_midpoint`, :func:`narrow`).
     ``g_start`` is the event function at ``start`` as used for the crossing test
     (its sign just after the start when it is zero there, :func:`start_value`).
-    ``method`` and ``rk`` as in :func:`trial_state`. Returns tau and the state
-    at the event (a 6-tuple).
+    Returns tau and the state at the event (a 6-tuple).
     """
     lo = 0.0
     hi = h
     g_lo = g_start
-    for _ in range(2200):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
+    for _ in range(MAX_HALVINGS):
+        mid = bisection_midpoint(lo, hi)
+        if mid < 0.0:
             break
-        trial = trial_state(method, start, t, mid, m, wt, wv, wint, rk)
-        g_mid = event_value(events, e, trial, m.radius)
-        if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
-            lo = mid
-            g_lo = g_mid
-        else:
-            hi = mid
-    return hi, trial_state(method, start, t, hi, m, wt, wv, wint, rk)
+        g_mid = event_value(events, e, fixed_trial(method, start, t, mid, m, wt, wv, wint), m.radius)
+        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, g_mid)
+    return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint)
+
+
+@jit_kernel
+def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, tmp, y_out):
+    """:func:`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
+
+    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, B, C`` are the
+    tableau, ``K`` (13, 6) and ``tmp`` (6,) scratch, and ``y_out`` (6,) receives the
+    state (:func:`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
+    the state at the event (a 6-tuple).
+    """
+    lo = 0.0
+    hi = h
+    g_lo = g_start
+    for _ in range(MAX_HALVINGS):
+        mid = bisection_midpoint(lo, hi)
+        if mid < 0.0:
+            break
+        dop853_step(t, y, f0, mid, m, wt, wv, A, B, C, K, y_out, tmp)
+        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, event_value(events, e, as_state(y_out), m.radius))
+    dop853_step(t, y, f0, hi, m, wt, wv, A, B, C, K, y_out, tmp)
+    return hi, as_state(y_out)
 
 
 @jit_kernel

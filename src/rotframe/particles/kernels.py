@@ -28,6 +28,13 @@ from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 __all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
 
+# numba compiles a separate version of a function for every constant it is called with
+# (the argument is typed Literal[int](1), not int64), and of everything the constant is
+# passed on to: method_steps(method, state, 1, ...) beside method_steps(method, state, n, ...)
+# compiled every step kernel twice. So no constant count goes to a compiled function: one
+# step is n = int(1) (a call's result is an int64, not a literal), and a method code is
+# passed on as the variable it is.
+
 # A compiled function that passes an array on to another one that is not inlined
 # increfs and decrefs it at every call (atomic operations, tens of ns in all). So what
 # runs for every sub-step or stage passes no array on: the step kernels take none (the
@@ -79,7 +86,7 @@ def make_plan(method, t, h, m, wt, wv, wint):
     if m.steady:
         return _steady_plan(method, h, m)
     if method == 1:
-        h1, h0 = _sub_steps(1, h)[1][:2]
+        h1, h0 = _sub_steps(method, h)[1][:2]
         return (_sub(_lookup(t, h1, wt, wv, wint), m), _sub(_lookup(t + h1, h0, wt, wv, wint), m),
                 _sub(_lookup(t + h1 + h0, h1, wt, wv, wint), m))
     if method == 2:
@@ -92,7 +99,7 @@ def make_plan(method, t, h, m, wt, wv, wint):
 def _steady_plan(method, h, m):
     """:func:`make_plan` at the steady rate ``m.w``."""
     if method == 1:
-        h1, h0 = _sub_steps(1, h)[1][:2]
+        h1, h0 = _sub_steps(method, h)[1][:2]
         outer = _sub((m.w, 0.0, m.w * h1), m)
         return outer, _sub((m.w, 0.0, m.w * h0), m), outer
     if method == 2:
@@ -296,7 +303,7 @@ def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
     if m.steady:
         return method_steps(method, state, n, h, m, plan)
     for k in range(k0, k0 + n):
-        state = method_steps(method, state, 1, h, m, make_plan(method, t0 + k * h, h, m, wt, wv, wint))
+        state = method_steps(method, state, int(1), h, m, make_plan(method, t0 + k * h, h, m, wt, wv, wint))
     return state
 
 

@@ -13,7 +13,25 @@ import numpy as np
 
 from rotframe.particles.packed import jit_kernel
 
-__all__ = ["omega_magnitude", "omega_rate", "omega_angle", "rates"]
+__all__ = ["node_index", "omega_magnitude", "omega_rate", "omega_angle", "rates"]
+
+
+@jit_kernel
+def node_index(wt, t):
+    """``np.searchsorted(wt, t)`` for increasing ``wt``, by bisection: the first index i with ``wt[i] >= t``.
+
+    Written out because numba's ``np.searchsorted`` compiles a generic version (complex
+    comparisons included) that costs a first run about a second of compiling.
+    """
+    lo = 0
+    hi = wt.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if wt[mid] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
 
 
 @jit_kernel
@@ -24,7 +42,7 @@ def omega_magnitude(t, wt, wv):
         return wv[0]
     if t >= wt[n - 1]:
         return wv[n - 1]
-    k = np.searchsorted(wt, t) - 1
+    k = node_index(wt, t) - 1
     s = (t - wt[k]) / (wt[k + 1] - wt[k])
     return wv[k] + s * (wv[k + 1] - wv[k])
 
@@ -35,7 +53,8 @@ def omega_rate(t, wt, wv):
     n = wt.shape[0]
     if n == 1 or t < wt[0] or t >= wt[n - 1]:
         return 0.0
-    k = np.searchsorted(wt, t, side="right") - 1
+    i = node_index(wt, t)
+    k = i if wt[i] == t else i - 1  # searchsorted side='right', less 1: the node times increase strictly
     return (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
 
 
@@ -47,7 +66,7 @@ def omega_angle(t, wt, wv, wint):
         return wv[0] * (t - wt[0])
     if t >= wt[n - 1]:
         return wint[n - 1] + wv[n - 1] * (t - wt[n - 1])
-    k = np.searchsorted(wt, t) - 1
+    k = node_index(wt, t) - 1
     dt = t - wt[k]
     slope = (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
     return wint[k] + wv[k] * dt + 0.5 * slope * dt * dt

@@ -1,0 +1,54 @@
+"""Each compiled particle driver compiles only the method it runs (issue 13: a fast first run).
+
+A first run's cost is numba compiling every function the driver reaches, so the DOP853
+driver must not reach the fixed-step maps (it locates events by re-stepping DOP853,
+rotframe.particles.events.locate_event_dop853) and the fixed-step driver must not reach
+the DOP853 step (rotframe.particles.events.locate_event). The check is structural, not a
+timing: in a fresh process with an empty numba cache, after a run with an event, the
+dispatchers of the other method's step functions hold no compiled version. (With a warm
+cache nothing is compiled at all and the check would prove nothing, hence the empty cache.)
+"""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+
+PROBE = r'''
+import sys
+import numpy as np
+from rotframe.particles import dop853_steps, kernels
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+from rotframe.particles.trajectory import Event
+
+model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
+                      g=np.array([0.0, 0.0, -9.81]))
+ground = Event("ground", "r", 2, 0.0, -1, True)
+traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 3.0, method=sys.argv[1], samples=3,
+                           events=[ground])
+assert len(traj.event_times["ground"][0]) == 1
+fixed = [kernels._free_steps, kernels._sphere_steps, kernels._rk4_steps]
+print(sum(len(f.signatures) for f in fixed), len(dop853_steps.dop853_step.signatures))
+'''
+
+
+def compiled_counts(method, tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    res = subprocess.run([sys.executable, "-c", PROBE, method], capture_output=True, text=True, env=env,
+                         timeout=600)
+    assert res.returncode == 0, res.stderr
+    fixed, dop = map(int, res.stdout.split())
+    return fixed, dop
+
+
+def test_dop853_driver_compiles_no_fixed_step_method(tmp_path):
+    fixed, dop = compiled_counts("dop853", tmp_path)
+    assert dop == 1 and fixed == 0
+
+
+def test_fixed_step_driver_compiles_no_dop853_step(tmp_path):
+    fixed, dop = compiled_counts("rotation-splitting", tmp_path)
+    assert fixed >= 1 and dop == 0
