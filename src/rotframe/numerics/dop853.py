@@ -23,10 +23,11 @@ Layout (0-based stage index ``i``; 12 stages, stage 11 is at ``c = 1``)::
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import functools
 
 import numpy as np
-from numba import njit
 
 __all__ = ["N_STAGES", "coefficients", "exact_tables", "dop853_error_norm"]
 
@@ -123,7 +124,7 @@ def coefficients():
     return tuple(np.ascontiguousarray(x, dtype=np.float64) for x in (A, B, C, E3, E5))
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@jit_kernel
 def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
     """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
 

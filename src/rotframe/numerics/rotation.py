@@ -21,8 +21,9 @@ formulas are in ``docs/physics/rigid-bodies.md`` (quaternion kinematics) and
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import numpy as np
-from numba import njit
 
 __all__ = [
     "skew",
@@ -33,7 +34,7 @@ __all__ = [
     "quat_about_axis",
 ]
 
-_jit = njit(cache=True, error_model="numpy", nogil=True)
+_jit = jit_kernel
 
 
 def skew(w) -> np.ndarray:

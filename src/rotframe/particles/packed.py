@@ -35,7 +35,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+
+from rotframe.numerics.compiled import jit_kernel  # the one configuration (see there)
 
 __all__ = ["I_G", "I_AXIS", "I_CORIOLIS", "I_CENTRIFUGAL", "I_EULER", "I_KLIN", "I_KQUAD", "I_GMODE", "I_GM",
            "I_R", "I_PLEN", "I_PIVOT", "I_G0", "I_SPRING", "I_SCALE_H", "N_PARAMS", "N_EVENT_FIELDS", "NFEV",
@@ -51,11 +52,6 @@ N_PARAMS = 21
 #   kind 2: altitude above the sphere of radius R about (0, 0, -R), minus value (curved ground)
 #   direction: +1 rising only, -1 falling only, 0 both. terminal: 1 stops that particle.
 N_EVENT_FIELDS = 5
-
-#: The decorator of every particle kernel: cached on disk; a division by zero gives inf or nan
-#: (caught as a non-finite state) instead of raising, which also lets numba drop the reference
-#: counting of arrays passed to small functions that it inlines; nogil: ensembles run blocks on threads.
-jit_kernel = njit(cache=True, error_model="numpy", nogil=True)
 
 #: Force evaluations per step of each fixed-step method code (0 splitting, 1 splitting4, 2 rk4).
 NFEV = (1, 3, 4)

@@ -25,18 +25,19 @@ tableau passed as arrays; the Python wrapper costs a few microseconds.
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import functools
 import math
 
 import numpy as np
-from numba import njit
 
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
-_jit = njit(cache=True, error_model="numpy", nogil=True)
+_jit = jit_kernel
 
 
 class RigidRun:

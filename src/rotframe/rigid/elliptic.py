@@ -19,6 +19,8 @@ All functions are pure, float64, no I/O. The formulas are written out in
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import math
 
 import numpy as np
@@ -37,7 +39,7 @@ __all__ = [
     "incomplete_pi_arrays",
 ]
 
-_jit = njit(cache=True, error_model="numpy", nogil=True)
+_jit = jit_kernel
 # duplication stops when every relative deviation is below this: the truncated series then errs
 # by about ERRTOL^6 / 4 ~ 1e-19 relative (Carlson 1995, eq. 2.2)
 _ERRTOL = 0.0008

@@ -15,10 +15,11 @@ rotation about the middle axis and ``L = 0`` go to ``free_body_exact``.
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import math
 
 import numpy as np
-from numba import njit
 
 from rotframe.numerics.rotation import quat_mul
 from rotframe.rigid.elliptic import carlson_rf, ellipk_agm, incomplete_pi, jacobi_reduced
@@ -26,7 +27,7 @@ from rotframe.rigid.free_body import free_body_exact
 
 __all__ = ["free_body_flow"]
 
-_jit = njit(cache=True, error_model="numpy", nogil=True)
+_jit = jit_kernel
 
 
 @_jit

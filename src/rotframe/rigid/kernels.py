@@ -15,6 +15,8 @@ of a heavy symmetric top (see :func:`rotframe.rigid.torqued.rigid_rhs`).
 
 from __future__ import annotations
 
+from rotframe.numerics.compiled import jit_kernel
+
 import math
 
 import numpy as np
@@ -25,7 +27,7 @@ from rotframe.numerics.rotation import quat_mul, rodrigues_rotate
 __all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "rk4_run"]
 
 # error_model="numpy": a zero quaternion gives NaN, caught by the callers' finiteness checks
-_jit_nan = njit(cache=True, error_model="numpy", nogil=True)
+_jit_nan = jit_kernel
 
 
 @njit(cache=True)
