@@ -54,3 +54,29 @@ def test_free_top_problem_runs_against_the_closed_form():
     assert 0 < p.error(y) < 10 * 1e-8 * nfev / 12
     y, _, _ = p.run("lie-poisson", 1e5)
     assert p.error(y) < 1e-10
+
+
+def test_an_unstable_setting_is_a_failed_row_not_the_end_of_the_bench():
+    """A ladder step that raises IntegrationError (RK4 past its stability limit) gives a row with
+    infinite error and a note; the next settings still run (the full bench stopped there once)."""
+    import math
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from rotframe.app.bench.measure import Plan, run_problem
+    from rotframe.errors import IntegrationError
+
+    def run(method, step):
+        if step > 0.01:
+            raise IntegrationError(f"unstable step: grew by t = 4 s (method {method}, step {step} s)")
+        return np.zeros(2), 10, 0.0
+
+    p = SimpleNamespace(scenario="fake", horizon="1 s", runs={"rk4": [0.04, 0.001]}, run=run,
+                        error=lambda y: 1e-6, error_kind="test", ref_error=0.0, spec=None, rhs=None,
+                        y0=np.zeros(2), scipy_rtols=(), atol=1e-12, scipy_budget_s=1.0)
+    rows = run_problem(p, plan=Plan(quick=False))  # no scipy tolerances, no spec: no peers
+    ours = [r for r in rows if r["method"] == "rk4"]
+    assert [r["setting"] for r in ours] == [0.04, 0.001]
+    assert math.isinf(ours[0]["error"]) and ours[0]["note"].startswith("failed: unstable step")
+    assert ours[1]["error"] == 1e-6 and ours[1]["compile_s"] >= 0

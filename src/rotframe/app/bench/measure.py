@@ -86,17 +86,27 @@ def run_problem(p, progress=None, plan=None):
             progress(row)
         plan.step(f"{p.scenario} {row['method']}")
 
+    from rotframe.errors import IntegrationError
+
     for method, settings in p.runs.items():
-        t0 = time.perf_counter()
-        p.run(method, settings[0])  # warm-up: loads or compiles the kernels
-        compile_s = time.perf_counter() - t0
+        compile_s = None
         for s in settings:
-            if method.endswith(PREPARED) and s is not settings[0]:
-                p.run(method, s)  # prepares (untimed, like a peer's compilation)
-            wall, (y, nfev, inv) = timed(lambda: p.run(method, s), plan.budget, plan.repeats)
+            try:
+                if compile_s is None:
+                    t0 = time.perf_counter()
+                    p.run(method, s)  # warm-up: loads or compiles the kernels
+                    compile_s = time.perf_counter() - t0
+                elif method.endswith(PREPARED):
+                    p.run(method, s)  # prepares (untimed, like a peer's compilation)
+                wall, (y, nfev, inv) = timed(lambda: p.run(method, s), plan.budget, plan.repeats)
+            except IntegrationError as exc:  # an unstable setting is a result, not the end of the bench
+                row = _row(p, method, s, math.nan, math.inf, 0, None, family="rotframe")
+                row["note"] = f"failed: {str(exc).splitlines()[0]}"
+                emit(row)
+                continue
             inv = inv() if callable(inv) else inv  # the invariant is measured after the timing, as for the peers
-            emit(_row(p, method, s, wall, p.error(y), nfev, inv, compile_s=compile_s, family="rotframe"))
-            compile_s = None
+            emit(_row(p, method, s, wall, p.error(y), nfev, inv, compile_s=compile_s or None, family="rotframe"))
+            compile_s = 0.0
     from scipy.integrate import solve_ivp
 
     scale = None
