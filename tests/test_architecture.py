@@ -161,3 +161,12 @@ def test_a_planted_upward_import_is_caught(tmp_path):
             test_imports_point_down()
     finally:
         EDGES = saved
+
+
+def test_every_package_ships_in_the_wheel():
+    """pyproject.toml lists its packages by name (scenarios/ is mapped in): a new folder must be listed."""
+    import tomllib
+
+    listed = set(tomllib.loads((SRC.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {_module_name(p.parent / "__init__.py") for p in PACKAGE.rglob("__init__.py")}
+    assert found <= listed, f"packages missing from pyproject.toml: {sorted(found - listed)}"
