@@ -188,3 +188,29 @@ def test_compile_s_counts_only_loading_done_by_this_call():
         integrate_particles(model, R0, V0, 1.0, method=method, samples=3)
         again = integrate_particles(model, R0, V0, 1.0, method=method, samples=3)
         assert again.extras["compile_s"] == 0.0
+
+
+def test_linear_propagate_agrees_with_scipy_expm():
+    """The batched Taylor propagator of event location (particles.linear.propagate) against scipy's
+    scaling-and-squaring expm (the samples' exponential), column by column, over brackets from a
+    millisecond to a pendulum period (event brackets are one sample interval) with a stiff spring:
+    two independent algorithms agree to 1e-12 of the state's size. (Over 1e4 s, |M| t ~ 1e4, they
+    part by up to 1e-10, and scipy is the one that errs: its last component, exactly 1 by the
+    matrix's zero last row, moves by 8e-10 after its squarings; the Taylor propagator keeps it.)"""
+    from scipy.linalg import expm
+
+    from rotframe.particles.linear import propagate
+
+    rng = np.random.default_rng(5)
+    M = np.zeros((7, 7))
+    M[0:3, 3:6] = np.eye(3)
+    w = np.array([0.0, 4.8e-5, 5.5e-5])
+    M[3:6, 3:6] = -2.0 * np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    M[3:6, 0:3] = -np.diag([0.146, 0.146, 0.0])  # small-angle pendulum spring g/L
+    M[3:6, 6] = [0.0, 0.0, -9.81]
+    tau = np.array([1e-3, 0.1, 0.7, 4.0, 16.4])
+    s = np.vstack([rng.normal(size=(6, tau.size)), np.ones((1, tau.size))])
+    got = propagate(M, s, tau)
+    for j, t in enumerate(tau):
+        want = expm(M * t) @ s[:, j]
+        assert np.allclose(got[:, j], want, rtol=0, atol=1e-12 * max(1.0, np.abs(want).max())), t
