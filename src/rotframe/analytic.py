@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 from scipy.special import ellipk
 
 from rotframe.errors import ScenarioError
-from rotframe.numerics.rotation import skew
+from rotframe.numerics.hat import skew
 from rotframe.validation import check_vector3
 
 __all__ = [

@@ -21,9 +21,10 @@ formulas are in ``docs/physics/rigid-bodies.md`` (quaternion kinematics) and
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import jit_kernel
-
 import numpy as np
+
+from rotframe.numerics.compiled import jit_kernel
+from rotframe.numerics.hat import skew  # numba-free, for callers that need only the matrix
 
 __all__ = [
     "skew",
@@ -34,24 +35,9 @@ __all__ = [
     "quat_about_axis",
 ]
 
-_jit = jit_kernel
 
 
-def skew(w) -> np.ndarray:
-    """The skew (hat) matrix ``W`` of a 3-vector: ``W @ v = w x v``.
-
-    Parameters
-    ----------
-    w : array_like, shape (3,)
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-    """
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-
-
-@_jit
+@jit_kernel
 def rodrigues_rotate(vx, vy, vz, ax, ay, az, c, s):
     """``v`` rotated about the unit axis ``(ax, ay, az)`` by the angle with cosine ``c``, sine ``s``.
 
@@ -66,7 +52,7 @@ def rodrigues_rotate(vx, vy, vz, ax, ay, az, c, s):
             vz * c + cz * s + az * d * one_c)
 
 
-@_jit
+@jit_kernel
 def _rotate_rows(axis, c, s, v, out):
     for i in range(c.shape[0]):
         out[i, 0], out[i, 1], out[i, 2] = rodrigues_rotate(v[0], v[1], v[2], axis[0], axis[1], axis[2],
@@ -87,14 +73,14 @@ def rotate_about(axis, angle, v) -> np.ndarray:
     return out
 
 
-@_jit
+@jit_kernel
 def quat_mul(a0, a1, a2, a3, b0, b1, b2, b3):
     """Hamilton product ``a * b`` of scalar-last quaternions given as components; a 4-tuple."""
     return (a3 * b0 + b3 * a0 + a1 * b2 - a2 * b1, a3 * b1 + b3 * a1 + a2 * b0 - a0 * b2,
             a3 * b2 + b3 * a2 + a0 * b1 - a1 * b0, a3 * b3 - a0 * b0 - a1 * b1 - a2 * b2)
 
 
-@_jit
+@jit_kernel
 def _quat_mul_rows(a, b, out):
     for i in range(out.shape[0]):
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = quat_mul(a[i, 0], a[i, 1], a[i, 2], a[i, 3],

@@ -253,7 +253,7 @@ class ParticleModel:
 
     def linear_matrices(self):
         """(K, C, b) with r'' = K r + C v + b, for a linear model (see :attr:`is_linear`)."""
-        from rotframe.numerics.rotation import skew  # numba-free callers stay cheap to import
+        from rotframe.numerics.hat import skew  # numba-free callers stay cheap to import
 
         w = self.omega.vector(0.0)
         W = skew(w)
