@@ -122,3 +122,15 @@ def test_a_level_below_the_goal_says_by_how_much_and_why():
     rows[1]["wall_s"] = 2e-3
     summ = {r["level"]: r for r in level_summary(rows)}
     assert summ[1e-3]["ratio"] == pytest.approx(10.0) and "reason" not in summ[1e-3] and "note" not in summ[1e-3]
+
+
+def test_the_larger_shortfall_names_the_reason():
+    """The peer does 5% less work but each of its evaluations costs 7x ours: ratio 6.7, and the
+    shortfall is the cost per evaluation (10/7 = 1.4), not the work (1/0.95 = 1.05)."""
+    from rotframe.app.bench.summary import shortfall_reason
+
+    mine = {"nfev": 1000, "wall_s": 1.0, "method": "dop853"}
+    peer = {"nfev": 950, "wall_s": 950 * 7.0 / 1000, "method": "diffrax-Dopri8", "setting": 1e-9}
+    assert shortfall_reason(mine, peer).startswith("the peer's evaluation costs only 7x ours")
+    peer_less_work = {"nfev": 200, "wall_s": 200 * 8.0 / 1000, "method": "scipy-LSODA", "setting": 1e-6}
+    assert shortfall_reason(mine, peer_less_work).startswith("the peer needs 5x less work")

@@ -97,7 +97,7 @@ def shortfall_reason(mine, peer):
         return "no work count to compare (a closed form or an unmeasured peer)"
     work = n_p / n_m  # > 1: the peer does more work
     unit = (peer["wall_s"] / n_p) / (mine["wall_s"] / n_m)  # > 1: each of the peer's units costs more
-    if work < 1 and work <= unit:
+    if work < 1 and 1 / work >= GOAL / unit:  # less work is the larger of the two shortfalls
         return (f"the peer needs {1 / work:.2g}x less work ({n_p} vs {n_m} nfev at "
                 f"{peer['method']} {peer.get('setting')}): its method suits this error level better")
     compiled = " (also compiled: the whole solve is one jax.jit call)" if peer["method"].startswith("diffrax") else ""
