@@ -186,7 +186,6 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
     re-raises with a SceneResult in ``exc.partial`` that can be analysed and
     recorded like a complete one.
     """
-    method = particle_methods().canonical(method)
     try:
         traj = integrate_particles(model, r0, v0, duration, method=method, step=step or run.get("step"),
                                    rtol=run_setting(run, "rtol"), samples=int(run_setting(run, "samples")),
