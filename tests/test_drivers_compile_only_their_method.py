@@ -52,3 +52,31 @@ def test_dop853_driver_compiles_no_fixed_step_method(tmp_path):
 def test_fixed_step_driver_compiles_no_dop853_step(tmp_path):
     fixed, dop = compiled_counts("rotation-splitting", tmp_path)
     assert fixed >= 1 and dop == 0
+
+
+PRUNED = r'''
+import sys
+import numpy as np
+from rotframe.particles import events, schedule
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
+                      g=np.array([0.0, 0.0, -9.81]))
+traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 1.0, method=sys.argv[1], samples=3)
+assert np.all(np.isfinite(traj.r))
+watchers = [events.event_value, events.start_value, events.locate_event, events.locate_event_dop853,
+            events.record_event]
+readers = [schedule.omega_magnitude, schedule.omega_rate, schedule.omega_angle, schedule.node_index]
+print(sum(len(f.signatures) for f in watchers), sum(len(f.signatures) for f in readers))
+'''
+
+
+def test_a_run_without_events_at_a_steady_rate_compiles_no_event_code_and_no_schedule_reader(tmp_path):
+    # what a run does not have is passed to the drivers as None and pruned by numba at compile time
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    for method in ("dop853", "rotation-splitting"):
+        res = subprocess.run([sys.executable, "-c", PRUNED, method], capture_output=True, text=True, env=env,
+                             timeout=600)
+        assert res.returncode == 0, res.stderr
+        assert res.stdout.split() == ["0", "0"], (method, res.stdout)

@@ -47,8 +47,9 @@ def _initial(model, n=3):
     return rng.normal(size=(n, 3)) + [0.0, 0.0, 50.0], rng.normal(size=(n, 3))
 
 
-def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samples=9):
+def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samples=9, steady_as_none=False):
     r, v = _initial(model)
+    wt = None if steady_as_none else model.omega.times
     n = r.shape[0]
     alive = np.ones(n, dtype=np.bool_)
     out_r = np.empty((n_samples, n, 3))
@@ -56,7 +57,7 @@ def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samp
     records = (np.full((n, 4), np.nan), np.zeros((n, 4, 3)), np.zeros((n, 4, 3)), np.zeros(n, np.int64),
                np.zeros((n, 4), np.int64), 4)
     result = run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
-                               model.omega.times, model.omega.values, model.omega.cumulative(), events,
+                               wt, model.omega.values, model.omega.cumulative(), events,
                                out_r, out_v, *records)
     return result, out_r, out_v, r, v
 
@@ -68,8 +69,22 @@ def test_watching_an_event_that_never_happens_changes_nothing(name, method):
     model = _models()[name]
     never = np.array([[0.0, 2.0, 1e9, 0.0, 1.0]])
     plain = _run_fixed(model, method, never)
-    fast = _run_fixed(model, method, np.zeros((0, 5)))
+    fast = _run_fixed(model, method, None)
     for a, b in zip(plain, fast):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+    # an empty event table takes the stepping path of a table (nothing pruned): the same numbers
+    for a, b in zip(_run_fixed(model, method, np.zeros((0, 5))), fast):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+@pytest.mark.parametrize("name", [name for name in _models() if name.startswith("steady")])
+@pytest.mark.parametrize("method", [0, 1, 2])
+@pytest.mark.parametrize("events", [None, "never"])
+def test_a_steady_schedule_passed_as_none_changes_nothing(name, method, events):
+    # wt = None prunes the schedule readers at compile time; the steady plan is the one used either way
+    model = _models()[name]
+    table = None if events is None else np.array([[0.0, 2.0, 1e9, 0.0, 1.0]])
+    for a, b in zip(_run_fixed(model, method, table), _run_fixed(model, method, table, steady_as_none=True)):
         assert np.array_equal(np.asarray(a), np.asarray(b))
 
 
@@ -80,7 +95,7 @@ def test_steady_rate_as_one_node_or_as_a_flat_table(method):
     norm = float(np.linalg.norm(w))
     flat = ParticleModel(("gravity", "coriolis", "centrifugal"),
                          omega=OmegaSchedule.table(w, [0.0, 1.0, 2.5], [norm] * 3), g=G)
-    for a, b in zip(_run_fixed(one, method, np.zeros((0, 5))), _run_fixed(flat, method, np.zeros((0, 5)))):
+    for a, b in zip(_run_fixed(one, method, None), _run_fixed(flat, method, None)):
         assert np.array_equal(np.asarray(a), np.asarray(b))
 
 
@@ -104,7 +119,7 @@ def _reference_splitting(model, r, v, t0, h, steps):
 def test_hoisted_rotation_matches_a_plain_reference_to_round_off():
     model = _models()["steady uniform"]
     r0, v0 = _initial(model)
-    (n_done, bad, _), out_r, out_v, _, _ = _run_fixed(model, 0, np.zeros((0, 5)), t0=12.5, h=0.01,
+    (n_done, bad, _), out_r, out_v, _, _ = _run_fixed(model, 0, None, t0=12.5, h=0.01,
                                                        steps_per_sample=500, n_samples=1)
     r_ref, v_ref = _reference_splitting(model, r0[0], v0[0], 12.5, 0.01, 500)
     assert (n_done, bad) == (1, -1)
@@ -117,7 +132,7 @@ def test_hoisted_rotation_matches_a_plain_reference_to_round_off():
 def test_array_step_functions_agree_with_the_driver(name, method):
     model = _models()[name]
     t0, h = 0.3, 0.01
-    _, out_r, out_v, _, _ = _run_fixed(model, method, np.zeros((0, 5)), t0=t0, h=h, steps_per_sample=1,
+    _, out_r, out_v, _, _ = _run_fixed(model, method, None, t0=t0, h=h, steps_per_sample=1,
                                        n_samples=3)
     r0, v0 = _initial(model)
     P, wt, wv, wint = model.pack(), model.omega.times, model.omega.values, model.omega.cumulative()

@@ -76,8 +76,11 @@ class KernelSetup:
         self.P = model.pack()
         self.wt, self.wv = model.omega.times, model.omega.values
         self.wint = model.omega.cumulative()
+        # what a run does not have is passed as None, which the compiled drivers prune at compile
+        # time: a steady rate compiles no table reader, a run without events no event code
+        self.wt_arg = None if bool(np.all(self.wv == self.wv[0])) else self.wt
         self.events = tuple(events)
-        self.ev_tab = event_table(self.events)
+        self.ev_tab = event_table(self.events) if self.events else None
         self.samples = samples
         self.duration = duration
         self.dt_sample = dt = duration / samples
@@ -125,12 +128,12 @@ class KernelSetup:
         start = self.times[first] if t0 is None else t0
         if self.info.kind == "fixed":
             n_done, bad, nfev = drivers.run_fixed(
-                self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt,
+                self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt_arg,
                 self.wv, self.wint, self.ev_tab, out_r, out_v, *evb.args())
             return n_done, bad, nfev, self.sps * n_done
         A, B, C, E3, E5 = self.tableau
         return drivers.run_dop853(
-            r, v, alive, start, self.times[first + 1:first + 1 + max(count, 1)], self.P, self.wt, self.wv,
+            r, v, alive, start, self.times[first + 1:first + 1 + max(count, 1)], self.P, self.wt_arg, self.wv,
             self.rtol, atol, self.h0 if h0 is None else h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
             *evb.args(), h_state)
 
@@ -177,7 +180,7 @@ class KernelSetup:
             k = min(piece, sps - j)
             last = j + k == sps
             n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
-                                                self.wt, self.wv, self.wint, self.ev_tab,
+                                                self.wt_arg, self.wv, self.wint, self.ev_tab,
                                                 out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
                                                 *evb.args())
             nfev += nf

@@ -39,8 +39,10 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         Particles still moving; a terminal event clears the flag (in place).
     h : float
         Step (s). Samples are stored every ``steps_per_sample`` steps.
-    events : (E, 5) array
-        Event table (see module docstring). Crossings are located by
+    events : (E, 5) array or None
+        Event table (see module docstring); None when there is none, which
+        numba prunes at compile time (a run without events compiles none of
+        the event code). Crossings are located by
         re-stepping from the last state before the crossing with a shorter step
         (bisection to round-off), so an event time is exact for the method's own
         discrete trajectory.
@@ -62,7 +64,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     plan = make_plan(method, t0, h, m, wt, wv, wint)
     nfev_step = NFEV[method]
     n = r.shape[0]
-    n_ev = events.shape[0]
+    n_ev = 0 if events is None else events.shape[0]
     g_old = np.empty(n_ev)
     nfev0 = 0
     n_done = n_samples
@@ -71,13 +73,13 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
         k_step = int(0)  # an int64: a literal 0 would compile advance a second time
-        if n_ev > 0:
+        if events is not None:
             w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
             for e in range(n_ev):
                 g_old[e] = start_value(events, e, state, m, w0, wd0)
         for s in range(n_samples):
             if is_alive:
-                if n_ev == 0:
+                if events is None:
                     # no event to watch: the whole sample interval in one call
                     state = advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan)
                     k_step += steps_per_sample
@@ -128,13 +130,15 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     step's start (an interpolant of the same order as the method). Events are
     located the same way, by bisection on the length of that extra step.
     ``h_state`` (N,) carries each particle's step size between calls.
+    ``events`` None (no event table) prunes the event code at compile time,
+    as in :func:`run_fixed`; so does ``wt`` None (a steady rotation rate).
 
     Returns (n_done, bad, nfev, steps) like :func:`run_fixed` (cost of particle 0).
     """
     m = unpack(P, wt, wv)
     n = r.shape[0]
     n_out = sample_times.shape[0]
-    n_ev = events.shape[0]
+    n_ev = 0 if events is None else events.shape[0]
     K = np.empty((13, 6))
     atol_vec = np.full(6, atol)
     Kt = np.empty((13, 6))
@@ -160,8 +164,9 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
         w, wd = rates(t, m.steady, m.w, wt, wv)
         f0 = derivative(as_state(y), m, w, wd)
         nf = 1
-        for e in range(n_ev):
-            g_old[e] = start_value(events, e, as_state(y), m, w, wd)
+        if events is not None:
+            for e in range(n_ev):
+                g_old[e] = start_value(events, e, as_state(y), m, w, wd)
         k_out = int(0)  # an int64: a literal 0 would compile store a second time
         while k_out < n_out and sample_times[k_out] <= t:
             store(out_r, out_v, k_out, p, y)
@@ -212,16 +217,17 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             # events inside (t, t_new]
             stop = False
             t_stop = t_new
-            for e in range(n_ev):
-                g_new = event_value(events, e, as_state(y_new), m.radius)
-                if crossed(events[e, 3], g_old[e], g_new):
-                    hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, B, C, f0, Kt, y, tmp,
-                                                  yt)
-                    record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
-                    if events[e, 4] != 0.0 and t + hi <= t_stop:
-                        stop = True
-                        t_stop = t + hi
-                g_old[e] = g_new
+            if events is not None:
+                for e in range(n_ev):
+                    g_new = event_value(events, e, as_state(y_new), m.radius)
+                    if crossed(events[e, 3], g_old[e], g_new):
+                        hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, B, C, f0, Kt, y, tmp,
+                                                      yt)
+                        record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
+                        if events[e, 4] != 0.0 and t + hi <= t_stop:
+                            stop = True
+                            t_stop = t + hi
+                    g_old[e] = g_new
             # samples inside (t, t_stop]
             while k_out < n_out and sample_times[k_out] <= t_stop:
                 ts = sample_times[k_out]

@@ -82,7 +82,10 @@ def make_plan(method, t, h, m, wt, wv, wint):
     the rates at t, t + h/2 and t + h (turn 0, cos 1, sin 0). At a steady
     rate the plan does not depend on t (the angle turned over a sub-step h' is
     w h'), so it is made once per step size and its sines and cosines are reused.
+    ``wt = None`` (a steady schedule known at compile time) compiles the steady plan only.
     """
+    if wt is None:
+        return _steady_plan(method, h, m)
     if m.steady:
         return _steady_plan(method, h, m)
     if method == 1:
@@ -298,8 +301,10 @@ def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
 
     ``plan`` is the :func:`make_plan` of every step when the rate is steady; a
     varying schedule is sampled here, once per step, so that the step
-    kernels take no array.
+    kernels take no array. ``wt = None`` is a steady schedule known at compile time.
     """
+    if wt is None:
+        return method_steps(method, state, n, h, m, plan)
     if m.steady:
         return method_steps(method, state, n, h, m, plan)
     for k in range(k0, k0 + n):

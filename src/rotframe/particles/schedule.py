@@ -5,6 +5,10 @@ rad/s); w(t) is piecewise linear between the nodes and held constant outside
 them. ``wint`` holds the integral of w from ``wt[0]`` to each node, so the
 rotation angle over any interval is exact for the piecewise-linear schedule
 (:meth:`rotframe.particles.model.OmegaSchedule.cumulative`).
+
+A steady schedule (one value at every node) is passed to the drivers as
+``wt = None``: numba prunes every branch under ``if wt is None`` at compile
+time, so a run at a steady rate compiles none of the table readers.
 """
 
 from __future__ import annotations
@@ -74,7 +78,12 @@ def omega_angle(t, wt, wv, wint):
 
 @jit_kernel
 def rates(t, steady, w, wt, wv):
-    """Rotation rate w(t) and its derivative (rad/s, rad/s^2): ``(w, 0)`` when ``steady``, else from the table."""
+    """Rotation rate w(t) and its derivative (rad/s, rad/s^2): ``(w, 0)`` when ``steady``, else from the table.
+
+    ``wt = None`` is a steady schedule known at compile time: the table readers are not compiled.
+    """
+    if wt is None:
+        return w, 0.0
     if steady:
         return w, 0.0
     return omega_magnitude(t, wt, wv), omega_rate(t, wt, wv)
