@@ -243,18 +243,25 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
     done = 0
     nfev = 0
     steps = 0
+    first = None  # the result of a first call already made on the run's own arrays
     try:
         compile_s = setup.warm_up()
         if info.kind != "fixed":
             # an adaptive method's cost is known only once it ran: a probe of the first sample
-            # interval, on copies (the run itself is untouched), projects the work and sizes the calls
-            probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
-                               EventBuffers(n, max_events), atol, h_state.copy())
+            # interval projects the work and sizes the calls. On copies (the run itself is untouched,
+            # so its chunks do not depend on the probe), except when that interval is the whole run
+            if samples == 1:
+                probe = first = setup.call(r, v, alive, 0, 1, out_r[1:2], out_v[1:2], evb, atol, h_state)
+            else:
+                probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
+                                   EventBuffers(n, max_events), atol, h_state.copy())
             chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
         while done < samples:
             m = min(chunk, samples - done)
             sl = slice(done + 1, done + 1 + m)
-            if info.kind == "fixed" and cost > 4e6:
+            if first is not None:
+                (n_done, bad, nf, st), first = first, None
+            elif info.kind == "fixed" and cost > 4e6:
                 # one sample interval is more than a chunk of work: advance it in pieces, so that
                 # Python regains control (signals, progress) about every 0.1 s
                 n_done, bad, nf, st = setup.one_sample_in_pieces(r, v, alive, done, out_r[sl], out_v[sl], evb, n)
