@@ -22,14 +22,15 @@ def _models():
 @pytest.mark.parametrize("method,kw", [("splitting", {"step": 1e-2}), ("splitting4", {"step": 1e-2}),
                                        ("rk4", {"step": 1e-2}), ("dop853", {"rtol": 1e-9})])
 @pytest.mark.parametrize("which", [0, 1])
-def test_prepared_equals_integrate_particles(method, kw, which):
+@pytest.mark.parametrize("samples", [5, 1])  # one sample: DOP853's probe is the run itself
+def test_prepared_equals_integrate_particles(method, kw, which, samples):
     model = list(_models())[which]
     rng = np.random.default_rng(4)
-    pr = PreparedRun(model, method, 3.0, samples=5, n=3, **kw)
+    pr = PreparedRun(model, method, 3.0, samples=samples, n=3, **kw)
     for _ in range(2):  # repeated calls: no state carried over
         r0, v0 = rng.normal(size=(3, 3)), rng.normal(size=(3, 3))
         r, v = pr(r0, v0)
-        traj = integrate_particles(model, r0, v0, 3.0, method=method, samples=5, **kw)
+        traj = integrate_particles(model, r0, v0, 3.0, method=method, samples=samples, **kw)
         assert np.array_equal(r, traj.r) and np.array_equal(v, traj.v)
         assert np.array_equal(pr.times, traj.times)
         assert pr.nfev == traj.nfev
