@@ -80,3 +80,16 @@ def test_a_run_without_events_at_a_steady_rate_compiles_no_event_code_and_no_sch
                              timeout=600)
         assert res.returncode == 0, res.stderr
         assert res.stdout.split() == ["0", "0"], (method, res.stdout)
+
+
+def test_a_kernel_for_compiled_code_only_refuses_a_python_call_instead_of_crashing():
+    # jit_internal kernels have no CPython entry point; numba alone would crash the interpreter
+    import pytest
+
+    from rotframe.numerics.dop853 import dop853_error_norm
+    from rotframe.particles import forces, kernels
+
+    for kernel in (forces.string_normal, forces.state_acceleration, kernels.method_steps, dop853_error_norm):
+        with pytest.raises(TypeError, match="compiled code only"):
+            kernel(1.0, 2.0, 3.0, None)
+        assert callable(kernel.py_func)

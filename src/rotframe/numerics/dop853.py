@@ -23,7 +23,7 @@ Layout (0-based stage index ``i``; 12 stages, stage 11 is at ``c = 1``)::
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import jit_kernel
+from rotframe.numerics.compiled import jit_internal
 
 import functools
 
@@ -124,7 +124,7 @@ def coefficients():
     return tuple(np.ascontiguousarray(x, dtype=np.float64) for x in (A, B, C, E3, E5))
 
 
-@jit_kernel
+@jit_internal
 def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
     """Hairer's DOP853 error norm of one step: the 5th- and 3rd-order estimates combined.
 
@@ -132,6 +132,8 @@ def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
     weighted zero), ``atol`` (n,) one absolute tolerance per component of ``y``;
     the scale of component j is ``atol[j] + rtol max(|y[j]|, |y_new[j]|)``. The
     particle and rigid-body kernels share this function (docs/physics/dop853.md).
+    Compiled for compiled callers only (:func:`rotframe.numerics.compiled.jit_internal`);
+    from Python, call ``dop853_error_norm.py_func``.
     """
     n = y.shape[0]
     e5 = 0.0

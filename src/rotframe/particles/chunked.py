@@ -113,6 +113,16 @@ class KernelSetup:
         scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
         return self.rtol * scale
 
+    def event_records(self, evb):
+        """The record arrays of ``evb`` as the drivers take them; None for each without an event table.
+
+        A run without events passes them as None too, so the driver's Python entry point
+        does not unbox five arrays that it never reads (and is that much smaller to compile).
+        """
+        if self.ev_tab is None:
+            return None, None, None, None, None, evb.max_events
+        return evb.args()
+
     def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
@@ -129,13 +139,13 @@ class KernelSetup:
         if self.info.kind == "fixed":
             n_done, bad, nfev = drivers.run_fixed(
                 self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt_arg,
-                self.wv, self.wint, self.ev_tab, out_r, out_v, *evb.args())
+                self.wv, self.wint, self.ev_tab, out_r, out_v, *self.event_records(evb))
             return n_done, bad, nfev, self.sps * n_done
         A, B, C, E3, E5 = self.tableau
         return drivers.run_dop853(
             r, v, alive, start, self.times[first + 1:first + 1 + max(count, 1)], self.P, self.wt_arg, self.wv,
             self.rtol, atol, self.h0 if h0 is None else h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
-            *evb.args(), h_state)
+            *self.event_records(evb), h_state)
 
     def warm_up(self):
         """Load or compile the driver now; the seconds it took, or 0.0 if it was ready.
@@ -182,7 +192,7 @@ class KernelSetup:
             n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
                                                 self.wt_arg, self.wv, self.wint, self.ev_tab,
                                                 out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
-                                                *evb.args())
+                                                *self.event_records(evb))
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from rotframe.particles.forces import derivative
-from rotframe.particles.packed import as_state, jit_kernel
+from rotframe.particles.packed import as_state, jit_internal
 from rotframe.particles.schedule import rates
 
 __all__ = ["dop853_step"]
 
 
-@jit_kernel
+@jit_internal
 def dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp):
     """One DOP853 step from (t, y) with f0 = f(t, y) (a 6-tuple); K (13, 6) receives the stages, tmp (6,) is scratch."""
     K[0, 0], K[0, 1], K[0, 2], K[0, 3], K[0, 4], K[0, 5] = f0

@@ -18,13 +18,13 @@ import numpy as np
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
-from rotframe.particles.packed import as_state, jit_kernel
+from rotframe.particles.packed import as_state, jit_internal
 
 __all__ = ["event_value", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
            "locate_event", "locate_event_dop853", "record_event"]
 
 
-@jit_kernel
+@jit_internal
 def event_value(events, e, state, radius):
     """Event function of row ``e`` of the event table at ``state``."""
     kind = events[e, 0]
@@ -38,7 +38,7 @@ def event_value(events, e, state, radius):
     return np.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
 
 
-@jit_kernel
+@jit_internal
 def start_value(events, e, state, m, w, wd):
     """Event function of row ``e`` at the start of a run or chunk, for crossing detection.
 
@@ -78,7 +78,7 @@ def start_value(events, e, state, m, w, wd):
     return 0.0
 
 
-@jit_kernel
+@jit_internal
 def crossed(direction, g0, g1):
     """Whether the event function went from g0 to g1 across zero in the given direction."""
     if direction > 0.0:
@@ -93,7 +93,7 @@ def crossed(direction, g0, g1):
 MAX_HALVINGS = 2200
 
 
-@jit_kernel
+@jit_internal
 def bisection_midpoint(lo, hi):
     """The midpoint of the bracket [lo, hi] (0 <= lo < hi), or -1.0 when it cannot shrink (round-off)."""
     mid = 0.5 * (lo + hi)
@@ -102,7 +102,7 @@ def bisection_midpoint(lo, hi):
     return mid
 
 
-@jit_kernel
+@jit_internal
 def narrow(lo, hi, g_lo, mid, g_mid):
     """The half of [lo, hi] that keeps the crossing, given g at ``mid``: ``(lo, hi, g_lo)``.
 
@@ -114,13 +114,13 @@ def narrow(lo, hi, g_lo, mid, g_mid):
     return lo, mid, g_lo
 
 
-@jit_kernel
+@jit_internal
 def fixed_trial(method, start, t, tau, m, wt, wv, wint):
     """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2)."""
     return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint))  # int64 1
 
 
-@jit_kernel
+@jit_internal
 def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint):
     """Sub-step tau in (0, h] at which event ``e`` of the fixed-step map from ``start`` vanishes.
 
@@ -142,7 +142,7 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint):
     return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint)
 
 
-@jit_kernel
+@jit_internal
 def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, tmp, y_out):
     """:func:`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
 
@@ -164,7 +164,7 @@ def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, 
     return hi, as_state(y_out)
 
 
-@jit_kernel
+@jit_internal
 def record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t_event, state):
     """Append event ``e`` of particle p at ``t_event`` with ``state`` (6-tuple) to the records.
 

@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.particles.packed import jit_kernel, unpack
+from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
 __all__ = ["position_acceleration", "state_acceleration", "acceleration", "derivative", "air_density",
            "drag_coefficients", "drag_flow", "string_normal"]
 
 
-@jit_kernel
+@jit_internal
 def position_acceleration(x, y, z, m, w, wd):
     """Forces that depend on position and time only: gravity, spring, centrifugal, Euler.
 
@@ -66,7 +66,7 @@ def position_acceleration(x, y, z, m, w, wd):
     return ax, ay, az
 
 
-@jit_kernel
+@jit_internal
 def state_acceleration(state, m, w, wd):
     """Total acceleration in the rotating frame at ``state``; see :func:`acceleration`."""
     x, y, z, vx, vy, vz = state
@@ -112,14 +112,14 @@ def acceleration(r, v, t, P, wt, wv, out):
     out[0], out[1], out[2] = state_acceleration((r[0], r[1], r[2], v[0], v[1], v[2]), m, w, wd)
 
 
-@jit_kernel
+@jit_internal
 def derivative(state, m, w, wd):
     """Right-hand side (v, a) of the first-order system at ``state`` for the rates w, w', as a 6-tuple."""
     ax, ay, az = state_acceleration(state, m, w, wd)
     return state[3], state[4], state[5], ax, ay, az
 
 
-@jit_kernel
+@jit_internal
 def air_density(z, m):
     """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
     H = m.scale_h
@@ -128,7 +128,7 @@ def air_density(z, m):
     return 1.0
 
 
-@jit_kernel
+@jit_internal
 def drag_flow(vx, vy, vz, k1, k2, h):
     """Exact flow of v' = -(k1 + k2 |v|) v over h at fixed position (direction kept, speed decays)."""
     if k1 == 0.0 and k2 == 0.0:
@@ -145,14 +145,14 @@ def drag_flow(vx, vy, vz, k1, k2, h):
     return vx * f, vy * f, vz * f
 
 
-@jit_kernel
+@jit_internal
 def drag_coefficients(z, m):
     """Drag coefficients (k1 (1/s), k2 (1/m)) at height z: the sea-level ones times :func:`air_density`."""
     air = air_density(z, m)
     return m.k1 * air, m.k2 * air
 
 
-@jit_kernel
+@jit_internal
 def string_normal(x, y, z, m):
     """Unit normal (r - pivot) / L of the pendulum's sphere at (x, y, z) (exact only on the sphere)."""
     L = m.length

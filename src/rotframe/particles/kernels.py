@@ -22,7 +22,7 @@ from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
-from rotframe.particles.packed import NFEV, jit_kernel, unpack
+from rotframe.particles.packed import NFEV, jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 
 __all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
@@ -43,13 +43,13 @@ __all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_spher
 # once per step.
 
 
-@jit_kernel
+@jit_internal
 def _stage(t, wt, wv):
     """Rotation data of a Runge-Kutta stage at time t, laid out as :func:`_sub`: ``(w, w', 0, 1, 0)``."""
     return omega_magnitude(t, wt, wv), omega_rate(t, wt, wv), 0.0, 1.0, 0.0
 
 
-@jit_kernel
+@jit_internal
 def _lookup(t, h, wt, wv, wint):
     """The schedule over [t, t + h]: w and w' at t + h/2, and the angle turned (the integral of w)."""
     tm = t + 0.5 * h
@@ -57,7 +57,7 @@ def _lookup(t, h, wt, wv, wint):
             omega_angle(t + h, wt, wv, wint) - omega_angle(t, wt, wv, wint))
 
 
-@jit_kernel
+@jit_internal
 def _sub(looked_up, m):
     """Rotation data ``(w, w', turn, cos, sin)`` of a splitting sub-step from its :func:`_lookup`.
 
@@ -74,7 +74,7 @@ def _sub(looked_up, m):
     return w, wd, turn, c, s
 
 
-@jit_kernel
+@jit_internal
 def make_plan(method, t, h, m, wt, wv, wint):
     """The rotation data a step [t, t + h] of ``method`` needs: three tuples laid out as :func:`_sub`.
 
@@ -98,7 +98,7 @@ def make_plan(method, t, h, m, wt, wv, wint):
     return sub, sub, sub
 
 
-@jit_kernel
+@jit_internal
 def _steady_plan(method, h, m):
     """:func:`make_plan` at the steady rate ``m.w``."""
     if method == 1:
@@ -112,7 +112,7 @@ def _steady_plan(method, h, m):
     return sub, sub, sub
 
 
-@jit_kernel
+@jit_internal
 def _sub_steps(method, h):
     """Number and lengths of the splitting sub-steps of a step h: one of h, or Yoshida's h1, h0, h1."""
     if method == 1:
@@ -121,7 +121,7 @@ def _sub_steps(method, h):
     return 1, (h, h, h)
 
 
-@jit_kernel
+@jit_internal
 def _free_steps(state, n, method, h, m, plan):
     """Exact-rotation splitting of a free particle; see :func:`step_splitting`.
 
@@ -165,7 +165,7 @@ def _free_steps(state, n, method, h, m, plan):
     return x, y, z, vx, vy, vz
 
 
-@jit_kernel
+@jit_internal
 def _sphere_steps(state, n, method, h, m, plan):
     """Splitting on the sphere |r - pivot| = L; see :func:`step_sphere`."""
     n_sub, lengths = _sub_steps(method, h)
@@ -175,7 +175,7 @@ def _sphere_steps(state, n, method, h, m, plan):
     return state
 
 
-@jit_kernel
+@jit_internal
 def _sphere_step(state, h, m, sub):
     """One sub-step of :func:`_sphere_steps` with the rotation data ``sub``."""
     x, y, z, vx, vy, vz = state
@@ -207,7 +207,7 @@ def _sphere_step(state, h, m, sub):
     return _great_circle(x, y, z, vx, vy, vz, hh, m)
 
 
-@jit_kernel
+@jit_internal
 def _great_circle(x, y, z, vx, vy, vz, tau, m):
     """Exact geodesic flow on the sphere of radius L about the pivot, for time tau."""
     L = m.length
@@ -240,7 +240,7 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
     return px + L * nx, py + L * ny, pz + L * nz, vx - vn * nx, vy - vn * ny, vz - vn * nz
 
 
-@jit_kernel
+@jit_internal
 def _rk4_steps(state, n, h, m, plan):
     """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see :func:`step_rk4`."""
     x, y, z, vx, vy, vz = state
@@ -281,7 +281,7 @@ def _rk4_steps(state, n, h, m, plan):
     return x, y, z, vx, vy, vz
 
 
-@jit_kernel
+@jit_internal
 def method_steps(method, state, n, h, m, plan):
     """``n`` steps of size h of method 0 splitting, 1 splitting4 or 2 rk4, all with the same ``plan``.
 
@@ -295,7 +295,7 @@ def method_steps(method, state, n, h, m, plan):
     return _free_steps(state, n, method, h, m, plan)
 
 
-@jit_kernel
+@jit_internal
 def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
     """Steps k0 .. k0 + n - 1 of size h from t0 (step k starts at t0 + k h).
 
@@ -312,7 +312,7 @@ def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
     return state
 
 
-@jit_kernel
+@jit_internal
 def _step_in_place(method, r, v, t, h, P, wt, wv, wint):
     """One step [t, t + h] on the state arrays r, v (updated in place); returns the force evaluations."""
     m = unpack(P, wt, wv)

@@ -36,11 +36,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from rotframe.numerics.compiled import jit_kernel  # the one configuration (see there)
+from rotframe.numerics.compiled import jit_internal, jit_kernel  # the one configuration (see there)
 
 __all__ = ["I_G", "I_AXIS", "I_CORIOLIS", "I_CENTRIFUGAL", "I_EULER", "I_KLIN", "I_KQUAD", "I_GMODE", "I_GM",
            "I_R", "I_PLEN", "I_PIVOT", "I_G0", "I_SPRING", "I_SCALE_H", "N_PARAMS", "N_EVENT_FIELDS", "NFEV",
-           "jit_kernel", "PackedModel", "unpack", "as_state", "is_finite", "store", "store_particle"]
+           "jit_kernel", "jit_internal", "PackedModel", "unpack", "as_state", "is_finite", "store", "store_particle"]
 
 # Parameter-vector indices (kept in one place; model.pack writes them).
 I_G, I_AXIS, I_CORIOLIS, I_CENTRIFUGAL, I_EULER = 0, 3, 6, 7, 8
@@ -84,7 +84,7 @@ class PackedModel(NamedTuple):
     w: float  # that rate (rad/s)
 
 
-@jit_kernel
+@jit_internal
 def unpack(P, wt, wv):
     """The :class:`PackedModel` of the parameter vector ``P`` and the schedule ``(wt, wv)``."""
     gmode = P[I_GMODE]
@@ -105,13 +105,13 @@ def unpack(P, wt, wv):
                   P[I_GM], P[I_R], P[I_G0], spring, P[I_SCALE_H], P[I_PLEN], pivot, uniform, steady, wv[0])
 
 
-@jit_kernel
+@jit_internal
 def as_state(y):
     """The state vector y (6,) as a tuple."""
     return y[0], y[1], y[2], y[3], y[4], y[5]
 
 
-@jit_kernel
+@jit_internal
 def is_finite(state):
     """Whether every component of the state tuple is finite."""
     for q in state:
@@ -120,7 +120,7 @@ def is_finite(state):
     return True
 
 
-@jit_kernel
+@jit_internal
 def store(out_r, out_v, k, p, state):
     """Write a state (a 6-tuple or a (6,) array) into row k, particle p of ``out_r``, ``out_v`` (K, N, 3)."""
     for i in range(3):
@@ -128,7 +128,7 @@ def store(out_r, out_v, k, p, state):
         out_v[k, p, i] = state[3 + i]
 
 
-@jit_kernel
+@jit_internal
 def store_particle(r, v, p, state):
     """Write a state (a 6-tuple or a (6,) array) into row p of ``r``, ``v`` (N, 3)."""
     for i in range(3):

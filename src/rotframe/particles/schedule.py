@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.particles.packed import jit_kernel
+from rotframe.particles.packed import jit_internal, jit_kernel
 
 __all__ = ["node_index", "omega_magnitude", "omega_rate", "omega_angle", "rates"]
 
@@ -76,7 +76,7 @@ def omega_angle(t, wt, wv, wint):
     return wint[k] + wv[k] * dt + 0.5 * slope * dt * dt
 
 
-@jit_kernel
+@jit_internal
 def rates(t, steady, w, wt, wv):
     """Rotation rate w(t) and its derivative (rad/s, rad/s^2): ``(w, 0)`` when ``steady``, else from the table.
 
