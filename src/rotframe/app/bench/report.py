@@ -88,7 +88,10 @@ def table(rows, speed) -> str:
             if "scaling" in r:
                 extra += f", {r['scaling']:.2f} x one worker (cluster start and warm-up {r['cluster_start_s']:.2g} s apart)"
         if "import_s" in r:
-            extra = f"  (imports {r['import_s']:.2f} s)"
+            cold = r["setting"].startswith("first")
+            extra = (f"  (imports {r['import_s']:.2f} s, beyond them {r['beyond_imports_s']:.2f} s; goal "
+                     f"{r['goal_s']:g} s {'beyond imports' if cold else 'in all'}: "
+                     f"{'met' if r['goal_met'] else 'not met'})")
         err = r["error"]
         comp = r.get("compile_s")
         lines.append(f"{r['scenario']:<12} {str(r.get('horizon', '')):<22} {r['method'][:22]:<22} "
