@@ -139,7 +139,9 @@ def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
     e5 = 0.0
     e3 = 0.0
     for j in range(n):
-        sc = atol[j] + rtol * max(abs(y[j]), abs(y_new[j]))
+        a = y[j] if y[j] >= 0.0 else -y[j]  # max(|y|, |y_new|) as comparisons: no overloads to compile
+        b = y_new[j] if y_new[j] >= 0.0 else -y_new[j]
+        sc = atol[j] + rtol * (a if a >= b else b)
         s5 = 0.0
         s3 = 0.0
         for q in range(13):

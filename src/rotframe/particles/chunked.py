@@ -145,7 +145,7 @@ class KernelSetup:
         return drivers.run_dop853(
             r, v, alive, start, self.times[first + 1:first + 1 + max(count, 1)], self.P, self.wt_arg, self.wv,
             self.rtol, atol, self.h0 if h0 is None else h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
-            *self.event_records(evb), h_state)
+            *self.event_records(evb), h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
 
     def warm_up(self):
         """Load or compile the driver now; the seconds it took, or 0.0 if it was ready.

@@ -65,7 +65,8 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     nfev_step = NFEV[method]
     n = r.shape[0]
     n_ev = 0 if events is None else events.shape[0]
-    g_old = np.empty(n_ev)
+    if events is not None:
+        g_old = np.empty(n_ev)
     nfev0 = 0
     n_done = n_samples
     bad = -1
@@ -121,7 +122,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 @jit_kernel
 def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C, E3, E5,
-               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state):
+               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state, K, Kt, rows):
     """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
 
     Error control as in Hairer's DOP853 (5th- and 3rd-order estimates combined).
@@ -132,6 +133,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     ``h_state`` (N,) carries each particle's step size between calls.
     ``events`` None (no event table) prunes the event code at compile time,
     as in :func:`run_fixed`; so does ``wt`` None (a steady rotation rate).
+    ``K``, ``Kt`` (13, 6) and ``rows`` (5, 6) are work arrays from the caller (a
+    kernel that allocates compiles numpy's allocators on a first run).
 
     Returns (n_done, bad, nfev, steps) like :func:`run_fixed` (cost of particle 0).
     """
@@ -139,14 +142,11 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     n = r.shape[0]
     n_out = sample_times.shape[0]
     n_ev = 0 if events is None else events.shape[0]
-    K = np.empty((13, 6))
-    atol_vec = np.full(6, atol)
-    Kt = np.empty((13, 6))
-    y = np.empty(6)
-    y_new = np.empty(6)
-    yt = np.empty(6)
-    tmp = np.empty(6)
-    g_old = np.empty(n_ev)
+    y, y_new, yt, tmp, atol_vec = rows[0], rows[1], rows[2], rows[3], rows[4]
+    for j in range(6):
+        atol_vec[j] = atol
+    if events is not None:
+        g_old = np.empty(n_ev)
     nfev0 = 0
     steps0 = 0
     n_done = n_out
@@ -182,7 +182,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 truncated = t + h > t_end
                 if truncated:
                     h = t_end - t
-                min_h = 10.0 * abs(np.nextafter(t, np.inf) - t)
+                min_h = 10.0 * (np.nextafter(t, np.inf) - t)  # > 0 for a finite t
                 if h < min_h:
                     if t_end - t < min_h:
                         # the steps summed to within a few ulp of the end: it is reached (the state
@@ -199,10 +199,14 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                     h *= 0.2
                     continue
                 if err < 1.0:
-                    fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
+                    fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
+                    if fac > 10.0:  # min(10, ...) as a comparison: no overload to compile
+                        fac = 10.0
                     accepted = True
                 else:
-                    fac = max(0.2, 0.9 * err ** (-1.0 / 8.0))
+                    fac = 0.9 * err ** (-1.0 / 8.0)
+                    if fac < 0.2:
+                        fac = 0.2
                 h_used = h
                 h = h * fac
             if failed:
