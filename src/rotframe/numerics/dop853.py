@@ -23,11 +23,12 @@ Layout (0-based stage index ``i``; 12 stages, stage 11 is at ``c = 1``)::
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import jit_internal
-
 import functools
+import math
 
 import numpy as np
+
+from rotframe.numerics.compiled import jit_internal
 
 __all__ = ["N_STAGES", "coefficients", "exact_tables", "dop853_error_norm"]
 
@@ -151,4 +152,4 @@ def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
         e3 += (s3 / sc) ** 2
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
-    return abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * n)

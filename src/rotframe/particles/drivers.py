@@ -11,6 +11,7 @@ handled between chunks without losing data.
 
 from __future__ import annotations
 
+import math
 import numpy as np
 
 from rotframe.numerics.dop853 import dop853_error_norm
@@ -195,7 +196,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
                 nf += 12
                 err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
-                if not np.isfinite(err):
+                if not math.isfinite(err):
                     h *= 0.2
                     continue
                 if err < 1.0:

@@ -13,7 +13,7 @@ so that neither compiles the other's steps; both bisect by one rule
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
@@ -35,7 +35,7 @@ def event_value(events, e, state, radius):
         return state[3 + c] - events[e, 2]
     x, y, z = state[0], state[1], state[2]
     dz = z + radius
-    return np.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
+    return math.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
 
 
 @jit_internal
@@ -66,7 +66,7 @@ def start_value(events, e, state, m, w, wd):
         d2 = 0.0
     else:
         dx, dy, dz = x, y, z + m.radius
-        n = np.sqrt(dx * dx + dy * dy + dz * dz)
+        n = math.sqrt(dx * dx + dy * dy + dz * dz)
         dv = dx * vx + dy * vy + dz * vz
         da = dx * a[0] + dy * a[1] + dz * a[2]
         d1 = dv / n

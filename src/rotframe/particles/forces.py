@@ -15,7 +15,7 @@ The step kernels (:mod:`rotframe.particles.kernels`), the DOP853 stages
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
@@ -40,7 +40,7 @@ def position_acceleration(x, y, z, m, w, wd):
     elif mode == 2.0:
         dz = z + m.radius
         d2 = x * x + y * y + dz * dz
-        f = -m.gm / (d2 * np.sqrt(d2))
+        f = -m.gm / (d2 * math.sqrt(d2))
         ax = f * x
         ay = f * y
         az = f * dz
@@ -81,7 +81,7 @@ def state_acceleration(state, m, w, wd):
         az -= ux * vy - uy * vx
     if m.drag:
         k1, k2 = drag_coefficients(z, m)
-        speed = np.sqrt(vx * vx + vy * vy + vz * vz)
+        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
         k = k1 + k2 * speed
         ax -= k * vx
         ay -= k * vy
@@ -124,7 +124,7 @@ def air_density(z, m):
     """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
     H = m.scale_h
     if H > 0.0:
-        return np.exp(-z / H)
+        return math.exp(-z / H)
     return 1.0
 
 
@@ -133,13 +133,13 @@ def drag_flow(vx, vy, vz, k1, k2, h):
     """Exact flow of v' = -(k1 + k2 |v|) v over h at fixed position (direction kept, speed decays)."""
     if k1 == 0.0 and k2 == 0.0:
         return vx, vy, vz
-    speed = np.sqrt(vx * vx + vy * vy + vz * vz)
+    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
     if speed == 0.0:
         return vx, vy, vz
     if k1 == 0.0:
         new = speed / (1.0 + k2 * speed * h)
     else:
-        e = np.exp(-k1 * h)
+        e = math.exp(-k1 * h)
         new = k1 * speed * e / (k1 + k2 * speed * (1.0 - e))
     f = new / speed
     return vx * f, vy * f, vz * f

@@ -16,7 +16,7 @@ an ensemble are in :mod:`rotframe.particles.drivers`; the forces in
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
@@ -69,8 +69,8 @@ def _sub(looked_up, m):
     s = 0.0
     if m.coriolis and not m.length > 0.0:
         angle = -2.0 * turn
-        c = np.cos(angle)
-        s = np.sin(angle)
+        c = math.cos(angle)
+        s = math.sin(angle)
     return w, wd, turn, c, s
 
 
@@ -198,7 +198,7 @@ def _sphere_step(state, h, m, sub):
     if m.coriolis:
         wn = m.axis[0] * nx + m.axis[1] * ny + m.axis[2] * nz
         angle = -2.0 * wn * sub[2]
-        vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, np.cos(angle), np.sin(angle))
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, math.cos(angle), math.sin(angle))
     if m.drag:
         vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     vx += hh * ax
@@ -217,14 +217,14 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
     vx = vx - vn * nx
     vy = vy - vn * ny
     vz = vz - vn * nz
-    speed = np.sqrt(vx * vx + vy * vy + vz * vz)
+    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
     if speed > 0.0:
         ux = vx / speed
         uy = vy / speed
         uz = vz / speed
         phi = speed * tau / L
-        c = np.cos(phi)
-        s = np.sin(phi)
+        c = math.cos(phi)
+        s = math.sin(phi)
         mx = nx * c + ux * s
         my = ny * c + uy * s
         mz = nz * c + uz * s
@@ -232,7 +232,7 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
         vy = speed * (uy * c - ny * s)
         vz = speed * (uz * c - nz * s)
         nx, ny, nz = mx, my, mz
-    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
     nx /= norm
     ny /= norm
     nz /= norm

@@ -32,9 +32,8 @@ Every kernel of :mod:`rotframe.particles` is compiled with :data:`jit_kernel`.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
-
-import numpy as np
 
 from rotframe.numerics.compiled import jit_internal, jit_kernel  # the one configuration (see there)
 
@@ -115,7 +114,7 @@ def as_state(y):
 def is_finite(state):
     """Whether every component of the state tuple is finite."""
     for q in state:
-        if not np.isfinite(q):
+        if not math.isfinite(q):
             return False
     return True
 

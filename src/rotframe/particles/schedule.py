@@ -13,7 +13,6 @@ time, so a run at a steady rate compiles none of the table readers.
 
 from __future__ import annotations
 
-import numpy as np
 
 from rotframe.particles.packed import jit_internal, jit_kernel
 
