@@ -16,22 +16,21 @@ import math
 
 __all__ = ["OMEGA_EARTH", "R_EARTH", "GM_EARTH", "G0", "ERA_RATE_RATIO", "WGS84_E2"]
 
-#: Ratio of the Earth Rotation Angle rate to one turn per UT1 day (IERS Conventions 2010,
-#: eq. 5.15: ERA = 2 pi (0.7790572732640 + 1.00273781191135448 Tu)).
 ERA_RATE_RATIO = 1.00273781191135448
+"""Ratio of the Earth Rotation Angle rate to one turn per UT1 day (IERS Conventions 2010,
+eq. 5.15: ERA = 2 pi (0.7790572732640 + 1.00273781191135448 Tu))."""
 
-#: Earth's rotation rate relative to inertial space, rad/s: the rate of the Earth
-#: Rotation Angle, ``2 pi x 1.00273781191135448 / 86400 s`` = 7.2921151467e-5 rad/s
-#: (the same float as astropy's ``(2 pi u.rad x ratio / (86400 u.s)).to_value(u.rad / u.s)``;
-#: tests/test_earth.py checks it). Not ``2 pi / u.sday`` (7.2921159e-5): astropy's
-#: sidereal day is measured against the precessing equinox, so that rate includes general
-#: precession (about 1e-7 relative too high). Not ``2 pi / 86400 s``: that is one turn per
-#: solar day, 0.27 % too low, since the Earth turns once more per year relative to the
-#: stars than relative to the Sun.
 OMEGA_EARTH: float = 2.0 * math.pi * ERA_RATE_RATIO / 86400.0
+"""Earth's rotation rate relative to inertial space, rad/s: the rate of the Earth Rotation
+Angle, ``2 pi x 1.00273781191135448 / 86400 s`` = 7.2921151467e-5 rad/s (the same float as
+astropy's ``(2 pi u.rad x ratio / (86400 u.s)).to_value(u.rad / u.s)``; tests/test_earth.py
+checks it). Not ``2 pi / u.sday`` (7.2921159e-5): astropy's sidereal day is measured against
+the precessing equinox, so that rate includes general precession (about 1e-7 relative too
+high). Not ``2 pi / 86400 s``: that is one turn per solar day, 0.27 % too low, since the
+Earth turns once more per year relative to the stars than relative to the Sun."""
 
-#: First eccentricity squared of the WGS84 ellipsoid (dimensionless).
 WGS84_E2 = 0.00669437999013
+"""First eccentricity squared of the WGS84 ellipsoid (dimensionless)."""
 
 R_EARTH: float
 """Nominal equatorial radius of the Earth, m (``astropy.constants.R_earth``, IAU 2015 B3)."""
