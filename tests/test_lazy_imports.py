@@ -69,6 +69,7 @@ def test_earth_names_all_resolve_lazily():
     code = ("import rotframe.earth as e\nfrom rotframe.earth import *  # noqa: F403\n"
             "missing = [n for n in e.__all__ if n not in dir(e) or getattr(e, n) is None]\n"
             "assert not missing, missing\n"
+            "assert e.gravity.__name__ == 'rotframe.earth.gravity' and e.local_frame.omega_enu is e.omega_enu\n"
             "try:\n    e.no_such_name\nexcept AttributeError:\n    pass\nelse:\n    raise SystemExit(1)")
     loaded_after(code)
 

@@ -82,6 +82,7 @@ _LAZY = {
                      "gravity_central"), "gravity"),
     **dict.fromkeys(("enu_to_ecef", "ecef_to_enu"), "ecef"),
 }
+_SUBMODULES = ("constants", "offline", "parsing", "sites", "local_frame", "gravity", "ecef")
 
 __all__ = [
     "OMEGA_EARTH",
@@ -120,6 +121,8 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
         globals()[name] = value
         return value
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
