@@ -57,6 +57,13 @@ def test_omega_earth_is_the_earth_rotation_angle_rate():
     assert OMEGA_EARTH / (2 * math.pi / 86400.0) == pytest.approx(1.0027378, rel=1e-7)
 
 
+def test_omega_earth_is_the_same_float_as_astropys_unit_arithmetic():
+    # rotframe computes it without astropy (so that importing it is cheap); astropy's own
+    # arithmetic, 2 pi rad x ratio / 86400 s in rad/s, must give the very same float
+    ratio = earth.ERA_RATE_RATIO
+    assert OMEGA_EARTH == (2.0 * np.pi * u.rad * ratio / (86400.0 * u.s)).to_value(u.rad / u.s)
+
+
 def test_constants_are_si_floats():
     for c in (OMEGA_EARTH, R_EARTH, GM_EARTH, G0):
         assert type(c) is float

@@ -1,6 +1,9 @@
 """Closed forms used as references for rotating-frame dynamics.
 
 Pure numpy/scipy: plain floats in SI units and radians, no units objects, no I/O.
+scipy is imported inside the functions that use it (``expm``, ``brentq``, ``ellipk``),
+so importing this module costs numpy alone: a scene that never finds a root does not
+load :mod:`scipy.optimize`.
 Local frame on the Earth: ENU, x east, y north, z up; Earth's angular velocity there is
 ``Omega (0, cos lat, sin lat)``. Pass ``g`` as the magnitude of the effective gravity
 (centrifugal term inside it) unless a function says otherwise. ``rotation_rate`` is the
@@ -14,9 +17,6 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from scipy.linalg import expm
-from scipy.optimize import brentq
-from scipy.special import ellipk
 
 from rotframe.errors import ScenarioError
 from rotframe.numerics.hat import skew
@@ -208,6 +208,8 @@ def linear_rotating_propagator(
     m[3:6, 0:3] = a_r
     m[3:6, 3:6] = -2.0 * W - float(linear_drag) * np.eye(3)
     m[3:6, 6] = g
+    from scipy.linalg import expm
+
     t = np.asarray(t, dtype=float)
     flat = t.reshape(-1)
     s = expm(m[None, :, :] * flat[:, None, None]) @ s0
@@ -261,6 +263,8 @@ def drop_exact_linear(height, latitude, g, rotation_rate) -> DropResult:
         lo, hi = hi, 2.0 * hi
     else:  # pragma: no cover - only for absurd rotation_rate
         raise ScenarioError(f"no landing found for height={height}, rotation_rate={rotation_rate}")
+    from scipy.optimize import brentq
+
     tf = brentq(z, lo, hi, xtol=1e-15 * t0, rtol=4.0 * np.finfo(float).eps)
     r, _ = linear_rotating_propagator(w, gv, tf, r0, v0)
     return DropResult(float(tf), float(r[0]), float(r[1]))
@@ -312,6 +316,8 @@ def pendulum_period(length, g, amplitude=0.0):
             f"pendulum amplitude {amplitude} m exceeds the length {length} m; "
             "allowed 0 <= amplitude <= length"
         )
+    from scipy.special import ellipk
+
     theta0 = np.arcsin(a / length)
     k2 = np.sin(0.5 * theta0) ** 2
     t = 4.0 * np.sqrt(length / g) * ellipk(k2)

@@ -3,6 +3,9 @@
 Plain numbers are degrees (angles) or metres (lengths); strings are read by astropy
 (:class:`astropy.coordinates.Angle`, :class:`astropy.units.Quantity` with the imperial
 units enabled for the call), inside :func:`~rotframe.earth.offline.astropy_offline`.
+astropy is imported by the parsers when they run, not with this module, so importing
+it (and the core's :func:`as_radians`) loads neither :mod:`astropy.units` nor
+:mod:`astropy.coordinates`.
 A hemisphere letter may follow an angle (S and W negate); each kind of angle takes
 only its own letters (:data:`HEMISPHERE_LETTERS`). Every refusal is a
 :class:`~rotframe.errors.ScenarioError` naming the parameter, the value and what is
@@ -13,13 +16,16 @@ from __future__ import annotations
 
 import math
 import re
+import sys
+from typing import TYPE_CHECKING
 
-import astropy.units as u
 import numpy as np
-from astropy.coordinates import Angle, Latitude, Longitude
 
 from rotframe.earth.offline import astropy_offline
 from rotframe.errors import ScenarioError
+
+if TYPE_CHECKING:
+    from astropy.coordinates import Angle
 
 __all__ = [
     "HEMISPHERE_LETTERS",
@@ -63,6 +69,8 @@ def parse_angle(value, name: str = "angle") -> float:
     ScenarioError
         If the value is not a finite scalar angle.
     """
+    import astropy.units as u
+
     ang = _to_angle(value, name)
     return float(ang.to_value(u.rad))
 
@@ -79,6 +87,9 @@ def parse_latitude(value, name: str = "latitude") -> float:
         If the value cannot be read as an angle or lies beyond +-90 deg; the message names
         the value and the allowed range.
     """
+    import astropy.units as u
+    from astropy.coordinates import Latitude
+
     ang = _to_angle(value, name, "latitude")
     try:
         with astropy_offline():
@@ -96,6 +107,9 @@ def parse_longitude(value, name: str = "longitude") -> float:
 
     Accepts the same forms as :func:`parse_angle`; a trailing N or S is refused.
     """
+    import astropy.units as u
+    from astropy.coordinates import Longitude
+
     ang = _to_angle(value, name, "longitude")
     with astropy_offline():
         lon = Longitude(ang, wrap_angle=180 * u.deg)
@@ -108,6 +122,8 @@ def parse_azimuth(value, name: str = "azimuth") -> float:
     Accepts the same forms as :func:`parse_angle`; a trailing E or W reads as
     east or west of north (``"30 W"`` is -30 deg, astropy's sign), N or S is refused.
     """
+    import astropy.units as u
+
     return float(_to_angle(value, name, "azimuth").to_value(u.rad))
 
 
@@ -147,6 +163,9 @@ def read_angle_text(text: str, name: str = "angle", kind: str = "angle"):
     -------
     astropy.coordinates.Angle
     """
+    import astropy.units as u
+    from astropy.coordinates import Angle
+
     text = text.strip()
     allowed = HEMISPHERE_LETTERS.get(kind, "")
     if _NUMBER_RE.match(text):
@@ -191,6 +210,9 @@ _ANGLE_EXAMPLES = {
 
 def _astropy_angle(text: str):
     """astropy's reading of ``text`` (degrees by default); a Quantity string with an angular unit as fallback."""
+    import astropy.units as u
+    from astropy.coordinates import Angle
+
     with astropy_offline():
         try:
             return Angle(text, unit=u.deg)
@@ -220,6 +242,8 @@ def parse_length(value, name: str = "length", *, positive: bool = False) -> floa
     ScenarioError
         Wrong dimension, unreadable or non-finite value, or (with ``positive``) not > 0.
     """
+    import astropy.units as u
+
     help_ = "a length in metres, or a quantity such as '520 ft' or '158.5 m'"
     if isinstance(value, (bool, np.bool_)):
         raise ScenarioError(f"{name} {value!r} is not a length; give {help_}")
@@ -258,8 +282,13 @@ def parse_length(value, name: str = "length", *, positive: bool = False) -> floa
 
 
 def as_radians(x):
-    """Plain radians (float, or float64 array) from a float/array, or from an astropy angle Quantity."""
-    if isinstance(x, u.Quantity):
+    """Plain radians (float, or float64 array) from a float/array, or from an astropy angle Quantity.
+
+    Core functions call it, so it does not import astropy: a Quantity can only exist once
+    :mod:`astropy.units` has been imported by whoever made it.
+    """
+    u = sys.modules.get("astropy.units")
+    if u is not None and isinstance(x, u.Quantity):
         x = x.to_value(u.rad)
     a = np.asarray(x, dtype=float)
     return float(a) if a.ndim == 0 else a
@@ -267,6 +296,9 @@ def as_radians(x):
 
 def _to_angle(value, name: str, kind: str = "any") -> Angle:
     """Read a scalar angle (numbers in degrees) as an astropy Angle; ScenarioError if not."""
+    import astropy.units as u
+    from astropy.coordinates import Angle
+
     if isinstance(value, (bool, np.bool_)):
         raise ScenarioError(f"{name} {value!r} is not an angle; give {_ANGLE_HELP}")
     try:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
+from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
+from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, method_rel_error, particle_methods,

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
+from rotframe import analytic
+# astropy's values, read when the scene is imported (before the run's clock starts): every run needs them
+from rotframe.earth import R_EARTH
 from rotframe.particles.integrators import Event
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
@@ -60,7 +62,7 @@ def aim_axes(azimuth_deg):
 def build(p, terms):
     Omega, w, g = earth_model_constants(p.latitude)
     terms = resolve_terms(terms, p.drag)
-    R = earth.R_EARTH
+    R = R_EARTH
     # GM chosen so that central gravity equals the effective g at the gun (same g at the start)
     model = ParticleModel(terms, omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                           k_quadratic=p.drag, scale_height=p.scale_height, radius=R,

@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe import analytic, earth  # noqa: F401  (astropy loads with the scene, before timing)
+from rotframe import analytic
+# astropy's values, read when the scene is imported (before the run's clock starts): every run needs them
+from rotframe.earth import GM_EARTH, R_EARTH
 from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
@@ -49,7 +51,7 @@ def build(p, terms):
     """(model, r0, v0, duration) for the parameters; drag > 0 adds quadratic drag."""
     Omega, w, g = earth_model_constants(p.latitude, p.g_model)
     model = ParticleModel(resolve_terms(terms, p.drag), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
-                          k_quadratic=p.drag, g0=g, radius=earth.R_EARTH, gm=earth.GM_EARTH)
+                          k_quadratic=p.drag, g0=g, radius=R_EARTH, gm=GM_EARTH)
     h = p.height
     t_vac = math.sqrt(2 * h / g)
     t_drag = h * math.sqrt(p.drag / g) if p.drag > 0 else 0.0
@@ -97,7 +99,7 @@ def theory_and_accuracy(p, model, g, Omega):
     theory = {"east_deflection_m": float(analytic.drop_east_deflection_first_order(h, lat, g, Omega)),
               "north_deflection_m": float(north), "fall_time_s": t}
     wt = Omega * t
-    extra = h / earth.R_EARTH if (model.has("altitude-gravity") or model.has("central-gravity")) else 0.0
+    extra = h / R_EARTH if (model.has("altitude-gravity") or model.has("central-gravity")) else 0.0
     accuracy = {"east_deflection_m": 2 * wt**2 + 2 * extra, "north_deflection_m": 2 * wt + 2 * extra,
                 "fall_time_s": 2 * wt**2 + 2 * extra}
     labels = {"east_deflection_m": "first order in Omega, uniform gravity, vacuum",
@@ -129,7 +131,7 @@ def analyse(p, result):
                      "air both prolongs the Coriolis push and damps the eastward drift (no energy invariant either)")
     if model.has("altitude-gravity") or model.has("central-gravity"):
         notes.append("theory assumes uniform gravity; weaker gravity aloft changes every value by up to a "
-                     f"relative h / R = {p.height / earth.R_EARTH:.2g}")
+                     f"relative h / R = {p.height / R_EARTH:.2g}")
     if not landed:
         notes.append("the body did not reach the ground in the simulated time")
     # a deflection below float64's normal range has no significant digits left: null, not a number
