@@ -71,10 +71,11 @@ def _tableau():
 
 
 @_jit
-def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q):
+def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q, y_new, tmp, F):
     """Take the steps from ``t`` (state ``y``, ``K[0] = f(y)``, first step ``h``) to ``times[-1]``.
 
-    Samples ``k_out..`` of ``times`` go to ``out_L`` and ``out_q`` (normalised).
+    Samples ``k_out..`` of ``times`` go to ``out_L`` and ``out_q`` (normalised);
+    ``y_new``, ``tmp`` (7,) and ``F`` (7, 7) are work arrays.
     ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``; ``A`` as :func:`_tableau`
     returns it. Returns (samples done, right-hand sides evaluated, accepted steps);
     samples done < len(times) when the step size collapsed or the state became
@@ -89,9 +90,6 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
     t_end = times[n_out - 1]
     i0, i1, i2, mgl = p[0], p[1], p[2], p[3]
     nb0, nb1, nb2, ns0, ns1, ns2 = p[4], p[5], p[6], p[7], p[8], p[9]
-    y_new = np.empty(7)
-    tmp = np.empty(7)
-    F = np.empty((7, 7))
     nfev = 0
     steps = 0
     while t < t_end:
@@ -126,7 +124,8 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
             h *= 0.2
             continue
         if err >= 1.0:
-            h *= max(0.2, 0.9 * err ** (-1.0 / 8.0))
+            fac = 0.9 * err ** (-1.0 / 8.0)
+            h *= fac if fac > 0.2 else 0.2  # max(0.2, fac)
             continue
         steps += 1
         if dense:  # the interpolant's coefficients (Hairer's dense output)
@@ -167,8 +166,9 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
         t = t_new
         if not finite:
             return k_out - 1, nfev, steps
-        fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
-        h = min(h * fac, h_max)
+        fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
+        h *= fac if fac < 10.0 else 10.0  # min(10, fac)
+        h = h_max if h_max < h else h  # min(h, h_max)
     return k_out, nfev, steps
 
 
@@ -235,7 +235,8 @@ def _run(y0, p, times, rtol, atol, h_max, out_L, out_q):
     with np.errstate(all="ignore"):  # a run of one sample has h = 0 and d2 = 0 / 0, as in a compiled kernel
         h = _first_step(y, K, p, times[n_out - 1] - times[0], atol_L, atol, rtol, h_max)
     A, E3, E5, D = _tableau()
-    done, nfev, steps = _steps(y, K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q)
+    done, nfev, steps = _steps(y, K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q,
+                               np.empty(7), np.empty(7), np.empty((7, 7)))
     return done, nfev + 2, steps
 
 
