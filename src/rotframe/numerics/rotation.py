@@ -91,7 +91,9 @@ def quat_mul_arrays(a, b) -> np.ndarray:
     """Hamilton product of scalar-last quaternions ``(..., 4)``, broadcasting over leading axes."""
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     shape = np.broadcast_shapes(a.shape, b.shape)
-    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4)) for x in (a, b)]  # writeable copies
+    # writeable C-ordered copies: the compiled loop has one signature (a broadcast or Fortran-ordered
+    # input would otherwise compile a version of its own on a first run)
+    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4), order="C") for x in (a, b)]
     out = np.empty_like(rows[0])
     _quat_mul_rows(rows[0], rows[1], out)
     return out.reshape(shape)

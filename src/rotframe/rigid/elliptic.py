@@ -115,7 +115,9 @@ def jacobi_reduced(u, m, m1, K):
             ur -= period
         elif ur < -2.0 * K:
             ur += period
-        j = np.round((u[i] - ur) / period)
+        j = (u[i] - ur) / period  # a whole number up to rounding: round half to even, as np.round, whose
+        if abs(j) < 4503599627370496.0:  # compiled version costs a first run 0.3 s; from 2^52 on (and
+            j = float(round(j))  # inf, nan) j is its own rounding
         sgn[i] = 1.0 if ur >= 0.0 else -1.0
         v = abs(ur)
         refl[i] = v > K
