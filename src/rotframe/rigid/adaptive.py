@@ -31,13 +31,17 @@ import functools
 import math
 
 import numpy as np
+from numba import njit
 
-from rotframe.numerics.dop853 import dop853_error_norm
+from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.rigid.dense_output import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
 _jit = jit_kernel
+# the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
+_error_norm = njit(inline="always", error_model="numpy")(dop853_error_norm.py_func)
 
 
 class RigidRun:
@@ -53,20 +57,17 @@ class RigidRun:
 def _tableau():
     """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output.
 
-    Rows 0..11 of ``A`` are the stages and rows 13..15 the dense-output stages of
-    scipy's table; row 12 holds the order-8 weights ``B`` of
-    :func:`rotframe.numerics.dop853.coefficients`, so that "stage 12" of the stage
-    loop forms ``y_new = y + h sum B_q k_q`` and ``f(y_new)``.
+    Rows 0..11 of ``A`` are the stages of :func:`rotframe.numerics.dop853.coefficients`,
+    row 12 its order-8 weights ``B`` (so that "stage 12" of the stage loop forms
+    ``y_new = y + h sum B_q k_q`` and ``f(y_new)``), rows 13..15 the dense-output
+    stages of :func:`rotframe.rigid.dense_output.dense_tables`.
     """
-    from scipy.integrate._ivp import dop853_coefficients as d
-
-    from rotframe.numerics.dop853 import coefficients
-
-    _, B, _, E3, E5 = coefficients()
-    A = np.array(d.A, dtype=np.float64, order="C")
+    A12, B, _, E3, E5 = coefficients()
+    A_extra, D = dense_tables()
+    A = np.zeros((16, 16))
+    A[:12, :12] = A12
     A[12, :12] = B
-    A[12, 12:] = 0.0
-    D = np.ascontiguousarray(d.D, dtype=np.float64)
+    A[13:] = A_extra
     return A, E3, E5, D
 
 
@@ -106,7 +107,7 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
                 nfev += 12
                 for j in range(7):
                     y_new[j] = tmp[j]
-                err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
+                err = _error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
                 # the 7th-order dense output needs stages 13..15, when the step holds a sample
                 if not (err < 1.0 and k_out < n_out and times[k_out] < t_new):
                     break
