@@ -122,12 +122,17 @@ def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1
 
 
 @njit(cache=True)
-def _torque_body(q, mgl, torque_body, torque_space):
-    """:func:`body_torque` of the state's ``q`` as an array (3,)."""
+def _kick(L, q, c, mgl, torque_body, torque_space):
+    """``L += c N_body(q)`` (``c`` = half the step) with :func:`body_torque`, element by element.
+
+    Scalars, not the array expression ``L += c * N``: the same operations, without
+    numba's array machinery to compile on a first run.
+    """
     tb, ts = torque_body, torque_space
-    out = np.empty(3)
-    out[0], out[1], out[2] = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
-    return out
+    n0, n1, n2 = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
+    L[0] += c * n0
+    L[1] += c * n1
+    L[2] += c * n2
 
 
 @njit(cache=True)
@@ -162,11 +167,13 @@ def split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, we
         for w in weights:
             tau = w * h
             if kick:
-                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
+                _kick(L, q, 0.5 * tau, mgl, torque_body, torque_space)
             free_step(L, q, tau, inv_i, sym)
             if kick:
-                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
-        q /= math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+                _kick(L, q, 0.5 * tau, mgl, torque_body, torque_space)
+        norm_q = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        for i in range(4):
+            q[i] /= norm_q
         if step % sample_every == 0 or step == n_steps:
             if not _store_row(out_L, out_q, kept, L, q):
                 return kept
@@ -197,12 +204,23 @@ def rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_ev
     kept = int(0)  # int(), not a literal 0 or 1: one compiled _store_row for every row
     _store_row(out_L, out_q, kept, L0, q0)
     kept += 1
+    # the stage sums element by element (the operations of y + h/2 k1 ... y += h/6 (k1 + 2 k2 + 2 k3 + k4) in
+    # their order, without numba's array expressions to compile on a first run)
+    half, sixth = 0.5 * h, h / 6.0
+    tmp = np.empty(7)
     for step in range(1, n_steps + 1):
         k1 = euler_rhs(y, inv_i, mgl, torque_body, torque_space)
-        k2 = euler_rhs(y + 0.5 * h * k1, inv_i, mgl, torque_body, torque_space)
-        k3 = euler_rhs(y + 0.5 * h * k2, inv_i, mgl, torque_body, torque_space)
-        k4 = euler_rhs(y + h * k3, inv_i, mgl, torque_body, torque_space)
-        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for i in range(7):
+            tmp[i] = y[i] + half * k1[i]
+        k2 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            tmp[i] = y[i] + half * k2[i]
+        k3 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            tmp[i] = y[i] + h * k3[i]
+        k4 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            y[i] += sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
         if step % sample_every == 0 or step == n_steps:
             if not _store_row(out_L, out_q, kept, y[:3], y[3:]):
                 return kept
