@@ -19,8 +19,10 @@ with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
 not projected during the run (the exact flow keeps ``|q| = 1``, and the drift
 is of the order of the tolerance); outputs are normalised.
 
-The whole run (every step, every sample) is one compiled call, with the
-tableau passed as arrays; the Python wrapper costs a few microseconds.
+Every step and every sample is one compiled call (:func:`_steps`, the tableau
+passed as arrays); the checks, sample 0 and the first step run in Python (a few
+microseconds), so that the kernel a first run compiles is as small as it can be
+(docs/architecture.md, "What a first run compiles").
 """
 
 from __future__ import annotations
