@@ -113,3 +113,16 @@ def test_bad_times_are_refused(times):
 def test_bad_torque_frame_is_refused():
     with pytest.raises(ScenarioError, match="torque_frame"):
         rigid_dop853(I, L0, Q0, [0.0, 1.0], torque=[0, 0, 1.0], torque_frame="world")
+
+
+def test_dense_output_tables_are_those_scipy_ships():
+    # the dense-output stages and weights are typed out in rotframe.rigid.dense_output (so that a run
+    # does not import scipy.integrate); scipy's solve_ivp ships the same published dop853.f constants,
+    # an independent transcription: equal to the last bit
+    from scipy.integrate._ivp import dop853_coefficients as d
+
+    from rotframe.rigid.dense_output import dense_tables
+
+    A_extra, D = dense_tables()
+    assert np.array_equal(A_extra, d.A[13:16]) and np.array_equal(D, d.D)
+

@@ -109,3 +109,17 @@ def test_check_vector3_accepts_and_refuses():
         check_vector3([1.0, np.nan, 0.0], "com", _Err, unit="m")
     with pytest.raises(ValueError, match=r"^v0 = .* has shape \(4, 3\); it must be 3 finite numbers$"):
         check_vector3(np.zeros((4, 3)), "v0")
+
+
+def test_array_forms_give_the_same_bits_compiled_or_not(monkeypatch):
+    # up to NUMPY_ROWS rows the array forms run the kernels' source on numpy arrays, above it a compiled
+    # loop: both evaluate one formula in one operation order (IEEE elementwise), so the bits agree
+    from rotframe.numerics import rotation
+
+    qa, qb = Rotation.random(40, random_state=3).as_quat(), Rotation.random(40, random_state=4).as_quat()
+    axis, angles, v = _unit(RNG.normal(size=3)), RNG.uniform(-10.0, 10.0, 40), RNG.normal(size=3)
+    small = quat_mul_arrays(qa, qb), quat_mul_arrays(qa[0], qb), rotate_about(axis, angles, v)
+    monkeypatch.setattr(rotation, "NUMPY_ROWS", 0)
+    big = quat_mul_arrays(qa, qb), quat_mul_arrays(qa[0], qb), rotate_about(axis, angles, v)
+    for x, y in zip(small, big):
+        assert x.shape == y.shape and np.array_equal(x, y)

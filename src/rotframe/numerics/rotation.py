@@ -13,13 +13,18 @@ Conventions
 
 The compiled kernels (:func:`rodrigues_rotate`, :func:`quat_mul`) take scalar
 components so that numba callers pay no array allocation; the array forms
-(:func:`rotate_about`, :func:`quat_mul_arrays`) loop over the same kernels, so
-every caller evaluates the same formula in the same operation order. The
+(:func:`rotate_about`, :func:`quat_mul_arrays`) evaluate the same kernels, so
+every caller gets the same formula in the same operation order: up to
+:data:`NUMPY_ROWS` rows the kernel's Python source on numpy arrays (elementwise
+IEEE operations, the same numbers to the last bit, and nothing to compile on a
+first run), above it a compiled loop over the kernel. The
 formulas are in ``docs/physics/rigid-bodies.md`` (quaternion kinematics) and
 ``docs/physics/splitting.md`` (exact Coriolis rotation).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -33,7 +38,13 @@ __all__ = [
     "quat_mul",
     "quat_mul_arrays",
     "quat_about_axis",
+    "NUMPY_ROWS",
 ]
+
+#: Rows up to which the array forms run the kernels' Python source on numpy arrays instead of a
+#: compiled loop: a few microseconds a call more, where the compiled loop would cost a first run
+#: 0.2-0.3 s to compile (the rigid scenes pass at most 4097 rows a call).
+NUMPY_ROWS = 65536
 
 
 
@@ -67,9 +78,12 @@ def rotate_about(axis, angle, v) -> np.ndarray:
     ndarray, shape (n, 3)
     """
     angle = np.asarray(angle, dtype=np.float64)
+    axis, v = np.asarray(axis, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    if angle.shape[0] <= NUMPY_ROWS:
+        return np.stack(rodrigues_rotate.py_func(v[0], v[1], v[2], axis[0], axis[1], axis[2], np.cos(angle),
+                                                 np.sin(angle)), axis=-1)
     out = np.empty((angle.shape[0], 3))
-    _rotate_rows(np.asarray(axis, dtype=np.float64), np.cos(angle), np.sin(angle),
-                 np.asarray(v, dtype=np.float64), out)
+    _rotate_rows(axis, np.cos(angle), np.sin(angle), v, out)
     return out
 
 
@@ -91,7 +105,12 @@ def quat_mul_arrays(a, b) -> np.ndarray:
     """Hamilton product of scalar-last quaternions ``(..., 4)``, broadcasting over leading axes."""
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     shape = np.broadcast_shapes(a.shape, b.shape)
-    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4)) for x in (a, b)]  # writeable copies
+    if math.prod(shape[:-1]) <= NUMPY_ROWS:
+        return np.stack(quat_mul.py_func(a[..., 0], a[..., 1], a[..., 2], a[..., 3],
+                                         b[..., 0], b[..., 1], b[..., 2], b[..., 3]), axis=-1)
+    # writeable C-ordered copies: the compiled loop has one signature (a broadcast or Fortran-ordered
+    # input would otherwise compile a version of its own)
+    rows = [np.array(np.broadcast_to(x, shape).reshape(-1, 4), order="C") for x in (a, b)]
     out = np.empty_like(rows[0])
     _quat_mul_rows(rows[0], rows[1], out)
     return out.reshape(shape)

@@ -19,8 +19,10 @@ with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
 not projected during the run (the exact flow keeps ``|q| = 1``, and the drift
 is of the order of the tolerance); outputs are normalised.
 
-The whole run (every step, every sample) is one compiled call, with the
-tableau passed as arrays; the Python wrapper costs a few microseconds.
+Every step and every sample is one compiled call (:func:`_steps`, the tableau
+passed as arrays); the checks, sample 0 and the first step run in Python (a few
+microseconds), so that the kernel a first run compiles is as small as it can be
+(docs/architecture.md, "What a first run compiles").
 """
 
 from __future__ import annotations
@@ -31,13 +33,17 @@ import functools
 import math
 
 import numpy as np
+from numba import njit
 
-from rotframe.numerics.dop853 import dop853_error_norm
+from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.rigid.dense_output import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
 _jit = jit_kernel
+# the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
+_error_norm = njit(inline="always", error_model="numpy")(dop853_error_norm.py_func)
 
 
 class RigidRun:
@@ -51,142 +57,81 @@ class RigidRun:
 
 @functools.cache
 def _tableau():
-    """(A (16, 16), B (12,), C (16,), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output."""
-    from scipy.integrate._ivp import dop853_coefficients as d
+    """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output.
 
-    from rotframe.numerics.dop853 import coefficients
+    Rows 0..11 of ``A`` are the stages of :func:`rotframe.numerics.dop853.coefficients`,
+    row 12 its order-8 weights ``B`` (so that "stage 12" of the stage loop forms
+    ``y_new = y + h sum B_q k_q`` and ``f(y_new)``), rows 13..15 the dense-output
+    stages of :func:`rotframe.rigid.dense_output.dense_tables`.
+    """
+    A12, B, _, E3, E5 = coefficients()
+    A_extra, D = dense_tables()
+    A = np.zeros((16, 16))
+    A[:12, :12] = A12
+    A[12, :12] = B
+    A[13:] = A_extra
+    return A, E3, E5, D
 
-    _, B, _, E3, E5 = coefficients()
-    A = np.ascontiguousarray(d.A, dtype=np.float64)
-    C = np.ascontiguousarray(d.C, dtype=np.float64)
-    D = np.ascontiguousarray(d.D, dtype=np.float64)
-    return A, B, C, E3, E5, D
-
-
-@_jit
-def _f(y, p, K, row):
-    """Right-hand side (:func:`rotframe.rigid.kernels.euler_rates`) into K[row];
-    p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))."""
-    (K[row, 0], K[row, 1], K[row, 2], K[row, 3], K[row, 4], K[row, 5], K[row, 6]) = euler_rates(
-        y[0], y[1], y[2], y[3], y[4], y[5], y[6], p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
 
 @_jit
-def _stages(y, h, p, A, K, tmp, first, last):
-    """Stages first..last-1 from y with step h (K[0..first-1] already there)."""
-    for s in range(first, last):
-        for j in range(7):
-            acc = 0.0
-            for q in range(s):
-                acc += A[s, q] * K[q, j]
-            tmp[j] = y[j] + h * acc
-        _f(tmp, p, K, s)
+def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q, y_new, tmp, F):
+    """Take the steps from ``t`` (state ``y``, ``K[0] = f(y)``, first step ``h``) to ``times[-1]``.
 
-@_jit
-def _store(out_L, out_q, k, y):
-    for i in range(3):
-        out_L[k, i] = y[i]
-    n = math.sqrt(y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
-    for i in range(4):
-        out_q[k, i] = y[3 + i] / n
+    Samples ``k_out..`` of ``times`` go to ``out_L`` and ``out_q`` (normalised);
+    ``y_new``, ``tmp`` (7,) and ``F`` (7, 7) are work arrays.
+    ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``; ``A`` as :func:`_tableau`
+    returns it. Returns (samples done, right-hand sides evaluated, accepted steps);
+    samples done < len(times) when the step size collapsed or the state became
+    non-finite.
 
-@_jit
-def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
-    """Integrate from times[0] to times[-1]; samples at every entry of ``times``.
-
-    ``p[:3]`` holds the moments of inertia on entry and their inverses after;
-    ``y0[3:]`` is normalised in place. Returns (samples done, nfev, accepted
-    steps); samples done < len(times) when the step size collapsed or the
-    state became non-finite, -1 for invalid input.
+    The kernel a run waits for on its first call is compiled from this function,
+    whose cost grows with its number of statements: everything that runs once per
+    call (checks, first step) is in :func:`rigid_dop853`, and the right-hand side
+    is called from one place (every stage, ``f(y_new)`` and the dense-output stages).
     """
     n_out = times.shape[0]
-    if n_out < 1 or times.ndim != 1:
-        return -1, 0, 0
-    for k in range(1, n_out):
-        if not times[k] > times[k - 1]:
-            return -1, 0, 0
-    for i in range(3):
-        if not p[i] > 0.0:
-            return -1, 0, 0
-        p[i] = 1.0 / p[i]
-    nq = math.sqrt(y0[3] * y0[3] + y0[4] * y0[4] + y0[5] * y0[5] + y0[6] * y0[6])
-    if not nq > 0.0:
-        return -1, 0, 0
-    for i in range(3, 7):
-        y0[i] /= nq
-    atol_q = atol
-    atol_L = atol * max(math.sqrt(y0[0] * y0[0] + y0[1] * y0[1] + y0[2] * y0[2]), 1e-300)
-    atol_vec = np.empty(7)
-    for j in range(7):
-        atol_vec[j] = atol_L if j < 3 else atol_q
-    K = np.empty((16, 7))
-    y = y0.copy()
-    y_new = np.empty(7)
-    tmp = np.empty(7)
-    F = np.empty((7, 7))
-    sc = np.empty(7)
-    for j in range(7):
-        sc[j] = (atol_L if j < 3 else atol_q) + rtol * abs(y[j])
-    t = times[0]
     t_end = times[n_out - 1]
-    _store(out_L, out_q, 0, y)
-    k_out = 1
-    while k_out < n_out and times[k_out] <= t:
-        _store(out_L, out_q, k_out, y)
-        k_out += 1
-    _f(y, p, K, 0)
-    nfev = 1
-    # first step (Hairer, II.4)
-    d0 = 0.0
-    d1 = 0.0
-    for j in range(7):
-        d0 += (y[j] / sc[j]) ** 2
-        d1 += (K[0, j] / sc[j]) ** 2
-    d0 = math.sqrt(d0 / 7)
-    d1 = math.sqrt(d1 / 7)
-    h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h = min(h, abs(t_end - t))
-    for j in range(7):
-        tmp[j] = y[j] + h * K[0, j]
-    _f(tmp, p, K, 1)
-    nfev += 1
-    d2 = 0.0
-    for j in range(7):
-        d2 += ((K[1, j] - K[0, j]) / sc[j]) ** 2
-    d2 = math.sqrt(d2 / 7) / h
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    h = min(100 * h, h1, h_max)
+    i0, i1, i2, mgl = p[0], p[1], p[2], p[3]
+    nb0, nb1, nb2, ns0, ns1, ns2 = p[4], p[5], p[6], p[7], p[8], p[9]
+    nfev = 0
     steps = 0
     while t < t_end:
         # a step cut to end at t_end lands on it exactly (t + (t_end - t) can round to an ulp short)
         clipped = t + h >= t_end
         if clipped:
             h = t_end - t
-        if h < 10.0 * abs(np.nextafter(t, np.inf) - t):
+        if h < 10.0 * abs(math.nextafter(t, math.inf) - t):
             return k_out, nfev, steps
-        _stages(y, h, p, A, K, tmp, 1, 12)
-        for j in range(7):
-            acc = 0.0
-            for q in range(12):
-                acc += B[q] * K[q, j]
-            y_new[j] = y[j] + h * acc
-        _f(y_new, p, K, 12)
-        nfev += 12
-        err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
-        if not np.isfinite(err):
+        t_new = t_end if clipped else t + h
+        dense = False
+        for s in range(1, 16):
+            if s == 13:  # tmp holds y_new (stage 12): estimate the error
+                nfev += 12
+                for j in range(7):
+                    y_new[j] = tmp[j]
+                err = _error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
+                # the 7th-order dense output needs stages 13..15, when the step holds a sample
+                if not (err < 1.0 and k_out < n_out and times[k_out] < t_new):
+                    break
+                nfev += 3
+                dense = True
+            for j in range(7):
+                acc = 0.0
+                for q in range(s):
+                    acc += A[s, q] * K[q, j]
+                tmp[j] = y[j] + h * acc
+            K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
+                tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5], tmp[6], i0, i1, i2, mgl, nb0, nb1, nb2,
+                ns0, ns1, ns2)
+        if not math.isfinite(err):
             h *= 0.2
             continue
         if err >= 1.0:
-            h *= max(0.2, 0.9 * err ** (-1.0 / 8.0))
+            fac = 0.9 * err ** (-1.0 / 8.0)
+            h *= fac if fac > 0.2 else 0.2  # max(0.2, fac)
             continue
-        t_new = t_end if clipped else t + h
         steps += 1
-        if k_out < n_out and times[k_out] < t_new:
-            # dense output (7th order) for the samples inside (t, t_new)
-            _stages(y, h, p, A, K, tmp, 13, 16)
-            nfev += 3
+        if dense:  # the interpolant's coefficients (Hairer's dense output)
             for j in range(7):
                 dy = y_new[j] - y[j]
                 F[0, j] = dy
@@ -197,33 +142,105 @@ def _run(y0, p, times, rtol, atol, h_max, A, B, C, E3, E5, D, out_L, out_q):
                     for q in range(16):
                         acc += D[r, q] * K[q, j]
                     F[3 + r, j] = h * acc
-            while k_out < n_out and times[k_out] < t_new:
-                x = (times[k_out] - t) / h
-                for j in range(7):
+        # the samples in (t, t_new]: interpolated inside, the new state at t_new
+        while k_out < n_out and times[k_out] <= t_new:
+            x = (times[k_out] - t) / h
+            for j in range(7):
+                if times[k_out] < t_new:
                     v = 0.0
                     for i in range(7):
                         v += F[6 - i, j]
                         v *= x if i % 2 == 0 else 1.0 - x
                     tmp[j] = y[j] + v
-                _store(out_L, out_q, k_out, tmp)
-                k_out += 1
-        for j in range(7):
-            y[j] = y_new[j]
-            K[0, j] = K[12, j]
-        t = t_new
-        while k_out < n_out and times[k_out] <= t:
-            _store(out_L, out_q, k_out, y)
+                else:
+                    tmp[j] = y_new[j]
+            n = math.sqrt(tmp[3] * tmp[3] + tmp[4] * tmp[4] + tmp[5] * tmp[5] + tmp[6] * tmp[6])
+            for i in range(7):
+                if i < 3:
+                    out_L[k_out, i] = tmp[i]
+                else:
+                    out_q[k_out, i - 3] = tmp[i] / n
             k_out += 1
         finite = True
         for j in range(7):
-            if not np.isfinite(y[j]):
-                finite = False
+            y[j] = y_new[j]
+            K[0, j] = K[12, j]
+            finite = finite and math.isfinite(y[j])
+        t = t_new
         if not finite:
             return k_out - 1, nfev, steps
-        fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
-        h = min(h * fac, h_max)
+        fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
+        h *= fac if fac < 10.0 else 10.0  # min(10, fac)
+        h = h_max if h_max < h else h  # min(h, h_max)
     return k_out, nfev, steps
 
+
+def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
+    """``K[0] = f(y)`` and the first step (Hairer, II.4), with one more evaluation into ``K[1]``.
+
+    Scalar arithmetic in the order of Hairer's code (float64 throughout, as in a
+    compiled kernel). Returns the step ``h``.
+    """
+    args = (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
+    K[0] = euler_rates(*y, *args)
+    d0 = d1 = 0.0
+    sc = [(atol_L if j < 3 else atol_q) + rtol * abs(y[j]) for j in range(7)]
+    for j in range(7):
+        a, b = y[j] / sc[j], K[0, j] / sc[j]
+        d0 += a * a
+        d1 += b * b
+    d0 = math.sqrt(d0 / 7)
+    d1 = math.sqrt(d1 / 7)
+    h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h = min(h, abs(t_span))
+    K[1] = euler_rates(*(y[j] + h * K[0, j] for j in range(7)), *args)
+    d2 = 0.0
+    for j in range(7):
+        c = (K[1, j] - K[0, j]) / sc[j]
+        d2 += c * c
+    d2 = math.sqrt(d2 / 7) / h
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100 * h, h1, h_max)
+
+
+def _run(y0, p, times, rtol, atol, h_max, out_L, out_q):
+    """Integrate from times[0] to times[-1]; samples at every entry of ``times``.
+
+    ``p[:3]`` holds the moments of inertia on entry and their inverses after;
+    ``y0[3:]`` is normalised in place. Returns (samples done, nfev, accepted
+    steps); samples done < len(times) when the step size collapsed or the
+    state became non-finite, -1 for invalid input. The checks, the first step and
+    sample 0 in Python (float64 scalars, the operations of Hairer's code), the steps in
+    :func:`_steps`.
+    """
+    n_out = times.shape[0]
+    if n_out < 1 or times.ndim != 1 or not np.all(times[1:] > times[:-1]):
+        return -1, 0, 0
+    for i in range(3):
+        if not p[i] > 0.0:
+            return -1, 0, 0
+        p[i] = 1.0 / p[i]
+    nq = math.sqrt(y0[3] * y0[3] + y0[4] * y0[4] + y0[5] * y0[5] + y0[6] * y0[6])
+    if not nq > 0.0:
+        return -1, 0, 0
+    for i in range(3, 7):
+        y0[i] /= nq
+    atol_L = atol * max(math.sqrt(y0[0] * y0[0] + y0[1] * y0[1] + y0[2] * y0[2]), 1e-300)
+    atol_vec = np.array([atol_L] * 3 + [atol] * 4)
+    y = y0.copy()
+    n = math.sqrt(y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
+    out_L[0] = y[:3]
+    out_q[0] = y[3:] / n
+    K = np.empty((16, 7))
+    with np.errstate(all="ignore"):  # a run of one sample has h = 0 and d2 = 0 / 0, as in a compiled kernel
+        h = _first_step(y, K, p, times[n_out - 1] - times[0], atol_L, atol, rtol, h_max)
+    A, E3, E5, D = _tableau()
+    done, nfev, steps = _steps(y, K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q,
+                               np.empty(7), np.empty(7), np.empty((7, 7)))
+    return done, nfev + 2, steps
 
 
 def rigid_dop853(inertia, L0_body, q0, times, *, rtol=1e-10, atol=None, mgl=0.0, torque=None,
@@ -277,9 +294,8 @@ def rigid_dop853(inertia, L0_body, q0, times, *, rtol=1e-10, atol=None, mgl=0.0,
             raise ScenarioError(f"torque_frame: {torque_frame!r}; allowed: body, space")
     out_L = np.empty((times.size, 3))
     out_q = np.empty((times.size, 4))
-    A, B, C, E3, E5, D = _tableau()
     done, nfev, steps = _run(y0, p, times, float(rtol), rtol if atol is None else float(atol), float(h_max),
-                             A, B, C, E3, E5, D, out_L, out_q)
+                             out_L, out_q)
     if done < 0:
         from rotframe.errors import ScenarioError
 

@@ -4,7 +4,9 @@
   ``sn, cn, dn(u | m)`` with ``m1 = 1 - m`` supplied exactly, by reduction modulo
   ``4K`` (A&S 16.8) and descending Landen transformations (A&S 16.12-16.13); keeps
   relative accuracy near the separatrix ``m -> 1``, where ``scipy.special.ellipj``
-  does not (scipy issue 8480).
+  does not (scipy issue 8480). :func:`jacobi_reduced_into` fills given arrays and
+  :func:`jacobi_reduced_arrays` is its numpy-allocating front for Python callers (a first
+  run then compiles no array allocation).
 * :func:`carlson_rf`, :func:`carlson_rj`, :func:`carlson_rc`: Carlson's duplication
   algorithm (Carlson 1995, Numer. Algorithms 10, 13; DLMF 19.16), compiled.
 * :func:`ellipk_agm`: the complete ``K(m)`` from ``m1`` by the arithmetic-geometric mean (A&S 17.6).
@@ -29,6 +31,8 @@ from scipy import special
 
 __all__ = [
     "jacobi_reduced",
+    "jacobi_reduced_into",
+    "jacobi_reduced_arrays",
     "sncndn_landen",
     "complete_pair",
     "carlson_rf",
@@ -46,7 +50,7 @@ _ERRTOL = 0.0008
 
 
 @njit(cache=True)
-def sncndn_landen(u, m, m1):
+def sncndn_landen(u, m, m1, ks, kps):
     """sn, cn, dn(u | m) by descending Landen transformations (A&S 16.12-16.13).
 
     Moduli are carried in pairs without cancellation, ``k_{n+1} = k_n^2 / (1 + k'_n)^2``
@@ -57,10 +61,9 @@ def sncndn_landen(u, m, m1):
     ``dn = sqrt(cn^2 + k'^2 sn^2)`` are ratios and sums of positive terms, and at
     each level the larger of ``sn, cn`` is recomputed from the smaller, so both
     keep their relative accuracy for ``u`` in ``[0, K/2]`` (unlike the AGM's
-    arcsine recursion, whose argument nears 1 when ``m -> 1``).
+    arcsine recursion, whose argument nears 1 when ``m -> 1``). ``ks``, ``kps``: scratch
+    arrays of 48 for the moduli, from the caller (which allocates them once for many calls).
     """
-    ks = np.empty(48)
-    kps = np.empty(48)
     k, kp = math.sqrt(m), math.sqrt(m1)
     v = u
     n = 0
@@ -100,13 +103,35 @@ def jacobi_reduced(u, m, m1, K):
 
     Returns ``sn_w, cn_w, dn_w`` at ``w in [0, K]``, the sign ``sgn`` of the
     reduced argument, whether ``w = 2K - |ur|`` (``refl``) and the period count
-    ``j`` (``u = ur + 4K j``). On ``[K/2, K]`` the quarter-period shift
-    ``sn(K - v) = cn v / dn v``, ``cn(K - v) = k' sn v / dn v``,
-    ``dn(K - v) = k' / dn v`` (A&S 16.8.2) keeps relative accuracy near ``K``.
+    ``j`` (``u = ur + 4K j``): the arrays :func:`jacobi_reduced_into` fills.
     """
     n = u.size
     sn_w, cn_w, dn_w = np.empty(n), np.empty(n), np.empty(n)
     sgn, refl, jj = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n)
+    jacobi_reduced_into(u, m, m1, K, sn_w, cn_w, dn_w, sgn, refl, jj, np.empty(48), np.empty(48))
+    return sn_w, cn_w, dn_w, sgn, refl, jj
+
+
+def jacobi_reduced_arrays(u, m, m1, K):
+    """:func:`jacobi_reduced` from Python: the arrays allocated by numpy, so that a first run
+    compiles only :func:`jacobi_reduced_into` and :func:`sncndn_landen` (no allocation)."""
+    n = u.size
+    sn_w, cn_w, dn_w = np.empty(n), np.empty(n), np.empty(n)
+    sgn, refl, jj = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n)
+    jacobi_reduced_into(np.ascontiguousarray(u, dtype=np.float64), float(m), float(m1), float(K), sn_w, cn_w,
+                        dn_w, sgn, refl, jj, np.empty(48), np.empty(48))
+    return sn_w, cn_w, dn_w, sgn, refl, jj
+
+
+@njit(cache=True)
+def jacobi_reduced_into(u, m, m1, K, sn_w, cn_w, dn_w, sgn, refl, jj, ks, kps):
+    """:func:`jacobi_reduced` into given arrays (``ks``, ``kps``: scratch of 48 for :func:`sncndn_landen`).
+
+    On ``[K/2, K]`` the quarter-period shift
+    ``sn(K - v) = cn v / dn v``, ``cn(K - v) = k' sn v / dn v``,
+    ``dn(K - v) = k' / dn v`` (A&S 16.8.2) keeps relative accuracy near ``K``.
+    """
+    n = u.size
     kp = math.sqrt(m1)
     period = 4.0 * K
     for i in range(n):
@@ -115,18 +140,19 @@ def jacobi_reduced(u, m, m1, K):
             ur -= period
         elif ur < -2.0 * K:
             ur += period
-        j = np.round((u[i] - ur) / period)
+        j = (u[i] - ur) / period  # a whole number up to rounding: round half to even, as np.round, whose
+        if abs(j) < 4503599627370496.0:  # compiled version costs a first run 0.3 s; from 2^52 on (and
+            j = float(round(j))  # inf, nan) j is its own rounding
         sgn[i] = 1.0 if ur >= 0.0 else -1.0
         v = abs(ur)
         refl[i] = v > K
         w = 2.0 * K - v if refl[i] else v
         if w <= 0.5 * K:
-            s, c, d = sncndn_landen(w, m, m1)
+            s, c, d = sncndn_landen(w, m, m1, ks, kps)
         else:
-            s1, c1, d1 = sncndn_landen(K - w, m, m1)
+            s1, c1, d1 = sncndn_landen(K - w, m, m1, ks, kps)
             s, c, d = c1 / d1, kp * s1 / d1, kp / d1
         sn_w[i], cn_w[i], dn_w[i], jj[i] = s, c, d, j
-    return sn_w, cn_w, dn_w, sgn, refl, jj
 
 
 @_jit

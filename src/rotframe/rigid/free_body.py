@@ -49,7 +49,7 @@ from rotframe.rigid.checks import (
     check_quaternion,
     symmetry_axis,
 )
-from rotframe.rigid.elliptic import incomplete_pi_arrays, jacobi_reduced
+from rotframe.rigid.elliptic import incomplete_pi_arrays, jacobi_reduced_arrays
 from rotframe.validation import check_vector3, guard_public
 
 __all__ = ["free_body_exact", "elliptic_period"]
@@ -308,7 +308,7 @@ def _jacobi_with_pi(u, fr):
         Pi = (u + root * np.arctan(root * sn)) / (1.0 - nu)
         return sn, cn, cn.copy(), np.arctan2(sn, cn), Pi
     K, Pic = fr["K"], fr["Pic"]
-    sn_w, cn_w, dn_w, sgn, refl, j = jacobi_reduced(u, fr["m"], fr["m1"], K)
+    sn_w, cn_w, dn_w, sgn, refl, j = jacobi_reduced_arrays(u, fr["m"], fr["m1"], K)
     G = incomplete_pi_arrays(sn_w, cn_w, dn_w, nu)
     sn = sgn * sn_w
     cn = np.where(refl, -cn_w, cn_w)

@@ -55,10 +55,10 @@ def _turn_about_axis(L, q, i, angle):
     corr = 0.5 * (before - after) / after if after > 0.0 else 0.0
     L[j] = nj + nj * corr
     L[k] = nk + nk * corr
-    r = np.zeros(4)
-    r[i] = math.sin(0.5 * angle)
-    r[3] = math.cos(0.5 * angle)
-    q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
+    s_half = math.sin(0.5 * angle)  # the quaternion (s_half e_i, cos(angle / 2)) as scalars (no array)
+    q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], s_half if i == 0 else 0.0,
+                                      s_half if i == 1 else 0.0, s_half if i == 2 else 0.0,
+                                      math.cos(0.5 * angle))
 
 
 @njit(cache=True)
@@ -69,17 +69,18 @@ def free_step(L, q, tau, inv_i, sym):
         norm_L = math.sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2])
         if norm_L > 0.0:  # |L|^2 / (2 Ip): rotation about L, L_body unchanged
             half = 0.5 * tau * norm_L * inv_p
-            r = np.empty(4)
-            r[:3] = math.sin(half) * L / norm_L
-            r[3] = math.cos(half)
-            q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], r[0], r[1], r[2], r[3])
+            s_half = math.sin(half)  # the quaternion (sin(half) L / |L|, cos(half)) as scalars (no array)
+            q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], s_half * L[0] / norm_L,
+                                              s_half * L[1] / norm_L, s_half * L[2] / norm_L, math.cos(half))
         _turn_about_axis(L, q, sym, tau * L[sym] * (inv_i[sym] - inv_p))
     else:
-        _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
-        _turn_about_axis(L, q, 1, 0.5 * tau * L[1] * inv_i[1])
-        _turn_about_axis(L, q, 2, tau * L[2] * inv_i[2])
-        _turn_about_axis(L, q, 1, 0.5 * tau * L[1] * inv_i[1])
-        _turn_about_axis(L, q, 0, 0.5 * tau * L[0] * inv_i[0])
+        # int(k), not the literal k: one compiled _turn_about_axis for every axis (a literal argument is a
+        # type of its own, compiled apart)
+        _turn_about_axis(L, q, int(0), 0.5 * tau * L[0] * inv_i[0])
+        _turn_about_axis(L, q, int(1), 0.5 * tau * L[1] * inv_i[1])
+        _turn_about_axis(L, q, int(2), tau * L[2] * inv_i[2])
+        _turn_about_axis(L, q, int(1), 0.5 * tau * L[1] * inv_i[1])
+        _turn_about_axis(L, q, int(0), 0.5 * tau * L[0] * inv_i[0])
 
 
 @_jit_nan
@@ -121,12 +122,34 @@ def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1
 
 
 @njit(cache=True)
-def _torque_body(q, mgl, torque_body, torque_space):
-    """:func:`body_torque` of the state's ``q`` as an array (3,)."""
+def _kick(L, q, c, mgl, torque_body, torque_space):
+    """``L += c N_body(q)`` (``c`` = half the step) with :func:`body_torque`, element by element.
+
+    Scalars, not the array expression ``L += c * N``: the same operations, without
+    numba's array machinery to compile on a first run.
+    """
     tb, ts = torque_body, torque_space
-    out = np.empty(3)
-    out[0], out[1], out[2] = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
-    return out
+    n0, n1, n2 = body_torque(q[0], q[1], q[2], q[3], mgl, tb[0], tb[1], tb[2], ts[0], ts[1], ts[2])
+    L[0] += c * n0
+    L[1] += c * n1
+    L[2] += c * n2
+
+
+@njit(cache=True)
+def _store_row(out_L, out_q, k, L, q):
+    """``out_L[k] = L``, ``out_q[k] = q`` element by element; whether all are finite.
+
+    An array assigned to a row would compile numba's shape-mismatch message (2.6 s
+    on a first run), and ``np.all(np.isfinite(...))`` numba's array ufunc machinery.
+    """
+    finite = True
+    for i in range(3):
+        out_L[k, i] = L[i]
+        finite = finite and math.isfinite(L[i])
+    for i in range(4):
+        out_q[k, i] = q[i]
+        finite = finite and math.isfinite(q[i])
+    return finite
 
 
 @njit(cache=True)
@@ -134,23 +157,27 @@ def split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, we
                sample_every, out_L, out_q):
     """Composition of Strang steps kick(tau/2) free(tau) kick(tau/2); returns samples kept."""
     L, q = L0.copy(), q0.copy()
-    kick = mgl != 0.0 or np.any(torque_body != 0.0) or np.any(torque_space != 0.0)
-    out_L[0], out_q[0] = L, q
-    kept = 1
+    tb, ts = torque_body, torque_space  # scalar tests: np.any of an array comparison compiles 0.3 s more
+    kick = (mgl != 0.0 or tb[0] != 0.0 or tb[1] != 0.0 or tb[2] != 0.0 or ts[0] != 0.0 or ts[1] != 0.0
+            or ts[2] != 0.0)
+    kept = int(0)  # int(), not a literal 0 or 1: one compiled _store_row for every row
+    _store_row(out_L, out_q, kept, L, q)
+    kept += 1
     for step in range(1, n_steps + 1):
         for w in weights:
             tau = w * h
             if kick:
-                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
+                _kick(L, q, 0.5 * tau, mgl, torque_body, torque_space)
             free_step(L, q, tau, inv_i, sym)
             if kick:
-                L += 0.5 * tau * _torque_body(q, mgl, torque_body, torque_space)
-        q /= math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+                _kick(L, q, 0.5 * tau, mgl, torque_body, torque_space)
+        norm_q = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        for i in range(4):
+            q[i] /= norm_q
         if step % sample_every == 0 or step == n_steps:
-            out_L[kept], out_q[kept] = L, q
+            if not _store_row(out_L, out_q, kept, L, q):
+                return kept
             kept += 1
-            if not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
-                return kept - 1
     return kept
 
 
@@ -170,18 +197,32 @@ def rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_ev
              out_q):
     """Classical RK4 on euler_rhs; returns samples kept."""
     y = np.empty(7)
-    y[:3], y[3:] = L0, q0
-    out_L[0], out_q[0] = L0, q0
-    kept = 1
+    for i in range(3):
+        y[i] = L0[i]
+    for i in range(4):
+        y[3 + i] = q0[i]
+    kept = int(0)  # int(), not a literal 0 or 1: one compiled _store_row for every row
+    _store_row(out_L, out_q, kept, L0, q0)
+    kept += 1
+    # the stage sums element by element (the operations of y + h/2 k1 ... y += h/6 (k1 + 2 k2 + 2 k3 + k4) in
+    # their order, without numba's array expressions to compile on a first run)
+    half, sixth = 0.5 * h, h / 6.0
+    tmp = np.empty(7)
     for step in range(1, n_steps + 1):
         k1 = euler_rhs(y, inv_i, mgl, torque_body, torque_space)
-        k2 = euler_rhs(y + 0.5 * h * k1, inv_i, mgl, torque_body, torque_space)
-        k3 = euler_rhs(y + 0.5 * h * k2, inv_i, mgl, torque_body, torque_space)
-        k4 = euler_rhs(y + h * k3, inv_i, mgl, torque_body, torque_space)
-        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for i in range(7):
+            tmp[i] = y[i] + half * k1[i]
+        k2 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            tmp[i] = y[i] + half * k2[i]
+        k3 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            tmp[i] = y[i] + h * k3[i]
+        k4 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
+        for i in range(7):
+            y[i] += sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
         if step % sample_every == 0 or step == n_steps:
-            out_L[kept], out_q[kept] = y[:3], y[3:]
+            if not _store_row(out_L, out_q, kept, y[:3], y[3:]):
+                return kept
             kept += 1
-            if not np.all(np.isfinite(y)):
-                return kept - 1
     return kept
