@@ -148,8 +148,10 @@ def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
         for q in range(13):
             s5 += E5[q] * K[q, j]
             s3 += E3[q] * K[q, j]
-        e5 += (s5 / sc) ** 2
-        e3 += (s3 / sc) ** 2
+        r5 = s5 / sc
+        r3 = s3 / sc
+        e5 += r5 * r5  # not ** 2: numba compiles an integer-power routine for that
+        e3 += r3 * r3
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * n)

@@ -17,7 +17,7 @@ import numpy as np
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.events import crossed, event_value, locate_event, locate_event_dop853, record_event, start_value
-from rotframe.particles.forces import derivative
+from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import advance, make_plan, method_steps
 from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
@@ -163,7 +163,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             h = h0
         is_alive = alive[p]
         w, wd = rates(t, m.steady, m.w, wt, wv)
-        f0 = derivative(as_state(y), m, w, wd)
+        ax, ay, az = state_acceleration(as_state(y), m, w, wd)
+        f0 = (y[3], y[4], y[5], ax, ay, az)
         nf = 1
         if events is not None:
             for e in range(n_ev):

@@ -20,7 +20,7 @@ import math
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
-__all__ = ["position_acceleration", "state_acceleration", "acceleration", "derivative", "air_density",
+__all__ = ["position_acceleration", "state_acceleration", "acceleration", "air_density",
            "drag_coefficients", "drag_flow", "string_normal"]
 
 
@@ -110,13 +110,6 @@ def acceleration(r, v, t, P, wt, wv, out):
     m = unpack(P, wt, wv)
     w, wd = rates(t, m.steady, m.w, wt, wv)
     out[0], out[1], out[2] = state_acceleration((r[0], r[1], r[2], v[0], v[1], v[2]), m, w, wd)
-
-
-@jit_internal
-def derivative(state, m, w, wd):
-    """Right-hand side (v, a) of the first-order system at ``state`` for the rates w, w', as a 6-tuple."""
-    ax, ay, az = state_acceleration(state, m, w, wd)
-    return state[3], state[4], state[5], ax, ay, az
 
 
 @jit_internal
