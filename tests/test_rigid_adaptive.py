@@ -116,12 +116,12 @@ def test_bad_torque_frame_is_refused():
 
 
 def test_dense_output_tables_are_those_scipy_ships():
-    # the dense-output stages and weights are typed out in rotframe.rigid.dense_output (so that a run
+    # the dense-output stages and weights are typed out in rotframe.numerics.dop853_dense (so that a run
     # does not import scipy.integrate); scipy's solve_ivp ships the same published dop853.f constants,
     # an independent transcription: equal to the last bit
     from scipy.integrate._ivp import dop853_coefficients as d
 
-    from rotframe.rigid.dense_output import dense_tables
+    from rotframe.numerics.dop853_dense import dense_tables
 
     A_extra, D = dense_tables()
     assert np.array_equal(A_extra, d.A[13:16]) and np.array_equal(D, d.D)

@@ -22,7 +22,7 @@ from __future__ import annotations
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["jit_kernel", "jit_internal", "CompiledOnlyDispatcher"]
+__all__ = ["jit_kernel", "jit_internal", "inlined", "CompiledOnlyDispatcher"]
 
 #: The decorator of every compiled kernel that reports failures as non-finite numbers.
 jit_kernel = njit(cache=True, error_model="numpy", nogil=True)
@@ -44,3 +44,11 @@ def jit_internal(func):
     dispatcher = _jit_without_entry_point(func)
     dispatcher.__class__ = CompiledOnlyDispatcher
     return dispatcher
+
+
+def inlined(kernel):
+    """A copy of compiled ``kernel`` that numba inlines into each caller (its IR, before typing).
+
+    For a kernel whose callers are few and large: a first run compiles one function less.
+    """
+    return njit(inline="always", error_model="numpy", nogil=True)(kernel.py_func)

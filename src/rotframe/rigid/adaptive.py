@@ -27,23 +27,21 @@ microseconds), so that the kernel a first run compiles is as small as it can be
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import jit_kernel
+from rotframe.numerics.compiled import inlined, jit_kernel
 
 import functools
 import math
 
 import numpy as np
-from numba import njit
-
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
-from rotframe.rigid.dense_output import dense_tables
+from rotframe.numerics.dop853_dense import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
 _jit = jit_kernel
 # the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
-_error_norm = njit(inline="always", error_model="numpy")(dop853_error_norm.py_func)
+_error_norm = inlined(dop853_error_norm)
 
 
 class RigidRun:
@@ -62,7 +60,7 @@ def _tableau():
     Rows 0..11 of ``A`` are the stages of :func:`rotframe.numerics.dop853.coefficients`,
     row 12 its order-8 weights ``B`` (so that "stage 12" of the stage loop forms
     ``y_new = y + h sum B_q k_q`` and ``f(y_new)``), rows 13..15 the dense-output
-    stages of :func:`rotframe.rigid.dense_output.dense_tables`.
+    stages of :func:`rotframe.numerics.dop853_dense.dense_tables`.
     """
     A12, B, _, E3, E5 = coefficients()
     A_extra, D = dense_tables()
