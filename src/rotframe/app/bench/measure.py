@@ -13,7 +13,7 @@ import time
 
 from rotframe.app.bench.problems import PREPARED
 
-__all__ = ["SCIPY_METHODS", "SCIPY_METHODS_QUICK", "PEER_RTOLS", "Plan", "timed", "planned_units", "run_problem"]
+__all__ = ["SCIPY_METHODS", "SCIPY_METHODS_QUICK", "PEER_RTOLS", "MIN_REPEAT_S", "Plan", "timed", "planned_units", "run_problem"]
 
 
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
@@ -23,16 +23,28 @@ SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
 PEER_RTOLS = tuple(10.0 ** -k for k in range(3, 14))
 
 
+#: A repeat of a short run calls it this many seconds' worth of times (timeit's autorange):
+#: one call of a 20-microsecond run is within the timer's and the scheduler's jitter.
+MIN_REPEAT_S = 0.02
+
+
 def timed(fn, budget=2.0, max_repeats=5):
-    """(median wall time, last result) over repeats that fit in ``budget`` seconds (at most ``max_repeats``)."""
-    times = []
-    result = None
-    while True:
+    """(median wall time of one call, last result) over repeats that fit in ``budget`` seconds.
+
+    At most ``max_repeats`` repeats. A run shorter than :data:`MIN_REPEAT_S` (judged from its
+    first call) is called ``k`` times a repeat, enough to fill that, and each repeat's time is
+    divided by ``k`` -- the same rule for rotframe and for every peer.
+    """
+    t0 = time.perf_counter()
+    result = fn()
+    first = time.perf_counter() - t0
+    k = 1 if first >= MIN_REPEAT_S else min(10_000, max(1, int(MIN_REPEAT_S / max(first, 1e-7))))
+    times = [] if k > 1 else [first]
+    while len(times) < max_repeats and sum(times) * k <= budget and not (len(times) >= 3 and sum(times) * k > budget / 4):
         t0 = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t0)
-        if len(times) >= max_repeats or sum(times) > budget or (len(times) >= 3 and sum(times) > budget / 4):
-            break
+        for _ in range(k):
+            result = fn()
+        times.append((time.perf_counter() - t0) / k)
     return statistics.median(times), result
 
 
