@@ -41,6 +41,8 @@ class PreparedRun:
     n : int
         Particles per call.
 
+    Notes
+    -----
     Calling ``run(r0, v0)`` returns ``(r, v)``, arrays (samples + 1, n, 3),
     owned by the caller (fresh each call); ``times`` holds the sample times and
     ``nfev`` the force evaluations of particle 0 in the last call.
