@@ -93,3 +93,29 @@ def test_a_kernel_for_compiled_code_only_refuses_a_python_call_instead_of_crashi
         with pytest.raises(TypeError, match="compiled code only"):
             kernel(1.0, 2.0, 3.0, None)
         assert callable(kernel.py_func)
+
+
+FAMILY = r'''
+import sys
+import numpy as np
+from rotframe.particles import kernels
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.ramp([0, 0, 1], 0.0, 0.5, 2.0),
+                      g=np.array([0.0, 0.0, -9.81]))
+traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 1.0, method=sys.argv[1], samples=3)
+assert np.all(np.isfinite(traj.r))
+print(len(kernels._free_steps.signatures), len(kernels._sphere_steps.signatures), len(kernels._rk4_steps.signatures))
+'''
+
+
+def test_a_free_particle_compiles_only_its_own_step_family(tmp_path):
+    # rk4 and sphere are passed as None where absent: the splitting of a free particle compiles no
+    # RK4 and no splitting on the sphere, RK4 no sphere
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    for method, want in (("rotation-splitting4", ["1", "0", "0"]), ("rk4", ["1", "0", "1"])):
+        res = subprocess.run([sys.executable, "-c", FAMILY, method], capture_output=True, text=True, env=env,
+                             timeout=600)
+        assert res.returncode == 0, res.stderr
+        assert res.stdout.split() == want, (method, res.stdout)

@@ -47,9 +47,15 @@ def _initial(model, n=3):
     return rng.normal(size=(n, 3)) + [0.0, 0.0, 50.0], rng.normal(size=(n, 3))
 
 
-def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samples=9, steady_as_none=False):
+def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samples=9, steady_as_none=False,
+               family_at_run_time=False):
     r, v = _initial(model)
     wt = None if steady_as_none else model.omega.times
+    pendulum = model.pendulum_length > 0
+    if family_at_run_time:  # booleans: every step kernel compiled, the choice made at run time
+        family = (method == 2, pendulum)
+    else:  # None where absent: pruned at compile time, as the drivers' callers pass them
+        family = (True if method == 2 else None, True if pendulum else None)
     n = r.shape[0]
     alive = np.ones(n, dtype=np.bool_)
     out_r = np.empty((n_samples, n, 3))
@@ -58,7 +64,7 @@ def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samp
                np.zeros((n, 4), np.int64), 4)
     result = run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
                                wt, model.omega.values, model.omega.cumulative(), events,
-                               out_r, out_v, *records)
+                               out_r, out_v, *records, *family)
     return result, out_r, out_v, r, v
 
 
@@ -85,6 +91,17 @@ def test_a_steady_schedule_passed_as_none_changes_nothing(name, method, events):
     model = _models()[name]
     table = None if events is None else np.array([[0.0, 2.0, 1e9, 0.0, 1.0]])
     for a, b in zip(_run_fixed(model, method, table), _run_fixed(model, method, table, steady_as_none=True)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+@pytest.mark.parametrize("name", list(_models()))
+@pytest.mark.parametrize("method", [0, 1, 2])
+@pytest.mark.parametrize("events", [None, "never"])
+def test_the_step_family_pruned_or_chosen_at_run_time_changes_nothing(name, method, events):
+    # rk4 / sphere passed as None (pruned at compile time) or as booleans read at run time
+    model = _models()[name]
+    table = None if events is None else np.array([[0.0, 2.0, 1e9, 0.0, 1.0]])
+    for a, b in zip(_run_fixed(model, method, table), _run_fixed(model, method, table, family_at_run_time=True)):
         assert np.array_equal(np.asarray(a), np.asarray(b))
 
 

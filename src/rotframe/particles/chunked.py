@@ -81,6 +81,9 @@ class KernelSetup:
         self.wt_arg = None if bool(np.all(self.wv == self.wv[0])) else self.wt
         self.events = tuple(events)
         self.ev_tab = event_table(self.events) if self.events else None
+        # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere
+        self.rk4 = True if info.kind == "fixed" and info.code == 2 else None
+        self.sphere = True if model.pendulum_length > 0 else None
         self.samples = samples
         self.duration = duration
         self.dt_sample = dt = duration / samples
@@ -139,7 +142,7 @@ class KernelSetup:
         if self.info.kind == "fixed":
             n_done, bad, nfev = drivers.run_fixed(
                 self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt_arg,
-                self.wv, self.wint, self.ev_tab, out_r, out_v, *self.event_records(evb))
+                self.wv, self.wint, self.ev_tab, out_r, out_v, *self.event_records(evb), self.rk4, self.sphere)
             return n_done, bad, nfev, self.sps * n_done
         A, B, C, E3, E5 = self.tableau
         return drivers.run_dop853(
@@ -192,7 +195,7 @@ class KernelSetup:
             n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
                                                 self.wt_arg, self.wv, self.wint, self.ev_tab,
                                                 out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
-                                                *self.event_records(evb))
+                                                *self.event_records(evb), self.rk4, self.sphere)
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0

@@ -27,7 +27,7 @@ __all__ = ["run_fixed", "run_dop853"]
 
 @jit_kernel
 def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
-              events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events):
+              events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, rk4, sphere):
     """Advance an ensemble with a fixed-step method and store samples.
 
     Parameters
@@ -51,6 +51,11 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         Filled with the state after each sample interval; a stopped particle
         keeps its state at the terminal event.
     ev_t, ev_r, ev_v, ev_count, ev_which : event records per particle (time, state, event index).
+    rk4, sphere : None or bool
+        Whether the method is RK4 (method 2) and the model a pendulum: None where it is
+        not, pruned at compile time (a free particle's splitting compiles neither RK4
+        nor the splitting on the sphere), else a boolean
+        (:func:`rotframe.particles.kernels.method_steps`).
 
     Returns
     -------
@@ -83,7 +88,8 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
             if is_alive:
                 if events is None:
                     # no event to watch: the whole sample interval in one call
-                    state = advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan)
+                    state = advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4,
+                                    sphere)
                     k_step += steps_per_sample
                     if p == 0:
                         nfev0 += nfev_step * steps_per_sample
@@ -92,7 +98,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         t = t0 + k_step * h
                         start = state
                         step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)
-                        state = method_steps(method, state, int(1), h, m, step_plan)  # int64, not a literal 1
+                        state = method_steps(method, state, int(1), h, m, step_plan, rk4, sphere)  # int64 1
                         if p == 0:
                             nfev0 += nfev_step
                         k_step += 1
@@ -100,7 +106,8 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         for e in range(n_ev):
                             g_new = event_value(events, e, state, m.radius)
                             if crossed(events[e, 3], g_old[e], g_new):
-                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint)
+                                tau, hit = locate_event(method, events, e, start, g_old[e], t, h, m, wt, wv, wint,
+                                                        rk4, sphere)
                                 record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + tau, hit)
                                 if events[e, 4] != 0.0:
                                     stop = True

@@ -115,13 +115,17 @@ def narrow(lo, hi, g_lo, mid, g_mid):
 
 
 @jit_internal
-def fixed_trial(method, start, t, tau, m, wt, wv, wint):
-    """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2)."""
-    return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint))  # int64 1
+def fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere):
+    """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2).
+
+    ``rk4``, ``sphere``: as in :func:`rotframe.particles.kernels.method_steps`.
+    """
+    return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint), rk4,
+                        sphere)  # int64 1
 
 
 @jit_internal
-def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint):
+def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, sphere):
     """Sub-step tau in (0, h] at which event ``e`` of the fixed-step map from ``start`` vanishes.
 
     Bisection on tau of g(:func:`fixed_trial` (start, tau)), halving until the
@@ -137,9 +141,9 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint):
         mid = bisection_midpoint(lo, hi)
         if mid < 0.0:
             break
-        g_mid = event_value(events, e, fixed_trial(method, start, t, mid, m, wt, wv, wint), m.radius)
+        g_mid = event_value(events, e, fixed_trial(method, start, t, mid, m, wt, wv, wint, rk4, sphere), m.radius)
         lo, hi, g_lo = narrow(lo, hi, g_lo, mid, g_mid)
-    return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint)
+    return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint, rk4, sphere)
 
 
 @jit_internal

@@ -282,33 +282,41 @@ def _rk4_steps(state, n, h, m, plan):
 
 
 @jit_internal
-def method_steps(method, state, n, h, m, plan):
+def method_steps(method, state, n, h, m, plan, rk4, sphere):
     """``n`` steps of size h of method 0 splitting, 1 splitting4 or 2 rk4, all with the same ``plan``.
 
     One step for a varying rate (the plan is the step's own); any number at a
-    steady rate, where every step has the same plan.
+    steady rate, where every step has the same plan. ``rk4`` (method 2) and
+    ``sphere`` (a pendulum, the splitting on the sphere) are None where the
+    caller knows they are false, which numba prunes at compile time (a free
+    particle's splitting compiles neither RK4 nor the sphere), or booleans
+    read at run time.
     """
-    if method == 2:
-        return _rk4_steps(state, n, h, m, plan)
-    if m.length > 0.0:
-        return _sphere_steps(state, n, method, h, m, plan)
+    if rk4 is not None:
+        if rk4:
+            return _rk4_steps(state, n, h, m, plan)
+    if sphere is not None:
+        if sphere:
+            return _sphere_steps(state, n, method, h, m, plan)
     return _free_steps(state, n, method, h, m, plan)
 
 
 @jit_internal
-def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
+def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan, rk4, sphere):
     """Steps k0 .. k0 + n - 1 of size h from t0 (step k starts at t0 + k h).
 
     ``plan`` is the :func:`make_plan` of every step when the rate is steady; a
     varying schedule is sampled here, once per step, so that the step
-    kernels take no array. ``wt = None`` is a steady schedule known at compile time.
+    kernels take no array. ``wt = None`` is a steady schedule known at compile time;
+    ``rk4`` and ``sphere`` as in :func:`method_steps`.
     """
     if wt is None:
-        return method_steps(method, state, n, h, m, plan)
+        return method_steps(method, state, n, h, m, plan, rk4, sphere)
     if m.steady:
-        return method_steps(method, state, n, h, m, plan)
+        return method_steps(method, state, n, h, m, plan, rk4, sphere)
     for k in range(k0, k0 + n):
-        state = method_steps(method, state, int(1), h, m, make_plan(method, t0 + k * h, h, m, wt, wv, wint))
+        state = method_steps(method, state, int(1), h, m, make_plan(method, t0 + k * h, h, m, wt, wv, wint), rk4,
+                             sphere)
     return state
 
 
@@ -316,7 +324,8 @@ def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan):
 def _step_in_place(method, r, v, t, h, P, wt, wv, wint):
     """One step [t, t + h] on the state arrays r, v (updated in place); returns the force evaluations."""
     m = unpack(P, wt, wv)
-    state = method_steps(method, (r[0], r[1], r[2], v[0], v[1], v[2]), 1, h, m, make_plan(method, t, h, m, wt, wv, wint))
+    state = method_steps(method, (r[0], r[1], r[2], v[0], v[1], v[2]), 1, h, m, make_plan(method, t, h, m, wt, wv, wint),
+                         method == 2, m.length > 0.0)
     r[0], r[1], r[2], v[0], v[1], v[2] = state
     return NFEV[method]
 
