@@ -80,3 +80,13 @@ def test_a_warm_foucault_run_imports_no_astropy():
                           "    assert main(['run', 'foucault', '--set', 'duration=40', '--no-record', '--json']) == 0")
     assert not {m for m in loaded if m.startswith("astropy")}, loaded
     assert "scipy.optimize" not in loaded
+
+
+def test_names_moved_out_of_local_frame_still_import_from_it():
+    # effective_gravity_enu and plumb_tilt moved to earth.gravity, enu_to_ecef and ecef_to_enu to
+    # earth.ecef (so that local_frame needs no astropy); the old imports give the same functions
+    from rotframe.earth import ecef, gravity
+    from rotframe.earth.local_frame import ecef_to_enu, effective_gravity_enu, enu_to_ecef, plumb_tilt
+
+    assert effective_gravity_enu is gravity.effective_gravity_enu and plumb_tilt is gravity.plumb_tilt
+    assert enu_to_ecef is ecef.enu_to_ecef and ecef_to_enu is ecef.ecef_to_enu

@@ -118,3 +118,17 @@ def ecef_to_enu_matrix(lat, lon) -> np.ndarray:
     north = np.stack([-sla * clo, -sla * slo, cla], axis=-1)
     up = np.stack([cla * clo, cla * slo, sla], axis=-1)
     return np.stack([east, north, up], axis=-2)
+
+
+#: Names that lived here before the split, and their modules now (old imports keep working).
+_MOVED = {"effective_gravity_enu": "rotframe.earth.gravity", "plumb_tilt": "rotframe.earth.gravity",
+          "enu_to_ecef": "rotframe.earth.ecef", "ecef_to_enu": "rotframe.earth.ecef"}
+
+
+def __getattr__(name):
+    """``rotframe.earth.local_frame.NAME`` for a name that moved, imported from its module on first use."""
+    if name in _MOVED:
+        import importlib
+
+        return getattr(importlib.import_module(_MOVED[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
