@@ -38,7 +38,8 @@ def table(rows) -> str:
                   "|---|---|---|---|"]
         by_name = {}
         for r in startup:
-            by_name.setdefault(r["method"].split()[2], {})["cold" if r["setting"].startswith("first") else "warm"] = r
+            name = r.get("run") or r["method"].split()[2]  # older JSON files have no "run"
+            by_name.setdefault(name, {})["cold" if r["setting"].startswith("first") else "warm"] = r
         for name, pair in by_name.items():
             cells = []
             for key in ("warm", "cold"):

@@ -78,7 +78,7 @@ class KernelSetup:
         self.wint = model.omega.cumulative()
         # what a run does not have is passed as None, which the compiled drivers prune at compile
         # time: a steady rate compiles no table reader, a run without events no event code
-        self.wt_arg = None if bool(np.all(self.wv == self.wv[0])) else self.wt
+        self.wt_arg = None if model.omega.is_constant else self.wt
         self.events = tuple(events)
         self.ev_tab = event_table(self.events) if self.events else None
         # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere

@@ -39,7 +39,6 @@ from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun"]
 
-_jit = jit_kernel
 # the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
 _error_norm = inlined(dop853_error_norm)
 
@@ -71,7 +70,7 @@ def _tableau():
     return A, E3, E5, D
 
 
-@_jit
+@jit_kernel
 def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q, y_new, tmp, F):
     """Take the steps from ``t`` (state ``y``, ``K[0] = f(y)``, first step ``h``) to ``times[-1]``.
 

@@ -12,7 +12,6 @@ import time
 
 import numpy as np
 
-from rotframe.app.bench.measure import timed
 
 __all__ = ["ensemble_rows", "same_work", "sweep_rows", "startup_rows", "record_rows"]
 
@@ -212,7 +211,17 @@ def _warm():
 STARTUP_GOALS = {"cold": 3.0, "warm": 1.0}
 
 
-def startup_rows(scenarios=None, progress=None):
+def _median_wall(cmd, repeats=1, env=None):
+    """Median wall time (s) of ``repeats`` runs of the command ``cmd`` in new processes."""
+    walls = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, env=env, capture_output=True, check=True)
+        walls.append(time.perf_counter() - t0)
+    return statistics.median(walls)
+
+
+def startup_rows(scenarios=None):
     """``rotframe run NAME --no-record`` in new processes, for every scenario: warm cache, then empty.
 
     ``import_s`` is the time of ``import rotframe.app.cli`` plus numpy, scipy and numba in a new
@@ -224,36 +233,21 @@ def startup_rows(scenarios=None, progress=None):
     from rotframe.scenes import SCENES
 
     names = list(scenarios or [n for n in SCENES if isinstance(SCENES[n], str)])
-    imp = [sys.executable, "-c", "import rotframe.app.cli, numpy, scipy, numba"]
-    imports = []
-    for _ in range(3):
-        t0 = time.perf_counter()
-        subprocess.run(imp, capture_output=True, check=True)
-        imports.append(time.perf_counter() - t0)
-    import_s = statistics.median(imports)
+    import_s = _median_wall([sys.executable, "-c", "import rotframe.app.cli, numpy, scipy, numba"], repeats=3)
     rows = []
-    for k, name in enumerate(names):
+    for name in names:
         cmd = [sys.executable, "-m", "rotframe", "run", name, "--no-record", "--json"]
-        subprocess.run(cmd, capture_output=True, check=True)  # fills the cache
-        walls = []
-        for _ in range(3):
-            t0 = time.perf_counter()
-            subprocess.run(cmd, capture_output=True, check=True)
-            walls.append(time.perf_counter() - t0)
-        warm = statistics.median(walls)
+        _median_wall(cmd)  # fills the cache
+        warm = _median_wall(cmd, repeats=3)
         with tempfile.TemporaryDirectory() as empty:
-            t0 = time.perf_counter()
-            subprocess.run(cmd, env=dict(os.environ, NUMBA_CACHE_DIR=empty), capture_output=True, check=True)
-            cold = time.perf_counter() - t0
+            cold = _median_wall(cmd, env=dict(os.environ, NUMBA_CACHE_DIR=empty))
         for setting, wall, goal, counted in (("warm compile cache", warm, STARTUP_GOALS["warm"], warm),
                                              ("first-ever run (empty compile cache)", cold, STARTUP_GOALS["cold"],
                                               cold - import_s)):
             rows.append({"scenario": "startup", "method": f"rotframe run {name} --no-record", "setting": setting,
-                         "wall_s": wall, "error": math.nan, "error_kind": "start-up", "nfev": 0,
+                         "run": name, "wall_s": wall, "error": math.nan, "error_kind": "start-up", "nfev": 0,
                          "import_s": import_s, "beyond_imports_s": wall - import_s, "goal_s": goal,
                          "goal_met": bool(counted <= goal)})
-        if progress is not None:
-            progress((k + 1) / len(names))
     return rows
 
 
