@@ -38,7 +38,8 @@ def test_prepared_equals_integrate_particles(method, kw, which, samples):
 
 def test_bad_method_and_duration_are_refused():
     model = next(_models())
-    with pytest.raises(ScenarioError, match="method"):
-        PreparedRun(model, "exact", 1.0)
+    pendulum = ParticleModel(("gravity", "pendulum"), g=np.array([0.0, 0.0, -9.81]), pendulum_length=1.0)
+    with pytest.raises(ScenarioError, match="method: 'exact'"):  # no exact flow: a nonlinear model
+        PreparedRun(pendulum, "exact", 1.0)
     with pytest.raises(ScenarioError, match="duration"):
         PreparedRun(model, "rk4", -1.0)

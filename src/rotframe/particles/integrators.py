@@ -71,7 +71,7 @@ METHODS = {
     "rotation-splitting4": MethodInfo("rotation-splitting4", 4, "fixed", "as rotation-splitting", 1),
     "rk4": MethodInfo("rk4", 4, "fixed", "nothing exactly", 2),
     "dop853": MethodInfo("dop853", 8, "adaptive", "nothing exactly; error per step below rtol"),
-    "exact": MethodInfo("exact", 0, "exact", "everything (exact solution of the linear model)"),
+    "exact": MethodInfo("exact", 0, "exact", "everything (the exact flow of a linear or force-free model)"),
 }
 
 #: Former names of particle methods, still accepted everywhere a particle method is named:
@@ -161,9 +161,10 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     samples = max(1, int(samples))
     _check_work(info, duration, step, samples, r0.shape[0])
     if info.kind == "exact":
-        if not model.is_linear:
+        if not model.has_exact_flow:
             why = "; ".join(model.nonlinear_reasons())
-            raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}); "
+            raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}) "
+                                "or a force-free one (only coriolis, centrifugal and euler); "
                                 "use rotation-splitting, rotation-splitting4, rk4 or dop853")
         return _integrate_exact(model, r0, v0, duration, samples, events, progress)
     setup = KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events)
@@ -171,6 +172,13 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
 
 
 # ---------------------------------------------------------------------------
+
+
+def exact_times(duration, samples):
+    """The sample times of method ``exact``: ``samples`` equal intervals, the last at ``duration`` exactly."""
+    times = np.arange(samples + 1) * (duration / samples)
+    times[-1] = duration
+    return times
 
 
 def _check_work(info, duration, step, samples, n):
@@ -184,41 +192,35 @@ def _check_work(info, duration, step, samples, n):
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
-    """Exact propagator: s(t) = expm(M t) s(0), s = (r, v, 1) (docs/physics/earth.md).
+    """The exact flow (:class:`rotframe.particles.linear.ExactFlow`): s(t_k) = Phi_k s(0), s = (r, v, 1).
 
-    expm is evaluated directly at every 64th sample and the samples between
-    are reached by powers of the one-interval propagator, so round-off stays
-    at a few tens of ulps however long the run. Events are located on the exact
-    flow for all particles at once (:func:`rotframe.particles.linear.locate_crossings`).
+    Events are located on the exact flow of a linear model for all particles at
+    once (:func:`rotframe.particles.linear.locate_crossings`).
     """
-    from scipy.linalg import expm
+    from rotframe.particles.linear import ExactFlow, locate_crossings
 
-    from rotframe.particles.linear import flow_matrix, locate_crossings
-
-    M = flow_matrix(model)
+    if events and not model.is_linear:
+        raise ScenarioError(f"event {events[0].name!r}: method 'exact' locates events on a linear model only "
+                            "(this one is force-free with a varying rate); use dop853")
     n = r0.shape[0]
     s0 = np.concatenate([r0, v0, np.ones((n, 1))], axis=1).T  # (7, N)
-    dt = duration / samples
-    times = np.arange(samples + 1) * dt
-    times[-1] = duration
-    block = 64
+    times = exact_times(duration, samples)
     out = np.empty((samples + 1, 7, n))
+    flow = None
     done = 0
+
+    def count(fraction):
+        nonlocal done
+        done = round(fraction * (samples + 1))
+        if progress is not None:
+            progress(fraction)
+
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             # an overflow (an unstable linear model run far) is caught below as a non-finite state
             warnings.simplefilter("ignore", RuntimeWarning)
-            powers = [np.eye(7)]
-            step_matrix = expm(M * dt)
-            for _ in range(block - 1):
-                powers.append(step_matrix @ powers[-1])
-            for start in range(0, samples + 1, block):
-                anchor = expm(M * times[start]) @ s0
-                for j in range(min(block, samples + 1 - start)):
-                    out[start + j] = powers[j] @ anchor
-                done = min(samples + 1, start + block)
-                if progress is not None:
-                    progress(min(1.0, (start + block) / (samples + 1)))
+            flow = ExactFlow(model, times)
+            flow.states(s0, out, count)
     except KeyboardInterrupt:
         partial = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)), np.transpose(out[:, 3:6, :], (0, 2, 1)),
                              "exact", 1, 0).truncated(max(done, 1)) if done else None
@@ -231,6 +233,8 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
         partial = traj.truncated(max(k, 1))
         raise IntegrationError(f"exact propagator produced a non-finite state at t = {times[k]:.6g} s",
                                t_reached=float(times[max(k - 1, 0)]), partial=partial)
+    M = flow.M if events else None
+    dt = duration / samples
     for ev in events:
         if ev.kind not in ("r", "v"):
             raise ScenarioError(f"event {ev.name!r}: kind {ev.kind!r} needs a nonlinear model, not 'exact'")

@@ -1,12 +1,22 @@
-"""The exact flow of linear particle models, s' = M s with s = (r, v, 1).
+"""The exact flow of particle models that have one: s(t_k) = Phi_k s(0), s = (r, v, 1).
 
-When a scene is linear with constant coefficients (uniform gravity, constant
-omega, linear drag, the small-angle spring), r'' = K r + C v + b, and the
-augmented state s = (r, v, 1) obeys s' = M s with the constant 7x7 matrix
-M = [[0, I, 0], [K, C, b], [0, 0, 0]] (docs/physics/earth.md, the exact linear flow). Then
-s(t) = expm(M t) s(0) exactly. This module holds M, a vectorised propagator
-for many states over many different times at once, and the location of event
-crossings on the exact flow, all particles and brackets in one call.
+Two kinds of model have an exact flow (docs/physics/earth.md, the exact flows):
+
+- **Linear with constant coefficients** (uniform gravity, constant omega, linear
+  drag, the small-angle spring): r'' = K r + C v + b, and the augmented state
+  s = (r, v, 1) obeys s' = M s with the constant 7x7 matrix
+  M = [[0, I, 0], [K, C, b], [0, 0, 0]]. Then s(t) = expm(M t) s(0) exactly.
+- **Force-free** (only the frame's own terms: Coriolis, centrifugal, and Euler's when
+  the rate varies), any rotation schedule about a fixed axis: the particle moves on a
+  straight line in inertial space, r_in(t) = r0 + t (v0 + w(0) x r0), seen from the
+  frame turned by the schedule's exact angle theta(t):
+  r(t) = R(n, -theta) r_in(t), v(t) = R(n, -theta) (v0 + w(0) x r0) - w(t) x r(t).
+
+Both are linear maps of s(0), so :class:`ExactFlow` holds the matrices Phi_k for a
+sample grid and applies them to any initial states (a prepared run applies them many
+times). This module also holds M, a vectorised propagator for many states over many
+different times at once, and the location of event crossings on the linear flow,
+all particles and brackets in one call.
 """
 
 from __future__ import annotations
@@ -15,7 +25,7 @@ import math
 
 import numpy as np
 
-__all__ = ["flow_matrix", "propagate", "locate_crossings"]
+__all__ = ["flow_matrix", "propagate", "locate_crossings", "turned_angle", "free_flow_matrices", "ExactFlow"]
 
 
 def flow_matrix(model) -> np.ndarray:
@@ -103,3 +113,128 @@ def locate_crossings(M, s_start, dt, g_lo, g_hi, column, value, t_start, max_ite
         bad = ~np.isfinite(newton) | (newton < lo) | (newton > hi)
         tau = np.where(converged, tau, np.where(bad, 0.5 * (lo + hi), newton))
     return tau, propagate(M, s_start, tau)
+
+
+def turned_angle(omega, t):
+    """Angle (rad) the frame has turned from t = 0 to each time ``t``, exact for the schedule (vectorised).
+
+    The schedule's rate is piecewise linear through its nodes and held outside them
+    (:class:`rotframe.particles.model.OmegaSchedule`), so the angle is piecewise
+    quadratic: the node integrals plus the part of the current segment.
+    """
+    t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+    wt, wv = omega.times, omega.values
+    wint = omega.cumulative()
+
+    def from_first_node(x):
+        if wt.size == 1:
+            return wv[0] * (x - wt[0])
+        k = np.clip(np.searchsorted(wt, x, side="right") - 1, 0, wt.size - 2)
+        before, after = x <= wt[0], x >= wt[-1]
+        dt = x - wt[k]
+        slope = (wv[k + 1] - wv[k]) / (wt[k + 1] - wt[k])
+        inside = wint[k] + wv[k] * dt + 0.5 * slope * dt * dt
+        return np.where(before, wv[0] * (x - wt[0]), np.where(after, wint[-1] + wv[-1] * (x - wt[-1]), inside))
+
+    return from_first_node(t) - from_first_node(np.zeros(1))
+
+
+def free_flow_matrices(model, times):
+    """Phi_k (K, 7, 7) of a force-free particle (see the module docstring) at ``times`` (K,), t = 0 the start.
+
+    Row blocks: position, velocity, the constant 1. With u0 = v0 + W0 r0 (W = [w x],
+    the inertial velocity), Q = R(n, -theta) and t the time: r = Q (r0 + t u0) and
+    v = Q u0 - W(t) r.
+    """
+    from rotframe.numerics.hat import skew
+
+    times = np.asarray(times, dtype=np.float64)
+    n = np.asarray(model.omega.axis, dtype=np.float64)
+    N = skew(n)
+    theta = turned_angle(model.omega, times)
+    c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
+    Q = c * np.eye(3) - s * N + (1.0 - c) * np.outer(n, n)  # Rodrigues, angle -theta
+    W0 = float(np.interp(0.0, model.omega.times, model.omega.values)) * N
+    Wt = np.interp(times, model.omega.times, model.omega.values)[:, None, None] * N
+    t = times[:, None, None]
+    top_r = Q + t * (Q @ W0)  # d r / d r0
+    top_v = t * Q  # d r / d v0
+    phi = np.zeros((times.size, 7, 7))
+    phi[:, 0:3, 0:3] = top_r
+    phi[:, 0:3, 3:6] = top_v
+    phi[:, 3:6, 0:3] = Q @ W0 - Wt @ top_r
+    phi[:, 3:6, 3:6] = Q - Wt @ top_v
+    phi[:, 6, 6] = 1.0
+    return phi
+
+
+class ExactFlow:
+    """The exact flow of a model over a uniform sample grid, applied to any initial states.
+
+    ``states(s0, out)`` writes s(t_k) = Phi_k s0 into ``out[k]`` (K, 7, N) for the
+    augmented initial states ``s0`` (7, N), block by block (64 samples), so that a
+    long run shows progress and can be interrupted. ``matrices()`` gives every
+    Phi_k, for a run that applies them many times (a prepared run).
+
+    Linear models: expm is evaluated directly at the first sample of every block
+    (the anchor) and the samples between are reached by powers of the one-interval
+    propagator, so round-off stays at a few tens of ulps however long the run.
+    Force-free models: :func:`free_flow_matrices`, exact at every sample.
+
+    Parameters
+    ----------
+    model : ParticleModel
+        ``model.is_linear`` or ``model.is_force_free``.
+    times : (K,) array
+        Sample times (s), uniform from 0.
+    """
+
+    BLOCK = 64
+
+    def __init__(self, model, times):
+        self.linear = bool(model.is_linear)
+        self.model = model
+        self.times = np.asarray(times, dtype=np.float64)
+        if self.linear:
+            from scipy.linalg import expm
+
+            self.M = flow_matrix(model)
+            self._expm = expm
+            dt = self.times[1] - self.times[0] if self.times.size > 1 else 0.0
+            powers = [np.eye(7)]
+            step_matrix = expm(self.M * dt)
+            for _ in range(self.BLOCK - 1):
+                powers.append(step_matrix @ powers[-1])
+            self.powers = powers
+
+    def _block(self, start):
+        """expm at the block's first sample (linear), or Phi_k of the block's samples (force-free)."""
+        if self.linear:
+            return self._expm(self.M * self.times[start])
+        return free_flow_matrices(self.model, self.times[start:start + self.BLOCK])
+
+    def states(self, s0, out, progress=None):
+        """Fill ``out`` (K, 7, N) with the states from ``s0`` (7, N); ``progress(fraction)`` after each block.
+
+        Returns the number of samples written (all of them unless interrupted).
+        """
+        K = self.times.size
+        done = 0
+        for start in range(0, K, self.BLOCK):
+            block = self._block(start)
+            if self.linear:
+                anchor = block @ s0
+                for j in range(min(self.BLOCK, K - start)):
+                    out[start + j] = self.powers[j] @ anchor
+            else:
+                out[start:start + block.shape[0]] = block @ s0
+            done = min(K, start + self.BLOCK)
+            if progress is not None:
+                progress(done / K)
+        return done
+
+    def matrices(self):
+        """Phi_k (K, 7, 7) for every sample: s(t_k) = Phi_k s(0) (for a run that applies them many times)."""
+        out = np.empty((self.times.size, 7, 7))
+        self.states(np.eye(7), out)
+        return out

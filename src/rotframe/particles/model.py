@@ -197,6 +197,23 @@ class ParticleModel:
         """
         return not self.nonlinear_reasons()
 
+    @property
+    def is_force_free(self) -> bool:
+        """True when no force acts in inertial space: the terms are just the frame's own.
+
+        That is Coriolis and centrifugal, and Euler's too when the rate varies (named or not
+        when it is steady, where it is zero), and nothing else. The particle then moves on a
+        straight inertial line, which :mod:`rotframe.particles.linear` gives exactly for any
+        rotation schedule.
+        """
+        frame = {"coriolis", "centrifugal"} if self.omega.is_constant else {"coriolis", "centrifugal", "euler"}
+        return set(self.terms) in (frame, frame | {"euler"})
+
+    @property
+    def has_exact_flow(self) -> bool:
+        """True when method ``exact`` applies: a linear model (:attr:`is_linear`) or a force-free one."""
+        return self.is_linear or self.is_force_free
+
     def nonlinear_reasons(self) -> list:
         """Why the model is not linear with constant coefficients (empty when it is).
 

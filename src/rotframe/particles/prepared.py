@@ -7,12 +7,17 @@ some 70 microseconds, more than the integration of a short run costs. A
 count (a :class:`rotframe.particles.chunked.KernelSetup`, the one set-up of
 ``integrate_particles`` too), and each call then only copies the initial state
 in and makes one call of the compiled driver with the same arguments, so the
-results are bitwise those of ``integrate_particles``. For optimisation loops,
+results are bitwise those of ``integrate_particles``. Method ``exact`` (a linear or
+force-free model) keeps the matrices of the exact flow for the sample grid, made
+once, and each call is one matrix product with the initial states: it agrees with
+``integrate_particles`` to round-off (the products are grouped differently). For optimisation loops,
 shooting, Monte Carlo over single particles and the bench. No events; a
 non-finite state raises ``IntegrationError``.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -26,8 +31,11 @@ class PreparedRun:
     ----------
     model : ParticleModel
     method : str
-        ``rotation-splitting``, ``rotation-splitting4``, ``rk4`` or ``dop853`` (or an alias,
-        :data:`rotframe.particles.integrators.ALIASES`).
+        ``rotation-splitting``, ``rotation-splitting4``, ``rk4``, ``dop853`` (or an alias,
+        :data:`rotframe.particles.integrators.ALIASES`), or ``exact`` for a model with an
+        exact flow (linear or force-free: ``ParticleModel.has_exact_flow``). ``exact``
+        makes the flow's matrices for the sample grid once, here; each call then only
+        multiplies them into the initial states.
     duration : float
         Simulated time (s), > 0.
     step : float, optional
@@ -55,25 +63,59 @@ class PreparedRun:
         from rotframe.particles.trajectory import EventBuffers
 
         method = canonical_method(method)
-        if METHODS[method].kind not in ("fixed", "adaptive"):
-            raise ScenarioError(f"method: {method!r}; allowed: rotation-splitting (splitting), "
-                                "rotation-splitting4 (splitting4), rk4, dop853")
         duration = float(duration)
         if not duration > 0:
             raise ScenarioError(f"duration: {duration} s; must be > 0")
         self.info = METHODS[method]
         self.samples = samples = max(1, int(samples))
         self.n = n = int(n)
+        self.nfev = 0
+        if self.info.kind == "exact":
+            from rotframe.particles.integrators import exact_times
+            from rotframe.particles.linear import ExactFlow
+
+            if not model.has_exact_flow:
+                raise ScenarioError(f"method: 'exact' needs a linear or force-free model "
+                                    f"({'; '.join(model.nonlinear_reasons())})")
+            self.times = exact_times(duration, samples)
+            with np.errstate(all="ignore"):  # an overflow (an unstable model run far) is caught per call
+                phi = ExactFlow(model, self.times).matrices()  # (K, 7, 7)
+            # out[k, p] = s0[p] @ phi[k]^T: one matrix product makes every sample's (r, v) at once
+            self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (0, 2, 1)))  # (K, 7, 6)
+            self.phi_finite = bool(np.isfinite(self.phi_t).all())  # else each product is made under errstate
+            self.s0 = np.ones((n, 7))
+            return
         self.setup = KernelSetup(model, self.info, duration, samples, step=step, rtol=rtol, atol=atol)
         self.times = self.setup.times
         self.alive = np.ones(n, dtype=np.bool_)
         self.evb = EventBuffers(n, 1)
         self.h_state = np.zeros(n)
-        self.nfev = 0
         self.run(np.zeros((n, 3)), np.zeros((n, 3)))  # load or compile the kernel now
+
+    def _run_exact(self, r0, v0):
+        """The exact flow's states: one product of the kept matrices with the initial states."""
+        s0 = self.s0
+        s0[:, 0:3] = r0
+        s0[:, 3:6] = v0
+        if self.phi_finite:
+            out = np.matmul(s0, self.phi_t)  # (K, n, 6)
+        else:
+            with np.errstate(all="ignore"):
+                out = np.matmul(s0, self.phi_t)
+        if not math.isfinite(float(np.add.reduce(out, axis=None))):  # one reduction: inf or nan anywhere
+            finite = np.all(np.isfinite(out), axis=(1, 2))
+            if not finite.all():
+                from rotframe.errors import IntegrationError
+
+                k = int(np.argmin(finite))
+                raise IntegrationError(f"exact propagator produced a non-finite state at t = {self.times[k]:.6g} s",
+                                       t_reached=float(self.times[max(k - 1, 0)]), partial=None)
+        return out[:, :, 0:3], out[:, :, 3:6]
 
     def run(self, r0, v0):
         """(r, v) samples (samples + 1, n, 3) from initial positions and velocities (n, 3) or (3,)."""
+        if self.info.kind == "exact":
+            return self._run_exact(r0, v0)
         n, samples = self.n, self.samples
         out_r = np.empty((samples + 1, n, 3))
         out_v = np.empty((samples + 1, n, 3))
