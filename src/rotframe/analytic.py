@@ -30,6 +30,7 @@ __all__ = [
     "drop_north_deflection_second_order",
     "drop_north_deflection_centrifugal_second_order",
     "linear_rotating_propagator",
+    "coriolis_uniform_gravity",
     "drop_exact_linear",
     "foucault_precession_rate",
     "pendulum_period",
@@ -215,6 +216,73 @@ def linear_rotating_propagator(
     s = expm(m[None, :, :] * flat[:, None, None]) @ s0
     s = s.reshape(t.shape + (7,))
     return s[..., 0:3], s[..., 3:6]
+
+
+def _sinc_like(theta):
+    """a = sin(x)/x, b = (1 - cos x)/x^2, c = (x - sin x)/x^3 at x = theta, without cancellation.
+
+    ``b`` as 2 sin^2(x/2)/x^2; ``c`` by its series sum_k (-1)^k x^(2k) / (2k + 3)! for |x| < 1
+    (ten terms: the next is below 1e-24), directly above.
+    """
+    x = float(theta)
+    if x == 0.0:
+        return 1.0, 0.5, 1.0 / 6.0
+    a = math.sin(x) / x
+    b = 2.0 * (math.sin(0.5 * x) / x) ** 2
+    if abs(x) < 1.0:
+        c, term = 0.0, 1.0 / 6.0
+        for k in range(10):
+            c += term
+            term *= -x * x / ((2 * k + 4) * (2 * k + 5))
+    else:
+        c = (x - math.sin(x)) / x**3
+    return a, b, c
+
+
+def coriolis_uniform_gravity(omega_vec, g_vec, r0, v0, t):
+    """Closed-form motion under uniform gravity and the Coriolis term alone, for any rotation rate.
+
+    Solves ``r'' = g - 2 w x v`` (constant ``w``, uniform ``g``; no centrifugal term:
+    ``g`` is the effective gravity). Along ``n = w / |w|`` the motion is uniformly
+    accelerated; across it the velocity turns about ``-n`` at 2|w| around the drift
+    ``-(n x g) / (2 |w|)``. With ``x = 2 |w| t``, ``v0p = v0 - (v0 . n) n``, ``gp = g - (g . n) n``
+    and the cancellation-free functions a = sin x / x, b = (1 - cos x) / x^2,
+    c = (x - sin x) / x^3 (so that the limit |w| -> 0 is regular):
+
+    ``r(t) = r0 + ((v0 . n) t + (g . n) t^2 / 2) n + v0p t a - 2 (w x v0) t^2 b + gp t^2 b - 2 (w x g) t^3 c``
+
+    ``v(t) = ((v0 . n) + (g . n) t) n + v0p cos x - 2 (w x v0) t a + gp t a - 2 (w x g) t^2 b``
+
+    For small |w| t, ``-2 (w x g) t^3 c -> -(w x g) t^3 / 3``, the classic eastward deflection
+    (:func:`drop_east_deflection_first_order`). An independent oracle for the exact linear
+    flow (no matrix exponential); docs/physics/earth.md.
+
+    Parameters
+    ----------
+    omega_vec, g_vec, r0, v0 : array_like, shape (3,)
+        Angular velocity (rad/s), gravity (m/s^2), initial position (m) and rotating-frame velocity (m/s).
+    t : float
+        Time (s).
+
+    Returns
+    -------
+    r, v : ndarray, shape (3,)
+    """
+    w = check_vector3(omega_vec, "omega_vec")
+    g = check_vector3(g_vec, "g_vec")
+    r0 = check_vector3(r0, "r0")
+    v0 = check_vector3(v0, "v0")
+    t = float(t)
+    rate = float(np.linalg.norm(w))
+    n = w / rate if rate > 0 else np.array([0.0, 0.0, 1.0])
+    a, b, c = _sinc_like(2.0 * rate * t)
+    v0_par, g_par = float(v0 @ n), float(g @ n)
+    v0p, gp = v0 - v0_par * n, g - g_par * n
+    wv, wg = np.cross(w, v0), np.cross(w, g)
+    r = (r0 + (v0_par * t + 0.5 * g_par * t * t) * n + v0p * t * a - 2.0 * wv * t * t * b + gp * t * t * b
+         - 2.0 * wg * t**3 * c)
+    v = (v0_par + g_par * t) * n + v0p * math.cos(2.0 * rate * t) - 2.0 * wv * t * a + gp * t * a - 2.0 * wg * t * t * b
+    return r, v
 
 
 def drop_exact_linear(height, latitude, g, rotation_rate) -> DropResult:

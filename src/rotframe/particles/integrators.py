@@ -27,10 +27,12 @@ Methods
     Use when the forces are not smooth in time or the step must adapt
     (drag, close approach), or as a tight reference.
 ``exact``
-    Matrix exponential of the augmented linear system (r, v, 1)
-    (docs/physics/earth.md, the exact linear flow). Exact to round-off; applies only when the model is
-    linear with constant coefficients (:attr:`ParticleModel.is_linear`), and is
-    then the default.
+    The exact flow, to round-off (docs/physics/earth.md, the exact linear flow and the exact
+    flow of a force-free particle): the matrix exponential of the augmented linear system
+    (r, v, 1) when the model is linear with constant coefficients
+    (:attr:`ParticleModel.is_linear`; then the default), or the inertial straight line
+    seen from the turning frame when the model is force-free under a varying rate
+    (:attr:`ParticleModel.is_force_free`; events are not located on that one).
 """
 
 from __future__ import annotations

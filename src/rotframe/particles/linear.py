@@ -1,6 +1,7 @@
 """The exact flow of particle models that have one: s(t_k) = Phi_k s(0), s = (r, v, 1).
 
-Two kinds of model have an exact flow (docs/physics/earth.md, the exact flows):
+Two kinds of model have an exact flow (docs/physics/earth.md, the exact linear flow and the
+exact flow of a force-free particle):
 
 - **Linear with constant coefficients** (uniform gravity, constant omega, linear
   drag, the small-angle spring): r'' = K r + C v + b, and the augmented state

@@ -80,8 +80,8 @@ class PreparedRun:
             self.times = exact_times(duration, samples)
             with np.errstate(all="ignore"):  # an overflow (an unstable model run far) is caught per call
                 phi = ExactFlow(model, self.times).matrices()  # (K, 7, 7)
-            # out[k, p] = s0[p] @ phi[k]^T: one matrix product makes every sample's (r, v) at once
-            self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (0, 2, 1)))  # (K, 7, 6)
+            # out[p, k] = s0[p] @ phi[k]^T: one matrix product makes every sample's (r, v) at once
+            self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (2, 0, 1)).reshape(7, -1))  # (7, K * 6)
             self.phi_finite = bool(np.isfinite(self.phi_t).all())  # else each product is made under errstate
             self.s0 = np.ones((n, 7))
             return
@@ -98,10 +98,11 @@ class PreparedRun:
         s0[:, 0:3] = r0
         s0[:, 3:6] = v0
         if self.phi_finite:
-            out = np.matmul(s0, self.phi_t)  # (K, n, 6)
+            out = np.dot(s0, self.phi_t)  # (n, K * 6)
         else:
             with np.errstate(all="ignore"):
-                out = np.matmul(s0, self.phi_t)
+                out = np.dot(s0, self.phi_t)
+        out = out.reshape(self.n, self.samples + 1, 6).transpose(1, 0, 2)  # (K, n, 6), a view
         if not math.isfinite(float(np.add.reduce(out, axis=None))):  # one reduction: inf or nan anywhere
             finite = np.all(np.isfinite(out), axis=(1, 2))
             if not finite.all():

@@ -31,8 +31,8 @@ def level_summary(rows, levels=LEVELS):
     """Summary rows: per (scenario, horizon) and error level, the fastest rotframe and peer runs and their ratio.
 
     A run counts for a level when its final error is at most the level. A
-    rotframe row with zero error counts only for the ``exact`` method (the
-    reference is that flow). ``ratio`` = peer time / rotframe time; ``note``
+    rotframe row with zero error counts only for an ``exact`` method, plain or
+    prepared (a reference that is that flow). ``ratio`` = peer time / rotframe time; ``note``
     says why a level has no ratio.
     """
     out = []
@@ -40,7 +40,7 @@ def level_summary(rows, levels=LEVELS):
     for scenario, horizon in keys:
         sel = [r for r in rows if (r["scenario"], r.get("horizon")) == (scenario, horizon)
                and r.get("kind") != "summary" and r["error"] is not None and np.isfinite(r["error"])]
-        mine = [r for r in sel if not is_peer(r) and (r["error"] > 0 or r["method"] == "exact")]
+        mine = [r for r in sel if not is_peer(r) and (r["error"] > 0 or r["method"].startswith("exact"))]
         theirs = [r for r in sel if is_peer(r)]
         ref_error = max((r.get("reference_error") or 0.0 for r in sel), default=0.0)
         for level in levels:
