@@ -19,8 +19,9 @@ __all__ = ["SCIPY_METHODS", "SCIPY_METHODS_QUICK", "PEER_RTOLS", "MIN_REPEAT_S",
 SCIPY_METHODS = ("RK45", "DOP853", "Radau", "LSODA")
 
 
-#: tolerances of the diffrax and scipy-numba peers
-PEER_RTOLS = tuple(10.0 ** -k for k in range(3, 14))
+#: tolerances of the strong peers (scipy + numba, diffrax): half decades from 1e-3 to 1e-13, as fine as
+#: rotframe's finest ladders, so that no level is lost to a coarse ladder
+PEER_RTOLS = (1e-3,) + tuple(float(f"{m}e-{k}") for k in range(4, 14) for m in (3, 1))
 
 
 #: A repeat of a short run calls it this many seconds' worth of times (timeit's autorange):

@@ -200,7 +200,8 @@ def _foucault(quick):
 
     steps = _ladder(quick, [5e-2, 2e-2, 1e-2, 5e-3, 2e-3], [1e-2])
     runs = _with_prepared({"rotation-splitting": steps, "rotation-splitting4": steps, "rk4": steps,
-                           "dop853": _ladder(quick, [1e-5, 1e-7, 1e-9, 1e-11, 1e-13], [1e-9])}, quick)
+                           "dop853": _ladder(quick, [1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-11, 1e-13],
+                                             [1e-9])}, quick)
     ref_kind = "rotation-splitting4, h = 2e-4 s" if not quick else "rotation-splitting4, h = 1e-3 s (quick)"
     return [Problem("foucault", f"{T / 3600:g} h, {T / 16.42:.0f} periods", T, np.concatenate([r0, v0]),
                     python_rhs(spec), lambda y: float(np.linalg.norm(y[:3] - y_ref[:3])),
