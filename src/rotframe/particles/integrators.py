@@ -103,9 +103,15 @@ def canonical_method(name: str) -> str:
     return name
 
 
-def default_method(model: ParticleModel) -> str:
-    """``exact`` for linear constant-coefficient models, else ``rotation-splitting``."""
-    return "exact" if model.is_linear else "rotation-splitting"
+def default_method(model: ParticleModel, events: Sequence[Event] = ()) -> str:
+    """``exact`` where the model has an exact flow, else ``rotation-splitting``.
+
+    The exact flow: a linear constant-coefficient model, or a force-free one without
+    events (events are located on the linear flow only).
+    """
+    if model.is_linear or (model.is_force_free and not events):
+        return "exact"
+    return "rotation-splitting"
 
 
 def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,
@@ -148,7 +154,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     RunInterrupted
         KeyboardInterrupt during the run; ``partial`` holds the samples before it.
     """
-    method = canonical_method(method or default_method(model))
+    method = canonical_method(method or default_method(model, events))
     info = METHODS[method]
     r0 = np.atleast_2d(np.asarray(r0, dtype=np.float64)).copy()
     v0 = np.atleast_2d(np.asarray(v0, dtype=np.float64)).copy()
