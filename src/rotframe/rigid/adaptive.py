@@ -37,7 +37,7 @@ from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.dop853_dense import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
-__all__ = ["rigid_dop853", "RigidRun"]
+__all__ = ["rigid_dop853", "RigidRun", "dop853_kernel"]
 
 # the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
 _error_norm = inlined(dop853_error_norm)
@@ -203,7 +203,7 @@ def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
     return min(100 * h, h1, h_max)
 
 
-def _run(y0, p, times, rtol, atol, h_max, out_L, out_q):
+def dop853_kernel(y0, p, times, rtol, atol, h_max, out_L, out_q):
     """Integrate from times[0] to times[-1]; samples at every entry of ``times``.
 
     ``p[:3]`` holds the moments of inertia on entry and their inverses after;
@@ -291,7 +291,7 @@ def rigid_dop853(inertia, L0_body, q0, times, *, rtol=1e-10, atol=None, mgl=0.0,
             raise ScenarioError(f"torque_frame: {torque_frame!r}; allowed: body, space")
     out_L = np.empty((times.size, 3))
     out_q = np.empty((times.size, 4))
-    done, nfev, steps = _run(y0, p, times, float(rtol), rtol if atol is None else float(atol), float(h_max),
+    done, nfev, steps = dop853_kernel(y0, p, times, float(rtol), rtol if atol is None else float(atol), float(h_max),
                              out_L, out_q)
     if done < 0:
         from rotframe.errors import ScenarioError
