@@ -178,22 +178,30 @@ def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
     Scalar arithmetic in the order of Hairer's code (float64 throughout, as in a
     compiled kernel). Returns the step ``h``.
     """
-    args = (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
-    K[0] = euler_rates(*y, *args)
+    # Python floats: the same IEEE double operations as float64 scalars, several times faster
+    args = p.tolist()
+    y = y.tolist()
+    f0 = euler_rates(*y, *args)
+    K[0] = f0
     d0 = d1 = 0.0
     sc = [(atol_L if j < 3 else atol_q) + rtol * abs(y[j]) for j in range(7)]
+    if min(sc) == 0.0:  # atol = 0 and a zero component: float64 scalars, whose x / 0 is inf or nan, not an error
+        y, sc = [np.float64(v) for v in y], [np.float64(v) for v in sc]
     for j in range(7):
-        a, b = y[j] / sc[j], K[0, j] / sc[j]
+        a, b = y[j] / sc[j], f0[j] / sc[j]
         d0 += a * a
         d1 += b * b
     d0 = math.sqrt(d0 / 7)
     d1 = math.sqrt(d1 / 7)
     h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h = min(h, abs(t_span))
-    K[1] = euler_rates(*(y[j] + h * K[0, j] for j in range(7)), *args)
+    f1 = euler_rates(*(y[j] + h * f0[j] for j in range(7)), *args)
+    K[1] = f1
+    if h == 0.0:  # a run of one sample: no step (min(100 h, h1, h_max) below is 0 whatever h1 is)
+        return 0.0
     d2 = 0.0
     for j in range(7):
-        c = (K[1, j] - K[0, j]) / sc[j]
+        c = (f1[j] - f0[j]) / sc[j]
         d2 += c * c
     d2 = math.sqrt(d2 / 7) / h
     if d1 <= 1e-15 and d2 <= 1e-15:
@@ -232,8 +240,8 @@ def dop853_kernel(y0, p, times, rtol, atol, h_max, out_L, out_q):
     out_L[0] = y[:3]
     out_q[0] = y[3:] / n
     K = np.empty((16, 7))
-    with np.errstate(all="ignore"):  # a run of one sample has h = 0 and d2 = 0 / 0, as in a compiled kernel
-        h = _first_step(y, K, p, times[n_out - 1] - times[0], atol_L, atol, rtol, h_max)
+    with np.errstate(all="ignore"):  # x / 0 with float64 scalars is inf or nan, as in a compiled kernel
+        h = _first_step(y, K, p, float(times[n_out - 1] - times[0]), float(atol_L), atol, rtol, h_max)
     A, E3, E5, D = _tableau()
     done, nfev, steps = _steps(y, K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q,
                                np.empty(7), np.empty(7), np.empty((7, 7)))
