@@ -95,6 +95,7 @@ class PreparedBodyRun:
         from rotframe.rigid import dynamics as rigid
         from rotframe.rigid.checks import check_inertia, heavy_top_mgl, symmetry_axis
         from rotframe.rigid.drivers import composition_weights, splitting_stepper
+        from rotframe.rigid.kernels import split_run
 
         samples = self.samples
         step = float(step or duration / samples / 20)
@@ -120,6 +121,7 @@ class PreparedBodyRun:
             sym = symmetry_axis(moments)
             self._consts = (inv_i, -1 if sym is None else sym, 0.0, zero, zero)
         self._weights = composition_weights(k)
+        self._split = split_run
         self._stepper = splitting_stepper(*self._consts, k)
         # integrate_body's chunks (samples per kernel call); one call when the run fits in one
         self._chunk = max(1, int(2e6 // sps))
@@ -135,10 +137,15 @@ class PreparedBodyRun:
         mgl = 0.0 if mgl is None else float(mgl)
         if not math.isfinite(mgl):
             raise ScenarioError(f"mgl: {mgl!r} N m; must be finite")
+        from rotframe.rigid.adaptive import dop853_from
+
         self.rtol = rtol
+        self._kernel = dop853_from
         self._p = np.zeros(10)
         self._p[:3] = inertia
         self._p[3] = mgl
+        for i in range(3):  # the inverse moments, as dop853_kernel computes them
+            self._p[i] = 1.0 / self._p[i]
         self._steps_estimate = 0.0
 
     def _state(self, L0, q0):
@@ -160,13 +167,11 @@ class PreparedBodyRun:
     __call__ = run
 
     def _run_fixed(self, L0, q0):
-        from rotframe.rigid.kernels import split_run
-
         samples, sps, h = self.samples, self.sps, self.h
         if self._one_call:
             out_L = np.empty((samples + 1, 3))
             out_q = np.empty((samples + 1, 4))
-            kept = split_run(*self._consts, L0, q0 / np.linalg.norm(q0), h, samples * sps, self._weights, sps,
+            kept = self._split(*self._consts, L0, q0 / np.linalg.norm(q0), h, samples * sps, self._weights, sps,
                              out_L, out_q)
             out_q[0] = q0
             self.steps = samples * sps
@@ -204,8 +209,6 @@ class PreparedBodyRun:
                                t_reached=t, partial=None)
 
     def _run_adaptive(self, L0, q0):
-        from rotframe.rigid.adaptive import dop853_kernel
-
         times = self.times
         y0 = np.empty(7)
         y0[:3] = L0
@@ -213,7 +216,7 @@ class PreparedBodyRun:
         out_L = np.empty((times.size, 3))
         out_q = np.empty((times.size, 4))
         rtol = self.rtol
-        done, self.nfev, self.steps = dop853_kernel(y0, self._p.copy(), times, rtol, rtol, math.inf, out_L, out_q)
+        done, self.nfev, self.steps = self._kernel(y0, self._p, times, rtol, rtol, math.inf, out_L, out_q)
         if done < times.size:
             good = max(done, 1)
             t = float(times[good - 1])
