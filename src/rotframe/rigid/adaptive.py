@@ -37,7 +37,7 @@ from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.dop853_dense import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
-__all__ = ["rigid_dop853", "RigidRun"]
+__all__ = ["rigid_dop853", "RigidRun", "dop853_kernel", "dop853_from"]
 
 # the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
 _error_norm = inlined(dop853_error_norm)
@@ -178,22 +178,26 @@ def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
     Scalar arithmetic in the order of Hairer's code (float64 throughout, as in a
     compiled kernel). Returns the step ``h``.
     """
-    args = (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
-    K[0] = euler_rates(*y, *args)
+    args = p.tolist()
+    f0 = euler_rates(*y, *args)
+    K[0] = f0
     d0 = d1 = 0.0
     sc = [(atol_L if j < 3 else atol_q) + rtol * abs(y[j]) for j in range(7)]
     for j in range(7):
-        a, b = y[j] / sc[j], K[0, j] / sc[j]
+        a, b = y[j] / sc[j], f0[j] / sc[j]
         d0 += a * a
         d1 += b * b
     d0 = math.sqrt(d0 / 7)
     d1 = math.sqrt(d1 / 7)
     h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h = min(h, abs(t_span))
-    K[1] = euler_rates(*(y[j] + h * K[0, j] for j in range(7)), *args)
+    f1 = euler_rates(*(y[j] + h * f0[j] for j in range(7)), *args)
+    K[1] = f1
+    if h == 0.0:  # a run of one sample: no step (min(100 h, h1, h_max) below is 0 whatever h1 is)
+        return 0.0
     d2 = 0.0
     for j in range(7):
-        c = (K[1, j] - K[0, j]) / sc[j]
+        c = (f1[j] - f0[j]) / sc[j]
         d2 += c * c
     d2 = math.sqrt(d2 / 7) / h
     if d1 <= 1e-15 and d2 <= 1e-15:
@@ -203,15 +207,14 @@ def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
     return min(100 * h, h1, h_max)
 
 
-def _run(y0, p, times, rtol, atol, h_max, out_L, out_q):
+def dop853_kernel(y0, p, times, rtol, atol, h_max, out_L, out_q):
     """Integrate from times[0] to times[-1]; samples at every entry of ``times``.
 
     ``p[:3]`` holds the moments of inertia on entry and their inverses after;
     ``y0[3:]`` is normalised in place. Returns (samples done, nfev, accepted
     steps); samples done < len(times) when the step size collapsed or the
-    state became non-finite, -1 for invalid input. The checks, the first step and
-    sample 0 in Python (float64 scalars, the operations of Hairer's code), the steps in
-    :func:`_steps`.
+    state became non-finite, -1 for invalid input. The checks here, the rest
+    in :func:`dop853_from`.
     """
     n_out = times.shape[0]
     if n_out < 1 or times.ndim != 1 or not np.all(times[1:] > times[:-1]):
@@ -220,23 +223,40 @@ def _run(y0, p, times, rtol, atol, h_max, out_L, out_q):
         if not p[i] > 0.0:
             return -1, 0, 0
         p[i] = 1.0 / p[i]
-    nq = math.sqrt(y0[3] * y0[3] + y0[4] * y0[4] + y0[5] * y0[5] + y0[6] * y0[6])
+    return dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q)
+
+
+def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
+    """:func:`dop853_kernel` after its checks: ``times`` increasing, ``p[:3]`` the inverse moments (not changed).
+
+    ``y0[3:]`` is normalised in place. Sample 0 and the first step in Python
+    (Python floats: the same IEEE double operations as float64 scalars, in the
+    order of Hairer's code), the steps in :func:`_steps`. For callers that check
+    once and run many times (:class:`rotframe.rigid.prepared.PreparedBodyRun`).
+    """
+    n_out = times.shape[0]
+    y = y0.tolist()
+    nq = math.sqrt(y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
     if not nq > 0.0:
         return -1, 0, 0
     for i in range(3, 7):
-        y0[i] /= nq
-    atol_L = atol * max(math.sqrt(y0[0] * y0[0] + y0[1] * y0[1] + y0[2] * y0[2]), 1e-300)
+        y[i] /= nq
+    y0[3:] = y[3:]
+    atol_L = atol * max(math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]), 1e-300)
     atol_vec = np.array([atol_L] * 3 + [atol] * 4)
-    y = y0.copy()
     n = math.sqrt(y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
     out_L[0] = y[:3]
-    out_q[0] = y[3:] / n
+    out_q[0] = [v / n for v in y[3:]]
     K = np.empty((16, 7))
-    with np.errstate(all="ignore"):  # a run of one sample has h = 0 and d2 = 0 / 0, as in a compiled kernel
-        h = _first_step(y, K, p, times[n_out - 1] - times[0], atol_L, atol, rtol, h_max)
+    t_span = float(times[n_out - 1] - times[0])
+    try:
+        h = _first_step(y, K, p, t_span, atol_L, atol, rtol, h_max)
+    except ZeroDivisionError:  # atol = 0 or a non-finite rate: float64 scalars, whose x / 0 is inf or nan
+        with np.errstate(all="ignore"):
+            h = _first_step([np.float64(v) for v in y], K, p, t_span, np.float64(atol_L), atol, rtol, h_max)
     A, E3, E5, D = _tableau()
-    done, nfev, steps = _steps(y, K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q,
-                               np.empty(7), np.empty(7), np.empty((7, 7)))
+    done, nfev, steps = _steps(np.array(y), K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D,
+                               out_L, out_q, np.empty(7), np.empty(7), np.empty((7, 7)))
     return done, nfev + 2, steps
 
 
@@ -291,7 +311,7 @@ def rigid_dop853(inertia, L0_body, q0, times, *, rtol=1e-10, atol=None, mgl=0.0,
             raise ScenarioError(f"torque_frame: {torque_frame!r}; allowed: body, space")
     out_L = np.empty((times.size, 3))
     out_q = np.empty((times.size, 4))
-    done, nfev, steps = _run(y0, p, times, float(rtol), rtol if atol is None else float(atol), float(h_max),
+    done, nfev, steps = dop853_kernel(y0, p, times, float(rtol), rtol if atol is None else float(atol), float(h_max),
                              out_L, out_q)
     if done < 0:
         from rotframe.errors import ScenarioError

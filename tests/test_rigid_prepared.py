@@ -1,0 +1,112 @@
+"""rotframe.rigid.prepared.PreparedBodyRun: bitwise the plain paths, checks once, per-call state checks.
+
+The oracle here is the plain public path with the same settings (``integrate_body`` for the
+fixed-step methods, ``rigid_dop853`` for dop853): a prepared run promises the same IEEE
+operations in the same order, so the comparison is exact (``np.array_equal``), no tolerance.
+The physics of those plain paths is proven by their own tests (closed forms, DOP853 in scipy).
+"""
+
+import numpy as np
+import pytest
+
+from rotframe.errors import IntegrationError, RotframeError, ScenarioError
+from rotframe.rigid.adaptive import rigid_dop853
+from rotframe.rigid.prepared import FIXED_METHODS, PreparedBodyRun
+from rotframe.scenes.rigid_base import integrate_body
+
+TOP_INERTIA = np.array([1.0, 1.0, 2.0])
+ASYM_INERTIA = np.array([1.0, 2.0, 3.0])
+TOP = (1.0, 0.5, 9.81)
+Q0 = np.array([0.1, 0.0, 0.0, 1.0])  # not normalised: the runs normalise it, row 0 keeps it as given
+
+
+@pytest.mark.parametrize("method", FIXED_METHODS)
+@pytest.mark.parametrize("top", [None, TOP])
+@pytest.mark.parametrize("samples", [1, 7])
+def test_fixed_step_bitwise_integrate_body(method, top, samples):
+    inertia = TOP_INERTIA if top is not None else ASYM_INERTIA
+    prep = PreparedBodyRun(inertia, method, 2.0, step=0.013, samples=samples, top=top)
+    for omega in ([0.3, 0.1, 5.0], [1.0, -0.2, 0.4]):  # two calls: nothing of the first leaks into the second
+        L0 = inertia * np.array(omega)
+        L, q = prep.run(L0, Q0)
+        ref = integrate_body(method, inertia, L0, Q0, 2.0, {"samples": samples, "step": 0.013}, None, top=top)
+        assert np.array_equal(L, ref.L) and np.array_equal(q, ref.q)
+        assert prep.steps == ref.steps
+        np.testing.assert_array_equal(prep.times, ref.times)
+
+
+def test_fixed_step_in_chunks_bitwise():
+    # 3e6 steps a sample > one kernel call of 2e6: integrate_body's pieces, taken the same way
+    prep = PreparedBodyRun(ASYM_INERTIA, "lie-poisson", 2.0, step=2.0 / 3e6 / 2, samples=2)
+    L0 = ASYM_INERTIA * np.array([0.01, 1.0, 0.01])
+    L, q = prep.run(L0, Q0)
+    ref = integrate_body("lie-poisson", ASYM_INERTIA, L0, Q0, 2.0, {"samples": 2, "step": 2.0 / 3e6 / 2}, None)
+    assert np.array_equal(L, ref.L) and np.array_equal(q, ref.q)
+
+
+@pytest.mark.parametrize("top", [None, TOP])
+@pytest.mark.parametrize("samples", [1, 9])
+@pytest.mark.parametrize("rtol", [1e-3, 3e-9])
+def test_dop853_bitwise_rigid_dop853(top, samples, rtol):
+    inertia = TOP_INERTIA if top is not None else ASYM_INERTIA
+    mgl = 0.0 if top is None else top[0] * top[1] * top[2]
+    prep = PreparedBodyRun(inertia, "dop853", 2.0, rtol=rtol, samples=samples, top=top)
+    for omega in ([0.3, 0.1, 5.0], [0.01, 1.0, 0.01]):
+        L0 = inertia * np.array(omega)
+        L, q = prep.run(L0, Q0)
+        ref = rigid_dop853(inertia, L0, Q0, np.linspace(0.0, 2.0, samples + 1), rtol=rtol, mgl=mgl)
+        assert np.array_equal(L, ref.L) and np.array_equal(q, ref.q)
+        assert (prep.nfev, prep.steps) == (ref.nfev, ref.steps)
+
+
+def test_dop853_mgl_keyword_equals_top():
+    a = PreparedBodyRun(TOP_INERTIA, "dop853", 1.0, rtol=1e-8, samples=3, top=TOP)
+    b = PreparedBodyRun(TOP_INERTIA, "dop853", 1.0, rtol=1e-8, samples=3, mgl=TOP[0] * TOP[1] * TOP[2])
+    L0 = TOP_INERTIA * np.array([0.3, 0.1, 5.0])
+    for x, y in zip(a.run(L0, Q0), b.run(L0, Q0)):
+        assert np.array_equal(x, y)
+
+
+def test_results_are_fresh_arrays():
+    prep = PreparedBodyRun(TOP_INERTIA, "top-splitting4", 1.0, step=0.01, samples=2, top=TOP)
+    L0 = TOP_INERTIA * np.array([0.3, 0.1, 5.0])
+    L1, _ = prep.run(L0, Q0)
+    keep = L1.copy()
+    prep.run(2 * L0, Q0)
+    assert np.array_equal(L1, keep)
+
+
+@pytest.mark.parametrize("method", ["top-splitting4", "dop853"])
+@pytest.mark.parametrize("L0, q0, key", [
+    ([1.0, np.nan, 0.0], Q0, "L0"),
+    ([1.0, 2.0], Q0, "L0"),
+    ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 0.0], "q0"),
+    ([1.0, 2.0, 3.0], [0.0, 0.0, np.inf, 1.0], "q0"),
+    ([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], "q0"),
+])
+def test_bad_state_is_one_line_scenario_error(method, L0, q0, key):
+    prep = PreparedBodyRun(TOP_INERTIA, method, 1.0, step=0.01, samples=1, top=TOP)
+    with pytest.raises(ScenarioError) as exc:
+        prep.run(L0, q0)
+    msg = str(exc.value)
+    assert msg.startswith(f"{key}:") and "\n" not in msg
+
+
+@pytest.mark.parametrize("kwargs, key", [
+    (dict(method="euler"), "method"),
+    (dict(duration=-1.0), "duration"),
+    (dict(duration=float("nan")), "duration"),
+    (dict(method="dop853", rtol=2.0), "rtol"),
+    (dict(method="dop853", inertia=[1.0, 0.0, 2.0]), "inertia"),
+])
+def test_bad_setup_is_scenario_error(kwargs, key):
+    args = dict(inertia=TOP_INERTIA, method="top-splitting", duration=1.0)
+    args.update(kwargs)
+    with pytest.raises(ScenarioError, match=key):
+        PreparedBodyRun(args.pop("inertia"), args.pop("method"), args.pop("duration"), **args)
+
+
+def test_bad_body_refused_by_the_plain_checks():
+    # a negative moment: the public function's own check (InvalidBodyError, a RotframeError: exit 2), once at set-up
+    with pytest.raises(RotframeError, match="-1.0"):
+        PreparedBodyRun([1.0, -1.0, 2.0], "lie-poisson", 1.0)
