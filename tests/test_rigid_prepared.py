@@ -110,3 +110,28 @@ def test_bad_body_refused_by_the_plain_checks():
     # a negative moment: the public function's own check (InvalidBodyError, a RotframeError: exit 2), once at set-up
     with pytest.raises(RotframeError, match="-1.0"):
         PreparedBodyRun([1.0, -1.0, 2.0], "lie-poisson", 1.0)
+
+
+def test_a_huge_momentum_is_refused_by_the_limits_not_run_for_ever():
+    """|L| = 1e300 would take ~1e300 dop853 steps: both paths refuse it (LimitError, exit 2 on the
+    command line) before integrating; the estimate gives inf rather than an OverflowError."""
+    from rotframe.limits import LimitError
+
+    L0, q0 = np.array([1e300, 2e300, 1e300]), np.array([1.0, 0.0, 0.0, 0.0])
+    with pytest.raises(LimitError, match="integration steps"):
+        integrate_body("dop853", ASYM_INERTIA, L0, q0, 10.0, {"samples": 5, "rtol": 1e-6}, None)
+    run = PreparedBodyRun(ASYM_INERTIA, "dop853", 10.0, samples=5, rtol=1e-6)
+    with pytest.raises(LimitError, match="integration steps"):
+        run(L0, q0)
+    L, _ = run(np.array([1.0, 2.0, 1.0]), q0)  # the same prepared run still takes a sane state
+    assert np.isfinite(L).all()
+
+
+@pytest.mark.parametrize("method", ["lie-poisson", "top-splitting4"])
+def test_a_non_finite_state_raises_integration_error(method):
+    """A momentum of 1e300 overflows within the first step of a splitting: an error, never inf returned."""
+    top = TOP if method.startswith("top") else None
+    inertia = TOP_INERTIA if top else ASYM_INERTIA
+    run = PreparedBodyRun(inertia, method, 10.0, samples=5, step=0.5, top=top)
+    with pytest.raises(IntegrationError, match="non-finite"):
+        run(np.array([1e300, 2e300, 1e300]), np.array([1.0, 0.0, 0.0, 0.0]))

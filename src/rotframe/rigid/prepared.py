@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.rigid.adaptive import steps_estimate
 
 __all__ = ["PreparedBodyRun", "FIXED_METHODS"]
 
@@ -137,8 +138,10 @@ class PreparedBodyRun:
         mgl = 0.0 if mgl is None else float(mgl)
         if not math.isfinite(mgl):
             raise ScenarioError(f"mgl: {mgl!r} N m; must be finite")
+        from rotframe import limits
         from rotframe.rigid.adaptive import dop853_from
 
+        self._max_steps = limits.current().max_steps  # read once: the limits in force at set-up
         self.rtol = rtol
         self._kernel = dop853_from
         self._p = np.zeros(10)
@@ -210,6 +213,12 @@ class PreparedBodyRun:
 
     def _run_adaptive(self, L0, q0):
         times = self.times
+        # the run's size depends on the state: refuse, as rigid_dop853's callers do, a run past the limits
+        steps = steps_estimate(self.inertia, L0, float(times[-1]), self.rtol, self._p[3])
+        if not steps <= self._max_steps:
+            from rotframe import limits
+
+            limits.check_run(steps=steps, what="method dop853")
         y0 = np.empty(7)
         y0[:3] = L0
         y0[3:] = q0

@@ -10,6 +10,7 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
+from rotframe.rigid.adaptive import steps_estimate as adaptive_steps_estimate  # noqa: F401 (its old home)
 from rotframe.scenes.base import MethodNames
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
@@ -60,20 +61,6 @@ class BodyTrajectory:
     complete: bool = True
     t_reached: float = math.nan
     extras: dict = field(default_factory=dict)
-
-
-def adaptive_steps_estimate(inertia, L0, duration, rtol, mgl=0.0):
-    """Steps ``dop853`` will take, roughly (for the run limits): ``duration w rtol^(-1/8) / 10``.
-
-    ``w`` is the fastest rate, the initial ``|omega|`` plus the gravity rate ``sqrt(|mgl| / I_min)``
-    of a heavy top; an 8th-order step resolves a turn of ``rtol^(1/8)`` rad times a constant. The
-    constant 1/10 is measured: the default heavy top (10 s, 300 rad/s, rtol 1e-9) takes 4222
-    steps, estimated 4529; the Dzhanibekov flip (100 s, 1 rad/s, rtol 1e-10) 189, estimated 180.
-    """
-    moments = [float(x) for x in inertia]  # scalar arithmetic: a short run pays microseconds, not tens
-    w = math.sqrt(sum((float(l) / i) ** 2 for l, i in zip(L0, moments) if i > 0))
-    w += math.sqrt(abs(mgl) / max(min(moments), 1e-300))
-    return duration * w * rtol ** (-1.0 / 8.0) / 10.0
 
 
 def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
