@@ -179,3 +179,9 @@ def test_coriolis_closed_form_gives_the_classic_eastward_deflection():
     w = rate * np.array([0.0, math.cos(lat), math.sin(lat)])
     r, _ = coriolis_uniform_gravity(w, [0.0, 0.0, -g], np.zeros(3), np.zeros(3), t)
     assert r[0] == pytest.approx(rate * g * t**3 * math.cos(lat) / 3, rel=1e-6)
+
+
+def test_prepared_exact_refuses_a_state_of_the_wrong_shape():
+    run = PreparedRun(_linear(), "exact", 1.0, n=2)
+    with pytest.raises(ScenarioError, match=r"r0 and v0 must be \(3,\) or \(2, 3\)"):
+        run(np.zeros((3, 3)), np.zeros((3, 3)))

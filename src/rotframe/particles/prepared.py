@@ -9,15 +9,14 @@ count (a :class:`rotframe.particles.chunked.KernelSetup`, the one set-up of
 in and makes one call of the compiled driver with the same arguments, so the
 results are bitwise those of ``integrate_particles``. Method ``exact`` (a linear or
 force-free model) keeps the matrices of the exact flow for the sample grid, made
-once, and each call is one matrix product with the initial states: it agrees with
-``integrate_particles`` to round-off (the products are grouped differently). For optimisation loops,
+once, and each call multiplies them into the initial states in one compiled loop
+(:mod:`rotframe.particles.exact_kernel`): it agrees with ``integrate_particles`` to
+round-off (the products are grouped differently). For optimisation loops,
 shooting, Monte Carlo over single particles and the bench. No events; a
 non-finite state raises ``IntegrationError``.
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -80,10 +79,11 @@ class PreparedRun:
             self.times = exact_times(duration, samples)
             with np.errstate(all="ignore"):  # an overflow (an unstable model run far) is caught per call
                 phi = ExactFlow(model, self.times).matrices()  # (K, 7, 7)
-            # out[p, k] = s0[p] @ phi[k]^T: one matrix product makes every sample's (r, v) at once
-            self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (2, 0, 1)).reshape(7, -1))  # (7, K * 6)
-            self.phi_finite = bool(np.isfinite(self.phi_t).all())  # else each product is made under errstate
-            self.s0 = np.ones((n, 7))
+            self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (0, 2, 1)))  # (K, 7, 6)
+            from rotframe.particles.exact_kernel import apply_flow
+
+            self._apply = apply_flow
+            apply_flow(self.phi_t, np.zeros((n, 3)), np.zeros((n, 3)))  # load or compile the kernel now
             return
         self.setup = KernelSetup(model, self.info, duration, samples, step=step, rtol=rtol, atol=atol)
         self.times = self.setup.times
@@ -93,25 +93,22 @@ class PreparedRun:
         self.run(np.zeros((n, 3)), np.zeros((n, 3)))  # load or compile the kernel now
 
     def _run_exact(self, r0, v0):
-        """The exact flow's states: one product of the kept matrices with the initial states."""
-        s0 = self.s0
-        s0[:, 0:3] = r0
-        s0[:, 3:6] = v0
-        if self.phi_finite:
-            out = np.dot(s0, self.phi_t)  # (n, K * 6)
-        else:
-            with np.errstate(all="ignore"):
-                out = np.dot(s0, self.phi_t)
-        out = out.reshape(self.n, self.samples + 1, 6).transpose(1, 0, 2)  # (K, n, 6), a view
-        if not math.isfinite(float(np.add.reduce(out, axis=None))):  # one reduction: inf or nan anywhere
-            finite = np.all(np.isfinite(out), axis=(1, 2))
-            if not finite.all():
-                from rotframe.errors import IntegrationError
+        """The exact flow's states: the kept matrices times the initial states, one compiled loop."""
+        r0 = np.asarray(r0, dtype=np.float64)
+        v0 = np.asarray(v0, dtype=np.float64)
+        if r0.ndim == 1:
+            r0 = r0[None]
+        if v0.ndim == 1:
+            v0 = v0[None]
+        if r0.shape != (self.n, 3) or v0.shape != (self.n, 3):
+            raise _bad_state(r0, v0, self.n)
+        r, v, k_bad = self._apply(self.phi_t, r0, v0)
+        if k_bad >= 0:
+            from rotframe.errors import IntegrationError
 
-                k = int(np.argmin(finite))
-                raise IntegrationError(f"exact propagator produced a non-finite state at t = {self.times[k]:.6g} s",
-                                       t_reached=float(self.times[max(k - 1, 0)]), partial=None)
-        return out[:, :, 0:3], out[:, :, 3:6]
+            raise IntegrationError(f"exact propagator produced a non-finite state at t = {self.times[k_bad]:.6g} s",
+                                   t_reached=float(self.times[max(k_bad - 1, 0)]), partial=None)
+        return r, v
 
     def run(self, r0, v0):
         """(r, v) samples (samples + 1, n, 3) from initial positions and velocities (n, 3) or (3,)."""
@@ -139,3 +136,10 @@ class PreparedRun:
         return out_r, out_v
 
     __call__ = run
+
+
+def _bad_state(r0, v0, n):
+    from rotframe.errors import ScenarioError
+
+    return ScenarioError(f"initial state: r0 and v0 must be (3,) or ({n}, 3) for this prepared run, "
+                         f"got {r0.shape} and {v0.shape}")

@@ -65,8 +65,9 @@ class PreparedBodyRun:
     ``q0`` four finite numbers not all zero (else ``ScenarioError`` naming the
     key and value). ``run(L0, q0)`` returns ``(L, q)``, arrays (samples + 1, 3)
     and (samples + 1, 4) owned by the caller: ``L`` in body axes, ``q``
-    scalar-last, body -> space (row 0 is ``q0`` as given, the later rows
-    normalised). ``times`` holds the sample times; ``steps`` and ``nfev`` (0 for
+    scalar-last, body -> space (the fixed-step methods keep ``q0`` as given in
+    row 0, as ``integrate_body`` does; ``dop853`` normalises it, as ``rigid_dop853``
+    does; the later rows are normalised). ``times`` holds the sample times; ``steps`` and ``nfev`` (0 for
     the fixed-step methods) count the last call's work. A non-finite state (or,
     for ``dop853``, a step-size collapse) raises ``IntegrationError``.
     """
