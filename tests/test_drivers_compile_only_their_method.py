@@ -61,8 +61,9 @@ from rotframe.particles import events, schedule
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
-                      g=np.array([0.0, 0.0, -9.81]))
+# linear drag: the general DOP853 driver (a model without it runs rotframe.particles.dop853_steady)
+model = ParticleModel(("gravity", "coriolis", "linear-drag"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
+                      g=np.array([0.0, 0.0, -9.81]), k_linear=0.01)
 traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 1.0, method=sys.argv[1], samples=3)
 assert np.all(np.isfinite(traj.r))
 watchers = [events.event_value, events.start_value, events.locate_event, events.locate_event_dop853,
@@ -119,3 +120,27 @@ def test_a_free_particle_compiles_only_its_own_step_family(tmp_path):
                              timeout=600)
         assert res.returncode == 0, res.stderr
         assert res.stdout.split() == want, (method, res.stdout)
+
+
+STEADY = r'''
+import numpy as np
+from rotframe.particles import dop853_steps, dop853_steady, drivers, forces
+from rotframe.particles.integrators import integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+model = ParticleModel(("gravity", "coriolis", "pendulum"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
+                      g=np.array([0.0, 0.0, -9.81]), pendulum_length=10.0, pivot=np.array([0.0, 0.0, 10.0]))
+traj = integrate_particles(model, [1.0, 0.0, 10.0 - np.sqrt(99.0)], [0.0, 0.0, 0.0], 5.0, method="dop853", samples=5)
+assert np.all(np.isfinite(traj.r))
+general = [drivers.run_dop853, dop853_steps.dop853_step, forces.state_acceleration]
+print(sum(len(f.signatures) for f in general), len(dop853_steady.run_dop853_steady.signatures))
+'''
+
+
+def test_a_steady_model_compiles_only_the_specialised_dop853_driver(tmp_path):
+    # a steady rotation, uniform gravity, no drag and no events: rotframe.particles.dop853_steady, whose
+    # first run compiles three functions instead of the general driver's fourteen
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    res = subprocess.run([sys.executable, "-c", STEADY], capture_output=True, text=True, env=env, timeout=600)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["0", "1"], res.stdout
