@@ -211,39 +211,66 @@ def _warm():
 STARTUP_GOALS = {"cold": 3.0, "warm": 1.0}
 
 
-def _median_wall(cmd, repeats=1, env=None):
-    """Median wall time (s) of ``repeats`` runs of the command ``cmd`` in new processes."""
-    walls = []
+def import_seconds(importtime_log):
+    """Seconds a process spent importing, from its ``python -X importtime`` report (stderr).
+
+    The sum of the cumulative times of the top-level imports: every module the process
+    imported, at start or later (a scene imports astropy or numba when it runs), counted once.
+    """
+    total_us = 0
+    for line in importtime_log.splitlines():
+        if not line.startswith("import time:"):
+            continue
+        fields = line.split("|")
+        if len(fields) != 3 or not fields[1].strip().isdigit():
+            continue  # the header
+        name = fields[2]
+        if len(name) - len(name.lstrip(" ")) == 1:  # one space after the bar: a top-level import
+            total_us += int(fields[1])
+    return total_us / 1e6
+
+
+def _timed_runs(cmd, repeats=1, env=None):
+    """Median wall time and median import time (s) of ``repeats`` runs of ``cmd`` in new processes.
+
+    ``cmd[0]`` is the interpreter; each run has ``-X importtime``, so that its own imports
+    (:func:`import_seconds`) are measured in the same process as its wall time.
+    """
+    walls, imports = [], []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        subprocess.run(cmd, env=env, capture_output=True, check=True)
+        res = subprocess.run([cmd[0], "-X", "importtime", *cmd[1:]], env=env, capture_output=True, text=True,
+                             check=True)
         walls.append(time.perf_counter() - t0)
-    return statistics.median(walls)
+        imports.append(import_seconds(res.stderr))
+    return statistics.median(walls), statistics.median(imports)
 
 
 def startup_rows(scenarios=None):
     """``rotframe run NAME --no-record`` in new processes, for every scenario: warm cache, then empty.
 
-    ``import_s`` is the time of ``import rotframe.app.cli`` plus numpy, scipy and numba in a new
-    process; ``beyond_imports_s = wall_s - import_s`` is what the goal of a first run counts
-    (:data:`STARTUP_GOALS`: cold 3 s beyond imports, warm 1 s in all). The warm time is the
-    median of three runs after one that fills the cache; the cold one is a run with an empty
-    numba cache (``NUMBA_CACHE_DIR`` set to a new folder), as in a fresh environment.
+    ``import_s`` is the time that run spent importing modules, measured in its own process
+    (``python -X importtime``, :func:`import_seconds`: numpy, scipy, numba, astropy, whatever
+    that scene imports, when it imports them); ``beyond_imports_s = wall_s - import_s`` is what
+    the goal of a first run counts (:data:`STARTUP_GOALS`: cold 3 s beyond imports, warm 1 s in
+    all). The warm time is the median of three runs after one that fills the cache; the cold
+    one is a run with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new folder), as in a
+    fresh environment.
     """
     from rotframe.scenes import SCENES
 
     names = list(scenarios or [n for n in SCENES if isinstance(SCENES[n], str)])
-    import_s = _median_wall([sys.executable, "-c", "import rotframe.app.cli, numpy, scipy, numba"], repeats=3)
     rows = []
     for name in names:
         cmd = [sys.executable, "-m", "rotframe", "run", name, "--no-record", "--json"]
-        _median_wall(cmd)  # fills the cache
-        warm = _median_wall(cmd, repeats=3)
+        _timed_runs(cmd)  # fills the cache
+        warm = _timed_runs(cmd, repeats=3)
         with tempfile.TemporaryDirectory() as empty:
-            cold = _median_wall(cmd, env=dict(os.environ, NUMBA_CACHE_DIR=empty))
-        for setting, wall, goal, counted in (("warm compile cache", warm, STARTUP_GOALS["warm"], warm),
-                                             ("first-ever run (empty compile cache)", cold, STARTUP_GOALS["cold"],
-                                              cold - import_s)):
+            cold = _timed_runs(cmd, env=dict(os.environ, NUMBA_CACHE_DIR=empty))
+        for setting, (wall, import_s), goal, cold_run in (
+                ("warm compile cache", warm, STARTUP_GOALS["warm"], False),
+                ("first-ever run (empty compile cache)", cold, STARTUP_GOALS["cold"], True)):
+            counted = wall - import_s if cold_run else wall
             rows.append({"scenario": "startup", "method": f"rotframe run {name} --no-record", "setting": setting,
                          "run": name, "wall_s": wall, "error": math.nan, "error_kind": "start-up", "nfev": 0,
                          "import_s": import_s, "beyond_imports_s": wall - import_s, "goal_s": goal,
