@@ -1,8 +1,8 @@
-"""DOP853 specialised to the steady models: few compiled functions, compiled in about 1 s.
+"""DOP853 specialised to the steady models: three compiled functions instead of fourteen.
 
 The general driver :func:`rotframe.particles.drivers.run_dop853` handles every
 term, rotation schedule and event, and a first run compiles it with its force,
-step, schedule and event helpers in about 3 s (numba's typing and lowering of
+step, schedule and event helpers in 3 to 4 s (numba's typing and lowering of
 about fourteen functions). Most scenes that run DOP853 need much less:
 
 - a **steady** rotation rate (``w`` constant, so no schedule and no Euler term);
@@ -15,8 +15,8 @@ written in place: the same stages, error norm, step control, sample steps and
 failure checks, in the same floating-point order, so that its results are
 bitwise those of the general driver (``tests/test_dop853_steady.py`` checks
 this on random models). It is three compiled functions instead of about
-fourteen, and a first ``rotframe run foucault`` compiles in about 1.3 s instead
-of about 3.3 s (numba's own start included).
+fourteen, and a first ``rotframe run foucault`` compiles for about 2.5 s instead of 3.3 to 4 s
+on the 2-core machine (numba's own start, about 0.5 s, included).
 
 :func:`steady_parameters` packs the model for it; :func:`is_steady_model` says
 whether a model qualifies.
