@@ -40,6 +40,15 @@ def test_no_scene_module_imports_astropy_coordinates_or_scipy_optimize(scene):
     assert not loaded & {"astropy.coordinates", "scipy.optimize"}, loaded
 
 
+@pytest.mark.parametrize("scene", SCENE_MODULES)
+def test_no_scene_module_imports_numba(scene):
+    # numba (about 0.3 s) is imported by the runs that compile, not by listing or describing a scene
+    probe = f"import sys, rotframe.scenes.{scene}\nprint('numba' in sys.modules)"
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["False"]
+
+
 def test_earth_rotation_and_normal_gravity_need_no_astropy():
     loaded = loaded_after("from rotframe.earth import OMEGA_EARTH, omega_enu, normal_gravity, geocentric_latitude, "
                           "ecef_to_enu_matrix, SITES, Site\n"

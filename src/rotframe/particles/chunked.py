@@ -22,10 +22,17 @@ import numpy as np
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
-__all__ = ["KernelSetup", "run_chunked", "steps_per_sample", "GROWTH_LIMIT"]
+__all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
 
 #: Relative growth of the inertial speed beyond which a run of a force-free model is unstable.
 GROWTH_LIMIT = 1e-3
+
+
+def sample_times(duration, samples):
+    """``samples`` equal intervals from 0, the last sample at ``duration`` exactly: (samples + 1,) times."""
+    times = np.arange(samples + 1) * (duration / samples)
+    times[-1] = duration
+    return times
 
 
 def steps_per_sample(dt_sample, step):
@@ -88,8 +95,7 @@ class KernelSetup:
         self.samples = samples
         self.duration = duration
         self.dt_sample = dt = duration / samples
-        self.times = np.arange(samples + 1) * dt
-        self.times[-1] = duration
+        self.times = sample_times(duration, samples)
         self.rtol = float(rtol)
         self.atol = atol
         if info.kind == "fixed":
@@ -105,9 +111,9 @@ class KernelSetup:
             self.tableau = coefficients()
             self.h0 = dt / 10.0
             # a steady model without events runs the specialised driver (bitwise the same results,
-            # a third of the first run's compile): rotframe.particles.dop853_steady
-            if info.kind == "adaptive" and is_steady_model(model, self.events):
-                self.steady_args = (steady_parameters(model), steady_tableau(*self.tableau))
+            # three compiled functions instead of fourteen): rotframe.particles.dop853_steady
+            if is_steady_model(model, self.events):
+                self.steady_args = (steady_parameters(model), steady_tableau())
 
     def kernel(self):
         """The compiled driver of this method."""
@@ -157,8 +163,8 @@ class KernelSetup:
         end = first + 1 + max(count, 1)
         if self.steady_args is not None:
             q, tab = self.steady_args
-            return kernel(r, v, start, self.times[first + 1:end], q, self.rtol, atol, h0, tab,
-                                 np.empty((31, 6)), out_r, out_v, h_state)
+            return kernel(r, v, start, self.times[first + 1:end], q, self.rtol, atol, h0, tab, np.empty((31, 6)),
+                          out_r, out_v, h_state)
         A, B, C, E3, E5 = self.tableau
         return kernel(
             r, v, alive, start, self.times[first + 1:end], self.P, self.wt_arg, self.wv,

@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
-from rotframe.particles.chunked import KernelSetup, run_chunked, steps_per_sample
+from rotframe.particles.chunked import KernelSetup, run_chunked, sample_times, steps_per_sample
 from rotframe.particles.trajectory import Event, RunInterrupted, Trajectory
 
 if TYPE_CHECKING:  # names used only in annotations
@@ -182,13 +182,6 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
 # ---------------------------------------------------------------------------
 
 
-def exact_times(duration, samples):
-    """The sample times of method ``exact``: ``samples`` equal intervals, the last at ``duration`` exactly."""
-    times = np.arange(samples + 1) * (duration / samples)
-    times[-1] = duration
-    return times
-
-
 def _check_work(info, duration, step, samples, n):
     """Refuse, before allocating anything, a run over the work limits (:mod:`rotframe.limits`)."""
     from rotframe import limits
@@ -212,7 +205,7 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
                             "(this one is force-free with a varying rate); use dop853")
     n = r0.shape[0]
     s0 = np.concatenate([r0, v0, np.ones((n, 1))], axis=1).T  # (7, N)
-    times = exact_times(duration, samples)
+    times = sample_times(duration, samples)
     out = np.empty((samples + 1, 7, n))
     flow = None
     done = 0

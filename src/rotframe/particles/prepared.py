@@ -70,13 +70,13 @@ class PreparedRun:
         self.n = n = int(n)
         self.nfev = 0
         if self.info.kind == "exact":
-            from rotframe.particles.integrators import exact_times
+            from rotframe.particles.chunked import sample_times
             from rotframe.particles.linear import ExactFlow
 
             if not model.has_exact_flow:
                 raise ScenarioError(f"method: 'exact' needs a linear or force-free model "
                                     f"({'; '.join(model.nonlinear_reasons())})")
-            self.times = exact_times(duration, samples)
+            self.times = sample_times(duration, samples)
             with np.errstate(all="ignore"):  # an overflow (an unstable model run far) is caught per call
                 phi = ExactFlow(model, self.times).matrices()  # (K, 7, 7)
             self.phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (0, 2, 1)))  # (K, 7, 6)

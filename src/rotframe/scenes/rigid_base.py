@@ -10,7 +10,6 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
-from rotframe.rigid.adaptive import steps_estimate as adaptive_steps_estimate  # noqa: F401 (its old home)
 from rotframe.scenes.base import MethodNames
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
@@ -86,7 +85,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     elif method == "dop853":
         rtol = float(run.get("rtol") or DEFAULT_RTOL)
         _check_adaptive(inertia, rtol)
-        steps = adaptive_steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
+        from rotframe.rigid.adaptive import steps_estimate  # numba: imported where a run needs it
+
+        steps = steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
     else:
         steps = samples * max(1.0, math.ceil(
             (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
