@@ -18,7 +18,8 @@ def test_particle_scenes_take_their_methods_from_the_registry():
 def test_heavy_top_methods_are_renamed_and_the_old_names_are_aliases():
     from rotframe.scenes import heavy_top
 
-    assert tuple(heavy_top.METHODS) == ("top-splitting", "top-splitting4", "top-splitting6", "rk4", "dop853")
+    assert tuple(heavy_top.METHODS) == ("top-splitting", "top-splitting4", "top-splitting6", "top-splitting8",
+                                        "rk4", "dop853")
     for old, new in (("splitting", "top-splitting"), ("splitting4", "top-splitting4"),
                      ("splitting6", "top-splitting6")):
         assert old in heavy_top.METHODS and heavy_top.METHODS.canonical(old) == new

@@ -328,7 +328,8 @@ def test_lie_poisson_keeps_norm_L_and_energy_has_no_trend_over_a_million_steps()
     assert abs(change4) > 0.5 * ptp4
 
 
-@pytest.mark.parametrize("order, h0", [(2, 0.1), (4, 0.1), (6, 0.2)])
+# steps long enough that the errors stay well above round-off (1e-14) at h0 / 4
+@pytest.mark.parametrize("order, h0", [(2, 0.1), (4, 0.1), (6, 0.4), (8, 1.25)])
 def test_lie_poisson_observed_order_by_halving_the_step(order, h0):
     I, L0 = np.array([1.0, 2.0, 3.0]), np.array([0.3, 1.0, -0.5])
     q0 = Rotation.from_rotvec([0.2, 0.1, -0.3]).as_quat()
@@ -456,6 +457,22 @@ def test_heavy_top_splitting_matches_dop853():
                                         sample_every=100)
     L_ref, q_ref = dop853(I, L0, q0, t, torque=gravity_torque(mgl))
     assert np.max(np.abs(L - L_ref)) / np.linalg.norm(L0) + rotation_error(q, q_ref) < 1e-9
+
+
+@pytest.mark.parametrize("order, h", [(4, 0.02), (6, 0.04), (8, 0.2)])
+def test_heavy_top_splitting_observed_order_against_dop853(order, h):
+    """Halving the step divides the error by 2^order (orders 6 and 8: Kahan & Li's compositions)."""
+    L0, q0 = top_state(TOP["i1"], TOP["i3"], 0.8, 0.3, 1.0, 20.0)
+    I = [TOP["i1"], TOP["i1"], TOP["i3"]]
+    L_ref, q_ref = dop853(I, L0, q0, np.array([0.0, 2.0]), torque=gravity_torque(TOP["mass"] * TOP["g"] * TOP["length"]))
+    errors = []
+    for step in (h, h / 2):
+        n = int(round(2.0 / step))
+        L, q, _ = rigid.heavy_top_splitting(**TOP, L0_body=L0, q0=q0, h=step, n_steps=n, order=order,
+                                            sample_every=n)
+        errors.append(np.max(np.abs(L[-1] - L_ref[-1])) / np.linalg.norm(L0) + rotation_error(q[-1:], q_ref[-1:]))
+    assert errors[1] > 1e-10  # well above the reference's own error (rtol 1e-13)
+    assert math.log2(errors[0] / errors[1]) == pytest.approx(order, abs=0.25)
 
 
 @pytest.mark.parametrize("factor, stays_up", [(1.2, True), (0.8, False)])

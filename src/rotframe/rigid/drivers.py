@@ -1,8 +1,9 @@
 """Python drivers shared by the fixed-step rigid-body integrators.
 
 Output arrays and sample times (steps ``0, s, 2s, ...`` and always the last), the
-triple-jump weights (:func:`rotframe.numerics.composition.triple_jump_weights`,
-refused orders as :class:`~rotframe.rigid.checks.InvalidStateError`), the end of
+composition weights (:func:`rotframe.numerics.composition.composition_weights`,
+refused orders as :class:`~rotframe.rigid.checks.InvalidStateError`; the order of a
+method name's suffix in :data:`SPLITTING_ORDERS`), the end of
 a run (an :class:`~rotframe.errors.IntegrationError` that keeps the finite
 samples), and the drivers of the compiled splitting :func:`run_splitting` and
 :func:`splitting_stepper` (the body checked once, for runs in chunks).
@@ -13,18 +14,26 @@ from __future__ import annotations
 import numpy as np
 
 from rotframe.errors import IntegrationError
-from rotframe.numerics.composition import triple_jump_weights
+from rotframe.numerics import composition
 from rotframe.rigid.checks import InvalidStateError, check_quaternion, check_steps
 from rotframe.rigid.kernels import split_run
 
-__all__ = ["composition_weights", "allocate_samples", "finish_samples", "splitting_stepper", "run_splitting"]
+__all__ = ["SPLITTING_ORDERS", "composition_weights", "allocate_samples", "finish_samples", "splitting_stepper", "run_splitting"]
+
+
+#: Order of a splitting method from its name's suffix: ``lie-poisson`` 2, ``lie-poisson4`` 4, ... ``8``.
+SPLITTING_ORDERS = {"": 2, "4": 4, "6": 6, "8": 8}
 
 
 def composition_weights(order):
-    """Weights of the order-2 step in Yoshida's triple-jump composition (Yoshida 1990)."""
-    if order not in (2, 4, 6):
-        raise InvalidStateError(f"order = {order!r}; allowed: 2, 4 or 6")
-    return triple_jump_weights(order)
+    """Fractions of the order-2 step in the composition of ``order`` (2, 4, 6 or 8).
+
+    Yoshida's triple jump for order 4, Kahan & Li's 9- and 17-stage methods for 6
+    and 8 (:func:`rotframe.numerics.composition.composition_weights`).
+    """
+    if order not in composition.COMPOSITION_ORDERS:
+        raise InvalidStateError(f"order = {order!r}; allowed: 2, 4, 6 or 8")
+    return composition.composition_weights(order)
 
 
 def allocate_samples(h, n_steps, sample_every):

@@ -8,7 +8,7 @@ appear only as inputs/outputs of the check formulas
 Goldstein's phi, theta, psi); they are never integrated.
 
 :func:`heavy_top_splitting`: Strang splitting gravity kick / exact symmetric free
-flow, order 2, 4 or 6; keeps ``p_phi = L . z`` and ``p_psi = L3`` to round-off.
+flow, order 2, 4, 6 or 8; keeps ``p_phi = L . z`` and ``p_psi = L3`` to round-off.
 Not stiff in the spin: spin and nutation are exact rotations, so no step-size
 limit comes from them (RK4 needs ``h < 2.8 / omega``). Accuracy is
 ``O(h^order)`` while ``h`` resolves the nutation period ``2 pi I1 / |L|``; with
@@ -66,7 +66,8 @@ def heavy_top_splitting(
     (orientation frozen, exact flow of the potential):
     ``L_body += (h/2) l e3 x (-m g z_body)``, ``z_body = R(q)^T (0, 0, 1)``;
     then the exact free symmetric flow over ``h``; then the kick again
-    (docs/physics/rigid-bodies.md). Orders 4 and 6 by Yoshida's triple jump. ``p_phi = L . z``
+    (docs/physics/rigid-bodies.md). Order 4 by Yoshida's triple jump, 6 and 8 by Kahan & Li's
+    compositions (:func:`rotframe.numerics.composition.composition_weights`). ``p_phi = L . z``
     and ``p_psi = L3`` are kept to round-off (the kick is horizontal and normal
     to ``e3``). Spin and nutation enter only through exact rotations, so no
     stability limit on ``h`` comes from the spin; the error is ``O(h^order)``

@@ -25,10 +25,8 @@ from rotframe.rigid.adaptive import steps_estimate
 __all__ = ["PreparedBodyRun", "FIXED_METHODS"]
 
 #: the fixed-step methods (canonical names, as ``integrate_body`` runs them); ``dop853`` is adaptive
-FIXED_METHODS = ("lie-poisson", "lie-poisson4", "lie-poisson6", "top-splitting", "top-splitting4",
-                 "top-splitting6")
-
-_ORDER = {"": 2, "4": 4, "6": 6}
+FIXED_METHODS = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "top-splitting",
+                 "top-splitting4", "top-splitting6", "top-splitting8")
 
 
 class PreparedBodyRun:
@@ -39,7 +37,7 @@ class PreparedBodyRun:
     inertia : (3,) array_like
         Principal moments (kg m^2), body axes.
     method : str
-        A name of :data:`FIXED_METHODS` (splitting of order 2, 4 or 6; the free
+        A name of :data:`FIXED_METHODS` (splitting of order 2, 4, 6 or 8; the free
         body or, with ``top``, the heavy symmetric top), or ``dop853``.
     duration : float
         Simulated time (s), finite and > 0.
@@ -96,7 +94,7 @@ class PreparedBodyRun:
     def _setup_fixed(self, inertia, duration, step, top):
         from rotframe.rigid import dynamics as rigid
         from rotframe.rigid.checks import check_inertia, heavy_top_mgl, symmetry_axis
-        from rotframe.rigid.drivers import composition_weights, splitting_stepper
+        from rotframe.rigid.drivers import SPLITTING_ORDERS, composition_weights, splitting_stepper
         from rotframe.rigid.kernels import split_run
 
         samples = self.samples
@@ -107,7 +105,7 @@ class PreparedBodyRun:
         self.sps = sps
         self._steps_estimate = samples * sps
         prefix = "lie-poisson" if self.method.startswith("lie-poisson") else "top-splitting"
-        k = _ORDER[self.method[len(prefix):]]
+        k = SPLITTING_ORDERS[self.method[len(prefix):]]
         zero = np.zeros(3)
         i1, i2, i3 = inertia
         if top is not None:

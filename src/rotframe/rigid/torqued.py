@@ -1,7 +1,7 @@
 """Free and torqued rigid body by Lie-Poisson splitting, and the plain right-hand side with RK4.
 
 * :func:`lie_poisson`: symmetric splitting into exact rotations about body axes
-  (McLachlan 1993; Dullweber, Leimkuhler & McLachlan 1997), order 2, 4 or 6:
+  (McLachlan 1993; Dullweber, Leimkuhler & McLachlan 1997), order 2, 4, 6 or 8:
   ``|L|`` kept to round-off, energy error bounded without trend; a constant torque
   in body or space axes.
 * :func:`torqued_splitting`: a torque that depends on time and state, Strang
@@ -18,6 +18,9 @@ References
 .. [6] McLachlan, Explicit Lie-Poisson integration and the Euler equations,
    Phys. Rev. Lett. 71 (1993) 3043; Dullweber, Leimkuhler & McLachlan,
    J. Chem. Phys. 107 (1997) 5840.
+.. [7] Kahan & Li, Composition constants for raising the orders of
+   unconventional schemes for ordinary differential equations, Math. Comp. 66
+   (1997) 1089.
 """
 
 from __future__ import annotations
@@ -65,8 +68,8 @@ def lie_poisson(
     split as ``|L|^2/(2 Ip) + (1/Is - 1/Ip) Ls^2/2``, two commuting exact
     rotations, so its free motion is exact at any step. A constant torque is a
     kick ``L_body += (h/2) N_body`` with the orientation frozen on both sides of
-    the free step (Strang). Orders 4 and 6 compose the order-2 step by
-    Yoshida's triple jump [5]. ``|L|`` is kept to round-off (without torque);
+    the free step (Strang). Orders 4, 6 and 8 compose the order-2 step
+    (Yoshida's triple jump [5] for 4, Kahan & Li's 9 and 17 stages [7] for 6 and 8). ``|L|`` is kept to round-off (without torque);
     the energy error is ``O(h^order)`` and bounded, without trend.
 
     Parameters
@@ -81,7 +84,7 @@ def lie_poisson(
         Step (s); negative runs backwards.
     n_steps : int
         Number of steps.
-    order : {2, 4, 6}
+    order : {2, 4, 6, 8}
         Order of the composition.
     torque : array_like, shape (3,), optional
         Constant torque (N m).
@@ -126,7 +129,7 @@ def torqued_splitting(
     :func:`lie_poisson`), kick(tau/2), with the orientation frozen during the
     kicks; a kick evaluates the torque at its midpoint in L (explicit midpoint
     rule), so a torque that depends on L (damping, say) keeps the step second
-    order. Orders 4 and 6 by Yoshida's triple jump. The loop runs in Python and
+    order. Orders 4, 6 and 8 as in :func:`lie_poisson`. The loop runs in Python and
     calls the compiled free flow (about a microsecond a step): for constant
     torques use :func:`lie_poisson`, which is compiled throughout.
 

@@ -12,14 +12,16 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
 from rotframe.scenes.base import MethodNames
 
-#: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6]`` the
-#: Lie-Poisson splitting of orders 2, 4, 6, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
+#: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6|8]`` the
+#: Lie-Poisson splitting of orders 2, 4, 6, 8, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
 #: (:func:`rotframe.rigid.adaptive.rigid_dop853`, relative tolerance ``rtol`` of the run).
-FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "rk4", "dop853"))
-#: Methods of the heavy top: ``top-splitting[4|6]`` (exact free symmetric-top flow and gravity kick, orders
-#: 2, 4, 6), ``rk4`` and the adaptive ``dop853``; the old names ``splitting``, ``splitting4``,
+FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "rk4",
+                            "dop853"))
+#: Methods of the heavy top: ``top-splitting[4|6|8]`` (exact free symmetric-top flow and gravity kick,
+#: orders 2, 4, 6, 8), ``rk4`` and the adaptive ``dop853``; the old names ``splitting``, ``splitting4``,
 #: ``splitting6`` are still accepted.
-HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "rk4", "dop853"),
+HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "top-splitting8", "rk4",
+                             "dop853"),
                             {"splitting": "top-splitting", "splitting4": "top-splitting4",
                              "splitting6": "top-splitting6"})
 
@@ -270,14 +272,14 @@ def _stepper(method, inertia, top):
     """
     from rotframe.rigid import dynamics as rigid
     from rotframe.rigid.checks import check_inertia, heavy_top_mgl, symmetry_axis
-    from rotframe.rigid.drivers import splitting_stepper
+    from rotframe.rigid.drivers import SPLITTING_ORDERS, splitting_stepper
 
     i1, i2, i3 = inertia
     mgl = 0.0 if top is None else top[0] * top[1] * top[2]
     if method == "rk4":
         rk4 = lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)  # noqa: E731
         return rk4, rk4
-    order = {"": 2, "4": 4, "6": 6}
+    order = SPLITTING_ORDERS
     zero = np.zeros(3)
     for prefix in ("lie-poisson", "top-splitting"):
         if method.startswith(prefix) and method[len(prefix):] in order:

@@ -282,7 +282,8 @@ def _dzhanibekov(quick):
         steps = _ladder(quick, [1e-1, 3e-2, 1e-2, 3e-3, 1e-3] if not long else [1e-1, 3e-2, 1e-2], [3e-3])
         rtols = HALF_DECADES
         runs = {"exact": [None], "dop853": _ladder(quick, rtols, [1e-8]), "lie-poisson": steps,
-                "lie-poisson4": steps, "rk4": steps}
+                "lie-poisson4": steps, "lie-poisson8": _ladder(quick, [3e-1, 1e-1, 3e-2, 1e-2], [1e-1]),
+                "rk4": steps}
         if long:
             runs = {"exact": [None], "dop853": [1e-6, 1e-8, 1e-10, 1e-12], "lie-poisson4": steps}
         base = _rigid_runner(inertia, L0, q0, T, invariant=invariant)
@@ -366,10 +367,13 @@ def _heavy_top(quick):
 
     steps = _ladder(quick, [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5], [1e-4])
     rtols = _ladder(quick, HALF_DECADES[:-2], [1e-8])  # to 1e-12: the reference is good to ~1e-12
-    runs = {"dop853": rtols, "top-splitting": steps, "top-splitting4": steps, "rk4": [s for s in steps if s <= 1e-3],
+    steps8 = _ladder(quick, [1e-1, 6e-2, 4e-2, 3e-2, 2e-2, 1.5e-2, 1e-2, 5e-3], [2e-2])
+    runs = {"dop853": rtols, "top-splitting": steps, "top-splitting4": steps,
+            "top-splitting6": _ladder(quick, [2e-2, 1e-2, 5e-3, 2e-3], [1e-2]), "top-splitting8": steps8,
+            "rk4": [s for s in steps if s <= 1e-3],
             # prepared runs (rigid.prepared): the fourth-order splitting on a finer ladder near the 1e-6 level
             "top-splitting4" + PREPARED: _ladder(quick, [1e-2, 5e-3, 3e-3, 2e-3, 1.5e-3, 1e-3, 3e-4, 1e-4], [1e-3]),
-            "dop853" + PREPARED: rtols}
+            "top-splitting8" + PREPARED: steps8, "dop853" + PREPARED: rtols}
     return [Problem("heavy-top", "2 s, 95 spins", T, np.concatenate([L0, q0]), rhs, err,
                     "reference (scipy DOP853, rtol 1e-13): max(|dL|/|L|, attitude angle)", invariant, runs,
                     _rigid_runner(inertia, L0, q0, T, top=(values["mass"], values["length"], values["g"]),
