@@ -80,3 +80,25 @@ def test_an_unstable_setting_is_a_failed_row_not_the_end_of_the_bench():
     assert [r["setting"] for r in ours] == [0.04, 0.001]
     assert math.isinf(ours[0]["error"]) and ours[0]["note"].startswith("failed: unstable step")
     assert ours[1]["error"] == 1e-6 and ours[1]["compile_s"] >= 0
+
+
+def test_a_prepared_run_is_timed_alone_and_gives_the_same_result():
+    """The bench times a prepared run's call alone (the final state is picked out after the timing,
+    as a peer's conversion to numpy is); ``finish`` gives bitwise what ``run`` gives."""
+    import numpy as np
+
+    from rotframe.app.bench.measure import timed_call
+    from rotframe.app.bench.problems import PREPARED, problems
+
+    for name, method, setting in (("tower-drop", "exact", None), ("heavy-top", "top-splitting8", 2e-2)):
+        p = problems([name], quick=True)[0]
+        call, finish = timed_call(p, method + PREPARED, setting)
+        raw = call()
+        assert isinstance(raw, tuple) and len(raw) == 2  # the prepared run's samples, nothing more
+        y, nfev, inv = finish(raw)
+        y_run, nfev_run, inv_run = p.run(method + PREPARED, setting)
+        np.testing.assert_array_equal(y, y_run)
+        assert nfev == nfev_run and inv() == inv_run()
+    # a method that is not prepared times run itself
+    call, finish = timed_call(p, "dop853", 1e-8)
+    np.testing.assert_array_equal(finish(call())[0], p.run("dop853", 1e-8)[0])

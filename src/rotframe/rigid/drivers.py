@@ -18,7 +18,8 @@ from rotframe.numerics import composition
 from rotframe.rigid.checks import InvalidStateError, check_quaternion, check_steps
 from rotframe.rigid.kernels import split_run
 
-__all__ = ["SPLITTING_ORDERS", "composition_weights", "allocate_samples", "finish_samples", "splitting_stepper", "run_splitting"]
+__all__ = ["SPLITTING_ORDERS", "composition_weights", "allocate_samples", "finish_samples", "splitting_stepper",
+           "run_splitting"]
 
 
 #: Order of a splitting method from its name's suffix: ``lie-poisson`` 2, ``lie-poisson4`` 4, ... ``8``.

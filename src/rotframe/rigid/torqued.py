@@ -69,8 +69,9 @@ def lie_poisson(
     rotations, so its free motion is exact at any step. A constant torque is a
     kick ``L_body += (h/2) N_body`` with the orientation frozen on both sides of
     the free step (Strang). Orders 4, 6 and 8 compose the order-2 step
-    (Yoshida's triple jump [5] for 4, Kahan & Li's 9 and 17 stages [7] for 6 and 8). ``|L|`` is kept to round-off (without torque);
-    the energy error is ``O(h^order)`` and bounded, without trend.
+    (Yoshida's triple jump [5] for 4, Kahan & Li's 9 and 17 stages [7] for 6
+    and 8). ``|L|`` is kept to round-off (without torque); the energy error
+    is ``O(h^order)`` and bounded, without trend.
 
     Parameters
     ----------

@@ -24,7 +24,10 @@ class Problem:
     ``error_kind``); ``invariant(Y)`` the worst invariant error over states
     ``Y`` (n, dim); ``runs`` maps a rotframe method to a list of settings and
     ``run(method, setting) -> (y_end, nfev, invariant_error)``, the invariant
-    error as a function to call after the timing (or None).
+    error as a function to call after the timing (or None). A runner with
+    prepared methods also carries ``run.prepared_call(method, setting) -> (call,
+    finish)``, so that the bench times the prepared call alone
+    (:func:`rotframe.app.bench.measure.timed_call`).
     """
 
     scenario: str
@@ -87,20 +90,30 @@ def _particle_runner(model, r0, v0, t_end, invariant_fn):
     prepared = {}
     times = np.array([0.0, t_end])
 
-    def run(method, setting):
+    def prepared_call(method, setting):
         base = method.removesuffix(PREPARED)
-        kw = {"rtol": setting} if base == "dop853" else {"step": setting}
-        if method.endswith(PREPARED):
-            pr = prepared.get((base, setting))
-            if pr is None:
-                pr = prepared[(base, setting)] = PreparedRun(model, base, t_end, **kw)
-            r, v = pr(r0, v0)  # the timed call returns the final state; the invariant's path is made later
+        pr = prepared.get((base, setting))
+        if pr is None:
+            kw = {"rtol": setting} if base == "dop853" else {"step": setting}
+            pr = prepared[(base, setting)] = PreparedRun(model, base, t_end, **kw)
+
+        def finish(rv):  # the final state and the invariant's path, after the timing
+            r, v = rv
             return (np.concatenate((r[-1, 0], v[-1, 0])), pr.nfev,
                     lambda: invariant_fn(times, np.concatenate([r[:, 0], v[:, 0]], axis=1)))
+
+        return (lambda: pr(r0, v0)), finish
+
+    def run(method, setting):
+        if method.endswith(PREPARED):
+            call, finish = prepared_call(method, setting)
+            return finish(call())
+        kw = {"rtol": setting} if method == "dop853" else {"step": setting}
         traj = integrate_particles(model, r0, v0, t_end, method=method, samples=1, **kw)
         Y = np.concatenate([traj.r[:, 0], traj.v[:, 0]], axis=1)
         return Y[-1], traj.nfev, lambda: invariant_fn(traj.times, Y)
 
+    run.prepared_call = prepared_call
     return run
 
 
@@ -219,18 +232,26 @@ def _rigid_runner(inertia, L0, q0, T, top=None, invariant=None):
     ends = np.array([0.0, T])
     prepared = {}
 
-    def run(method, setting):
-        if method.endswith(PREPARED):  # rigid.prepared.PreparedBodyRun: set up once (untimed), bitwise the plain run
-            from rotframe.rigid.prepared import PreparedBodyRun
+    def prepared_call(method, setting):  # rigid.prepared.PreparedBodyRun: set up once (untimed), bitwise the plain run
+        from rotframe.rigid.prepared import PreparedBodyRun
 
-            base = method.removesuffix(PREPARED)
-            pr = prepared.get((base, setting))
-            if pr is None:
-                kw = {"rtol": setting, "mgl": mgl} if base == "dop853" else {"step": setting, "top": top}
-                pr = prepared[(base, setting)] = PreparedBodyRun(inertia, base, T, **kw)
-            L, q = pr(L0, q0)
+        base = method.removesuffix(PREPARED)
+        pr = prepared.get((base, setting))
+        if pr is None:
+            kw = {"rtol": setting, "mgl": mgl} if base == "dop853" else {"step": setting, "top": top}
+            pr = prepared[(base, setting)] = PreparedBodyRun(inertia, base, T, **kw)
+
+        def finish(Lq):  # the final state and the invariant's path, after the timing
+            L, q = Lq
             return (np.concatenate((L[-1], q[-1])), pr.nfev or pr.steps,
                     None if invariant is None else (lambda: invariant(ends, np.concatenate([L, q], axis=1))))
+
+        return (lambda: pr(L0, q0)), finish
+
+    def run(method, setting):
+        if method.endswith(PREPARED):
+            call, finish = prepared_call(method, setting)
+            return finish(call())
         if method == "dop853":
             res = rigid_dop853(inertia, L0, q0, ends, rtol=setting, mgl=mgl)
             Y = np.concatenate([res.L, res.q], axis=1)
@@ -240,6 +261,7 @@ def _rigid_runner(inertia, L0, q0, T, top=None, invariant=None):
         Y = np.concatenate([traj.L, traj.q], axis=1)
         return Y[-1], traj.steps, None if invariant is None else (lambda: invariant(traj.times, Y))
 
+    run.prepared_call = prepared_call
     return run
 
 
