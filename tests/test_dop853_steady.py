@@ -22,7 +22,7 @@ from rotframe.particles.trajectory import Event
 
 def general_driver(monkeypatch):
     """Make every run in this test take the general DOP853 driver."""
-    monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(): False)
+    monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(), packed=None: False)
 
 
 def random_case(seed):
@@ -79,8 +79,8 @@ def test_the_foucault_scene_takes_the_steady_driver_with_the_same_numbers(monkey
 
     calls = []
     monkeypatch.setattr(dop853_steady, "is_steady_model",
-                        lambda model, events=(), real=dop853_steady.is_steady_model: calls.append(real(model, events))
-                        or calls[-1])
+                        lambda model, events=(), packed=None, real=dop853_steady.is_steady_model:
+                        calls.append(real(model, events, packed)) or calls[-1])
     summary, result = runner.run("foucault", {"duration": 120.0})
     assert result.method == "dop853" and calls == [True]
     with monkeypatch.context() as m:

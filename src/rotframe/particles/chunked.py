@@ -112,8 +112,8 @@ class KernelSetup:
             self.h0 = dt / 10.0
             # a steady model without events runs the specialised driver (bitwise the same results,
             # three compiled functions instead of fourteen): rotframe.particles.dop853_steady
-            if is_steady_model(model, self.events):
-                self.steady_args = (steady_parameters(model), steady_tableau())
+            if is_steady_model(model, self.events, self.P):
+                self.steady_args = (steady_parameters(model, self.P), steady_tableau())
 
     def kernel(self):
         """The compiled driver of this method."""

@@ -34,9 +34,12 @@ from rotframe.numerics.dop853 import coefficients
 
 __all__ = ["is_steady_model", "steady_parameters", "steady_tableau", "run_dop853_steady", "STEADY_TERMS"]
 
-# The error norm (rotframe.numerics.dop853.dop853_error_norm) and the step-size control of the general
-# driver are written in place below, in the same order, rather than shared: sharing them with numba's
-# IR inlining (numerics.compiled.inlined) made a first run's compile 5 to 8 % more work, measured.
+# The force (rotframe.particles.forces.state_acceleration, its string constraint included), the error norm
+# (rotframe.numerics.dop853.dop853_error_norm), the step-size control and the sample steps of the general
+# driver (rotframe.particles.drivers.run_dop853) are written in place below, in the same order, rather than
+# shared: calling the general force compiles the packed model and its helpers (what this driver exists to
+# avoid), and sharing the others by numba's IR inlining (numerics.compiled.inlined) made a first run's
+# compile 5 to 8 % more work, measured. tests/test_dop853_steady.py keeps the copies bitwise the same.
 
 #: The terms that the steady driver evaluates (a model with any other term runs the general driver).
 STEADY_TERMS = frozenset({"gravity", "coriolis", "centrifugal", "pendulum"})
@@ -46,30 +49,32 @@ _G, _W, _PIVOT, _L, _CORIOLIS, _CENTRIFUGAL, _W_MAG = 0, 3, 6, 9, 10, 11, 12
 _N = 13
 
 
-def is_steady_model(model, events=()):
+def is_steady_model(model, events=(), packed=None):
     """Whether ``model`` (and a run with ``events``) can run :func:`run_dop853_steady`.
 
     True for a constant rotation rate, uniform gravity (or none) and no term
-    outside :data:`STEADY_TERMS`, without events.
+    outside :data:`STEADY_TERMS`, without events. ``packed`` is ``model.pack()``
+    where the caller has it.
     """
     from rotframe.particles.packed import I_GMODE
 
     if events or not model.omega.is_constant or not set(model.terms) <= STEADY_TERMS:
         return False
-    P = model.pack()
+    P = model.pack() if packed is None else packed
     return P[I_GMODE] in (0.0, -1.0)
 
 
-def steady_parameters(model):
+def steady_parameters(model, packed=None):
     """The parameter vector (13,) of :func:`run_dop853_steady` for a model that qualifies.
 
-    The values are those of ``model.pack()`` (the same floats, so the same results):
-    uniform gravity (zero when off), the unit axis, the pivot and string length,
-    the Coriolis and centrifugal switches and the rate ``w`` (rad/s).
+    The values are those of ``model.pack()`` (the same floats, so the same results;
+    ``packed`` where the caller has it): uniform gravity (zero when off), the unit
+    axis, the pivot and string length, the Coriolis and centrifugal switches and the
+    rate ``w`` (rad/s).
     """
     from rotframe.particles import packed as k
 
-    P = model.pack()
+    P = model.pack() if packed is None else packed
     q = np.zeros(_N)
     if P[k.I_GMODE] == 0.0:
         q[_G:_G + 3] = P[k.I_G:k.I_G + 3]

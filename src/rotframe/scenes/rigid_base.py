@@ -279,11 +279,10 @@ def _stepper(method, inertia, top):
     if method == "rk4":
         rk4 = lambda L, q, h, n, every: rigid.rigid_rk4(inertia, L, q, h, n, mgl=mgl, sample_every=every)  # noqa: E731
         return rk4, rk4
-    order = SPLITTING_ORDERS
     zero = np.zeros(3)
     for prefix in ("lie-poisson", "top-splitting"):
-        if method.startswith(prefix) and method[len(prefix):] in order:
-            k = order[method[len(prefix):]]
+        if method.startswith(prefix) and method[len(prefix):] in SPLITTING_ORDERS:
+            k = SPLITTING_ORDERS[method[len(prefix):]]
             if top is not None:
                 mass, length, g = top
 
