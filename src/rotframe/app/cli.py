@@ -198,6 +198,9 @@ def cmd_show(args) -> int:
     methods = getattr(scenes.get(scn.scene), "METHODS", None)
     run = {k: v for k, v in scn.run.items() if v is not None}
     print("run: " + ", ".join(f"{k} = {v}" for k, v in run.items()))
+    default = getattr(scenes.get(scn.scene), "DEFAULT_METHOD", None)
+    if default and "method" not in run:
+        print(f"default method: {default}")
     if methods:
         print(f"methods: {', '.join(methods)}")
     print("\nparameters (--set KEY=VALUE):")

@@ -50,6 +50,8 @@ PARAMETERS = FoucaultParameters
 
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
+#: What runs when ``--method`` names none (``rotframe show`` prints it).
+DEFAULT_METHOD = "dop853 for the full pendulum; exact for the linearised one (small_angle)"
 SAMPLES_PER_PERIOD = 32
 #: Samples kept at most (memory: 48 bytes each); beyond, the period is not measured.
 MAX_SAMPLES = 2_000_000

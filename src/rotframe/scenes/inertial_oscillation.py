@@ -39,6 +39,8 @@ PARAMETERS = InertialOscillationParameters
 
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
+#: What runs when ``--method`` names none (``rotframe show`` prints it).
+DEFAULT_METHOD = "exact where the model is linear (the default terms), else rotation-splitting"
 
 
 @with_parameters(InertialOscillationParameters)

@@ -50,6 +50,8 @@ PARAMETERS = ProjectileParameters
 
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
+#: What runs when neither ``--method`` nor the scenario file names a method (``rotframe show`` prints it).
+DEFAULT_METHOD = "exact where the model is linear (the default terms, with or without centrifugal), else dop853"
 
 
 def aim_axes(azimuth_deg):
@@ -80,7 +82,9 @@ def build(p, terms):
 def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     model, r0, v0, ground, duration, g = build(p, terms)
-    method = method or run.get("method") or "dop853"
+    # the exact flow where it exists (the default terms, with or without centrifugal: linear), which is exact to
+    # round-off and compiles nothing; DOP853 at the scenario's rtol once central gravity, curvature or drag enter
+    method = method or run.get("method") or ("exact" if model.is_linear else "dop853")
 
     # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
     flight = 2 * p.speed * math.sin(math.radians(p.elevation)) / g

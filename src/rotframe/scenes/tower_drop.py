@@ -43,6 +43,8 @@ PARAMETERS = TowerDropParameters
 
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
+#: What runs when neither ``--method`` nor the scenario file names a method (``rotframe show`` prints it).
+DEFAULT_METHOD = "exact where the model is linear (the default terms, with or without centrifugal), else rotation-splitting"
 GROUND = Event("ground", "r", 2, 0.0, -1, True)
 
 

@@ -41,6 +41,8 @@ PARAMETERS = TurntableParameters
 
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
+#: What runs when ``--method`` names none (``rotframe show`` prints it).
+DEFAULT_METHOD = "exact (the puck is force-free: a straight line in inertial space)"
 
 Z = np.array([0.0, 0.0, 1.0])
 
