@@ -156,3 +156,14 @@ def test_exact_refused_on_curvature_names_curvature(tmp_path):
     assert len(lines) == 1, res.stderr
     assert "curvature" in lines[0] and "exact" in lines[0]
     assert "omega varies" not in lines[0]
+
+
+def test_show_says_which_method_runs_by_default(tmp_path):
+    # projectile.toml names no method: the scene picks exact (linear model) or dop853, and show says so
+    res = rotframe("show", "projectile", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    line = next(x for x in res.stdout.splitlines() if x.startswith("default method:"))
+    assert "exact" in line and "dop853" in line
+    # heavy-top.toml names its method: the run line carries it and no default line is added
+    res = rotframe("show", "heavy-top", cwd=tmp_path)
+    assert "method = dop853" in res.stdout and "default method:" not in res.stdout

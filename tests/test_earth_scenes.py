@@ -151,7 +151,8 @@ def test_projectile_deflects_right_in_the_north_left_in_the_south(lat):
     assert math.copysign(1, s["metrics"]["lateral_deflection_m"]) == math.copysign(1, lat)
 
 
-def test_projectile_matches_solve_ivp_flat_vacuum():
+@pytest.mark.parametrize("method", [None, "dop853"])
+def test_projectile_matches_solve_ivp_flat_vacuum(method):
     lat, az, el, V = math.radians(49.6), math.radians(232.0), math.radians(50.0), 1600.0
     g = normal_gravity(lat)
     w = OMEGA * np.array([0.0, math.cos(lat), math.sin(lat)])
@@ -168,7 +169,8 @@ def test_projectile_matches_solve_ivp_flat_vacuum():
     v0 = V * (math.cos(el) * aim + [0, 0, math.sin(el)])
     ref = solve_ivp(rhs, (0, 400), [0, 0, 0, *v0], method="DOP853", rtol=1e-13, atol=1e-12, events=ground)
     hit = ref.y_events[0][0][:3]
-    s = run("projectile")
+    s = run("projectile", method=method)
+    assert s["method"] == (method or "exact")  # the default terms are linear: the exact flow
     assert s["metrics"]["flight_time_s"] == pytest.approx(ref.t_events[0][0], rel=1e-9)
     assert s["metrics"]["range_m"] == pytest.approx(hit @ aim, rel=1e-9)
     assert s["metrics"]["lateral_deflection_m"] == pytest.approx(hit @ right, rel=1e-7)
@@ -177,6 +179,7 @@ def test_projectile_matches_solve_ivp_flat_vacuum():
 def test_curvature_matters_for_the_paris_gun_and_not_for_the_tower():
     gun = runner.run("projectile", {})[0]
     curved = runner.run("projectile", {}, terms=["central-gravity", "coriolis", "curvature"])[0]
+    assert (gun["method"], curved["method"]) == ("exact", "dop853")  # no exact flow once gravity turns
     assert curved["metrics"]["range_m"] > gun["metrics"]["range_m"] * 1.01  # the ground falls away
 
 
