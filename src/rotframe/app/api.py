@@ -180,7 +180,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
         if progress is True:  # the bar is ours to end
             callback.close()
     simulate_s = time.perf_counter() - t0
-    summary = runner.summarize(scn, values, scene_result, {"simulate_s": simulate_s})
+    summary = runner.summarize(scn, values, scene_result, {"simulate_s": simulate_s}, given=params or ())
     return Result(scn, values, scene_result, _finish_summary(scn, summary, scene_result, simulate_s, t_start))
 
 

@@ -276,7 +276,7 @@ def _run(args) -> int:
         _error((message or "run failed") + "; nothing was computed, so nothing was recorded")
         return status
     try:
-        summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s})
+        summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets)
     except KeyboardInterrupt as exc:  # during the analysis: keep the trajectory as a partial recording
         scope.note(exc)
         status = scope.exit_code

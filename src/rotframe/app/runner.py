@@ -11,7 +11,7 @@ import time
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["run", "simulate", "summarize", "record_result"]
+__all__ = ["run", "simulate", "summarize", "unused_settings", "record_result"]
 
 
 def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
@@ -34,7 +34,7 @@ def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
     t0 = time.perf_counter()
     result = simulate(scn, values, method=method, terms=terms, progress=progress)
     simulate_s = time.perf_counter() - t0
-    summary = summarize(scn, values, result, {"simulate_s": simulate_s})
+    summary = summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets or ())
     return summary, result
 
 
@@ -53,7 +53,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
     return scene.simulate(params, terms, method, run_settings, progress)
 
 
-def summarize(scn, values, result, timing):
+def summarize(scn, values, result, timing, given=()):
     """The run summary (the JSON contract described in README.md).
 
     Besides the contract's keys it always has ``warnings`` (a list of strings,
@@ -63,7 +63,8 @@ def summarize(scn, values, result, timing):
     scene's stated tolerance (``tolerance`` in the scene's analysis: the method's
     accuracy for an exact theory, the approximation's accuracy otherwise; a metric
     with no tolerance is compared with an indicative theory only), plus the
-    scene's own warnings.
+    scene's own warnings, plus one for each run setting in ``given`` (the keys the
+    caller set) that the method does not read (:func:`unused_settings`).
     """
     from rotframe import scenes
 
@@ -82,7 +83,8 @@ def summarize(scn, values, result, timing):
         "theory_notes": dict(analysis.get("theory_notes", {})),
         "diagnostics": _plain(analysis.get("diagnostics", {})),
         "warnings": list(analysis.get("warnings", [])) + theory_warnings(
-            analysis["metrics"], theory, analysis.get("tolerance", {}), analysis.get("theory_notes", {})),
+            analysis["metrics"], theory, analysis.get("tolerance", {}), analysis.get("theory_notes", {}))
+        + unused_settings(given, values["run"], result.method),
         "timing": dict(timing),
         "recording": None,
     }
@@ -92,6 +94,29 @@ def summarize(scn, values, result, timing):
         summary["complete"] = False
         summary["t_reached_s"] = float(result.trajectory.t_reached)
     return summary
+
+
+#: The run settings that each kind of method does not read: an adaptive method chooses its own steps,
+#: a fixed-step one has no tolerance, the exact flow neither.
+_UNREAD = {"exact": ("step", "rtol"), "adaptive": ("step",), "fixed": ("rtol",)}
+
+
+def unused_settings(given, run, method):
+    """Warnings for the run settings a caller set (keys in ``given``) that ``method`` does not read.
+
+    ``exact`` reads neither ``step`` nor ``rtol``, ``dop853`` (adaptive) chooses its own
+    steps from ``rtol``, and every other method (particle and rigid) takes fixed steps and
+    has no tolerance. A setting the scenario file gives is not warned about: files set both
+    for whichever method runs.
+
+    >>> unused_settings({"step": "0.5"}, {"step": 0.5, "rtol": 1e-10}, "dop853")
+    ['step = 0.5 is not used: dop853 is adaptive and chooses its own steps (set rtol instead)']
+    """
+    kind = "exact" if method == "exact" else "adaptive" if method == "dop853" else "fixed"
+    why = {"exact": f"{method} evaluates the exact flow, with no steps and no tolerance",
+           "adaptive": f"{method} is adaptive and chooses its own steps (set rtol instead)",
+           "fixed": f"{method} takes fixed steps and has no tolerance (set step instead)"}[kind]
+    return [f"{key} = {run.get(key)} is not used: {why}" for key in _UNREAD[kind] if key in given]
 
 
 def _plain(values: dict) -> dict:
