@@ -88,3 +88,23 @@ def test_exact_runs_land_a_long_shot_to_round_off():
     assert abs(t_hit - float(t_ref)) < 4e-15 * float(t_ref)
     r_hit = traj.event_states["ground"][0][0][:3]
     assert np.max(np.abs(r_hit - r_ref)) < 4e-15 * np.max(np.abs(r_ref))
+
+
+def test_a_steady_force_free_run_stays_on_its_inertial_line_over_many_turns():
+    """Coriolis and centrifugal at 1 rad/s for 160 turns: the inertial straight line, seen turning (written here).
+
+    This model is linear, but its M is defective (double eigenvalues +-i w) and expm's
+    round-off grows like the square of the turns (6e-10 relative here); the exact run takes the
+    force-free closed form instead.
+    """
+    w = 1.0
+    model = ParticleModel(("coriolis", "centrifugal"), omega=OmegaSchedule.constant([0.0, 0.0, w]))
+    r0, v0 = np.array([2.0, 0.0, 0.5]), np.array([-1.0, 0.3, 0.2])
+    traj = integrate_particles(model, r0, v0, 1000.0, method="exact", samples=4000)
+    t = traj.times
+    u = v0 + np.cross([0.0, 0.0, w], r0)  # inertial velocity
+    line = r0[None] + t[:, None] * u[None]
+    c, s = np.cos(w * t), np.sin(w * t)  # the frame has turned by w t: rotate back by -w t
+    seen = np.stack([c * line[:, 0] + s * line[:, 1], -s * line[:, 0] + c * line[:, 1], line[:, 2]], axis=1)
+    err = np.max(np.linalg.norm(traj.r[:, 0] - seen, axis=1) / np.maximum(1.0, np.linalg.norm(seen, axis=1)))
+    assert err < 1e-13, err
