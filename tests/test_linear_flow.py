@@ -38,21 +38,21 @@ MODELS = {
 
 
 def mp_flow(model, spec, t):
-    """expm(M t) in mpmath, M from r'' = b - 2 w x v - w x (w x r) - k v - s r_h written out here (r_h: x and y)."""
-    mp.mp.dps = 40
-    w = [mp.mpf(float(x)) for x in model.omega.vector(0.0)]
-    M = mp.zeros(7, 7)
-    for i in range(3):
-        M[i, 3 + i] = 1
-    hat = mp.matrix([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    hat2 = hat * hat
-    for i in range(3):
-        for j in range(3):
-            M[3 + i, 3 + j] = -2 * hat[i, j] - (mp.mpf(spec["drag"]) if "drag" in spec and i == j else 0)
-            M[3 + i, j] = (-hat2[i, j] if spec.get("centrifugal") else 0) - (
-                mp.mpf(spec["spring"]) if "spring" in spec and i == j < 2 else 0)
-        M[3 + i, 6] = mp.mpf(float(G[i])) if spec.get("gravity") else 0
-    return mp.expm(M * mp.mpf(t))
+    """expm(M t) in mpmath at 40 digits, M from r'' = b - 2 w x v - w x (w x r) - k v - s r_h written out here (r_h: x and y)."""
+    with mp.workdps(40):
+        w = [mp.mpf(float(x)) for x in model.omega.vector(0.0)]
+        M = mp.zeros(7, 7)
+        for i in range(3):
+            M[i, 3 + i] = 1
+        hat = mp.matrix([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+        hat2 = hat * hat
+        for i in range(3):
+            for j in range(3):
+                M[3 + i, 3 + j] = -2 * hat[i, j] - (mp.mpf(spec["drag"]) if "drag" in spec and i == j else 0)
+                M[3 + i, j] = (-hat2[i, j] if spec.get("centrifugal") else 0) - (
+                    mp.mpf(spec["spring"]) if "spring" in spec and i == j < 2 else 0)
+            M[3 + i, 6] = mp.mpf(float(G[i])) if spec.get("gravity") else 0
+        return mp.expm(M * mp.mpf(t))
 
 
 @pytest.mark.parametrize("name", MODELS)
@@ -61,8 +61,8 @@ def test_flow_at_against_mpmath(name, t, tol):
     model, spec = MODELS[name]
     s0 = np.array([1.0, -2.0, 3.0, 100.0, 50.0, 800.0, 1.0])
     got = flow_at(flow_matrix(model), t) @ s0
-    ref = mp_flow(model, spec, t) * mp.matrix(s0.tolist())
-    ref = np.array([float(x) for x in ref])
+    with mp.workdps(40):
+        ref = np.array([float(x) for x in mp_flow(model, spec, t) * mp.matrix(s0.tolist())])
     for block in (slice(0, 3), slice(3, 6)):
         err = np.max(np.abs(got[block] - ref[block])) / np.max(np.abs(ref[block]))
         assert err < tol, (name, t, block, err)
@@ -82,9 +82,10 @@ def test_exact_runs_land_a_long_shot_to_round_off():
     traj = integrate_particles(model, np.zeros(3), v0, 400.0, method="exact", samples=2000,
                                events=[Event("ground", "r", 2, 0.0, -1, True)])
     t_hit = float(traj.event_times["ground"][0][0])
-    s0 = mp.matrix([0, 0, 0] + [mp.mpf(float(x)) for x in v0] + [1])
-    t_ref = mp.findroot(lambda t: (mp_flow(model, spec, t) * s0)[2], mp.mpf(t_hit))
-    r_ref = np.array([float(x) for x in (mp_flow(model, spec, t_ref) * s0)[0:3]])
+    with mp.workdps(40):
+        s0 = mp.matrix([0, 0, 0] + [mp.mpf(float(x)) for x in v0] + [1])
+        t_ref = mp.findroot(lambda t: (mp_flow(model, spec, t) * s0)[2], mp.mpf(t_hit))
+        r_ref = np.array([float(x) for x in (mp_flow(model, spec, t_ref) * s0)[0:3]])
     assert abs(t_hit - float(t_ref)) < 4e-15 * float(t_ref)
     r_hit = traj.event_states["ground"][0][0][:3]
     assert np.max(np.abs(r_hit - r_ref)) < 4e-15 * np.max(np.abs(r_ref))

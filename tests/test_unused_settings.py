@@ -29,8 +29,9 @@ def test_an_unread_setting_is_flagged_and_changes_nothing(name, method, key, val
         flagged = [w for w in summary["warnings"] if w.startswith(f"{key} = ") and "is not used" in w]
         assert len(flagged) == 1 and method in flagged[0], summary["warnings"]
     (_, first), (_, second) = runs
-    assert np.array_equal(first.trajectory.r if hasattr(first.trajectory, "r") else first.trajectory.L,
-                          second.trajectory.r if hasattr(second.trajectory, "r") else second.trajectory.L)
+    for field in ("r", "v", "L", "q"):  # particle (r, v) or rigid body (L, q) states
+        if hasattr(first.trajectory, field):
+            assert np.array_equal(getattr(first.trajectory, field), getattr(second.trajectory, field)), field
 
 
 def test_a_read_setting_and_the_file_defaults_are_not_flagged():

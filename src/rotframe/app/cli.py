@@ -195,10 +195,11 @@ def cmd_show(args) -> int:
         print(f"optional terms (--audit toggles them): {', '.join(scn.optional_terms)}")
     from rotframe import scenes
 
-    methods = getattr(scenes.get(scn.scene), "METHODS", None)
+    scene = scenes.get(scn.scene)
+    methods = getattr(scene, "METHODS", None)
     run = {k: v for k, v in scn.run.items() if v is not None}
     print("run: " + ", ".join(f"{k} = {v}" for k, v in run.items()))
-    default = getattr(scenes.get(scn.scene), "DEFAULT_METHOD", None)
+    default = getattr(scene, "DEFAULT_METHOD", None)
     if default and "method" not in run:
         print(f"default method: {default}")
     if methods:

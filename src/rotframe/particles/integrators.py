@@ -103,15 +103,16 @@ def canonical_method(name: str) -> str:
     return name
 
 
-def default_method(model: ParticleModel, events: Sequence[Event] = ()) -> str:
-    """``exact`` where the model has an exact flow, else ``rotation-splitting``.
+def default_method(model: ParticleModel, events: Sequence[Event] = (), otherwise: str = "rotation-splitting") -> str:
+    """``exact`` where the model has an exact flow, else ``otherwise`` (``rotation-splitting``).
 
     The exact flow: a linear constant-coefficient model, or a force-free one without
-    events (events are located on the linear flow only).
+    events (events are located on the linear flow only). A scene whose other models need
+    an adaptive method passes ``otherwise="dop853"``.
     """
     if model.is_linear or (model.is_force_free and not events):
         return "exact"
-    return "rotation-splitting"
+    return otherwise
 
 
 def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,

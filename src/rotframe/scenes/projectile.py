@@ -24,7 +24,7 @@ import numpy as np
 from rotframe import analytic
 # astropy's values, read when the scene is imported (before the run's clock starts): every run needs them
 from rotframe.earth import R_EARTH
-from rotframe.particles.integrators import Event
+from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
@@ -82,9 +82,9 @@ def build(p, terms):
 def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     model, r0, v0, ground, duration, g = build(p, terms)
-    # the exact flow where it exists (the default terms, with or without centrifugal: linear), which is exact to
-    # round-off and compiles nothing; DOP853 at the scenario's rtol once central gravity, curvature or drag enter
-    method = method or run.get("method") or ("exact" if model.is_linear else "dop853")
+    # the exact flow where it exists (round-off accurate, nothing to compile); DOP853 at the scenario's rtol once
+    # central gravity, curvature or drag make the model nonlinear
+    method = method or run.get("method") or default_method(model, [ground], otherwise="dop853")
 
     # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
     flight = 2 * p.speed * math.sin(math.radians(p.elevation)) / g
