@@ -45,12 +45,15 @@ _LAZY = {
     "Result": "rotframe.app.api",
     "TrajectoryArrays": "rotframe.app.api",
     "register_scene": "rotframe.app.api",
+    "simulate": "rotframe.app.problems",
+    "simulate_body": "rotframe.app.problems",
+    "Force": "rotframe.problem.particles",
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
 }
 _SUBMODULES = ("analytic", "app", "earth", "errors", "frames", "limits", "numerics", "particles",
-               "rigid", "scenes", "validation")
+               "problem", "rigid", "scenes", "validation")
 
 #: Where the modules of the first, flat layout live now: ``rotframe.inertia`` and
 #: ``from rotframe import integrators`` keep working (``import rotframe.inertia`` does not).

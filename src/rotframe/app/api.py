@@ -344,8 +344,9 @@ class Result:
         The loaded scenario.
     """
 
-    def __init__(self, scenario, values, scene_result, summary):
+    def __init__(self, scenario, values, scene_result, summary, scene=None):
         self.scenario = scenario
+        self._scene = scene  # a problem posed in Python (rotframe.simulate) records through its own scene
         self._values = values
         self._scene_result = scene_result
         self._summary = _python_scalars(summary)  # np.float64(11.3) -> 11.3: reads as the JSON does
@@ -388,7 +389,7 @@ class Result:
             raise ScenarioError(f"record({str(path)!r}): a recording path must end in .rrd")
         t0 = time.perf_counter()
         final = runner.record_result(self.scenario, self._values, self._scene_result, self._summary, str(path),
-                                     complete=self.complete)
+                                     complete=self.complete, scene=self._scene)
         self._summary["timing"]["record_s"] = time.perf_counter() - t0
         self._summary["recording"] = str(final)
         return Path(final)

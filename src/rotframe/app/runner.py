@@ -159,12 +159,15 @@ def summarize_minimal(scn, values, result, timing):
             "t_reached_s": float(result.trajectory.t_reached)}
 
 
-def record_result(scn, values, result, summary, path, complete=True):
-    """Write the recording; returns the final path (``.partial.rrd`` if not complete)."""
+def record_result(scn, values, result, summary, path, complete=True, scene=None):
+    """Write the recording; returns the final path (``.partial.rrd`` if not complete).
+
+    ``scene``: the object that records (default: the scenario's registered scene).
+    """
     from rotframe import scenes
     from rotframe.app.record import Recording
 
-    scene = scenes.get(scn.scene)
+    scene = scene if scene is not None else scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}
     rec = Recording(path, scn.name)
     try:

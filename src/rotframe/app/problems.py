@@ -1,0 +1,192 @@
+"""``rotframe.simulate`` and ``rotframe.simulate_body``: your own problem, as a :class:`Result`.
+
+The numerical work is :mod:`rotframe.problem` (the numerical core's layer); this edge wraps
+what it returns in the same :class:`rotframe.app.api.Result` as ``rotframe.run``: arrays,
+diagnostics, warnings, ``record()``, ``export()``, ``to_dataframe()``, ``to_json()``.
+Arguments are keyword-only, SI units, vectors in the frame's axes (DESIGN, "Python: your own
+problem").
+
+Examples
+--------
+>>> import numpy as np, rotframe
+>>> def spring(t, r, v, k):
+...     return -k * r[0], -k * r[1], -k * r[2]
+>>> res = rotframe.simulate(omega=[0, 0, 0], r0=[1, 0, 0], v0=[0, 1, 0], duration=2 * np.pi,
+...                         forces=[spring], params=(1.0,), samples=4)
+>>> bool(np.allclose(res.trajectory.r[-1, 0], [1, 0, 0], atol=1e-8))    # one full turn
+True
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["simulate", "simulate_body", "ProblemScenario"]
+
+
+@dataclass
+class ProblemScenario:
+    """What a :class:`Result` needs of a scenario, for a problem posed in Python."""
+
+    name: str
+    scene: str
+    title: str
+    description: str
+    parameters: dict = field(default_factory=dict)
+    run: dict = field(default_factory=dict)
+    model: list = field(default_factory=list)
+
+
+@dataclass
+class _SceneResult:
+    trajectory: Any
+    terms: list
+    method: str
+    steps: int
+    nfev: int = 0
+    extras: dict = field(default_factory=dict)
+
+
+def _summary(name, params, terms, method, steps, diagnostics, warnings, notes, timing, complete, t_reached):
+    summary = {"scenario": name, "params": params, "model": terms, "method": method, "steps": int(steps),
+               "metrics": {}, "theory": {}, "theory_notes": {}, "diagnostics": dict(diagnostics),
+               "warnings": list(warnings), "timing": timing, "recording": None, "units": {}}
+    if notes:
+        summary["notes"] = list(notes)
+    if not complete:
+        summary["complete"] = False
+        summary["t_reached_s"] = float(t_reached)
+    return summary
+
+
+def _describe(f):
+    from rotframe.problem.callables import display_name
+
+    accel = getattr(f, "accel", f)
+    return display_name(accel)
+
+
+def _result(scn, scene, scene_result, summary):
+    from rotframe.app.api import Result
+
+    return Result(scn, {"run": {}}, scene_result, summary, scene=scene)
+
+
+def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(), method=None,
+             rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None, jit=True,
+             progress=None):
+    """Particles under your forces in any rotating frame; returns a :class:`rotframe.Result`.
+
+    Solves ``r'' = sum f(t, r, v) - 2 w x v - w x (w x r) - w' x r - a0(t)`` in the frame's
+    axes (the fictitious forces are rotframe's; never add them yourself).
+
+    Parameters
+    ----------
+    omega : 3-vector, (times, vectors), callable or rigid-body Result
+        The frame's angular velocity relative to inertial space, rad/s, in its own axes: a
+        constant; a table (a C2 cubic spline through it); a function ``t -> (3,)`` (with
+        ``omega_dot`` or derived); or a rigid-body ``Result`` (the frame of that tumbling body).
+    r0, v0 : (3,) or (N, 3)
+        Initial positions (m) and velocities (m/s) in the frame; N particles at once.
+    duration : float
+        Seconds.
+    forces : sequence of callables or :class:`rotframe.problem.particles.Force`
+        ``f(t, r, v, *params) -> (ax, ay, az)``, m/s^2, frame axes (``Force(f, axes="inertial")``
+        for inertial axes; ``potential=U`` for the energy or Jacobi diagnostic).
+    params : tuple
+        Numbers or float arrays passed to every force and event after ``(t, r, v)``.
+    origin_acceleration : None, 3-vector, table or callable
+        a0(t), m/s^2, frame axes.
+    events : sequence of callables
+        ``g(t, r, v, *params) -> float`` with optional ``terminal`` and ``direction``
+        attributes, as in ``scipy.integrate.solve_ivp``; times in ``trajectory.event_times``.
+    method : {"dop853", "rk4"}, optional
+        Any case; default DOP853 at ``rtol`` (default 1e-10).
+    rtol, step, samples : optional
+        DOP853's tolerance; RK4's step (s); samples kept (default 1000 intervals).
+    jit : bool
+        False runs the forces and the integrator in plain Python (slow; for what numba cannot compile).
+
+    Raises
+    ------
+    rotframe.errors.ScenarioError
+        Bad input, or a user function that raises, returns the wrong shape or NaN at the start,
+        or cannot be compiled (the message names it and numba's reason).
+    rotframe.errors.IntegrationError
+        A non-finite state during the run (``exc.partial`` keeps what was computed).
+    """
+    from rotframe.problem.particles import simulate_particles
+    from rotframe.scenes.user_problem import ParticleProblemScene
+
+    t0 = time.perf_counter()
+    forces = list(forces)
+    events = list(events)
+    run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
+                             origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol,
+                             step=step, samples=samples, omega_dot=omega_dot, atol=atol,
+                             frame_attitude=frame_attitude, jit=jit, progress=progress)
+    simulate_s = time.perf_counter() - t0
+    traj = run.trajectory
+    terms = [_describe(f) for f in forces] + ["coriolis", "centrifugal", "euler"]
+    if origin_acceleration is not None:
+        terms.append("origin acceleration")
+    params_out = {"duration": float(duration), "particles": int(traj.r.shape[1]), "frame": run.frame.kind}
+    timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
+    summary = _summary("simulate", params_out, terms, traj.method, traj.steps, run.diagnostics, run.warnings,
+                       run.notes, timing, traj.complete, traj.t_reached)
+    summary["units"] = {"duration": "s"}
+    scn = ProblemScenario("simulate", "simulate", "Your own problem (rotframe.simulate)",
+                          f"{traj.r.shape[1]} particle(s) in a frame given as {run.frame.kind}; forces: "
+                          + (", ".join(terms[:len(forces)]) or "none"))
+    scene_result = _SceneResult(traj, terms, traj.method, traj.steps, traj.nfev,
+                                extras={"diagnostics": run.diagnostics, "frame": run.frame})
+    result = _result(scn, ParticleProblemScene(), scene_result, summary)
+    result.trajectory.frame = "the frame given by omega (its own axes)"
+    return result
+
+
+def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                  samples=None, jit=True, progress=None):
+    """A rigid body under your torque; returns a :class:`rotframe.Result` (``trajectory.L``, ``.q``).
+
+    Parameters
+    ----------
+    inertia : (3,) principal moments or (3, 3) tensor, kg m^2
+        In the body axes that ``L0`` and the torque use.
+    L0 : (3,)
+        Angular momentum in body axes, kg m^2/s.
+    q0 : (4,)
+        Attitude, a scalar-last unit quaternion rotating body components into space components.
+    torque : callable, optional
+        ``tau(t, L, q, *params) -> (3,)``, N m, body axes, compiled with numba as the forces are.
+    method : {"dop853", "rk4", "exact"}, optional
+        Any case; ``exact`` only without a torque (principal axes). The built-in splittings
+        refuse a torque by name.
+
+    The result carries ``inertia`` (3, 3), so that it can be the frame of ``rotframe.simulate``
+    (``omega=result``: the body's axes).
+    """
+    import numpy as np
+
+    from rotframe.problem.body import simulate_rigid_body
+    from rotframe.scenes.user_problem import BodyProblemScene
+
+    t0 = time.perf_counter()
+    run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,
+                              method=method, rtol=rtol, step=step, samples=samples, jit=jit, progress=progress)
+    simulate_s = time.perf_counter() - t0
+    terms = ["euler equations"] + ([f"torque {_describe(torque)}"] if torque is not None else [])
+    timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
+    summary = _summary("simulate_body", {"duration": float(duration)}, terms, run.method, run.steps,
+                       run.diagnostics, run.warnings, run.notes, timing, run.complete, run.t_reached)
+    scn = ProblemScenario("simulate_body", "simulate_body", "Your own rigid body (rotframe.simulate_body)",
+                          "Euler's equations" + (" with a torque" if torque is not None else ", torque-free"))
+    scene_result = _SceneResult(run, terms, run.method, run.steps, run.nfev,
+                                extras={"diagnostics": run.diagnostics, "inertia": np.diag(run.inertia).copy()
+                                        if np.all(run.inertia == np.diag(np.diag(run.inertia))) else run.inertia})
+    result = _result(scn, BodyProblemScene(), scene_result, summary)
+    result.inertia = run.inertia
+    result.torque_samples = run.torque_samples
+    return result

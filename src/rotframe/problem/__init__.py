@@ -1,0 +1,39 @@
+"""Your own problem: your forces, torques and events, in any rotating frame.
+
+Layer 3 of the house (``docs/architecture.md``), beside ``earth`` and ``analytic``: it
+imports the numerical cores (``particles``, ``rigid``, ``numerics``) and nothing above.
+``rotframe.simulate`` and ``rotframe.simulate_body`` wrap these functions in a
+``rotframe.Result``.
+
+Modules, one concept each:
+
+* ``frame``: a frame that rotates any way (omega as a constant, a table, a function, or a
+  rigid body's axes) and an accelerating origin;
+* ``callables``: the user's functions: fingerprints, numba compilation, one-line errors;
+* ``codegen``: the generated, disk-cached driver module of a problem;
+* ``evaluators``: source of the frame's compiled evaluators;
+* ``particle_driver``, ``body_driver``: source of the compiled drivers;
+* ``particles``: :func:`simulate_particles`, :class:`Force`;
+* ``body``: :func:`simulate_rigid_body`;
+* ``forces``: the built-in forces as ordinary members of the same system.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_NAMES = {
+    "Force": "rotframe.problem.particles",
+    "simulate_particles": "rotframe.problem.particles",
+    "simulate_rigid_body": "rotframe.problem.body",
+    "frame_spec": "rotframe.problem.frame",
+}
+
+__all__ = list(_NAMES)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _NAMES:
+        return getattr(importlib.import_module(_NAMES[name]), name)
+    raise AttributeError(f"module 'rotframe.problem' has no attribute {name!r}")

@@ -1,0 +1,225 @@
+"""A rigid body of the user's own: any inertia tensor, a torque of the user's, DOP853 or RK4.
+
+:func:`simulate_rigid_body` is the numerical core of ``rotframe.simulate_body``. The torque
+is a function ``tau(t, L, q, *params) -> (3,)`` in body axes (N m), compiled with numba into
+a driver generated for it (:mod:`rotframe.problem.codegen`, cached on disk), as the forces of
+a particle problem are. A torque-free body may also take ``exact``, the closed-form flow of
+``rotframe.rigid.free_body_exact`` (principal axes).
+
+The splitting methods of the built-in scenes (``lie-poisson``, ``rotation-splitting``...)
+compose the free body's exact flow with a torque's flow, which exists in closed form only
+for torques of a known shape (the heavy top's gravity); a user's torque is refused by them,
+by name.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.particles.trajectory import RunInterrupted
+from rotframe.problem import callables as uf
+from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
+from rotframe.problem.codegen import build_module
+from rotframe.problem.particles import DEFAULT_RTOL, DEFAULT_SAMPLES, STATUS, canonical_method
+
+__all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES"]
+
+#: Methods of a user's rigid body (names are case-insensitive)
+BODY_METHODS = ("dop853", "rk4", "exact")
+#: Splitting methods of the built-in scenes that cannot take a user's torque
+SPLITTING_NAMES = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "rotation-splitting",
+                   "top-splitting", "top-splitting4", "top-splitting6", "top-splitting8")
+
+
+class BodyRun:
+    """What :func:`simulate_rigid_body` returns: samples of L and q, diagnostics, warnings."""
+
+    def __init__(self, times, L, q, method, steps, nfev, complete, inertia, diagnostics, warnings, notes,
+                 torque_samples=None, compile_s=0.0):
+        self.times, self.L, self.q = times, L, q
+        self.method, self.steps, self.nfev, self.complete = method, steps, nfev, complete
+        self.t_reached = float(times[-1]) if len(times) else math.nan
+        self.inertia = inertia
+        self.diagnostics, self.warnings, self.notes = diagnostics, warnings, notes
+        self.torque_samples = torque_samples
+        self.compile_s = compile_s
+        self.extras = {"compile_s": compile_s}
+
+
+def _inertia(inertia):
+    I = np.asarray(inertia, dtype=float)
+    if I.shape == (3,):
+        I = np.diag(I)
+    if I.shape != (3, 3) or not np.all(np.isfinite(I)):
+        raise ScenarioError(f"inertia: expected 3 principal moments or a 3x3 tensor (kg m^2), got shape {I.shape}")
+    if not np.allclose(I, I.T, rtol=1e-12, atol=0.0):
+        raise ScenarioError("inertia: the tensor is not symmetric")
+    ev = np.linalg.eigvalsh(I)
+    if ev[0] <= 0:
+        raise ScenarioError(f"inertia: principal moments {ev.tolist()} must be > 0")
+    a, b, c = ev
+    if a + b < c * (1 - 1e-12):
+        raise ScenarioError(f"inertia: principal moments {ev.tolist()} break the triangle inequality "
+                            "(no rigid body has them)")
+    return np.ascontiguousarray(I)
+
+
+def _header(nparams):
+    args = "".join(f", P[{j}]" for j in range(nparams))
+    return (f"\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n"
+            + (f"    a = torque_fn(t, y[0:3], y[3:7]{args})\n    return a[0], a[1], a[2]\n" if nparams >= 0 else ""))
+
+
+_FREE_HEADER = "\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n    return 0.0, 0.0, 0.0\n"
+
+
+def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                        samples=None, jit=True, progress=None) -> BodyRun:
+    """Integrate a rigid body under the user's torque; see :func:`rotframe.simulate_body`."""
+    import time
+
+    from rotframe import limits
+    from rotframe.problem.particles import check_params
+
+    if torque is None and isinstance(method, str) and method.lower() in SPLITTING_NAMES:
+        raise ScenarioError(f"method={method!r} is a built-in scene's splitting; simulate_body takes "
+                            f"{', '.join(BODY_METHODS)}")
+    if torque is not None and isinstance(method, str) and method.lower() in SPLITTING_NAMES + ("exact",):
+        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: a user's torque has no "
+                            "closed-form flow to split with (or compose into the exact free flow); use dop853 or rk4")
+    method = canonical_method(method, BODY_METHODS, "dop853")
+    I = _inertia(inertia)
+    L = np.asarray(L0, dtype=float)
+    q = np.asarray(q0, dtype=float)
+    if L.shape != (3,) or q.shape != (4,) or not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
+        raise ScenarioError(f"L0, q0: expected finite (3,) and (4,), got shapes {L.shape} and {q.shape}")
+    nq = float(np.linalg.norm(q))
+    if abs(nq - 1.0) > 1e-6:
+        raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
+    q = q / nq
+    duration = float(duration)
+    if not (math.isfinite(duration) and duration > 0):
+        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
+    if torque is not None and not callable(torque):
+        raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
+    params = check_params(params)
+    samples = DEFAULT_SAMPLES if samples is None else samples
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
+    samples = int(samples)
+    times = np.linspace(0.0, duration, samples + 1)
+    rtol = DEFAULT_RTOL if rtol is None else float(rtol)
+    if not (1e-15 <= rtol < 1):
+        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
+    if method == "exact":
+        return _exact(I, L, q, times)
+    hfix = 0.0
+    if method == "rk4":
+        step = duration / samples / 20 if step is None else float(step)
+        if not (math.isfinite(step) and step > 0) or step < 1e-300:
+            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
+        per = max(1, math.ceil((duration / samples) / step - 1e-9))
+        hfix = (duration / samples) / per
+        limits.check_run(steps=per * samples, samples=samples + 1, what="method rk4")
+    else:
+        limits.check_run(steps=samples, samples=samples + 1, what="method dop853")
+    if torque is not None:
+        uf.check_call("torque", torque, (0.0, L.copy(), q.copy(), *params), (3,),
+                      when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")
+        import numba
+
+        fn = numba.njit(uf.plain_function(torque), error_model="numpy") if jit else uf.plain_function(torque)
+        functions = {"torque_fn": fn}
+        header = _header(len(params))
+        key = uf.fingerprint(torque) + f"|{len(params)}"
+    else:
+        functions, header, key = {}, _FREE_HEADER, "free"
+    module = build_module("body", key, functions, header, BODY_SOURCE, compiled=jit)
+    y = np.concatenate([L, q])[None, :].copy()
+    n = samples + 1
+    OUT = np.full((n, 1, 7), np.nan)
+    Iinv = np.ascontiguousarray(np.linalg.inv(I))
+    sL = max(float(np.max(np.abs(L))), 1e-300)
+    atol = np.array([rtol * sL] * 3 + [rtol] * 4)
+    st = {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")}
+    TC, H = np.zeros(1), np.zeros(1)
+    EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
+    GPREV = np.zeros((1, 1))
+    EDIR, ETERM = np.zeros(1), np.zeros(1, dtype=bool)
+    code = 0 if method == "dop853" else 1
+    t0 = time.perf_counter()
+    compile_s = None
+    try:
+        while True:
+            try:
+                module.advance(times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+                               st["NSTEP"], st["NFEV"], 20000, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
+                               (np.zeros(3),))
+            except Exception as exc:
+                import numba
+
+                if isinstance(exc, numba.core.errors.NumbaError):
+                    reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
+                    raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to "
+                                               "run it in plain Python (slow)") from None
+                raise
+            if compile_s is None:
+                compile_s = time.perf_counter() - t0
+            if progress is not None:
+                progress(float(st["IDX"][0]) / n)
+            if st["ST"][0] != 0:
+                break
+            if float(st["NSTEP"][0]) > limits.current().max_steps:
+                raise limits.LimitError(f"simulate_body: more than {limits.current().max_steps:.3g} steps")
+    except KeyboardInterrupt:
+        k = max(int(st["IDX"][0]), 1)
+        raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, torque, compile_s or 0.0,
+                                  [], jit)) from None
+    k = int(st["IDX"][0])
+    if st["ST"][0] >= 3:
+        partial = _run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, torque, compile_s, [], jit)
+        t_bad = float(TC[0])
+        raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]} after t = {t_bad:.9g} s (method {method})",
+                               t_reached=t_bad, partial=partial)
+    return _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
+
+
+def _run(times, Y, method, st, I, complete, params, torque, compile_s, warnings, jit):
+    L = Y[:, :3].copy()
+    q = Y[:, 3:7].copy()
+    norms = np.linalg.norm(q, axis=1)
+    diagnostics = {"quaternion_norm_drift": float(np.max(np.abs(norms - 1.0)))}
+    q /= norms[:, None]
+    notes = []
+    torque_samples = None
+    if torque is None:
+        w = L @ np.linalg.inv(I).T
+        E = 0.5 * np.einsum("ij,ij->i", L, w)
+        Lm = np.linalg.norm(L, axis=1)
+        diagnostics["energy_rel_drift"] = float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] else 0.0
+        diagnostics["momentum_rel_drift"] = float(np.max(np.abs(Lm - Lm[0])) / Lm[0]) if Lm[0] else 0.0
+    else:
+        f = uf.plain_function(torque)
+        torque_samples = np.array([np.asarray(f(t, L[i], q[i], *params), float) for i, t in enumerate(times)])
+        notes.append("a torque acts: energy and |L| are not conserved, and not reported")
+    warnings = list(warnings)
+    if not jit:
+        warnings.append("jit=False: the torque and the integrator ran as plain Python, some 100 to 1000 times "
+                        "slower than compiled")
+    return BodyRun(times, L, q, method, int(st["NSTEP"][0]), int(st["NFEV"][0]), complete, I, diagnostics,
+                   warnings, notes, torque_samples, compile_s or 0.0)
+
+
+def _exact(I, L, q, times):
+    """The torque-free body's closed-form flow (principal axes required)."""
+    from rotframe.rigid.free_body import free_body_exact
+
+    if np.any(I != np.diag(np.diag(I))):
+        raise ScenarioError("method='exact' needs principal axes (a diagonal inertia); give the 3 principal "
+                            "moments, or use dop853")
+    Ls, qs = free_body_exact(np.diag(I).copy(), L, q, times)
+    st = {"NSTEP": np.zeros(1, np.int64), "NFEV": np.zeros(1, np.int64)}
+    return _run(times, np.concatenate([Ls, qs], axis=1), "exact", st, I, True, (), None, 0.0, [], True)

@@ -1,0 +1,254 @@
+"""A frame that rotates any way: omega(t), its derivative, and an accelerating origin.
+
+The transport theorem holds for any angular velocity ``omega(t)`` of the frame relative to
+inertial space (docs/physics/rotating-frames.md). A particle seen from such a frame, with an
+origin that accelerates at ``a0(t)``, obeys (all vectors in the frame's own axes)::
+
+    r'' = f(t, r, v) - 2 omega x v - omega x (omega x r) - omega' x r - a0(t)
+
+where ``omega'`` is the derivative of omega (the same in the frame's axes and in inertial
+axes, since omega x omega = 0). :class:`FrameSpec` turns the forms a user may give into
+arrays that the compiled drivers read:
+
+==========  =========================================================================
+kind        data
+==========  =========================================================================
+constant    the vector omega; omega' = 0
+table       a C2 cubic spline through ``(times, vectors)`` (scipy's ``CubicSpline``,
+            not-a-knot): omega and omega' are the spline and its derivative
+function    a user function ``t -> (3,)``; omega' given (``omega_dot=``) or derived
+            by a fourth-order central difference (error about 1e-11 of omega's scale
+            over its time scale)
+body        the body axes of a rigid-body solution: omega = I^-1 L at each sample,
+            omega' and omega'' from Euler's equations there, and a quintic Hermite
+            interpolant between samples (cubic where the body had a torque)
+==========  =========================================================================
+
+The origin's acceleration ``a0(t)`` takes the constant, table and function forms.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["FrameSpec", "frame_spec", "origin_spec", "KINDS"]
+
+KINDS = ("constant", "table", "function", "body")
+
+
+@dataclass
+class FrameSpec:
+    """What the drivers need to evaluate a vector function of time and its derivative.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS` (``"zero"`` for a missing origin acceleration).
+    data : tuple of float64 arrays
+        The kind's arrays (see :func:`frame_spec`); for ``function``, empty.
+    funcs : tuple of callables
+        For ``function``: the user's ``omega(t)`` and, if given, ``omega_dot(t)``.
+    t_range : (float, float)
+        Times where the spec is defined (a table or a body solution); +-inf otherwise.
+    is_constant : bool
+        Constant in time (omega' = 0): with potentials, the Jacobi integral is conserved.
+    """
+
+    kind: str
+    data: tuple = ()
+    funcs: tuple = ()
+    t_range: tuple = (-math.inf, math.inf)
+    is_constant: bool = False
+    notes: list = field(default_factory=list)
+
+    def vector_at(self, t):
+        """The vector and its derivative at times ``t`` (numpy, for analysis and tests): two (n, 3) arrays."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if self.kind == "zero":
+            return np.zeros((t.size, 3)), np.zeros((t.size, 3))
+        if self.kind == "constant":
+            return np.tile(self.data[0], (t.size, 1)), np.zeros((t.size, 3))
+        if self.kind == "table":
+            knots, coef = self.data
+            out = np.empty((t.size, 3))
+            der = np.empty((t.size, 3))
+            for n, tt in enumerate(t):
+                out[n], der[n] = spline_at(knots, coef, tt)
+            return out, der
+        if self.kind == "body":
+            out = np.empty((t.size, 3))
+            der = np.empty((t.size, 3))
+            for n, tt in enumerate(t):
+                out[n], der[n] = hermite_at(*self.data, tt)
+            return out, der
+        f = self.funcs[0]
+        fd = self.funcs[1] if len(self.funcs) > 1 else None
+        out = np.array([np.asarray(f(float(tt)), dtype=float) for tt in t])
+        der = np.array([np.asarray(fd(float(tt)), dtype=float) if fd is not None else central_difference(f, float(tt))
+                        for tt in t])
+        return out, der
+
+
+def central_difference(f, t):
+    """omega'(t) by the fourth-order central difference (h about eps^(1/5) times the time scale)."""
+    h = 2.0 ** -9 * max(1.0, abs(t))
+    a = np.asarray(f(t - 2 * h), float)
+    b = np.asarray(f(t - h), float)
+    c = np.asarray(f(t + h), float)
+    d = np.asarray(f(t + 2 * h), float)
+    return (a - 8 * b + 8 * c - d) / (12 * h)
+
+
+def spline_at(knots, coef, t):
+    """A piecewise cubic ``coef[i, k, :] (t - knots[i])^(3 - k)`` and its derivative at ``t`` (numpy)."""
+    i = int(np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2))
+    s = t - knots[i]
+    c = coef[i]
+    return ((c[0] * s + c[1]) * s + c[2]) * s + c[3], (3 * c[0] * s + 2 * c[1]) * s + c[2]
+
+
+def hermite_at(times, w, wd, wdd, t):
+    """Quintic Hermite interpolant through (w, w', w'') at the samples, and its derivative (numpy)."""
+    i = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2))
+    h = times[i + 1] - times[i]
+    s = (t - times[i]) / h
+    H = _quintic_basis(s)
+    D = _quintic_basis_derivative(s)
+    p = (H[0] * w[i] + H[1] * h * wd[i] + H[2] * h * h * wdd[i]
+         + H[3] * w[i + 1] + H[4] * h * wd[i + 1] + H[5] * h * h * wdd[i + 1])
+    dp = (D[0] * w[i] + D[1] * h * wd[i] + D[2] * h * h * wdd[i]
+          + D[3] * w[i + 1] + D[4] * h * wd[i + 1] + D[5] * h * h * wdd[i + 1]) / h
+    return p, dp
+
+
+def _quintic_basis(s):
+    s2, s3 = s * s, s * s * s
+    s4, s5 = s3 * s, s3 * s2
+    return (1 - 10 * s3 + 15 * s4 - 6 * s5, s - 6 * s3 + 8 * s4 - 3 * s5, 0.5 * (s2 - 3 * s3 + 3 * s4 - s5),
+            10 * s3 - 15 * s4 + 6 * s5, -4 * s3 + 7 * s4 - 3 * s5, 0.5 * (s3 - 2 * s4 + s5))
+
+
+def _quintic_basis_derivative(s):
+    s2, s3, s4 = s * s, s * s * s, s * s * s * s
+    return (-30 * s2 + 60 * s3 - 30 * s4, 1 - 18 * s2 + 32 * s3 - 15 * s4, 0.5 * (2 * s - 9 * s2 + 12 * s3 - 5 * s4),
+            30 * s2 - 60 * s3 + 30 * s4, -12 * s2 + 28 * s3 - 15 * s4, 0.5 * (3 * s2 - 8 * s3 + 5 * s4))
+
+
+def _vector3(value, what):
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,):
+        raise ScenarioError(f"{what}: expected a 3-vector, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ScenarioError(f"{what}: {arr.tolist()} is not finite")
+    return np.ascontiguousarray(arr)
+
+
+def _table(value, what):
+    times, vectors = value
+    times = np.asarray(times, dtype=float)
+    vectors = np.asarray(vectors, dtype=float)
+    if times.ndim != 1 or times.size < 2 or vectors.shape != (times.size, 3):
+        raise ScenarioError(f"{what}: a table is (times (n,), vectors (n, 3)) with n >= 2; got shapes "
+                            f"{times.shape} and {vectors.shape}")
+    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(vectors))):
+        raise ScenarioError(f"{what}: the table has non-finite entries")
+    bad = np.flatnonzero(np.diff(times) <= 0)
+    if bad.size:
+        k = int(bad[0])
+        raise ScenarioError(f"{what}: the table's times must increase; times[{k + 1}] = {times[k + 1]:g} s "
+                            f"follows times[{k}] = {times[k]:g} s")
+    from scipy.interpolate import CubicSpline
+
+    spline = CubicSpline(times, vectors, axis=0, bc_type="not-a-knot" if times.size > 3 else "natural")
+    coef = np.ascontiguousarray(np.transpose(spline.c, (1, 0, 2)))  # (n - 1, 4, 3)
+    return FrameSpec("table", (np.ascontiguousarray(times), coef), t_range=(times[0], times[-1]),
+                     is_constant=bool(np.all(vectors == vectors[0])))
+
+
+def _body(result, what):
+    """The body axes of a rigid-body Result: omega = I^-1 L, with omega', omega'' from Euler's equations."""
+    traj = getattr(result, "trajectory", None)
+    L = getattr(traj, "L", None)
+    q = getattr(traj, "q", None)
+    inertia = getattr(result, "inertia", None)
+    if L is None or q is None:
+        raise ScenarioError(f"{what}: the result has no attitudes (trajectory.L and trajectory.q): give the "
+                            "Result of a rigid-body run (rotframe.simulate_body or a rigid scene)")
+    if inertia is None:
+        raise ScenarioError(f"{what}: the result does not carry its body's inertia (result.inertia)")
+    times = np.asarray(traj.times, dtype=float)
+    L = np.asarray(L, dtype=float)
+    if times.size < 2:
+        raise ScenarioError(f"{what}: the body solution has fewer than two samples")
+    I = np.asarray(inertia, dtype=float)
+    Iinv = np.linalg.inv(I)
+    w = L @ Iinv.T
+    torque = getattr(result, "torque_samples", None)
+    tau = np.zeros_like(L) if torque is None else np.asarray(torque, float)
+    Ld = np.cross(L, w) + tau  # body-frame dL/dt = L x omega + tau
+    wd = Ld @ Iinv.T
+    notes = []
+    if torque is None:
+        Ldd = np.cross(Ld, w) + np.cross(L, wd)
+        wdd = Ldd @ Iinv.T
+    else:
+        wdd = np.gradient(wd, times, axis=0)
+        notes.append("the body had a torque: omega'' between samples from differences of omega' (cubic accuracy)")
+    return FrameSpec("body", tuple(np.ascontiguousarray(a) for a in (times, w, wd, wdd)),
+                     t_range=(times[0], times[-1]), notes=notes)
+
+
+def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
+    """Normalise a frame's angular velocity (rad/s, frame axes) to a :class:`FrameSpec`.
+
+    Parameters
+    ----------
+    value : 3-vector, (times, vectors), callable or rigid-body Result
+        The forms of ``rotframe.simulate(omega=...)``.
+    omega_dot : callable, optional
+        ``t -> (3,)``, the derivative of a callable omega (else it is derived).
+    """
+    if callable(value) and not hasattr(value, "trajectory"):
+        if omega_dot is not None and not callable(omega_dot):
+            raise ScenarioError(f"{what}_dot: must be a callable t -> (3,) beside a callable {what}")
+        for f, name in ((value, what), (omega_dot, f"{what}_dot")):
+            if f is None:
+                continue
+            try:
+                out = np.asarray(getattr(f, "py_func", f)(0.0), dtype=float)
+            except Exception as exc:  # the user's function: any error is theirs, reported in one line
+                raise ScenarioError(f"{name}: {_name(f)} raised {type(exc).__name__}: {exc} at t = 0") from None
+            if out.shape != (3,):
+                raise ScenarioError(f"{name}: {_name(f)} returned shape {out.shape} at t = 0; expected (3,)")
+            if not np.all(np.isfinite(out)):
+                raise ScenarioError(f"{name}: {_name(f)} returned {out.tolist()} at t = 0 (not finite)")
+        funcs = (value,) if omega_dot is None else (value, omega_dot)
+        return FrameSpec("function", (), funcs)
+    if omega_dot is not None:
+        raise ScenarioError(f"{what}_dot is only for a callable {what}")
+    if hasattr(value, "trajectory"):
+        return _body(value, what)
+    if isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1 and np.ndim(value[1]) == 2:
+        return _table(value, what)
+    return FrameSpec("constant", (_vector3(value, what),), is_constant=True)
+
+
+def origin_spec(value, what="origin_acceleration") -> FrameSpec:
+    """The origin's acceleration (m/s^2, frame axes): None, a 3-vector, a table or a callable."""
+    if value is None:
+        return FrameSpec("zero", (np.zeros(3),), is_constant=True)
+    if hasattr(value, "trajectory"):
+        raise ScenarioError(f"{what}: a rigid-body Result is a form of omega only")
+    spec = frame_spec(value, what=what)
+    if spec.kind == "constant" and not np.any(spec.data[0]):
+        return FrameSpec("zero", (np.zeros(3),), is_constant=True)
+    return spec
+
+
+def _name(f):
+    return getattr(f, "__qualname__", None) or getattr(f, "__name__", None) or repr(f)

@@ -1,0 +1,101 @@
+"""Source of the compiled particle driver of a user's problem (DOP853 and RK4, events, energy).
+
+:mod:`rotframe.problem.codegen` writes a module made of a generated header (the user's
+functions bound to names, the frame's evaluators, the state size ``D``, the event count
+``NE``) followed by :data:`SOURCE`, and numba compiles it with ``cache=True``. The header
+defines, besides ``jit``, ``jit_parallel``, ``prange``, ``math``, ``np`` and the DOP853
+tableau ``A, B, C, E3, E5`` and error norm ``error_norm``::
+
+    frame_rates(t, F) -> (wx, wy, wz, ex, ey, ez)    omega and omega' in frame axes
+    origin_acceleration(t, G) -> (ax, ay, az)        the frame origin's acceleration
+    user_acceleration(t, y, P) -> (ax, ay, az)       the sum of the user's forces, frame axes
+    event_value(k, t, y, P) -> float                 event k's function
+    potential(t, y, P) -> float                      the sum of the forces' potentials
+
+The state ``y`` of one particle is ``(x, y, z, vx, vy, vz)`` in the frame's axes, followed,
+when a force is given in inertial axes, by the frame's attitude ``(qx, qy, qz, qw)``
+(scalar last, rotating frame components into inertial ones), integrated with the rest:
+``q' = q (omega, 0) / 2``.
+
+Equation of motion (docs/physics/rotating-frames.md)::
+
+    r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)
+
+Each particle is integrated alone (its own steps, its own events), so the samples do not
+depend on how many threads share the ensemble (``prange`` over particles). A call advances
+every particle by at most ``budget`` steps and returns, so that Python sees Ctrl-C, SIGTERM
+and progress between calls; the state to continue from is kept in the arrays passed in.
+
+Status codes per particle: 0 running, 1 finished, 2 stopped by a terminal event,
+3 non-finite state, 4 step size collapsed.
+"""
+
+from rotframe.problem.stepping import SOURCE as STEPPING_SOURCE
+
+SOURCE = r'''
+# ---- the body shared by every generated particle driver (rotframe.problem.particle_driver) ----
+
+@jit
+def rhs(t, y, dy, P, F, G):
+    wx, wy, wz, ex, ey, ez = frame_rates(t, F)
+    x = y[0]
+    yy = y[1]
+    z = y[2]
+    vx = y[3]
+    vy = y[4]
+    vz = y[5]
+    ax, ay, az = user_acceleration(t, y, P)
+    # Coriolis: -2 w x v
+    ax -= 2.0 * (wy * vz - wz * vy)
+    ay -= 2.0 * (wz * vx - wx * vz)
+    az -= 2.0 * (wx * vy - wy * vx)
+    # centrifugal: -w x (w x r) = |w|^2 r - (w . r) w
+    wr = wx * x + wy * yy + wz * z
+    w2 = wx * wx + wy * wy + wz * wz
+    ax += w2 * x - wr * wx
+    ay += w2 * yy - wr * wy
+    az += w2 * z - wr * wz
+    # Euler: -w' x r
+    ax -= ey * z - ez * yy
+    ay -= ez * x - ex * z
+    az -= ex * yy - ey * x
+    ox, oy, oz = origin_acceleration(t, G)
+    dy[0] = vx
+    dy[1] = vy
+    dy[2] = vz
+    dy[3] = ax - ox
+    dy[4] = ay - oy
+    dy[5] = az - oz
+    if D == 10:
+        qx = y[6]
+        qy = y[7]
+        qz = y[8]
+        qw = y[9]
+        dy[6] = 0.5 * (qw * wx + qy * wz - qz * wy)
+        dy[7] = 0.5 * (qw * wy + qz * wx - qx * wz)
+        dy[8] = 0.5 * (qw * wz + qx * wy - qy * wx)
+        dy[9] = -0.5 * (qx * wx + qy * wy + qz * wz)
+
+
+@jit
+def energies(T, OUT, P, F, rotating):
+    """Energy (rotating = False) or the Jacobi integral (rotating = True) per sample and particle, per unit mass."""
+    n = OUT.shape[0]
+    N = OUT.shape[1]
+    E = np.empty((n, N))
+    for a in range(n):
+        wx, wy, wz, ex, ey, ez = frame_rates(T[a], F)
+        for i in range(N):
+            y = OUT[a, i]
+            kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
+            e = kin + potential(T[a], y, P)
+            if rotating:
+                cx = wy * y[2] - wz * y[1]
+                cy = wz * y[0] - wx * y[2]
+                cz = wx * y[1] - wy * y[0]
+                e -= 0.5 * (cx * cx + cy * cy + cz * cz)
+            E[a, i] = e
+    return E
+'''
+
+SOURCE = SOURCE + STEPPING_SOURCE

@@ -1,0 +1,458 @@
+"""Particles of the user's own problem: their forces, their events, any rotating frame.
+
+:func:`simulate_particles` is the numerical core of ``rotframe.simulate``: float64 arrays in
+SI units, no printing, no files. It builds (or finds in the cache) a driver compiled for the
+problem's functions (:mod:`rotframe.problem.codegen`), integrates every particle on its own
+(DOP853 with Hairer's step control, or RK4 at a fixed step), locates the events by bisection
+on the method's own re-steps, and reports the energy or the Jacobi integral where the forces
+give their potentials.
+
+A force is a function ``f(t, r, v, *params) -> (ax, ay, az)`` (m/s^2; ``r``, ``v`` arrays of
+3 in the frame's axes). Attach ``axes="inertial"`` (its result is then turned into frame
+axes by the frame's attitude, integrated with the particle) or ``potential=U`` with
+``U(t, r, *params)`` (J/kg) by wrapping it in :class:`Force`, or by setting attributes of
+those names on the function. An event is ``g(t, r, v, *params) -> float`` with optional
+attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.particles.trajectory import RunInterrupted, Trajectory
+from rotframe.problem import callables as uf
+from rotframe.problem.codegen import build_module
+from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
+from rotframe.problem.frame import frame_spec, origin_spec
+from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
+
+__all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params"]
+
+#: Methods of a user's particle problem (names are case-insensitive)
+PARTICLE_METHODS = ("dop853", "rk4")
+DEFAULT_RTOL = 1e-10
+DEFAULT_SAMPLES = 1000
+STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
+
+
+@dataclass(frozen=True)
+class Force:
+    """A user force with what rotframe should know about it.
+
+    Attributes
+    ----------
+    accel : callable
+        ``accel(t, r, v, *params) -> (ax, ay, az)``, m/s^2.
+    axes : str
+        ``"frame"`` (default: the frame's axes) or ``"inertial"``.
+    potential : callable, optional
+        ``U(t, r, *params)``, J/kg, with ``accel = -grad U`` (frame axes); enables the energy
+        or Jacobi diagnostic.
+    name : str, optional
+        For messages.
+    """
+
+    accel: object
+    axes: str = "frame"
+    potential: object = None
+    name: str = ""
+
+    def __call__(self, *args):
+        return self.accel(*args)
+
+
+@dataclass
+class ProblemRun:
+    """What :func:`simulate_particles` returns: the trajectory and what was measured on it."""
+
+    trajectory: Trajectory
+    diagnostics: dict
+    warnings: list
+    notes: list
+    frame: object
+    compile_s: float = 0.0
+
+
+def canonical_method(method, allowed, default):
+    """``method`` in lower case, checked against ``allowed`` (``None``: ``default``)."""
+    if method is None:
+        return default
+    if not isinstance(method, str) or method.lower() not in allowed:
+        raise ScenarioError(f"method={method!r}: allowed: {', '.join(allowed)} (any case)")
+    return method.lower()
+
+
+def _as_force(f, k):
+    if isinstance(f, Force):
+        force = f
+    elif callable(f):
+        force = Force(f, getattr(f, "axes", "frame"), getattr(f, "potential", None))
+    else:
+        raise ScenarioError(f"forces[{k}]: {f!r} is not callable (a function f(t, r, v, *params) -> (3,))")
+    if force.axes not in ("frame", "inertial"):
+        raise ScenarioError(f"forces[{k}]: axes={force.axes!r}; allowed: 'frame', 'inertial'")
+    if not callable(force.accel) or (force.potential is not None and not callable(force.potential)):
+        raise ScenarioError(f"forces[{k}]: accel and potential must be callables")
+    return force
+
+
+def check_params(params):
+    out = []
+    for k, p in enumerate(params):
+        if isinstance(p, (bool, int, float, np.integer, np.floating)):
+            out.append(float(p))
+            continue
+        arr = np.asarray(p, dtype=float) if not isinstance(p, str) else None
+        if arr is None or arr.dtype != np.float64:
+            raise ScenarioError(f"params[{k}]: {p!r}; allowed: numbers and float arrays")
+        out.append(np.ascontiguousarray(arr))
+    return tuple(out)
+
+
+def _states(r0, v0):
+    r = np.atleast_2d(np.asarray(r0, dtype=float))
+    v = np.atleast_2d(np.asarray(v0, dtype=float))
+    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
+        raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
+    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
+        raise ScenarioError("r0, v0: not finite")
+    return r, v
+
+
+def _call_args(nparams):
+    return "".join(f", P[{j}]" for j in range(nparams))
+
+
+def _header(frame, origin, forces, events, nparams, D):
+    """The problem's own definitions: frame evaluators, the forces' sum, the events, the potential."""
+    args = _call_args(nparams)
+    src = [f"\nD = {D}\nNE = {len(events)}\n", SEARCH_SOURCE,
+           vector_source("frame_rates", frame.kind, True, "omega_fn", "omega_dot_fn" if len(frame.funcs) > 1 else ""),
+           vector_source("origin_acceleration", origin.kind, False, "origin_fn")]
+    body = ["", "@jit", "def user_acceleration(t, y, P):", "    r = y[0:3]", "    v = y[3:6]",
+            "    ax = 0.0", "    ay = 0.0", "    az = 0.0"]
+    for k, f in enumerate(forces):
+        body.append(f"    a = force_{k}(t, r, v{args})")
+        if f.axes == "inertial":  # R^T a with R = R(q): a - 2 s (u x a) + 2 u x (u x a)
+            body += ["    qx = y[6]", "    qy = y[7]", "    qz = y[8]", "    qs = y[9]",
+                     "    bx = a[0]", "    by = a[1]", "    bz = a[2]",
+                     "    cx = qy * bz - qz * by", "    cy = qz * bx - qx * bz", "    cz = qx * by - qy * bx",
+                     "    ax += bx - 2.0 * qs * cx + 2.0 * (qy * cz - qz * cy)",
+                     "    ay += by - 2.0 * qs * cy + 2.0 * (qz * cx - qx * cz)",
+                     "    az += bz - 2.0 * qs * cz + 2.0 * (qx * cy - qy * cx)"]
+        else:
+            body += ["    ax += a[0]", "    ay += a[1]", "    az += a[2]"]
+    body.append("    return ax, ay, az")
+    src.append("\n".join(body) + "\n")
+    ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = y[0:3]", "    v = y[3:6]"]
+    for k in range(len(events)):
+        ev.append(f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))")
+    ev.append("    return 0.0")
+    src.append("\n".join(ev) + "\n")
+    pot = ["", "@jit", "def potential(t, y, P):", "    r = y[0:3]", "    u = 0.0"]
+    for k, f in enumerate(forces):
+        if f.potential is not None:
+            pot.append(f"    u += float(potential_{k}(t, r{args}))")
+    pot.append("    return u")
+    src.append("\n".join(pot) + "\n")
+    return "".join(src)
+
+
+def _bind(frame, origin, forces, events, compiled):
+    import numba
+
+    def prep(f):
+        f = uf.plain_function(f)
+        return numba.njit(f, error_model="numpy") if compiled else f
+
+    functions = {}
+    if frame.kind == "function":
+        functions["omega_fn"] = prep(frame.funcs[0])
+        if len(frame.funcs) > 1:
+            functions["omega_dot_fn"] = prep(frame.funcs[1])
+    if origin.kind == "function":
+        functions["origin_fn"] = prep(origin.funcs[0])
+    for k, f in enumerate(forces):
+        functions[f"force_{k}"] = prep(f.accel)
+        if f.potential is not None:
+            functions[f"potential_{k}"] = prep(f.potential)
+    for k, g in enumerate(events):
+        functions[f"event_{k}"] = prep(g)
+    return functions
+
+
+def _roles(frame, origin, forces, events):
+    roles = []
+    if frame.kind == "function":
+        roles.append(("omega", frame.funcs[0]))
+        if len(frame.funcs) > 1:
+            roles.append(("omega_dot", frame.funcs[1]))
+    if origin.kind == "function":
+        roles.append(("origin_acceleration", origin.funcs[0]))
+    roles += [(f"forces[{k}]", f.accel) for k, f in enumerate(forces)]
+    roles += [(f"forces[{k}].potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
+    roles += [(f"events[{k}]", g) for k, g in enumerate(events)]
+    return roles
+
+
+def _check_functions(forces, events, params, r, v, t0):
+    """Each force, potential and event once, in plain Python, at the start: shape, finiteness, raises."""
+    when = f"at t = {t0:g} s, r = {r.tolist()}, v = {v.tolist()}"
+    for k, f in enumerate(forces):
+        uf.check_call(f"forces[{k}]", f.accel, (t0, r.copy(), v.copy(), *params), (3,), when=when)
+        if f.potential is not None:
+            uf.check_call(f"forces[{k}].potential", f.potential, (t0, r.copy(), *params), (), when=when)
+    for k, g in enumerate(events):
+        uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
+
+
+def _blame(forces, params, t, y):
+    """After a non-finite state: which force gives a non-finite value at the last finite state (or '')."""
+    r, v = y[:3].copy(), y[3:6].copy()
+    for k, f in enumerate(forces):
+        try:
+            a = np.asarray(uf.plain_function(f.accel)(t, r, v, *params), dtype=float)
+        except Exception as exc:  # the user's function, reported in the message
+            return f"; forces[{k}] ({uf.display_name(f.accel)}) raised {type(exc).__name__}: {exc} at t = {t:.9g} s"
+        if a.shape == (3,) and not np.all(np.isfinite(a)):
+            return (f"; forces[{k}] ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {t:.9g} s, "
+                    f"r = {r.tolist()}, v = {v.tolist()}")
+    return ""
+
+
+def _scales(r, v, duration, rtol, atol, D):
+    if atol is not None:
+        a = np.asarray(atol, dtype=float)
+        if a.ndim == 0:
+            a = np.full(6, float(a))
+        if a.shape != (6,) or not np.all(a > 0):
+            raise ScenarioError(f"atol={atol!r}: a positive number or 6 positive numbers (r then v)")
+    else:
+        sr = max(float(np.max(np.abs(r))), float(np.max(np.abs(v))) * duration)
+        sv = max(float(np.max(np.abs(v))), sr / duration)
+        if sr == 0.0:
+            sr, sv = 1.0, 1.0 / duration
+        a = np.array([rtol * sr] * 3 + [rtol * sv] * 3)
+    return np.ascontiguousarray(np.concatenate([a, np.full(D - 6, rtol)]))
+
+
+def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
+                       method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
+                       frame_attitude=None, jit=True, progress=None, max_events=256) -> ProblemRun:
+    """Integrate particles of the user's problem; see :func:`rotframe.simulate` for the arguments.
+
+    Returns
+    -------
+    ProblemRun
+        ``trajectory`` (a :class:`rotframe.particles.trajectory.Trajectory`: ``times`` (n,),
+        ``r``, ``v`` (n, N, 3), ``event_times``/``event_states`` by event name, ``extras``
+        with ``frame_q`` (n, 4) where the attitude was integrated and ``energy`` (n, N) where
+        it is conserved), ``diagnostics``, ``warnings``, ``notes``.
+    """
+    import time
+
+    from rotframe import limits
+
+    method = canonical_method(method, PARTICLE_METHODS, "dop853")
+    duration = float(duration)
+    if not (math.isfinite(duration) and duration > 0):
+        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
+    r, v = _states(r0, v0)
+    N = r.shape[0]
+    frame = frame_spec(omega, omega_dot)
+    origin = origin_spec(origin_acceleration)
+    for spec, what in ((frame, "omega"), (origin, "origin_acceleration")):
+        if spec.t_range[1] < duration or spec.t_range[0] > 0.0:
+            raise ScenarioError(f"{what}: defined for t in [{spec.t_range[0]:g}, {spec.t_range[1]:g}] s, "
+                                f"not over the run's [0, {duration:g}] s")
+    forces = [_as_force(f, k) for k, f in enumerate(forces)]
+    events = list(events)
+    for k, g in enumerate(events):
+        if not callable(g):
+            raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
+    params = check_params(params)
+    rtol = DEFAULT_RTOL if rtol is None else float(rtol)
+    if not (1e-15 <= rtol < 1):
+        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
+    samples = DEFAULT_SAMPLES if samples is None else samples
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
+    samples = int(samples)
+    times = np.linspace(0.0, duration, samples + 1)
+    hfix = 0.0
+    if method == "rk4":
+        step = duration / samples / 20 if step is None else float(step)
+        if not (math.isfinite(step) and step > 0) or step < 1e-300:
+            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
+        per = max(1, math.ceil((duration / samples) / step - 1e-9))
+        hfix = (duration / samples) / per
+        limits.check_run(steps=per * samples, samples=samples + 1, particles=N, what="method rk4")
+    else:
+        limits.check_run(steps=samples, samples=samples + 1, particles=N, what="method dop853")
+    inertial = any(f.axes == "inertial" for f in forces)
+    D = 10 if inertial else 6
+    _check_functions(forces, events, params, r[0], v[0], 0.0)
+    if frame.kind == "function":
+        frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
+    roles = _roles(frame, origin, forces, events)
+    key = uf.fingerprint(*(f for _, f in roles)) + f"|{[f.axes for f in forces]}|{len(params)}"
+    header = _header(frame, origin, forces, events, len(params), D)
+    module = build_module("particle", key, _bind(frame, origin, forces, events, jit), header, PARTICLE_SOURCE,
+                          compiled=jit)
+    y = np.zeros((N, D))
+    y[:, :3] = r
+    y[:, 3:6] = v
+    if D == 10:
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else np.asarray(frame_attitude, float)
+        if frame_attitude is None and frame.kind == "body":
+            q0 = np.asarray(omega.trajectory.q[0], dtype=float)
+        y[:, 6:] = q0 / np.linalg.norm(q0)
+    F = frame.data if frame.kind != "function" else (np.zeros(3),)
+    G = origin.data if origin.kind != "function" else (np.zeros(3),)
+    atol_arr = _scales(r, v, duration, rtol, atol, D)
+    n = samples + 1
+    OUT = np.full((n, N, D), np.nan)
+    state = dict(TC=np.zeros(N), H=np.zeros(N), IDX=np.zeros(N, np.int64), SUB=np.zeros(N, np.int64),
+                 ST=np.zeros(N, np.int64), EVT=np.full((N, max_events), np.nan), EVY=np.zeros((N, max_events, D)),
+                 EVK=np.zeros((N, max_events), np.int64), EVN=np.zeros(N, np.int64),
+                 GPREV=np.zeros((N, max(len(events), 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
+    EDIR = np.array([float(np.sign(getattr(g, "direction", 0) or 0)) for g in events] or [0.0])
+    ETERM = np.array([bool(getattr(g, "terminal", False)) for g in events] or [False])
+    budget = max(16, int(2e5 // max(N, 1)))
+    code = 0 if method == "dop853" else 1
+    lim = limits.current()
+    t0 = time.perf_counter()
+    compile_s = 0.0
+    first = True
+    try:
+        if events:
+            module.start_events(0.0, y, state["GPREV"], params)
+        while True:
+            try:
+                module.advance(times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT,
+                               state["EVT"], state["EVY"], state["EVK"], state["EVN"], state["GPREV"],
+                               state["NSTEP"], state["NFEV"], budget, code, rtol, atol_arr, hfix, EDIR, ETERM,
+                               params, F, G)
+            except Exception as exc:
+                import numba
+
+                if isinstance(exc, numba.core.errors.NumbaError):
+                    _compile_failure(exc, roles, params, r[0], v[0], frame)
+                raise
+            if first:
+                compile_s = time.perf_counter() - t0
+                first = False
+            ST = state["ST"]
+            if progress is not None:
+                progress(float(np.min(state["IDX"])) / n)
+            if np.any(ST >= 3):
+                break
+            if np.all(ST != 0):
+                break
+            if float(np.sum(state["NSTEP"])) > lim.max_steps:
+                raise limits.LimitError(f"simulate: more than {lim.max_steps:.3g} integration steps; lower rtol's "
+                                        "demand or the duration, or raise the limit (--max-steps)")
+    except KeyboardInterrupt:
+        traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])))
+        raise RunInterrupted(traj) from None
+    traj = _trajectory(times, OUT, state, events, method, n)
+    if np.any(state["ST"] >= 3):
+        i = int(np.flatnonzero(state["ST"] >= 3)[0])
+        good = int(state["IDX"][i])
+        t_bad = float(state["TC"][i])
+        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i])
+        partial = _trajectory(times, OUT, state, events, method, good)
+        raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
+                               "samples up to there are kept", t_reached=t_bad, partial=partial)
+    warnings, notes, diagnostics = [], list(frame.notes), {}
+    if not jit:
+        warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
+                        "slower than compiled")
+    _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagnostics, notes)
+    if D == 10:
+        traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
+    dropped = int(np.sum(np.maximum(state["EVN"] - max_events, 0)))
+    if dropped:
+        warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
+    traj.extras["compile_s"] = compile_s
+    return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
+
+
+def _compile_failure(exc, roles, params, r, v, frame):
+    def sample_args(role):
+        if role.startswith("forces") and role.endswith("potential"):
+            return (0.0, r.copy(), *params)
+        if role.startswith(("forces", "events")):
+            return (0.0, r.copy(), v.copy(), *params)
+        return (0.0,)
+
+    found = uf.diagnose_compile(roles, sample_args)
+    reason = found or f"numba cannot compile the problem: {uf.numba_reason(exc)}"
+    raise uf.UserFunctionError(f"simulate: {reason}; pass jit=False to run it in plain Python (slow)") from None
+
+
+def _trajectory(times, OUT, state, events, method, n_kept):
+    n_kept = max(int(n_kept), 1)
+    r = OUT[:n_kept, :, :3].copy()
+    v = OUT[:n_kept, :, 3:6].copy()
+    steps = int(np.max(state["NSTEP"])) if state["NSTEP"].size else 0
+    nfev = int(np.max(state["NFEV"])) if state["NFEV"].size else 0
+    complete = n_kept == times.size
+    traj = Trajectory(times[:n_kept].copy(), r, v, method, steps, nfev, complete,
+                      float(times[n_kept - 1]) if complete else float(times[n_kept - 1]))
+    names = _event_names(events)
+    N = OUT.shape[1]
+    for k, name in enumerate(names):
+        traj.event_times[name] = []
+        traj.event_states[name] = []
+        for i in range(N):
+            m = min(int(state["EVN"][i]), state["EVT"].shape[1])
+            sel = np.flatnonzero(state["EVK"][i, :m] == k)
+            order = sel[np.argsort(state["EVT"][i, sel], kind="stable")]
+            traj.event_times[name].append(state["EVT"][i, order].copy())
+            traj.event_states[name].append(state["EVY"][i, order, :6].copy())
+    traj.extras["status"] = state["ST"].copy()
+    return traj
+
+
+def _event_names(events):
+    names = []
+    for k, g in enumerate(events):
+        base = getattr(uf.plain_function(g), "__name__", "") or f"event_{k}"
+        if base == "<lambda>":
+            base = f"event_{k}"
+        name = base
+        j = 2
+        while name in names:
+            name = f"{base}_{j}"
+            j += 1
+        names.append(name)
+    return names
+
+
+def _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagnostics, notes):
+    """Energy (inertial frame) or Jacobi integral (steadily rotating frame) and its relative drift."""
+    if not forces or any(f.potential is None for f in forces):
+        return
+    if origin.kind != "zero" or not frame.is_constant or frame.kind == "function":
+        notes.append("energy is not conserved in a frame whose rotation rate changes or whose origin "
+                     "accelerates: no energy diagnostic")
+        return
+    w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
+    rotating = bool(np.any(w != 0.0))
+    F = frame.data
+    E = module.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), params, F, rotating)
+    traj.extras["energy"] = E
+    name = "jacobi" if rotating else "energy"
+    E0 = E[0]
+    scale = np.where(E0 != 0.0, np.abs(E0), 1.0)
+    drift = float(np.max(np.abs(E - E0) / scale))
+    diagnostics[f"{name}_rel_drift"] = drift
+    if np.any(E0 == 0.0):
+        notes.append(f"{name} is 0 at the start for some particle: its drift is absolute (J/kg) there")
+    if rotating:
+        notes.append("jacobi_rel_drift: the Jacobi integral v^2/2 + U - |omega x r|^2/2 of the steadily rotating frame")
