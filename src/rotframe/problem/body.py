@@ -48,6 +48,11 @@ class BodyRun:
         self.compile_s = compile_s
         self.extras = {"compile_s": compile_s}
 
+    @property
+    def trajectory(self):
+        """Itself: a BodyRun is the trajectory of a body (``times``, ``L``, ``q``), usable as a frame."""
+        return self
+
 
 def _inertia(inertia):
     I = np.asarray(inertia, dtype=float)

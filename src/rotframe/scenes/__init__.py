@@ -58,6 +58,8 @@ SCENES: dict[str, Any] = {
     "free-top": "rotframe.scenes.free_top",
     "dzhanibekov": "rotframe.scenes.dzhanibekov",
     "heavy-top": "rotframe.scenes.heavy_top",
+    "cr3bp": "rotframe.scenes.cr3bp",
+    "tumbling-ball": "rotframe.scenes.tumbling_ball",
 }
 
 #: scenario name -> scenario file, for scenarios registered with their scene
