@@ -25,6 +25,9 @@ RUNS = {
     "aerospace_ypr.py": ([], "body rates"),
     "sweep_latitude.py": (["--points", "3", "--duration", "300"], "3 runs"),
     "spin_gravity.py": (["--height", "6 ft"], "spinward_offset_m"),
+    "own_force_lorentz.py": (["--omega", "2"], "gyration radius"),
+    "own_frame_station.py": (["--duration", "5"], "error against the inertial line"),
+    "own_torque_damping.py": ([], "exact 3 exp"),
 }
 
 
