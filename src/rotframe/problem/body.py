@@ -160,7 +160,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     try:
         while True:
             try:
-                module.advance(times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+                module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
                                st["NSTEP"], st["NFEV"], 20000, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
                                (np.zeros(3),))
             except Exception as exc:

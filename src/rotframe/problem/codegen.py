@@ -57,12 +57,11 @@ def cache_dir() -> Path:
 _HEADER_COMPILED = """\
 import math
 import numpy as np
-from numba import njit, prange
+from numba import njit
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as error_norm
 
 jit = njit(cache=True, error_model="numpy", nogil=True)
-jit_parallel = njit(cache=True, error_model="numpy", nogil=True, parallel=True)
 """
 
 _HEADER_PLAIN = """\
@@ -72,14 +71,10 @@ from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as _norm
 
 error_norm = _norm.py_func
-prange = range
-
 
 def jit(f):
     return f
 
-
-jit_parallel = jit
 """
 
 

@@ -3,7 +3,7 @@
 :mod:`rotframe.problem.codegen` writes a module made of a generated header (the user's
 functions bound to names, the frame's evaluators, the state size ``D``, the event count
 ``NE``) followed by :data:`SOURCE`, and numba compiles it with ``cache=True``. The header
-defines, besides ``jit``, ``jit_parallel``, ``prange``, ``math``, ``np`` and the DOP853
+defines, besides ``jit``, ``math``, ``np`` and the DOP853
 tableau ``A, B, C, E3, E5`` and error norm ``error_norm``::
 
     frame_rates(t, F) -> (wx, wy, wz, ex, ey, ez)    omega and omega' in frame axes
@@ -22,7 +22,7 @@ Equation of motion (docs/physics/rotating-frames.md)::
     r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)
 
 Each particle is integrated alone (its own steps, its own events), so the samples do not
-depend on how many threads share the ensemble (``prange`` over particles). A call advances
+depend on how many threads share the ensemble (blocks of particles on threads). A call advances
 every particle by at most ``budget`` steps and returns, so that Python sees Ctrl-C, SIGTERM
 and progress between calls; the state to continue from is kept in the arrays passed in.
 

@@ -322,7 +322,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                  GPREV=np.zeros((N, max(len(events), 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
     EDIR = np.array([float(np.sign(getattr(g, "direction", 0) or 0)) for g in events] or [0.0])
     ETERM = np.array([bool(getattr(g, "terminal", False)) for g in events] or [False])
-    budget = max(16, int(2e5 // max(N, 1)))
+    budget = max(16, int(2e5 // max(N, 1)))  # about 0.1 s of work a call: signals and progress between calls
     code = 0 if method == "dop853" else 1
     lim = limits.current()
     t0 = time.perf_counter()
@@ -333,10 +333,10 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             module.start_events(0.0, y, state["GPREV"], params)
         while True:
             try:
-                module.advance(times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT,
-                               state["EVT"], state["EVY"], state["EVK"], state["EVN"], state["GPREV"],
-                               state["NSTEP"], state["NFEV"], budget, code, rtol, atol_arr, hfix, EDIR, ETERM,
-                               params, F, G)
+                run_blocks(module.advance, N, (times, y, state["TC"], state["H"], state["IDX"], state["SUB"],
+                                               state["ST"], OUT, state["EVT"], state["EVY"], state["EVK"],
+                                               state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"], budget,
+                                               code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G))
             except Exception as exc:
                 import numba
 
@@ -380,6 +380,34 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
     traj.extras["compile_s"] = compile_s
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
+
+
+#: particles per block handed to a thread (fixed: the numbers never depend on it, each particle runs alone)
+BLOCK = 512
+
+
+def run_blocks(advance, N, args):
+    """``advance(lo, hi, *args)`` over fixed blocks of the N particles, on the ensemble's threads.
+
+    The compiled driver releases the GIL, so blocks run in parallel on
+    ``rotframe.particles.ensemble.resolve_threads`` threads (every core, or ``--threads``).
+    """
+    if N <= BLOCK:
+        advance(0, N, *args)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    from rotframe.particles.ensemble import resolve_threads
+
+    blocks = [(lo, min(N, lo + BLOCK)) for lo in range(0, N, BLOCK)]
+    threads = max(1, min(int(resolve_threads(None)), len(blocks)))
+    if threads == 1:
+        for lo, hi in blocks:
+            advance(lo, hi, *args)
+        return
+    with ThreadPoolExecutor(threads) as pool:
+        for future in [pool.submit(advance, lo, hi, *args) for lo, hi in blocks]:
+            future.result()
 
 
 def _compile_failure(exc, roles, params, r, v, frame):

@@ -35,6 +35,7 @@ from rotframe.app.bench.problems import EXTRAS, PREPARED, Problem, attitude_erro
 from rotframe.app.bench.report import environment, json_rows, plot, table
 from rotframe.app.bench.summary import LEVELS, is_peer, level_summary, problem_keys, speedups  # noqa: F401
 from rotframe.app.bench.throughput import ensemble_rows, record_rows, startup_rows, sweep_rows
+from rotframe.app.bench.user_force import user_force_rows
 
 __all__ = ["Problem", "problems", "run_bench", "level_summary", "speedups", "main"]
 
@@ -68,7 +69,8 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
         notes.extend(f"{p.scenario}: {n}" for n in p.notes)
     for name in extras:
         fn = {"ensemble": lambda: ensemble_rows(quick), "sweep": lambda: sweep_rows(quick),
-              "startup": startup_rows, "record": lambda: record_rows(10**5 if quick else 10**6)}[name]
+              "startup": startup_rows, "record": lambda: record_rows(10**5 if quick else 10**6),
+              "user-force": lambda: user_force_rows(quick)}[name]
         rows.extend(fn())
         plan.step(name)
     rows.extend(level_summary(rows))
