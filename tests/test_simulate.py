@@ -13,6 +13,7 @@ frame tests allow 1e-9 of the scale; the scipy oracles run at ``rtol=1e-13``.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -146,11 +147,16 @@ def _omega_numpy(t):
     return np.array([0.4 * math.sin(0.7 * t), 0.3 * math.cos(0.5 * t), 1.0 + 0.05 * t])
 
 
-@pytest.fixture(scope="module")
-def line_oracle():
-    times = np.linspace(0.0, DURATION, 81)
+@functools.lru_cache(maxsize=None)
+def _line(duration, samples):
+    times = np.linspace(0.0, duration, samples + 1)
     R = attitude_oracle(_omega_numpy, times)
     return times, inertial_line_in_frame(R, times, R0, V0, _omega_numpy(0.0))
+
+
+@pytest.fixture(scope="module")
+def line_oracle():
+    return _line(DURATION, 80)
 
 
 def _scale():
@@ -161,15 +167,21 @@ def _scale():
 # 1. the inertial straight line seen from a frame turning about a moving axis
 # ---------------------------------------------------------------------------------------------
 
+@pytest.mark.parametrize("duration", [DURATION, 100.0])
 @pytest.mark.parametrize("form", ["derived", "given"])
-def test_moving_axis_callable(form, line_oracle):
-    """omega(t) as a function, omega' derived (4th-order difference) or given: error ~ rtol x scale."""
-    times, expected = line_oracle
+def test_moving_axis_callable(form, duration):
+    """omega(t) as a function, omega' derived (4th-order difference) or given: error ~ rtol x scale.
+
+    Over 100 s (omega_z grows to 6 rad/s, some 55 turns) the error is still DOP853's, some 1e-10 of the
+    scale: the derived omega' must not lose accuracy late in a run (a difference step growing with t did).
+    """
+    times, expected = _line(duration, 80)
     kwargs = {"omega_dot": omega_dot_fn} if form == "given" else {}
-    res = rotframe.simulate(omega=omega_fn, r0=R0, v0=V0, duration=DURATION, rtol=RTOL, samples=80, **kwargs)
+    res = rotframe.simulate(omega=omega_fn, r0=R0, v0=V0, duration=duration, rtol=RTOL, samples=80, **kwargs)
     np.testing.assert_array_equal(res.trajectory.times, times)
+    scale = np.max(np.abs(expected))
     err = np.max(np.abs(res.trajectory.r[:, 0] - expected))
-    assert err < 1e-9 * _scale(), err
+    assert err < 1e-9 * scale, err / scale
     assert res.complete and res.warnings == []
 
 
@@ -244,7 +256,6 @@ def test_accelerating_origin_free_particle():
     expected = R0 + V0 * t - 0.5 * a0 * t * t
     assert np.max(np.abs(res.trajectory.r[:, 0] - expected)) < 1e-12 * np.max(np.abs(expected))
     assert np.max(np.abs(res.trajectory.v[:, 0] - (V0 - a0 * t))) < 1e-12 * np.max(np.abs(a0)) * 3.0
-    assert any("energy is not conserved" in n for n in res.notes) or "energy_rel_drift" not in res.diagnostics
 
 
 # ---------------------------------------------------------------------------------------------
@@ -430,6 +441,25 @@ def test_force_becomes_nan_later_keeps_partial():
     assert part.r.shape == (part.times.size, 1, 3)
 
 
+def raise_after_one_second(t, r, v):
+    if t > 1.0:
+        raise ValueError("too late")
+    return -r[0], -r[1], -r[2]
+
+
+def test_force_raises_later_gives_time_and_state():
+    """A force that raises inside the compiled run: one line naming it, with the time and the state of the step."""
+    with pytest.raises(ScenarioError) as info:
+        rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=3.0, forces=[raise_after_one_second],
+                          samples=30)
+    exc = info.value
+    msg = _one_line(exc)
+    assert "raise_after_one_second" in msg and "ValueError" in msg and "too late" in msg
+    assert "t = 1 s" in msg and "r = [" in msg and "v = [" in msg
+    assert exc.partial is not None and 0.9 <= exc.partial.times[-1] <= 1.0
+    assert np.all(np.isfinite(exc.partial.r))
+
+
 def test_omega_table_not_increasing():
     tt = np.array([0.0, 1.0, 1.0, 2.0])
     with pytest.raises(ScenarioError) as info:
@@ -527,25 +557,26 @@ def test_second_process_compiles_nothing(tmp_path):
 # ---------------------------------------------------------------------------------------------
 
 def test_many_particles_bitwise_and_thread_independent():
-    import numba
+    """N particles of very different scales: each particle's numbers are those of its run alone, bitwise
+    (its own tolerance scale, its own steps), and do not depend on the thread count (over 512 particles,
+    blocks of them run on threads)."""
+    from rotframe.particles.ensemble import threads_scope
 
-    r0 = np.array([[1.0, 0.0, 0.0], [30.0, -2.0, 5.0], [0.01, 0.02, -0.03], [0.0, 0.0, 0.0]])
-    v0 = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [0.5, -0.2, 0.1], [0.3, 0.3, 0.3]])
-    kw = dict(omega=W_USER, duration=10.0, forces=[SPRING], params=(2.0,), rtol=1e-10, samples=50)
-    previous = numba.get_num_threads()
-    try:
-        runs = {}
-        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
-            numba.set_num_threads(threads)
+    rng = np.random.default_rng(7)
+    N = 600
+    r0 = rng.normal(size=(N, 3)) * np.exp(rng.uniform(-5, 4, size=(N, 1)))
+    v0 = rng.normal(size=(N, 3)) * np.exp(rng.uniform(-5, 2, size=(N, 1)))
+    r0[3] = 0.0
+    kw = dict(omega=W_USER, duration=3.0, forces=[SPRING], params=(2.0,), rtol=1e-10, samples=12)
+    runs = {}
+    for threads in (1, 2):
+        with threads_scope(threads):
             runs[threads] = rotframe.simulate(r0=r0, v0=v0, **kw)
-    finally:
-        numba.set_num_threads(previous)
     together = runs[1]
-    for other in runs.values():
-        np.testing.assert_array_equal(other.trajectory.r, together.trajectory.r)
-        np.testing.assert_array_equal(other.trajectory.v, together.trajectory.v)
-    assert together.trajectory.r.shape == (51, 4, 3)
-    for i in range(r0.shape[0]):
+    np.testing.assert_array_equal(runs[2].trajectory.r, together.trajectory.r)
+    np.testing.assert_array_equal(runs[2].trajectory.v, together.trajectory.v)
+    assert together.trajectory.r.shape == (13, N, 3)
+    for i in (0, 1, 2, 3, 511, 512, N - 1):
         alone = rotframe.simulate(r0=r0[i], v0=v0[i], **kw)
         np.testing.assert_array_equal(alone.trajectory.r[:, 0], together.trajectory.r[:, i])
         np.testing.assert_array_equal(alone.trajectory.v[:, 0], together.trajectory.v[:, i])
@@ -590,11 +621,7 @@ def test_result_surface(tmp_path):
     assert not list(tmp_path.glob("*.partial.rrd"))
     import rerun as rr
 
-    paths = set()
-    for chunk in rr.chunk.RrdReader(str(path)).stream():
-        try:
-            paths.add(str(chunk.entity_path))
-        except AttributeError:
-            break
-    if paths:
-        assert any("particle_0" in p for p in paths), paths
+    paths = {str(chunk.entity_path) for chunk in rr.chunk.RrdReader(str(path)).stream()}
+    assert any(p.endswith("world/particle_0") for p in paths), paths
+    assert any(p.endswith("world/particle_1") for p in paths), paths
+    assert any("diagnostics/jacobi" in p for p in paths), paths

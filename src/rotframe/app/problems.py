@@ -115,19 +115,37 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         Bad input, or a user function that raises, returns the wrong shape or NaN at the start,
         or cannot be compiled (the message names it and numba's reason).
     rotframe.errors.IntegrationError
-        A non-finite state during the run (``exc.partial`` keeps what was computed).
+        A non-finite state during the run (``exc.partial``: a ``Result`` of what was computed).
+    rotframe.particles.trajectory.RunInterrupted
+        Ctrl-C or SIGTERM during the run (``exc.partial``: a ``Result`` of what was computed).
     """
-    from rotframe.problem.particles import simulate_particles
-    from rotframe.scenes.user_problem import ParticleProblemScene
+    from rotframe.errors import IntegrationError
+    from rotframe.particles.trajectory import RunInterrupted
+    from rotframe.problem.particles import ProblemRun, simulate_particles
 
     t0 = time.perf_counter()
     forces = list(forces)
     events = list(events)
-    run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
-                             origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol,
-                             step=step, samples=samples, omega_dot=omega_dot, atol=atol,
-                             frame_attitude=frame_attitude, jit=jit, progress=progress)
-    simulate_s = time.perf_counter() - t0
+    try:
+        run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
+                                 origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol,
+                                 step=step, samples=samples, omega_dot=omega_dot, atol=atol,
+                                 frame_attitude=frame_attitude, jit=jit, progress=progress)
+    except (IntegrationError, RunInterrupted) as exc:  # what was computed, as a Result like rotframe.run's
+        partial = getattr(exc, "partial", None)
+        if partial is not None and hasattr(partial, "r"):
+            from rotframe.problem.frame import frame_spec
+
+            stopped = ProblemRun(partial, {}, ["the run stopped early: " + str(exc)], [], frame_spec(omega, omega_dot))
+            exc.partial = _particle_result(stopped, forces, origin_acceleration, duration,
+                                           time.perf_counter() - t0)
+        raise
+    return _particle_result(run, forces, origin_acceleration, duration, time.perf_counter() - t0)
+
+
+def _particle_result(run, forces, origin_acceleration, duration, simulate_s):
+    from rotframe.scenes.user_problem import ParticleProblemScene
+
     traj = run.trajectory
     terms = [_describe(f) for f in forces] + ["coriolis", "centrifugal", "euler"]
     if origin_acceleration is not None:

@@ -148,7 +148,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     OUT = np.full((n, 1, 7), np.nan)
     Iinv = np.ascontiguousarray(np.linalg.inv(I))
     sL = max(float(np.max(np.abs(L))), 1e-300)
-    atol = np.array([rtol * sL] * 3 + [rtol] * 4)
+    atol = np.array([[rtol * sL] * 3 + [rtol] * 4])  # one row per body (the stepping's per-particle atol)
     st = {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")}
     TC, H = np.zeros(1), np.zeros(1)
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
@@ -157,12 +157,16 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     code = 0 if method == "dop853" else 1
     t0 = time.perf_counter()
     compile_s = None
+    def call(budget):
+        module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+                       st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
+                       (np.zeros(3),))
+
     try:
         while True:
+            saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
             try:
-                module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                               st["NSTEP"], st["NFEV"], 20000, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
-                               (np.zeros(3),))
+                call(20000)
             except Exception as exc:
                 import numba
 
@@ -170,7 +174,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                     reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
                     raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to "
                                                "run it in plain Python (slow)") from None
-                raise
+                _torque_raised(exc, call, saved, y, TC, H, st, torque)
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
             if progress is not None:
@@ -187,9 +191,37 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if st["ST"][0] >= 3:
         partial = _run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, torque, compile_s, [], jit)
         t_bad = float(TC[0])
-        raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]} after t = {t_bad:.9g} s (method {method})",
-                               t_reached=t_bad, partial=partial)
+        blame = ""
+        if torque is not None:  # a torque that turns non-finite at a time: probe it inside the failed step
+            dt = hfix if method == "rk4" else 10.0 * float(H[0])
+            for tp in (t_bad, t_bad + 1e-3 * dt, t_bad + 0.5 * dt, t_bad + dt):
+                a = np.asarray(uf.plain_function(torque)(tp, y[0, :3].copy(), y[0, 3:].copy(), *params), float)
+                if a.shape == (3,) and not np.all(np.isfinite(a)):
+                    blame = f"; torque ({uf.display_name(torque)}) returned {a.tolist()} at t = {tp:.9g} s"
+                    break
+        raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
+                               f"(method {method})", t_reached=t_bad, partial=partial)
     return _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
+
+
+def _torque_raised(exc, call, saved, y, TC, H, st, torque):
+    """The torque raised inside a compiled call: replay the call one step at a time to give the time and state."""
+    y[...], TC[...], H[...] = saved[0], saved[1], saved[2]
+    for key, a in saved[3].items():
+        st[key][...] = a
+    what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
+    where = f"after t = {float(TC[0]):.9g} s"
+    for _ in range(20001):
+        t, yi = float(TC[0]), y[0].copy()
+        try:
+            call(1)
+        except Exception:  # raised again: in this step
+            where = f"in the step from t = {t:.9g} s, L = {yi[:3].tolist()}, q = {yi[3:].tolist()}"
+            break
+        if st["ST"][0] != 0:
+            break
+    name = uf.display_name(torque) if torque is not None else "?"
+    raise uf.UserFunctionError(f"simulate_body: torque ({name}) raised {what} {where}") from None
 
 
 def _run(times, Y, method, st, I, complete, params, torque, compile_s, warnings, jit):

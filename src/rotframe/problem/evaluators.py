@@ -10,7 +10,8 @@ from __future__ import annotations
 
 __all__ = ["SEARCH_SOURCE", "vector_source", "central_difference_step"]
 
-#: h of the fourth-order central difference for omega' of a function, in units of max(1, |t|)
+#: h of the fourth-order central difference for omega' of a function, in units of min(1 s, 1 / |omega(0)|)
+#: (frame.derivative_step computes it; the drivers read it from F[0][0])
 central_difference_step = 2.0 ** -9
 
 #: the interval search shared by the table and body forms
@@ -84,7 +85,7 @@ def vector_source(name: str, kind: str, derivative: bool, fn: str = "", fn_dot: 
             if fn_dot:
                 lines += [f"    e = {fn_dot}(t)", "    dx = e[0]", "    dy = e[1]", "    dz = e[2]"]
             else:
-                lines += [f"    hh = {central_difference_step!r} * max(1.0, abs(t))",
+                lines += ["    hh = (t + F[0][0]) - t",  # the step of frame.derivative_step, exact in floats
                           f"    a = {fn}(t - 2.0 * hh)", f"    b = {fn}(t - hh)", f"    c = {fn}(t + hh)",
                           f"    d = {fn}(t + 2.0 * hh)",
                           "    dx = (a[0] - 8.0 * b[0] + 8.0 * c[0] - d[0]) / (12.0 * hh)",

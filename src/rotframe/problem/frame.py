@@ -17,8 +17,10 @@ constant    the vector omega; omega' = 0
 table       a C2 cubic spline through ``(times, vectors)`` (scipy's ``CubicSpline``,
             not-a-knot): omega and omega' are the spline and its derivative
 function    a user function ``t -> (3,)``; omega' given (``omega_dot=``) or derived
-            by a fourth-order central difference (error about 1e-11 of omega's scale
-            over its time scale)
+            by a fourth-order central difference with a fixed step
+            h = 2^-9 min(1 s, 1 / |omega(0)|) (error about h^4 |omega^(5)| / 30, some
+            1e-13 of omega's scale for a rate that changes over a second or more; give
+            ``omega_dot`` for a faster one). ``data`` holds ``[h, 0, 0]``
 body        the body axes of a rigid-body solution: omega = I^-1 L at each sample,
             omega' and omega'' from Euler's equations there, and a quintic Hermite
             interpolant between samples (cubic where the body had a torque)
@@ -50,7 +52,7 @@ class FrameSpec:
     kind : str
         One of :data:`KINDS` (``"zero"`` for a missing origin acceleration).
     data : tuple of float64 arrays
-        The kind's arrays (see :func:`frame_spec`); for ``function``, empty.
+        The kind's arrays (see :func:`frame_spec`); for ``function``, ``([h, 0, 0],)``: the step of a derived omega'.
     funcs : tuple of callables
         For ``function``: the user's ``omega(t)`` and, if given, ``omega_dot(t)``.
     t_range : (float, float)
@@ -89,14 +91,25 @@ class FrameSpec:
         f = self.funcs[0]
         fd = self.funcs[1] if len(self.funcs) > 1 else None
         out = np.array([np.asarray(f(float(tt)), dtype=float) for tt in t])
-        der = np.array([np.asarray(fd(float(tt)), dtype=float) if fd is not None else central_difference(f, float(tt))
-                        for tt in t])
+        h = float(self.data[0][0]) if self.data else derivative_step(f)
+        der = np.array([np.asarray(fd(float(tt)), dtype=float) if fd is not None
+                        else central_difference(f, float(tt), h) for tt in t])
         return out, der
 
 
-def central_difference(f, t):
-    """omega'(t) by the fourth-order central difference (h about eps^(1/5) times the time scale)."""
-    h = 2.0 ** -9 * max(1.0, abs(t))
+def derivative_step(f) -> float:
+    """The step (s) of the central difference for omega' of a function ``f``: 2^-9 min(1 s, 1 / |f(0)|).
+
+    Fixed in time: a step that grew with |t| would make omega' wrong by (h/tau)^4 late in a long
+    run (h = 0.4 s at t = 200 s); 1 / |omega| is the frame's own time scale.
+    """
+    w0 = float(np.linalg.norm(np.asarray(f(0.0), dtype=float)))
+    return 2.0 ** -9 * (min(1.0, 1.0 / w0) if w0 > 0.0 else 1.0)
+
+
+def central_difference(f, t, h):
+    """omega'(t) by the fourth-order central difference of step ``h`` (taken as (t + h) - t, exact in floats)."""
+    h = (t + h) - t
     a = np.asarray(f(t - 2 * h), float)
     b = np.asarray(f(t - h), float)
     c = np.asarray(f(t + h), float)
@@ -228,7 +241,8 @@ def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
             if not np.all(np.isfinite(out)):
                 raise ScenarioError(f"{name}: {_name(f)} returned {out.tolist()} at t = 0 (not finite)")
         funcs = (value,) if omega_dot is None else (value, omega_dot)
-        return FrameSpec("function", (), funcs)
+        step = derivative_step(getattr(value, "py_func", value)) if omega_dot is None else 0.0
+        return FrameSpec("function", (np.array([step, 0.0, 0.0]),), funcs)
     if omega_dot is not None:
         raise ScenarioError(f"{what}_dot is only for a callable {what}")
     if hasattr(value, "trajectory"):

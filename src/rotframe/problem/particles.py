@@ -210,34 +210,47 @@ def _check_functions(forces, events, params, r, v, t0):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
 
-def _blame(forces, params, t, y):
-    """After a non-finite state: which force gives a non-finite value at the last finite state (or '')."""
+def _blame(forces, params, t, y, dt=0.0):
+    """After a non-finite state: which force gives a non-finite value (or raises) near the last finite state.
+
+    The force is probed at the last finite state, at ``t`` and at times inside the failed step
+    ``(t, t + dt]`` (a force that turns NaN at a time, not a state, fails only there). Returns
+    '' when none does.
+    """
     r, v = y[:3].copy(), y[3:6].copy()
+    probes = [t] + [t + f * dt for f in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]
     for k, f in enumerate(forces):
-        try:
-            a = np.asarray(uf.plain_function(f.accel)(t, r, v, *params), dtype=float)
-        except Exception as exc:  # the user's function, reported in the message
-            return f"; forces[{k}] ({uf.display_name(f.accel)}) raised {type(exc).__name__}: {exc} at t = {t:.9g} s"
-        if a.shape == (3,) and not np.all(np.isfinite(a)):
-            return (f"; forces[{k}] ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {t:.9g} s, "
-                    f"r = {r.tolist()}, v = {v.tolist()}")
+        for tp in probes:
+            try:
+                a = np.asarray(uf.plain_function(f.accel)(tp, r.copy(), v.copy(), *params), dtype=float)
+            except Exception as exc:  # the user's function, reported in the message
+                return (f"; forces[{k}] ({uf.display_name(f.accel)}) raised {type(exc).__name__}: {exc} "
+                        f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
+            if a.shape == (3,) and not np.all(np.isfinite(a)):
+                return (f"; forces[{k}] ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {tp:.9g} s, "
+                        f"r = {r.tolist()}, v = {v.tolist()}")
     return ""
 
 
 def _scales(r, v, duration, rtol, atol, D):
+    """Absolute tolerances, one row per particle ((N, D)): each particle's from its own scales, so that its
+    steps, and its numbers, do not depend on the other particles of the ensemble."""
+    N = r.shape[0]
     if atol is not None:
         a = np.asarray(atol, dtype=float)
         if a.ndim == 0:
             a = np.full(6, float(a))
         if a.shape != (6,) or not np.all(a > 0):
             raise ScenarioError(f"atol={atol!r}: a positive number or 6 positive numbers (r then v)")
+        a = np.tile(a, (N, 1))
     else:
-        sr = max(float(np.max(np.abs(r))), float(np.max(np.abs(v))) * duration)
-        sv = max(float(np.max(np.abs(v))), sr / duration)
-        if sr == 0.0:
-            sr, sv = 1.0, 1.0 / duration
-        a = np.array([rtol * sr] * 3 + [rtol * sv] * 3)
-    return np.ascontiguousarray(np.concatenate([a, np.full(D - 6, rtol)]))
+        sr = np.maximum(np.max(np.abs(r), axis=1), np.max(np.abs(v), axis=1) * duration)
+        sv = np.maximum(np.max(np.abs(v), axis=1), sr / duration)
+        still = sr == 0.0
+        sr[still], sv[still] = 1.0, 1.0 / duration
+        a = np.concatenate([np.repeat(rtol * sr[:, None], 3, axis=1), np.repeat(rtol * sv[:, None], 3, axis=1)],
+                           axis=1)
+    return np.ascontiguousarray(np.concatenate([a, np.full((N, D - 6), rtol)], axis=1))
 
 
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
@@ -311,7 +324,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if frame_attitude is None and frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
-    F = frame.data if frame.kind != "function" else (np.zeros(3),)
+    F = frame.data  # for a function: ([h, 0, 0],), the step of its derived omega'
     G = origin.data if origin.kind != "function" else (np.zeros(3),)
     atol_arr = _scales(r, v, duration, rtol, atol, D)
     n = samples + 1
@@ -331,18 +344,21 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     try:
         if events:
             module.start_events(0.0, y, state["GPREV"], params)
+        before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
+                  state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
+        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G)
         while True:
+            saved = {key: state[key].copy() for key in _REPLAYED}
+            saved["Y"] = y.copy()
             try:
-                run_blocks(module.advance, N, (times, y, state["TC"], state["H"], state["IDX"], state["SUB"],
-                                               state["ST"], OUT, state["EVT"], state["EVY"], state["EVK"],
-                                               state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"], budget,
-                                               code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G))
+                run_blocks(module.advance, N, before + (budget,) + after)
             except Exception as exc:
                 import numba
 
                 if isinstance(exc, numba.core.errors.NumbaError):
                     _compile_failure(exc, roles, params, r[0], v[0], frame)
-                raise
+                _raised_later(exc, module, y, saved, {"before": before, "after": after, "budget": budget}, forces,
+                              params, method, hfix, times, OUT, state, events)
             if first:
                 compile_s = time.perf_counter() - t0
                 first = False
@@ -364,7 +380,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         i = int(np.flatnonzero(state["ST"] >= 3)[0])
         good = int(state["IDX"][i])
         t_bad = float(state["TC"][i])
-        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i])
+        # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
+        dt_failed = hfix if method == "rk4" else 10.0 * float(state["H"][i])
+        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i], dt_failed)
         partial = _trajectory(times, OUT, state, events, method, good)
         raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
                                "samples up to there are kept", t_reached=t_bad, partial=partial)
@@ -408,6 +426,50 @@ def run_blocks(advance, N, args):
     with ThreadPoolExecutor(threads) as pool:
         for future in [pool.submit(advance, lo, hi, *args) for lo, hi in blocks]:
             future.result()
+
+
+#: the per-particle arrays a driver call changes besides the samples and event records (copied before each
+#: call, so that a call in which a user function raised can be replayed one step at a time)
+_REPLAYED = ("TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
+
+
+def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events):
+    """A user function raised inside a compiled call: find the step, name the function, give time and state.
+
+    The call is replayed from the state saved before it, one step per call, particle by particle
+    (the drivers are deterministic), up to the step where the exception comes again; the force that
+    raises there in plain Python is named. Raises :class:`UserFunctionError` (``.t_reached`` and
+    ``.partial`` keep the samples up to that step).
+    """
+    y[...] = saved["Y"]
+    for key in _REPLAYED:
+        state[key][...] = saved[key]
+    what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
+    where = ""
+    for i in np.flatnonzero(state["ST"] == 0):
+        for _ in range(int(args["budget"]) + 1):
+            t, yi = float(state["TC"][i]), y[i].copy()
+            try:
+                module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
+            except Exception:  # the user's function raised again: this step
+                dt = hfix if method == "rk4" else float(state["H"][i])
+                blame = _blame(forces, params, t, yi, dt)
+                where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
+                         f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
+                state["TC"][i] = t
+                break
+            if state["ST"][i] != 0:
+                break
+        if where:
+            break
+    if not where:
+        t = float(np.min(state["TC"]))
+        where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
+    good = int(np.min(state["IDX"]))
+    err = uf.UserFunctionError(f"simulate: {where}; samples up to there are kept")
+    err.t_reached = float(times[max(good, 1) - 1])
+    err.partial = _trajectory(times, OUT, state, events, method, good)
+    raise err from None
 
 
 def _compile_failure(exc, roles, params, r, v, frame):

@@ -14,6 +14,7 @@ header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
   time on the method's own discrete trajectory (as the built-in ground event,
   docs/physics/events.md). The earliest terminal crossing ends the particle; samples after
   it keep the state at the event.
+* ``atol`` is (N, D), one row per particle (its own scales).
 * Each particle is integrated alone, ``budget`` steps per call, so results do not depend on
   the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
   particles ``lo:hi``; Python runs blocks of them on threads (the driver holds no GIL). numba's
@@ -29,7 +30,7 @@ SAFE = 0.9
 
 
 @jit
-def dop853_step(t, y, h, K, yt, yn, P, F, G):
+def dop853_step(t, y, h, t_end, K, yt, yn, P, F, G):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
     for s in range(1, 12):
         for j in range(D):
@@ -43,7 +44,7 @@ def dop853_step(t, y, h, K, yt, yn, P, F, G):
         for s in range(12):
             acc += B[s] * K[s, j]
         yn[j] = y[j] + h * acc
-    rhs(t + h, yn, K[12], P, F, G)
+    rhs(t_end, yn, K[12], P, F, G)  # at the time the step ends on (a sample time exactly where it lands)
 
 
 @jit
@@ -63,9 +64,9 @@ def rk4_step(t, y, h, K, yt, yn, P, F, G):
 
 
 @jit
-def take_step(method, t, y, h, K, yt, yn, P, F, G):
+def take_step(method, t, y, h, t_end, K, yt, yn, P, F, G):
     if method == 0:
-        dop853_step(t, y, h, K, yt, yn, P, F, G)
+        dop853_step(t, y, h, t_end, K, yt, yn, P, F, G)
     else:
         rk4_step(t, y, h, K, yt, yn, P, F, G)
 
@@ -121,7 +122,7 @@ def locate(method, k, t, y, h, g_lo, g_hi, Kb, ytb, ylo, yhi, ybuf, P, F, G):
         mid = 0.5 * (lo + hi)
         if not (lo < mid < hi):
             break
-        take_step(method, t, y, mid, Kb, ytb, ybuf, P, F, G)
+        take_step(method, t, y, mid, t + mid, Kb, ytb, ybuf, P, F, G)
         gm = event_value(k, t + mid, ybuf, P)
         if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
             lo = mid
@@ -162,7 +163,9 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         h = first_step(t, y, K, yt, rtol, atol, P, F, G, T[n - 1] - T[0])
         NFEV[i] += 1
     steps = 0
-    rejected = False
+    # DOP853 keeps in SUB whether its last try was rejected (no growth right after a rejection), so that
+    # the steps, and the numbers, do not depend on where the budget cut the calls
+    rejected = method == 0 and sub != 0
     status = 0
     while idx < n and steps < budget:
         if t >= T[idx]:
@@ -179,7 +182,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             hh = hfix
             sub += 1
             landing = sub * hfix >= (T[idx] - T[idx - 1]) * (1.0 - 1e-12)
-        take_step(method, t, y, hh, K, yt, yn, P, F, G)
+        take_step(method, t, y, hh, T[idx] if landing else t + hh, K, yt, yn, P, F, G)
         steps += 1
         NSTEP[i] += 1
         NFEV[i] += 12 if method == 0 else 3
@@ -274,7 +277,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
     TC[i] = t
     H[i] = h
     IDX[i] = idx
-    SUB[i] = sub
+    SUB[i] = sub if method != 0 else (1 if rejected else 0)
     ST[i] = status
 
 
@@ -284,7 +287,7 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     for i in range(lo, hi):
         if ST[i] == 0:
             advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol, hfix, EDIR, ETERM, P, F, G)
+                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G)
 
 
 @jit
