@@ -50,8 +50,11 @@ def main(argv=None) -> int:
     bad = 0
     for name in scenarios():
         name = getattr(name, "name", name)
-        now = {k: v for k, v in summary(name).items() if k in KEYS}
         path = args.folder / f"{name}.json"
+        if args.action == "check" and not path.is_file():
+            print(f"{name}: new (no snapshot to compare with)")
+            continue
+        now = {k: v for k, v in summary(name).items() if k in KEYS}
         if args.action == "save":
             args.folder.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(now, indent=1, sort_keys=True))
