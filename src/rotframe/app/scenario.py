@@ -287,6 +287,50 @@ def _parameter(key: str, spec: dict, src: str) -> Parameter:
     return p
 
 
+def _in_scene_unit(key: str, spec: dict, base: dict, src: str) -> dict:
+    """``spec`` (a file's redeclaration of the scene's parameter ``key``) with its numbers in the scene's unit.
+
+    The scene reads every value in the unit of its own scenario file; a file that
+    declares another unit (``unit = "km"`` where the scene has ``"m"``) has its
+    ``default``, ``min`` and ``max`` converted (astropy). A unit of another
+    dimension, or one astropy does not know, is refused naming the file, the
+    key, the unit and the scene's unit.
+    """
+    unit, scene_unit = spec.get("unit"), base.get("unit", "")
+    if unit is None or not isinstance(unit, str) or not isinstance(scene_unit, str) or unit == scene_unit:
+        return spec
+    import astropy.units as u
+    from astropy.units import imperial
+
+    with imperial.enable():
+        try:
+            factor = float(u.Unit(unit or "").to(u.Unit(scene_unit) if scene_unit else u.dimensionless_unscaled))
+        except (ValueError, TypeError, u.UnitsError) as exc:
+            raise ScenarioError(f"{src}: parameters.{key}.unit = {unit!r}: the scene's {key} is in "
+                                f"{scene_unit or 'no unit'!r} and {unit!r} does not convert to it "
+                                f"({first_line(exc)[:120]}); allowed: a unit of the same dimension") from None
+    out = dict(spec, unit=scene_unit)
+
+    def scaled(value):
+        if isinstance(value, bool):
+            return value
+        if isinstance(value, (int, float)):
+            return value * factor
+        if isinstance(value, str):
+            try:
+                return float(value) * factor
+            except ValueError:
+                return value  # a quantity string carries its own unit
+        if isinstance(value, list):
+            return [scaled(v) for v in value]
+        return value
+
+    for k in ("default", "min", "max"):
+        if k in spec:
+            out[k] = scaled(spec[k])
+    return out
+
+
 def load(name_or_path: str) -> Scenario:
     """Load and validate a scenario by name or path.
 
@@ -325,8 +369,8 @@ def load(name_or_path: str) -> Scenario:
             spec = {"default": spec}
         base = builtin.get("parameters", {}).get(key)
         if key in data.get("parameters", {}) and isinstance(base, dict):
-            # a file may override only the default; the scene's parameter keeps its kind
-            spec = {"type": _infer_type(base), **base, **spec}
+            # a file may override only the default; the scene's parameter keeps its kind and its unit
+            spec = {"type": _infer_type(base), **base, **_in_scene_unit(key, spec, base, src)}
         _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
         if "default" not in spec:
             raise ScenarioError(f"{src}: parameters.{key} has no default")
