@@ -166,4 +166,4 @@ def test_show_says_which_method_runs_by_default(tmp_path):
     assert "exact" in line and "dop853" in line
     # heavy-top.toml names its method: the run line carries it and no default line is added
     res = rotframe("show", "heavy-top", cwd=tmp_path)
-    assert "method = dop853" in res.stdout and "default method:" not in res.stdout
+    assert "method = top-splitting8" in res.stdout and "default method:" not in res.stdout
