@@ -93,7 +93,12 @@ class InterruptScope:
     def __enter__(self):
         self._previous_hook = sys.unraisablehook
         sys.unraisablehook = self._unraisable
-        for sig, handler in ((signal.SIGTERM, self._on_term), (signal.SIGINT, self._on_int)):
+        # SIGXFSZ (a write beyond ``ulimit -f``) ignored: the write fails with EFBIG instead of killing the
+        # process, and the one writer (rotframe.app.outputs.write_atomic) removes its temporary file
+        handlers = [(signal.SIGTERM, self._on_term), (signal.SIGINT, self._on_int)]
+        if hasattr(signal, "SIGXFSZ"):
+            handlers.append((signal.SIGXFSZ, signal.SIG_IGN))
+        for sig, handler in handlers:
             try:
                 self._previous[sig] = signal.signal(sig, handler)
             except (ValueError, OSError):  # not the main thread: signals stay as they are
@@ -104,7 +109,7 @@ class InterruptScope:
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self._previous_hook
         for sig, handler in self._previous.items():
-            if self.final:
+            if self.final and sig in (signal.SIGTERM, signal.SIGINT):
                 handler = self._on_late
             try:
                 signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
