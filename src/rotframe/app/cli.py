@@ -74,10 +74,24 @@ def main(argv=None) -> int:
 
 
 def _dispatch(args) -> int:
+    try:
+        return args.func(args)
+    except Exception as exc:  # noqa: BLE001 -- sorted by _failure, unless a signal caused it
+        scope = getattr(args, "scope", None)
+        if scope is None or not scope.interrupted:
+            return _failure(exc)
+        # a signal that arrived inside a library (numba compiling, an import) surfaces as whatever that
+        # library raises: it is still the signal, answered with its exit code and one line
+        _error(f"{scope.verb} (during {type(exc).__name__}); stopped before any result was written")
+        return scope.exit_code
+
+
+def _failure(exc) -> int:
+    """The exit code and one line for an exception of the command (not a signal)."""
     from rotframe.errors import IntegrationError, RotframeError
 
     try:
-        return args.func(args)
+        raise exc
     except IntegrationError as exc:
         _error(f"numerical failure: {_one_line(exc)}")
         return EXIT_NUMERICAL
