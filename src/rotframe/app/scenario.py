@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -190,8 +191,17 @@ _SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
 _TYPES = ("float", "int", "bool", "str", "vector")
 
 
+#: The largest scenario file read (bytes): a scenario is a page of text; a bigger file is refused by its size
+#: before it is read (a sparse file of gigabytes would fill the memory).
+MAX_SCENARIO_BYTES = 1 << 20
+
+
 def _read_toml(path: Path, src: str) -> dict:
     try:
+        size = path.stat().st_size
+        if size > MAX_SCENARIO_BYTES:
+            raise ScenarioError(f"{src}: {size} bytes, too large for a scenario file; allowed: at most "
+                                f"{MAX_SCENARIO_BYTES} bytes (a scenario is a page of TOML)")
         raw = path.read_bytes()
     except OSError as exc:
         raise ScenarioError(f"{src}: cannot read the file ({exc.strerror or exc})") from None
@@ -220,7 +230,7 @@ def _builtin_for_scene(scene: str, path: Path) -> dict | None:
     candidates = [folder / f"{scene}.toml", *SCENARIO_FILES.values()] + sorted(folder.glob("*.toml"))
     for cand in candidates:
         try:
-            if not cand.is_file() or cand.resolve() == path.resolve():
+            if not cand.is_file() or cand.resolve() == path.resolve() or cand.stat().st_size > MAX_SCENARIO_BYTES:
                 continue
             data = tomllib.loads(cand.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
@@ -550,6 +560,9 @@ def parse_run_value(key, raw, source, scene=None):
                   exclusive_min=True)
     value = _to_float(p, raw, where)
     _check_bounds(p, value, raw, where)
+    if 0.0 < value < sys.float_info.min:  # a subnormal keeps too few digits; every count from it overflows
+        raise ScenarioError(f"{where}{key} = {raw!r}: below the smallest normal float64 ({sys.float_info.min:.4g}), "
+                            f"too small to compute with; allowed: {key} >= {sys.float_info.min:.4g}")
     if kind is int:
         if value != int(value):
             raise ScenarioError(f"{where}{key} = {raw!r}: expected a whole number")

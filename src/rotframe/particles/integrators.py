@@ -189,7 +189,9 @@ def _check_work(info, duration, step, samples, n, model):
 
     steps = 0.0
     if info.kind == "fixed":
-        steps = float(samples * steps_per_sample(duration / samples, step))
+        # in floats: a step far below the sample interval gives a count beyond any integer a float holds
+        per = (duration / samples) / float(step) if step else 20.0
+        steps = float(samples) * math.ceil(per) if per < 1e300 else math.inf
     elif info.kind == "adaptive":
         # the least an adaptive method can take, from the model's own rates (a closed form, before any
         # compiling or probing): no step spans more than MAX_RAD_PER_STEP of its fastest oscillation

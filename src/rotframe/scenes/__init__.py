@@ -110,8 +110,10 @@ def register(name: str, scene: Any, scenario: str | Path | None = None, override
         if not path.is_file():
             raise ScenarioError(f"register_scene({name!r}): scenario file {str(path)!r} does not exist")
         try:
+            if path.stat().st_size > 1 << 20:  # as rotframe.app.scenario.MAX_SCENARIO_BYTES: refused unread
+                raise ValueError(f"{path.stat().st_size} bytes, more than a scenario file's 1048576")
             data = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
+        except (OSError, ValueError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
             raise ScenarioError(f"register_scene({name!r}): scenario file {str(path)!r} is not a TOML scenario "
                                 f"file ({_cut(exc)})") from None
         scenario_name = str(data.get("name", path.stem))

@@ -93,8 +93,9 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
 
         steps = steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
     else:
-        steps = samples * max(1.0, math.ceil(
-            (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
+        per = (duration / samples) / float(run.get("step") or duration / samples / 20)
+        # in floats: a step far below the sample interval gives a count beyond any integer a float holds
+        steps = float(samples) * max(1.0, math.ceil(per - 1e-9)) if per < 1e300 else math.inf
     limits.check_run(steps=steps, samples=samples + 1, what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
     if method == "dop853":
