@@ -75,8 +75,8 @@ def check_output_file(path, option: str, suffix: str | None = None) -> Path:
     return p
 
 
-def _one_line(exc: OSError) -> str:
-    return exc.strerror or " ".join(str(exc).split()) or type(exc).__name__
+def _one_line(exc: Exception) -> str:
+    return getattr(exc, "strerror", None) or " ".join(str(exc).split()) or type(exc).__name__
 
 
 @contextlib.contextmanager
@@ -90,7 +90,7 @@ def atomic_path(final, what: str = "file"):
         final.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=str(final.parent), prefix=f".{final.name}.", suffix=".tmp")
         os.close(fd)
-    except OSError as exc:
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
         raise OutputError(f"cannot write the {what} {str(final)!r}: {_one_line(exc)}") from None
     try:
         yield Path(tmp)

@@ -282,7 +282,18 @@ def free_body_state(inertia, omega_body):
 
     inertia = np.asarray(inertia, dtype=float)
     mass_properties.check_moments(inertia)
-    return inertia, inertia * np.asarray(omega_body, dtype=float), np.array([0.0, 0.0, 0.0, 1.0])
+    omega = np.asarray(omega_body, dtype=float)
+    L = inertia * omega
+    with np.errstate(over="ignore", invalid="ignore"):
+        # what the numbers become: |L| and the energy L . omega / 2, from which every metric is measured
+        energy = 0.5 * float(np.sum(np.abs(L) * np.abs(omega)))
+        size = float(np.sqrt(np.sum(L * L)))
+    if not (math.isfinite(energy) and math.isfinite(size)):
+        bound = math.sqrt(1e308 / max(float(np.max(inertia)), 1e-300))
+        raise ScenarioError(f"omega = {omega.tolist()} rad/s: the body's angular momentum or kinetic energy overflows "
+                            f"a float64, so no metric can be measured; allowed: |omega| below about {bound:.3g} rad/s "
+                            "for these moments")
+    return inertia, L, np.array([0.0, 0.0, 0.0, 1.0])
 
 
 def simulate_free_body(body, duration, method, run, progress):
