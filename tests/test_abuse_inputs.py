@@ -178,7 +178,7 @@ def test_file_recording_goes_under_recordings(tmp_path, capsys, monkeypatch):
     # foucault's default (dop853) chooses its own steps: a fixed step is a fixed-step method's setting
     (["run", "foucault", "--method", "splitting", "--set", "step=1e-12"], "--max-steps"),
     (["run", "free-top", "--set", "samples=1e12"], "--max-samples"),
-    # heavy-top's default (dop853, since issue 13) chooses its own steps, as foucault's does
+    # a fixed step far below what the work limit allows
     (["run", "heavy-top", "--method", "top-splitting", "--set", "step=1e-12"], "--max-steps"),
     (["run", "heavy-top", "--set", "duration=1e9"], "--max-steps"),
     (["sweep", "tower-drop", "--grid", "latitude=0:90:1000000000"], "--max-rows"),

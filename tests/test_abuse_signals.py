@@ -12,7 +12,6 @@ import signal
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import pytest
@@ -120,10 +119,11 @@ def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path):
     warm = subprocess.run([sys.executable, "-m", "rotframe", "run", "tower-drop", "--method", "splitting",
                            "--set", "step=1e-3", "--no-record"], cwd=tmp_path, env=env, capture_output=True)
     assert warm.returncode == 0
-    proc = subprocess.Popen([sys.executable, "-m", "rotframe", "run", "tower-drop", "--method", "splitting",
-                             "--set", "step=1e-8", "--set", "samples=1", "--no-record"], cwd=tmp_path, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(5.0)
+    from signs import start, wait_for
+
+    proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.one_sample_in_pieces", 1, "run",
+                       "tower-drop", "--method", "splitting", "--set", "step=1e-8", "--set", "samples=1", "--no-record")
+    wait_for(sign, proc)  # the long compiled loop has begun
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)  # not a timing assertion: a bound so that a hang fails the test
     assert proc.returncode == 130, err

@@ -4,7 +4,6 @@ import json
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -118,10 +117,12 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
     # compile the kernels first, so that the signal arrives while the run integrates
     assert rotframe("run", "turntable", "--set", "duration=0.1", "--method", "splitting", "--no-record",
                     cwd=tmp_path).returncode == 0
-    proc = subprocess.Popen([sys.executable, "-m", "rotframe", "run", "turntable", "--set", "duration=4000",
-                             "--set", "step=1e-5", "--method", "splitting"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(4.0)
+    from signs import start, wait_for
+
+    # the sign: the second compiled call (the first after loading the kernel), so the run is integrating
+    proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.call", 2, "run", "turntable",
+                       "--set", "duration=4000", "--set", "step=1e-5", "--method", "splitting")
+    wait_for(sign, proc)
     proc.send_signal(signal.SIGTERM)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 143, err
@@ -166,4 +167,4 @@ def test_show_says_which_method_runs_by_default(tmp_path):
     assert "exact" in line and "dop853" in line
     # heavy-top.toml names its method: the run line carries it and no default line is added
     res = rotframe("show", "heavy-top", cwd=tmp_path)
-    assert "method = dop853" in res.stdout and "default method:" not in res.stdout
+    assert "method = top-splitting8" in res.stdout and "default method:" not in res.stdout

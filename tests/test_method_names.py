@@ -47,7 +47,7 @@ def test_heavy_top_default_is_the_canonical_name(capsys):
 
     code, out, err = call(capsys, "run", "heavy-top", "--set", "duration=0.2", "--no-record", "--json")
     assert_clean(code, out, err, allowed=(0,))
-    assert json.loads(out)["method"] == "dop853"  # the scenario's default since issue 13 (measured cheaper)
+    assert json.loads(out)["method"] == "top-splitting8"  # the scenario's default since issue 27
     code, out, err = call(capsys, "run", "heavy-top", "--method", "splitting", "--set", "duration=0.2",
                           "--no-record", "--json")
     assert_clean(code, out, err, allowed=(0,))

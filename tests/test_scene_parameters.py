@@ -74,3 +74,61 @@ def test_an_unknown_parameter_in_a_scenario_file_is_refused_with_exit_2(tmp_path
     code, out, err = call(capsys, "run", path, "--no-record")
     assert_clean(code, out, err, allowed=(2,))
     assert "hieght" in err and "not a parameter" in err and "height" in err
+
+
+def _normal_gravity(lat_rad):  # WGS84 normal gravity (Somigliana), written out here as the oracle
+    import math
+    s2 = math.sin(lat_rad) ** 2
+    return 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
+
+
+def test_a_file_that_redeclares_a_parameter_in_another_unit_is_converted_to_the_scenes_unit(tmp_path, capsys):
+    """height in km in a user file runs as the same height in metres (issue 27): the fall time is the
+    one of 158.5 m, to round-off, and agrees with sqrt(2 h / g) (g: normal gravity at the latitude)."""
+    import json
+    import math
+
+    km = tmp_path / "km.toml"
+    km.write_text('scene = "tower-drop"\n[parameters.height]\ndefault = 0.1585\nunit = "km"\nmin = 0.0\n',
+                  encoding="utf-8")
+    code, out, err = call(capsys, "run", km, "--no-record", "--json")
+    assert_clean(code, out, err, allowed=(0,))
+    got = json.loads(out)
+    assert got["params"]["height"] == pytest.approx(158.5, rel=1e-15)
+    code, out, err = call(capsys, "run", "tower-drop", "--no-record", "--json")
+    ref = json.loads(out)
+    assert got["metrics"]["fall_time_s"] == pytest.approx(ref["metrics"]["fall_time_s"], rel=1e-13)
+    lat = math.radians(50 + 53 / 60)
+    closed = math.sqrt(2 * 158.5 / _normal_gravity(lat))
+    assert abs(got["metrics"]["fall_time_s"] - closed) < 1e-6  # Coriolis changes the fall time by ~1e-7 s
+    # the bounds a file gives in its own unit are converted too: 0.2 km is above a max of 0.19 km
+    km.write_text('scene = "tower-drop"\n[parameters.height]\ndefault = 0.2\nunit = "km"\nmax = 0.19\n',
+                  encoding="utf-8")
+    code, out, err = call(capsys, "run", km, "--no-record")
+    assert_clean(code, out, err, allowed=(2,))
+    assert "height" in err and "190" in err
+
+
+@pytest.mark.parametrize("unit", ["s", "kg", "furlong/fortnight", "not-a-unit"])
+def test_a_redeclared_unit_of_another_dimension_is_refused_naming_file_key_and_units(tmp_path, capsys, unit):
+    path = tmp_path / "odd.toml"
+    path.write_text(f'scene = "tower-drop"\n[parameters.height]\ndefault = 0.1585\nunit = "{unit}"\n',
+                    encoding="utf-8")
+    code, out, err = call(capsys, "run", path, "--no-record")
+    assert_clean(code, out, err, allowed=(2,))
+    assert "odd.toml" in err and "height" in err and repr(unit) in err and "'m'" in err
+    with pytest.raises(ScenarioError, match="height"):
+        import rotframe
+        rotframe.run(str(path))
+
+
+def test_a_redeclared_angle_in_radians_is_converted_to_degrees(tmp_path):
+    import math
+
+    from rotframe.app import scenario as sc
+
+    path = tmp_path / "rad.toml"
+    path.write_text('scene = "tower-drop"\n[parameters.latitude]\ndefault = 0.5\nunit = "rad"\n', encoding="utf-8")
+    p = sc.load(str(path)).parameters["latitude"]
+    assert p.unit == "deg" and p.default == pytest.approx(math.degrees(0.5), rel=1e-15)
+    assert (p.min, p.max) == (-90, 90)

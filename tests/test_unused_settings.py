@@ -39,7 +39,7 @@ def test_a_read_setting_and_the_file_defaults_are_not_flagged():
     assert not any("is not used" in w for w in summary["warnings"])
     summary, _ = runner.run("heavy-top", {"duration": "0.5", "step": "1e-4"}, method="top-splitting")
     assert not any("is not used" in w for w in summary["warnings"])
-    # heavy-top.toml sets both step and rtol; the default dop853 run reads rtol only, and says nothing
+    # heavy-top.toml sets both step and rtol; the default top-splitting8 run reads step only, and says nothing
     summary, _ = runner.run("heavy-top", {"duration": "0.5"})
     assert not any("is not used" in w for w in summary["warnings"])
 

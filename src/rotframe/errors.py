@@ -18,8 +18,29 @@ __all__ = [
 ]
 
 
+#: The longest message an error keeps (characters): a value of a million numbers is cut, not printed.
+MAX_MESSAGE = 600
+
+
+def readable(message: str, limit: int = MAX_MESSAGE) -> str:
+    """``message`` on one readable line: at most ``limit`` characters, the middle cut out and counted."""
+    if len(message) <= limit:
+        return message
+    head, tail = message[:limit * 2 // 3], message[-(limit // 4):]
+    return f"{head} ... [{len(message) - len(head) - len(tail)} characters cut] ... {tail}"
+
+
 class RotframeError(Exception):
-    """Base class of every error rotframe raises on purpose."""
+    """Base class of every error rotframe raises on purpose.
+
+    The one door for messages: a message longer than :data:`MAX_MESSAGE` characters
+    (a huge value echoed back) is cut to a readable length here, for every subclass.
+    """
+
+    def __init__(self, *args):
+        if args and isinstance(args[0], str):
+            args = (readable(args[0]),) + args[1:]
+        super().__init__(*args)
 
 
 class NotARotationError(RotframeError, ValueError):

@@ -488,7 +488,7 @@ def _progress_callback(progress: ProgressLike):
 # ---------------------------------------------------------------------------
 
 
-def register_scene(name: str, scene: Any, scenario: str | Path | None = None) -> None:
+def register_scene(name: str, scene: Any, scenario: str | Path | None = None, override: bool = False) -> None:
     """Make a scene of your own runnable like the built-in ones.
 
     Parameters
@@ -500,10 +500,18 @@ def register_scene(name: str, scene: Any, scenario: str | Path | None = None) ->
         ``simulate(values, terms, method, run, progress) -> SceneResult``,
         ``analyse(values, result) -> {"metrics", "theory", "diagnostics", "notes"}``,
         ``record(recording, values, result)``, and optionally ``METHODS``.
-        May also be a module name (``"mypkg.myscene"``), imported when first used.
+        May also be a module name (``"mypkg.myscene"``), imported now.
     scenario : path, optional
         A scenario file whose ``scene`` is ``name``; ``rotframe.run(name)`` and
         ``rotframe run NAME`` then find it by ``name``.
+    override : bool
+        Allow ``name`` (or the scenario's name) to replace a built-in one; refused otherwise.
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the plugin: a module that is missing or raises on import, a scene
+        without the protocol's functions, a scenario file that is not TOML, a built-in name.
 
     Notes
     -----
@@ -513,4 +521,4 @@ def register_scene(name: str, scene: Any, scenario: str | Path | None = None) ->
     """
     from rotframe import scenes
 
-    scenes.register(name, scene, scenario)
+    scenes.register(name, scene, scenario, override=override)

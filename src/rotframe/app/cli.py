@@ -53,8 +53,8 @@ def main(argv=None) -> int:
     code = EXIT_OK
     # from the command line (argv None) a signal after the work ends the process with the
     # command's own exit code, never a traceback from the interpreter's shutdown
-    with InterruptScope(final=argv is None) as scope, _JsonStdout(getattr(args, "json", False)), \
-            warnings.catch_warnings():
+    json_out = _JsonStdout(getattr(args, "json", False))
+    with InterruptScope(final=argv is None) as scope, json_out, warnings.catch_warnings():
         if argv is None:
             # on the command line numpy's overflow warnings are not messages for the user: an
             # overflow that matters is caught as a non-finite value and reported in one line
@@ -70,14 +70,34 @@ def main(argv=None) -> int:
         finally:
             scope.exit_status = code
             scope.closing = True
+    if json_out.failed is not None and code == EXIT_OK:
+        if not isinstance(json_out.failed, BrokenPipeError):  # the reader went away (| head): nothing to say
+            _error(f"cannot write the JSON document to stdout: "
+                   f"{getattr(json_out.failed, 'strerror', None) or json_out.failed}")
+        code = EXIT_INPUT
+        scope.exit_status = code
     return code
 
 
 def _dispatch(args) -> int:
+    try:
+        return args.func(args)
+    except Exception as exc:  # noqa: BLE001 -- sorted by _failure, unless a signal caused it
+        scope = getattr(args, "scope", None)
+        if scope is None or not scope.interrupted:
+            return _failure(exc)
+        # a signal that arrived inside a library (numba compiling, an import) surfaces as whatever that
+        # library raises: it is still the signal, answered with its exit code and one line
+        _error(f"{scope.verb} (during {type(exc).__name__}); stopped before any result was written")
+        return scope.exit_code
+
+
+def _failure(exc) -> int:
+    """The exit code and one line for an exception of the command (not a signal)."""
     from rotframe.errors import IntegrationError, RotframeError
 
     try:
-        return args.func(args)
+        raise exc
     except IntegrationError as exc:
         _error(f"numerical failure: {_one_line(exc)}")
         return EXIT_NUMERICAL
@@ -121,6 +141,8 @@ class _JsonStdout:
     def __init__(self, enabled):
         self.enabled = bool(enabled)
         self.saved = None
+        #: the OSError of writing the document out, if that failed
+        self.failed = None
 
     def __enter__(self):
         if not self.enabled:
@@ -142,9 +164,12 @@ class _JsonStdout:
         if self.saved is not None:
             try:
                 sys.stdout.flush()
-            except (OSError, ValueError):
+            except (OSError, ValueError) as err:  # a full disk, /dev/full: the command reports it in one line
+                self.failed = err
+            try:
+                sys.stdout.close()
+            except (OSError, ValueError):  # the same write failing again: reported once
                 pass
-            sys.stdout.close()
             sys.stdout = self._old
             os.dup2(self.saved, 1)
             os.close(self.saved)

@@ -34,21 +34,21 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
     traj : TrajectoryArrays
         The samples.
     path : path-like
-        Ends in ``.npz``, ``.csv`` or ``.parquet``. Written to a temporary name
-        and renamed, so an existing file is only replaced by a complete one.
+        Ends in ``.npz``, ``.csv`` or ``.parquet``. Written through
+        :func:`rotframe.app.outputs.write_atomic` (a temporary file of its own, then a
+        rename), so an existing file is only replaced by a complete one; a write error
+        is an :class:`~rotframe.app.outputs.OutputError`.
     summary : mapping, optional
         The run summary (JSON-ready) to store beside the arrays.
     """
-    import os
-
     import numpy as np
+
+    from rotframe.app.outputs import write_atomic
 
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise ScenarioError(f"--export {str(path)!r}: the file must end in {', '.join(FORMATS)}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp" + suffix)
     units = dict(traj.units)
     meta = {"scenario": (summary or {}).get("scenario", ""), "frame": traj.frame, "units": units}
     if suffix == ".npz":
@@ -57,8 +57,9 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
             value = getattr(traj, name)
             if value is not None:
                 arrays[name] = value
-        np.savez(tmp, **arrays, units=json.dumps(units), frame=traj.frame,
-                 summary=json.dumps(dict(summary or {})))
+
+        def write(f):
+            np.savez(f, **arrays, units=json.dumps(units), frame=traj.frame, summary=json.dumps(dict(summary or {})))
     else:
         cols = traj.columns()
         if suffix == ".csv":
@@ -66,16 +67,31 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
             table = np.column_stack([np.asarray(cols[k], dtype=float) for k in names])
             fmt = ["%d" if k == "particle" else "%.17g" for k in names]
             header = f"{json.dumps(meta)}\n" + ",".join(names)
-            np.savetxt(tmp, table, delimiter=",", fmt=fmt, header=header, comments="# ")
+
+            def write(f):
+                np.savetxt(f, table, delimiter=",", fmt=fmt, header=header, comments="# ")
         else:
-            try:
-                import pyarrow as pa
-                import pyarrow.parquet as pq
-            except ImportError:
-                raise ScenarioError(f"--export {str(path)!r}: parquet needs pyarrow "
-                                    '(python -m pip install "rotframe[export]"); .npz and .csv need nothing') from None
+            pa, pq = _pyarrow(path)
             table = pa.table({k: np.asarray(v) for k, v in cols.items()})
             table = table.replace_schema_metadata({"rotframe": json.dumps(dict(meta, summary=dict(summary or {})))})
-            pq.write_table(table, tmp)
-    os.replace(tmp, path)
-    return path
+
+            def write(f):
+                pq.write_table(table, f)
+    return write_atomic(path, write, what="export")
+
+
+def _pyarrow(path):
+    """(pyarrow, pyarrow.parquet), or a one-line ScenarioError naming the ``export`` extra.
+
+    Any failure to import (missing, or a broken install raising something other than
+    ImportError) is reported the same way.
+    """
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except Exception as exc:  # noqa: BLE001 -- a broken install raises anything; the remedy is the same
+        why = "is not installed" if isinstance(exc, ImportError) else \
+            f"failed to import ({type(exc).__name__}: {str(exc).splitlines()[0][:120] if str(exc) else ''})"
+        raise ScenarioError(f"--export {str(path)!r}: parquet needs pyarrow, which {why}; install the export "
+                            'extra (python -m pip install "rotframe[export]"); .npz and .csv need nothing') from None
+    return pa, pq

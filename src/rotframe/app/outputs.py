@@ -21,7 +21,8 @@ from pathlib import Path
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["OutputError", "check_output_file", "check_output_dir", "atomic_path", "write_bytes_atomic"]
+__all__ = ["OutputError", "check_output_file", "check_output_dir", "atomic_path", "write_atomic",
+           "write_bytes_atomic", "write_text_atomic"]
 
 
 class OutputError(ScenarioError):
@@ -74,8 +75,8 @@ def check_output_file(path, option: str, suffix: str | None = None) -> Path:
     return p
 
 
-def _one_line(exc: OSError) -> str:
-    return exc.strerror or " ".join(str(exc).split()) or type(exc).__name__
+def _one_line(exc: Exception) -> str:
+    return getattr(exc, "strerror", None) or " ".join(str(exc).split()) or type(exc).__name__
 
 
 @contextlib.contextmanager
@@ -89,7 +90,7 @@ def atomic_path(final, what: str = "file"):
         final.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=str(final.parent), prefix=f".{final.name}.", suffix=".tmp")
         os.close(fd)
-    except OSError as exc:
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
         raise OutputError(f"cannot write the {what} {str(final)!r}: {_one_line(exc)}") from None
     try:
         yield Path(tmp)
@@ -102,16 +103,45 @@ def atomic_path(final, what: str = "file"):
         raise
 
 
-def write_bytes_atomic(final, data: bytes, what: str = "file") -> Path:
-    """Write ``data`` to ``final`` through a unique temporary file and a rename."""
+def write_atomic(final, write, what: str = "file") -> Path:
+    """The one door for every file rotframe writes: ``write(f)`` fills an open binary file, then a rename.
+
+    ``write`` receives a file object opened ``"wb"`` on a unique temporary file in
+    ``final``'s folder (``np.savez(f, ...)``, ``fig.savefig(f, format="png")``,
+    ``pq.write_table(table, f)``, ``f.write(data)``). Only when it returns is the file
+    flushed, synced and renamed to ``final``; on any failure the temporary file is
+    removed, an earlier file under ``final`` is left as it was, and an OSError (full
+    disk, ``ulimit -f``, no permission, a folder in the way) becomes :class:`OutputError`,
+    one line naming the path (a :class:`~rotframe.errors.RotframeError`, exit 2).
+    Two writers of the same path at once each publish a whole file of their own.
+
+    Returns
+    -------
+    Path
+        ``final``.
+    """
     with atomic_path(final, what) as tmp:
         with open(tmp, "wb") as f:
-            view = memoryview(data)
-            for start in range(0, len(view), 1 << 22):  # 4 MiB at a time: a signal is handled between writes
-                f.write(view[start:start + (1 << 22)])
+            write(f)
             f.flush()
             os.fsync(f.fileno())
     return Path(final)
+
+
+def write_bytes_atomic(final, data: bytes, what: str = "file") -> Path:
+    """Write ``data`` to ``final`` through :func:`write_atomic`."""
+
+    def write(f):
+        view = memoryview(data)
+        for start in range(0, len(view), 1 << 22):  # 4 MiB at a time: a signal is handled between writes
+            f.write(view[start:start + (1 << 22)])
+
+    return write_atomic(final, write, what)
+
+
+def write_text_atomic(final, text: str, what: str = "file") -> Path:
+    """Write ``text`` (UTF-8) to ``final`` through :func:`write_atomic`."""
+    return write_bytes_atomic(final, text.encode("utf-8"), what)
 
 
 def _publish(tmp, final):

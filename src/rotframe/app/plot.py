@@ -70,7 +70,9 @@ def plot_result(result, path: str | Path | None = None):
     fig.suptitle(f"{result.scenario.name} ({result.method}): " + "; ".join(lines), fontsize=8)
     fig.tight_layout()
     if path is not None:
+        from rotframe.app.outputs import write_atomic
+
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=110)
+        fmt = path.suffix.lower().lstrip(".") or "png"
+        write_atomic(path, lambda f: fig.savefig(f, dpi=110, format=fmt), what="picture")
     return fig

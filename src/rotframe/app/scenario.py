@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -190,8 +191,17 @@ _SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
 _TYPES = ("float", "int", "bool", "str", "vector")
 
 
+#: The largest scenario file read (bytes): a scenario is a page of text; a bigger file is refused by its size
+#: before it is read (a sparse file of gigabytes would fill the memory).
+MAX_SCENARIO_BYTES = 1 << 20
+
+
 def _read_toml(path: Path, src: str) -> dict:
     try:
+        size = path.stat().st_size
+        if size > MAX_SCENARIO_BYTES:
+            raise ScenarioError(f"{src}: {size} bytes, too large for a scenario file; allowed: at most "
+                                f"{MAX_SCENARIO_BYTES} bytes (a scenario is a page of TOML)")
         raw = path.read_bytes()
     except OSError as exc:
         raise ScenarioError(f"{src}: cannot read the file ({exc.strerror or exc})") from None
@@ -220,7 +230,7 @@ def _builtin_for_scene(scene: str, path: Path) -> dict | None:
     candidates = [folder / f"{scene}.toml", *SCENARIO_FILES.values()] + sorted(folder.glob("*.toml"))
     for cand in candidates:
         try:
-            if not cand.is_file() or cand.resolve() == path.resolve():
+            if not cand.is_file() or cand.resolve() == path.resolve() or cand.stat().st_size > MAX_SCENARIO_BYTES:
                 continue
             data = tomllib.loads(cand.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
@@ -287,6 +297,50 @@ def _parameter(key: str, spec: dict, src: str) -> Parameter:
     return p
 
 
+def _in_scene_unit(key: str, spec: dict, base: dict, src: str) -> dict:
+    """``spec`` (a file's redeclaration of the scene's parameter ``key``) with its numbers in the scene's unit.
+
+    The scene reads every value in the unit of its own scenario file; a file that
+    declares another unit (``unit = "km"`` where the scene has ``"m"``) has its
+    ``default``, ``min`` and ``max`` converted (astropy). A unit of another
+    dimension, or one astropy does not know, is refused naming the file, the
+    key, the unit and the scene's unit.
+    """
+    unit, scene_unit = spec.get("unit"), base.get("unit", "")
+    if unit is None or not isinstance(unit, str) or not isinstance(scene_unit, str) or unit == scene_unit:
+        return spec
+    import astropy.units as u
+    from astropy.units import imperial
+
+    with imperial.enable():
+        try:
+            factor = float(u.Unit(unit or "").to(u.Unit(scene_unit) if scene_unit else u.dimensionless_unscaled))
+        except (ValueError, TypeError, u.UnitsError) as exc:
+            raise ScenarioError(f"{src}: parameters.{key}.unit = {unit!r}: the scene's {key} is in "
+                                f"{scene_unit or 'no unit'!r} and {unit!r} does not convert to it "
+                                f"({first_line(exc)[:120]}); allowed: a unit of the same dimension") from None
+    out = dict(spec, unit=scene_unit)
+
+    def scaled(value):
+        if isinstance(value, bool):
+            return value
+        if isinstance(value, (int, float)):
+            return value * factor
+        if isinstance(value, str):
+            try:
+                return float(value) * factor
+            except ValueError:
+                return value  # a quantity string carries its own unit
+        if isinstance(value, list):
+            return [scaled(v) for v in value]
+        return value
+
+    for k in ("default", "min", "max"):
+        if k in spec:
+            out[k] = scaled(spec[k])
+    return out
+
+
 def load(name_or_path: str) -> Scenario:
     """Load and validate a scenario by name or path.
 
@@ -325,8 +379,8 @@ def load(name_or_path: str) -> Scenario:
             spec = {"default": spec}
         base = builtin.get("parameters", {}).get(key)
         if key in data.get("parameters", {}) and isinstance(base, dict):
-            # a file may override only the default; the scene's parameter keeps its kind
-            spec = {"type": _infer_type(base), **base, **spec}
+            # a file may override only the default; the scene's parameter keeps its kind and its unit
+            spec = {"type": _infer_type(base), **base, **_in_scene_unit(key, spec, base, src)}
         _check_keys(spec, _PARAM_KEYS, src, f"parameters.{key}")
         if "default" not in spec:
             raise ScenarioError(f"{src}: parameters.{key} has no default")
@@ -506,6 +560,9 @@ def parse_run_value(key, raw, source, scene=None):
                   exclusive_min=True)
     value = _to_float(p, raw, where)
     _check_bounds(p, value, raw, where)
+    if 0.0 < value < sys.float_info.min:  # a subnormal keeps too few digits; every count from it overflows
+        raise ScenarioError(f"{where}{key} = {raw!r}: below the smallest normal float64 ({sys.float_info.min:.4g}), "
+                            f"too small to compute with; allowed: {key} >= {sys.float_info.min:.4g}")
     if kind is int:
         if value != int(value):
             raise ScenarioError(f"{where}{key} = {raw!r}: expected a whole number")

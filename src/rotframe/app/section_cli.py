@@ -33,6 +33,7 @@ import numpy as np
 
 from rotframe.app.choices import did_you_mean
 from rotframe.app.options import split_set
+from rotframe.app.outputs import OutputError
 from rotframe.app.quantities import NotAQuantity, WrongDimension, value_in
 from rotframe.app.section_plot import plot_section
 from rotframe.rigid.sections import (
@@ -154,6 +155,8 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
     if png:
         try:
             written = str(plot_section(section, png, title=f"{name}: " + _params_text(params)))
+        except OutputError as exc:  # the one writer's error: one line naming the path
+            return _fail(f"--png {png!r}: {exc}")
         except OSError as exc:
             return _fail(f"--png {png!r}: cannot write the file ({exc.strerror or exc}); allowed: a writable path")
 

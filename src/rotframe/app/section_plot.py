@@ -83,5 +83,7 @@ def plot_section(section: Section, path, *, title: str | None = None) -> Path:
         else f"A = {section.area:.4g} m$^2$, major axis at {section.principal_angle:.2f} deg"
         + (" (isotropic: every axis principal)" if section.is_isotropic else "")
     )
-    fig.savefig(out, format="png")
+    from rotframe.app.outputs import write_atomic
+
+    write_atomic(out, lambda f: fig.savefig(f, format="png"), what="picture")
     return out

@@ -48,6 +48,7 @@ class InterruptScope:
         self.final = final
         self.exit_status = 0
         self._previous = {}
+        self._active = False
 
     # the handlers --------------------------------------------------------------
 
@@ -82,7 +83,7 @@ class InterruptScope:
             import threading
 
             sig = signal.SIGTERM if isinstance(info.exc_value, Terminated) else signal.SIGINT
-            timer = threading.Timer(0.05, os.kill, (os.getpid(), sig))
+            timer = threading.Timer(0.05, self._redeliver, (sig,))
             timer.daemon = True
             timer.start()
             return
@@ -90,10 +91,21 @@ class InterruptScope:
             return
         self._previous_hook(info)
 
+    def _redeliver(self, sig):
+        """The signal again, while this scope still handles it (never to a process that has moved on)."""
+        if self._active and not self.closing:
+            os.kill(os.getpid(), sig)
+
     def __enter__(self):
+        self._active = True
         self._previous_hook = sys.unraisablehook
         sys.unraisablehook = self._unraisable
-        for sig, handler in ((signal.SIGTERM, self._on_term), (signal.SIGINT, self._on_int)):
+        # SIGXFSZ (a write beyond ``ulimit -f``) ignored: the write fails with EFBIG instead of killing the
+        # process, and the one writer (rotframe.app.outputs.write_atomic) removes its temporary file
+        handlers = [(signal.SIGTERM, self._on_term), (signal.SIGINT, self._on_int)]
+        if hasattr(signal, "SIGXFSZ"):
+            handlers.append((signal.SIGXFSZ, signal.SIG_IGN))
+        for sig, handler in handlers:
             try:
                 self._previous[sig] = signal.signal(sig, handler)
             except (ValueError, OSError):  # not the main thread: signals stay as they are
@@ -101,10 +113,11 @@ class InterruptScope:
         return self
 
     def __exit__(self, *exc):
+        self._active = False
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self._previous_hook
         for sig, handler in self._previous.items():
-            if self.final:
+            if self.final and sig in (signal.SIGTERM, signal.SIGINT):
                 handler = self._on_late
             try:
                 signal.signal(sig, handler if handler is not None else signal.SIG_DFL)

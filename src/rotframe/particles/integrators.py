@@ -168,7 +168,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         raise ScenarioError("initial state: the parameters give a non-finite position or velocity "
                             "(a parameter too large?)")
     samples = max(1, int(samples))
-    _check_work(info, duration, step, samples, r0.shape[0])
+    _check_work(info, duration, step, samples, r0.shape[0], model)
     if info.kind == "exact":
         if not model.has_exact_flow:
             why = "; ".join(model.nonlinear_reasons())
@@ -183,14 +183,43 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
 # ---------------------------------------------------------------------------
 
 
-def _check_work(info, duration, step, samples, n):
+def _check_work(info, duration, step, samples, n, model):
     """Refuse, before allocating anything, a run over the work limits (:mod:`rotframe.limits`)."""
     from rotframe import limits
 
     steps = 0.0
     if info.kind == "fixed":
-        steps = float(samples * steps_per_sample(duration / samples, step))
+        # in floats: a step far below the sample interval gives a count beyond any integer a float holds
+        per = (duration / samples) / float(step) if step else 20.0
+        steps = float(samples) * math.ceil(per) if per < 1e300 else math.inf
+    elif info.kind == "adaptive":
+        # the least an adaptive method can take, from the model's own rates (a closed form, before any
+        # compiling or probing): no step spans more than MAX_RAD_PER_STEP of its fastest oscillation
+        steps = duration * fastest_rate(model) / MAX_RAD_PER_STEP
     limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
+
+
+#: The most radians of its fastest oscillation one adaptive step can span: DOP853's stability interval on
+#: the imaginary axis is shorter (about 4.5); an accurate step spans far less (0.2 at rtol 1e-10).
+MAX_RAD_PER_STEP = 6.0
+
+
+def fastest_rate(model) -> float:
+    """The fastest angular rate (rad/s) of ``model``'s motion, from its parameters: the pendulum's
+    sqrt(g / length), the spring's sqrt(k) and twice the frame's largest rate (the inertial
+    oscillation of a Coriolis term). 0 when it has none (a steady fall)."""
+    rates = [0.0]
+    if model.has("pendulum") and model.pendulum_length > 0:
+        g = float(np.linalg.norm(model.g)) or float(model.g0)
+        rates.append(math.sqrt(g / model.pendulum_length))
+    if model.has("spring") and model.spring > 0:
+        rates.append(math.sqrt(model.spring))
+    if any(model.has(t) for t in ("coriolis", "centrifugal", "euler")):
+        values = np.asarray(model.omega.values, dtype=float)
+        if values.size:
+            rates.append(2.0 * float(np.max(np.abs(values))))
+    rate = max(rates)
+    return rate if math.isfinite(rate) else math.inf
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
@@ -226,6 +255,10 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
     except KeyboardInterrupt:
         partial = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)), np.transpose(out[:, 3:6, :], (0, 2, 1)),
                              "exact", 1, 0).truncated(max(done, 1)) if done else None
+        if partial is not None:  # events not located in a partial run: none, for every particle
+            for ev in events:
+                partial.event_times.setdefault(ev.name, [np.empty(0) for _ in range(n)])
+                partial.event_states.setdefault(ev.name, [np.empty((0, 6)) for _ in range(n)])
         raise RunInterrupted(partial) from None
     traj = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)).copy(),
                       np.transpose(out[:, 3:6, :], (0, 2, 1)).copy(), "exact", 1, 0, True, duration)

@@ -34,7 +34,13 @@ class InvalidStateError(RotframeError, ValueError):
 
 
 def check_inertia(inertia):
-    """Principal moments as float64 (3,) and their inverses (0 for a zero moment)."""
+    """Principal moments as float64 (3,) and their inverses (4,): ``1/I_i`` (0 for a zero moment), then
+    ``1/I_s - 1/I_p`` of a symmetric body (``s`` its :func:`symmetry_axis`, ``p`` an equal one; 0 if none).
+
+    The difference is computed as ``(I_p - I_s) / (I_p I_s)``: ``1/I_s - 1/I_p`` of the two rounded
+    inverses cancels, losing five digits for a nearly spherical top (I3/I1 - 1 = 1e-12). The kernels
+    read it as ``inv_i[3]``; every other use reads the first three entries.
+    """
     moments = np.array(check_moments(inertia), dtype=np.float64)
     moments = np.maximum(moments, 0.0)
     if np.count_nonzero(moments) < 2:
@@ -42,8 +48,13 @@ def check_inertia(inertia):
             f"principal moments {moments.tolist()} kg m^2: a rotating body needs at least two "
             "non-zero moments (a point mass has no rotational dynamics)"
         )
-    inv_i = np.zeros(3)
-    np.divide(1.0, moments, out=inv_i, where=moments > 0.0)
+    inv_i = np.zeros(4)
+    np.divide(1.0, moments, out=inv_i[:3], where=moments > 0.0)
+    sym = symmetry_axis(moments)
+    if sym is not None:
+        i_s, i_p = moments[sym], moments[(sym + 1) % 3]
+        if i_s > 0.0 and i_p > 0.0:
+            inv_i[3] = (i_p - i_s) / (i_p * i_s)
     return moments, inv_i
 
 

@@ -170,7 +170,7 @@ def elliptic_period(inertia: ArrayLike, L0_body: ArrayLike) -> float:
         return math.inf
     sym = symmetry_axis(inertia)
     if sym is not None:
-        k = L0[sym] * (inv_i[sym] - inv_i[(sym + 1) % 3])
+        k = L0[sym] * inv_i[3]  # 1/I_s - 1/I_p without cancellation (checks.check_inertia)
         return math.inf if k == 0.0 else 2.0 * math.pi / abs(k)
     frame = _elliptic_frame(inertia, L0)
     if frame is None or frame["m1"] == 0.0:
@@ -182,7 +182,7 @@ def _free_symmetric(inv_i, s, L0, q0, t):
     """Exact free symmetric body: two commuting exact rotations (see free_body_exact)."""
     norm_L = math.hypot(*L0)
     inv_p = inv_i[(s + 1) % 3]
-    gamma = L0[s] * (inv_i[s] - inv_p)  # body rate of the second flow, = -k
+    gamma = L0[s] * inv_i[3]  # body rate of the second flow, = -k; 1/I_s - 1/I_p without cancellation
     e_s = np.eye(3)[s]
     q = quat_mul_arrays(quat_mul_arrays(q0, quat_about_axis(L0 / norm_L, norm_L * inv_p * t)), quat_about_axis(e_s, gamma * t))
     L = rotate_about(e_s, -gamma * t, L0)

@@ -72,7 +72,8 @@ def free_step(L, q, tau, inv_i, sym):
             s_half = math.sin(half)  # the quaternion (sin(half) L / |L|, cos(half)) as scalars (no array)
             q[0], q[1], q[2], q[3] = quat_mul(q[0], q[1], q[2], q[3], s_half * L[0] / norm_L,
                                               s_half * L[1] / norm_L, s_half * L[2] / norm_L, math.cos(half))
-        _turn_about_axis(L, q, sym, tau * L[sym] * (inv_i[sym] - inv_p))
+        # 1/I_s - 1/I_p as (I_p - I_s) / (I_p I_s) (checks.check_inertia: the plain difference cancels)
+        _turn_about_axis(L, q, sym, tau * L[sym] * (inv_i[3] if inv_i.shape[0] > 3 else inv_i[sym] - inv_p))
     else:
         # int(k), not the literal k: one compiled _turn_about_axis for every axis (a literal argument is a
         # type of its own, compiled apart)

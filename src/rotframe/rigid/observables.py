@@ -54,7 +54,7 @@ def omega_body(inertia: ArrayLike, L: ArrayLike) -> np.ndarray:
     inertia, inv_i = check_inertia(inertia)
     L = np.asarray(L, dtype=np.float64)
     check_axis_momentum(inertia, L)
-    return L * inv_i
+    return L * inv_i[:3]
 
 
 def body_to_space(q: ArrayLike, vec: ArrayLike) -> np.ndarray:

@@ -64,6 +64,8 @@ SCENES: dict[str, Any] = {
 
 #: scenario name -> scenario file, for scenarios registered with their scene
 SCENARIO_FILES: dict[str, Path] = {}
+#: the built-in scene names: a plugin may not take one unless it says so (``override=True``)
+BUILTIN = frozenset(SCENES)
 
 _PROTOCOL = ("simulate", "analyse", "record")
 _PLUGINS_LOADED: set[str] = set()
@@ -76,41 +78,73 @@ def get(name: str):
     return importlib.import_module(scene) if isinstance(scene, str) else scene
 
 
-def register(name: str, scene: Any, scenario: str | Path | None = None) -> None:
+def register(name: str, scene: Any, scenario: str | Path | None = None, override: bool = False) -> None:
     """Add scene ``name`` (an object or module with the scene protocol, or a module name).
 
     ``scenario``, a scenario file whose ``scene`` is ``name``, makes the
     scenario findable by its name (its file's ``name``, else its stem).
+
+    The fence every plugin passes (one :class:`~rotframe.errors.ScenarioError` line naming
+    it, exit 2 on the command line): a module name is imported now (a missing module, or
+    one that raises on import, is refused); the scene must have the protocol's functions;
+    the scenario file must be TOML; a name that is a built-in scene or scenario is refused
+    unless ``override=True``.
     """
     from rotframe.errors import ScenarioError
 
     if not isinstance(name, str) or not name or "/" in name:
         raise ScenarioError(f"register_scene: name {name!r} must be a non-empty string without '/'")
-    if not isinstance(scene, str):
-        missing = [f for f in _PROTOCOL if not callable(getattr(scene, f, None))]
-        if missing:
-            raise ScenarioError(f"register_scene({name!r}): the scene lacks {', '.join(missing)} "
-                                "(see the scene protocol in rotframe.scenes)")
-    SCENES[name] = scene
+    if name in BUILTIN and not override:
+        raise ScenarioError(f"register_scene({name!r}): {name!r} is a built-in scene; choose another name, or "
+                            "pass override=True to replace it")
+    target = scene
+    if isinstance(scene, str):
+        target = _import_plugin(scene, f"register_scene({name!r})")
+    missing = [f for f in _PROTOCOL if not callable(getattr(target, f, None))]
+    if missing:
+        raise ScenarioError(f"register_scene({name!r}): the scene {_shown(scene)} lacks {', '.join(missing)} "
+                            "(see the scene protocol in rotframe.scenes)")
+    scenario_name = path = None
     if scenario is not None:
         import tomllib
 
         path = Path(scenario)
         if not path.is_file():
             raise ScenarioError(f"register_scene({name!r}): scenario file {str(path)!r} does not exist")
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-        SCENARIO_FILES[str(data.get("name", path.stem))] = path
+        try:
+            if path.stat().st_size > 1 << 20:  # as rotframe.app.scenario.MAX_SCENARIO_BYTES: refused unread
+                raise ValueError(f"{path.stat().st_size} bytes, more than a scenario file's 1048576")
+            data = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
+            raise ScenarioError(f"register_scene({name!r}): scenario file {str(path)!r} is not a TOML scenario "
+                                f"file ({_cut(exc)})") from None
+        scenario_name = str(data.get("name", path.stem))
+        # each built-in scenario file is named as its scene
+        if scenario_name in BUILTIN and not override and SCENARIO_FILES.get(scenario_name) != path:
+            raise ScenarioError(f"register_scene({name!r}): scenario name {scenario_name!r} (from {str(path)!r}) is a "
+                                "built-in scenario; give the file another name, or pass override=True")
+    SCENES[name] = scene
+    if scenario_name is not None:
+        SCENARIO_FILES[scenario_name] = path
 
 
-def load_plugins() -> None:
-    """Import the modules in ``$ROTFRAME_PLUGINS`` once (module names or ``.py`` paths, comma-separated)."""
+def _shown(scene) -> str:
+    return repr(scene) if isinstance(scene, str) else repr(getattr(scene, "__name__", type(scene).__name__))
+
+
+def _cut(exc, limit=160) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def _import_plugin(item: str, who: str):
+    """Import a plugin module (a name or a ``.py`` path), its prints sent to stderr; ScenarioError on any failure."""
+    import contextlib
+
     from rotframe.errors import ScenarioError
 
-    for item in filter(None, (s.strip() for s in os.environ.get("ROTFRAME_PLUGINS", "").split(","))):
-        if item in _PLUGINS_LOADED:
-            continue
-        _PLUGINS_LOADED.add(item)
-        try:
+    try:
+        with contextlib.redirect_stdout(sys.stderr):  # a plugin's prints never join --json's one document
             if item.endswith(".py"):
                 path = Path(item)
                 spec = importlib.util.spec_from_file_location(f"rotframe_plugin_{path.stem}", path)
@@ -118,8 +152,31 @@ def load_plugins() -> None:
                     raise ImportError(f"no file {item}")
                 module = importlib.util.module_from_spec(spec)
                 sys.modules[spec.name] = module  # so that the plugin can name itself (sys.modules[__name__])
-                spec.loader.exec_module(module)
-            else:
-                importlib.import_module(item)
-        except ImportError as exc:
-            raise ScenarioError(f"ROTFRAME_PLUGINS: cannot import {item!r}: {exc}") from None
+                try:
+                    spec.loader.exec_module(module)
+                except BaseException:
+                    sys.modules.pop(spec.name, None)
+                    raise
+                return module
+            return importlib.import_module(item)
+    except ScenarioError as exc:  # the plugin's own register_scene refused something: say which plugin
+        raise ScenarioError(f"{who}: plugin {item!r}: {exc}") from None
+    except SyntaxError as exc:
+        raise ScenarioError(f"{who}: plugin {item!r} has a syntax error (line {exc.lineno}: "
+                            f"{_cut(exc.msg)})") from None
+    except ImportError as exc:
+        raise ScenarioError(f"{who}: cannot import {item!r}: {_cut(exc)}") from None
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 -- a plugin may raise anything at import: fenced
+        raise ScenarioError(f"{who}: plugin {item!r} failed on import ({type(exc).__name__}: {_cut(exc)})") from None
+
+
+def load_plugins() -> None:
+    """Import the modules in ``$ROTFRAME_PLUGINS`` once (module names or ``.py`` paths, comma-separated).
+
+    Each goes through :func:`_import_plugin`: any failure is one ScenarioError naming the plugin.
+    """
+    for item in filter(None, (s.strip() for s in os.environ.get("ROTFRAME_PLUGINS", "").split(","))):
+        if item in _PLUGINS_LOADED:
+            continue
+        _PLUGINS_LOADED.add(item)
+        _import_plugin(item, "ROTFRAME_PLUGINS")

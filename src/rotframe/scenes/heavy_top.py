@@ -102,6 +102,9 @@ def simulate(p, terms, method, run, progress):
                    progress, top=top)
 
 
+#: Order of each fixed-step method (its global error goes as h^order): what its stated accuracy scales by.
+ORDERS = {"top-splitting": 2, "top-splitting4": 4, "top-splitting6": 6, "top-splitting8": 8, "rk4": 4}
+
 #: Theory: turning points closer than this (rad) are steady motion (no nutation).
 NUTATION_FLOOR = 1e-12
 
@@ -204,13 +207,14 @@ def analyse(p, result):
                 theory["nutation_period_s"] = math.nan
                 notes.append(f"theory: theta stays at {math.degrees(tp[0]):.6g} deg (steady to the resolution of the cubic; the period of "
                              f"small nods about it would be {tp[2]:.6g} s)")
-            # method error of an order-2 splitting, (w h)^2 relative with w the fastest rate, factor 10 margin
-            # (dop853: its bound from the tolerance, rigid_base.adaptive_rel_error);
+            # method error of an order-p fixed-step method, (w h)^p relative with w the fastest rate, factor 10
+            # margin (dop853: its bound from the tolerance, rigid_base.adaptive_rel_error);
             # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
             T = float(tp[2]) if len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0 else math.inf
             w_fast = max(abs(w3), abs(p.phidot0), 2 * math.pi / T)
             method_rel = (adaptive_rel_error(traj) if traj.method == "dop853"
-                          else 10 * (w_fast * h) ** 2 if traj.method != "exact" else 1e-9)
+                          else 10 * (w_fast * h) ** ORDERS.get(traj.method, 2) + 1e-9 if traj.method != "exact"
+                          else 1e-9)
             amp_deg = math.degrees(tp[1] - tp[0])
             for key, i in (("theta_min_deg", int(np.argmin(theta))), ("theta_max_deg", int(np.argmax(theta)))):
                 # the true extreme lies within a sample of the sampled one, so it differs from it by at most

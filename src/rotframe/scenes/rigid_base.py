@@ -29,6 +29,8 @@ HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6"
 DEFAULT_RTOL = 1e-10
 #: Samples per compiled call of the adaptive and exact runs: between calls progress shows and Ctrl-C is seen.
 SAMPLES_PER_CALL = 4096
+#: Steps per compiled call of the adaptive run, at most (about 0.1 s): the bound on how long a signal waits.
+STEPS_PER_CALL = 1e5
 
 
 def adaptive_rel_error(traj):
@@ -91,13 +93,14 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
 
         steps = steps_estimate(inertia, L0, duration, rtol, 0.0 if top is None else top[0] * top[1] * top[2])
     else:
-        steps = samples * max(1.0, math.ceil(
-            (duration / samples) / float(run.get("step") or duration / samples / 20) - 1e-9))
+        per = (duration / samples) / float(run.get("step") or duration / samples / 20)
+        # in floats: a step far below the sample interval gives a count beyond any integer a float holds
+        steps = float(samples) * max(1.0, math.ceil(per - 1e-9)) if per < 1e300 else math.inf
     limits.check_run(steps=steps, samples=samples + 1, what=f"method {method}")
     times = np.linspace(0.0, duration, samples + 1)
     if method == "dop853":
         return _integrate_adaptive(inertia, L0, q0, times, rtol, 0.0 if top is None else top[0] * top[1] * top[2],
-                                   progress)
+                                   progress, steps)
     if method == "exact":
         if top is not None:
             raise ScenarioError("method 'exact' is the free body's flow; the heavy top has gravity")
@@ -165,9 +168,11 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     return traj
 
 
-def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
+def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress, steps_estimate=0.0):
     """The ``dop853`` run at ``times`` (``rtol`` and moments checked by :func:`_check_adaptive`): compiled
-    adaptive DOP853, :data:`SAMPLES_PER_CALL` samples a call.
+    adaptive DOP853, at most :data:`SAMPLES_PER_CALL` samples and about :data:`STEPS_PER_CALL` steps a call
+    (from ``steps_estimate``, the run's estimated steps), so that a signal is answered within a fraction
+    of a second however long a sample interval is: one that needs more is advanced in pieces.
 
     Each call starts from the last sample of the one before (its state at a step's end, the
     quaternion normalised) and chooses its first step afresh. ``steps`` counts accepted steps;
@@ -185,13 +190,21 @@ def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
     compile_s = time.perf_counter() - t0
     done = 1  # samples filled
     L, q = L0, q0
+    per_sample = float(steps_estimate) / max(n - 1, 1)
+    per_call = int(min(SAMPLES_PER_CALL, max(1.0, STEPS_PER_CALL / max(per_sample, 1e-300))))
+    pieces = int(min(1e6, math.ceil(per_sample / STEPS_PER_CALL))) if per_sample > STEPS_PER_CALL else 1
     try:
         while done < n:
-            stop = min(n, done + SAMPLES_PER_CALL)
+            stop = min(n, done + per_call)
             try:
-                res = rigid_dop853(inertia, L, q, times[done - 1:stop], rtol=rtol, mgl=mgl)
+                if pieces > 1:  # one sample interval in pieces: Python regains control between them
+                    res = _one_sample_in_pieces(rigid_dop853, inertia, L, q, times[done - 1], times[done], pieces,
+                                                rtol, mgl)
+                    stop = done + 1
+                else:
+                    res = rigid_dop853(inertia, L, q, times[done - 1:stop], rtol=rtol, mgl=mgl)
             except IntegrationError as exc:
-                k = len(exc.partial.times)
+                k = 1 if pieces > 1 else len(exc.partial.times)  # pieces: the sample was not reached
                 out_L[done:done + k - 1], out_q[done:done + k - 1] = exc.partial.L[1:], exc.partial.q[1:]
                 good = done + k - 1
                 partial = _truncate(BodyTrajectory(times, out_L, out_q, "dop853", steps + exc.partial.steps), good)
@@ -210,6 +223,29 @@ def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress):
     traj = BodyTrajectory(times, out_L, out_q, "dop853", steps, True, float(times[-1]))
     traj.extras.update(compile_s=compile_s, rtol=rtol, nfev=nfev)
     return traj
+
+
+def _one_sample_in_pieces(rigid_dop853, inertia, L, q, t0, t1, pieces, rtol, mgl):
+    """One sample interval [t0, t1] as ``pieces`` calls; a result with the two samples' L, q and the cost."""
+    grid = np.linspace(t0, t1, pieces + 1)
+    L_out, q_out = [np.asarray(L, float)], [np.asarray(q, float)]
+    steps = nfev = 0
+    for k in range(pieces):
+        res = rigid_dop853(inertia, L, q, grid[k:k + 2], rtol=rtol, mgl=mgl)
+        L, q = res.L[-1], res.q[-1]
+        steps += res.steps
+        nfev += res.nfev
+    L_out.append(L)
+    q_out.append(q)
+    return _Pieces(np.array(L_out), np.array(q_out), steps, nfev)
+
+
+@dataclass
+class _Pieces:
+    L: np.ndarray
+    q: np.ndarray
+    steps: int
+    nfev: int
 
 
 def _check_adaptive(inertia, rtol):
@@ -246,7 +282,18 @@ def free_body_state(inertia, omega_body):
 
     inertia = np.asarray(inertia, dtype=float)
     mass_properties.check_moments(inertia)
-    return inertia, inertia * np.asarray(omega_body, dtype=float), np.array([0.0, 0.0, 0.0, 1.0])
+    omega = np.asarray(omega_body, dtype=float)
+    L = inertia * omega
+    with np.errstate(over="ignore", invalid="ignore"):
+        # what the numbers become: |L| and the energy L . omega / 2, from which every metric is measured
+        energy = 0.5 * float(np.sum(np.abs(L) * np.abs(omega)))
+        size = float(np.sqrt(np.sum(L * L)))
+    if not (math.isfinite(energy) and math.isfinite(size)):
+        bound = math.sqrt(1e308 / max(float(np.max(inertia)), 1e-300))
+        raise ScenarioError(f"omega = {omega.tolist()} rad/s: the body's angular momentum or kinetic energy overflows "
+                            f"a float64, so no metric can be measured; allowed: |omega| below about {bound:.3g} rad/s "
+                            "for these moments")
+    return inertia, L, np.array([0.0, 0.0, 0.0, 1.0])
 
 
 def simulate_free_body(body, duration, method, run, progress):

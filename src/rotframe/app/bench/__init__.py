@@ -99,10 +99,10 @@ def main(args) -> int:
     speed = speedups(rows)
     plots = plot(rows, args.plots) if getattr(args, "plots", None) else []
     if plots:  # keep the numbers beside the pictures
-        with open(os.path.join(args.plots, "bench.json"), "w") as f:
-            json.dump(json_rows(rows), f, indent=0)
-        with open(os.path.join(args.plots, "bench.txt"), "w") as f:
-            f.write(table(rows, speed) + "\n")
+        from rotframe.app.outputs import write_text_atomic
+
+        write_text_atomic(os.path.join(args.plots, "bench.json"), json.dumps(json_rows(rows), indent=0), "bench table")
+        write_text_atomic(os.path.join(args.plots, "bench.txt"), table(rows, speed) + "\n", "bench table")
     if args.json:
         print(json.dumps(json_rows(rows)))
     else:
