@@ -9,8 +9,8 @@ tolerance (``same_answer_rel``).
 
 ``cr3bp``: the scene's orbit (100 synodic periods near L4) by ``rotframe.problem`` against
 scipy's ``solve_ivp`` (DOP853) with a numba-compiled right-hand side, at the same rtol; each
-row gives the wall time and the error against a tighter rotframe run. diffrax, where
-installed, is left to the scenario benches (it is not installed on the reference machine).
+row gives the wall time and the error against a tighter rotframe run, and, where jax and
+diffrax are installed (the ``bench`` extra), diffrax's jit-compiled Dopri8 at the same rtol.
 """
 
 from __future__ import annotations
@@ -113,13 +113,58 @@ def _cr3bp_rows(quick, repeats):
         return solve_ivp(rhs, (0, T), y0, method="DOP853", rtol=rtol, atol=rtol * 1e-3).y[:3, -1]
 
     ref = ours(1e-14)
+    jax_run = _diffrax_cr3bp(mu, y0, T)
     rows = []
     for rtol in (1e-6, 1e-9, 1e-12):
         scipy_run(rtol)
         t_o, a = _best(lambda: ours(rtol), repeats)
         t_s, b = _best(lambda: scipy_run(rtol), max(1, repeats // 2))
-        rows.append({"scenario": "cr3bp", "kind": "cr3bp", "method": "dop853 (rotframe.problem)", "setting": rtol,
-                     "wall_s": t_o, "error": float(np.linalg.norm(a - ref)), "error_kind": "position vs rtol 1e-14",
-                     "peer": "scipy DOP853 + numba rhs", "peer_wall_s": t_s,
-                     "peer_error": float(np.linalg.norm(b - ref)), "speedup": t_s / t_o, "nfev": 0})
+        row = {"scenario": "cr3bp", "kind": "cr3bp", "method": "dop853 (rotframe.problem)", "setting": rtol,
+               "wall_s": t_o, "error": float(np.linalg.norm(a - ref)), "error_kind": "position vs rtol 1e-14",
+               "peer": "scipy DOP853 + numba rhs", "peer_wall_s": t_s,
+               "peer_error": float(np.linalg.norm(b - ref)), "speedup": t_s / t_o, "nfev": 0}
+        if jax_run is not None:
+            t_d, c = _best(lambda: jax_run(rtol), repeats)
+            row.update({"diffrax_wall_s": t_d, "diffrax_error": float(np.linalg.norm(c - ref)),
+                        "speedup_vs_diffrax": t_d / t_o})
+        else:
+            row["diffrax"] = "not installed (pip install 'rotframe[bench]')"
+        rows.append(row)
     return rows
+
+
+def _diffrax_cr3bp(mu, y0, T):
+    """diffrax's Dopri8 on the CR3BP (jax.jit-compiled once, rtol traced), or None without jax/diffrax."""
+    try:
+        import diffrax
+        import jax
+    except Exception:  # noqa: BLE001 (any import failure: no diffrax row)
+        return None
+    jax.config.update("jax_enable_x64", True)
+    import jax.numpy as jnp
+
+    def field(t, y, args):
+        x, yy, z, vx, vy, vz = y[0], y[1], y[2], y[3], y[4], y[5]
+        d1 = x + mu
+        d2 = x - 1 + mu
+        r1 = jnp.sqrt(d1 * d1 + yy * yy + z * z)
+        r2 = jnp.sqrt(d2 * d2 + yy * yy + z * z)
+        k1 = (1 - mu) / r1 ** 3
+        k2 = mu / r2 ** 3
+        return jnp.stack([vx, vy, vz, x + 2 * vy - k1 * d1 - k2 * d2, yy - 2 * vx - (k1 + k2) * yy, -(k1 + k2) * z])
+
+    term = diffrax.ODETerm(field)
+    y0j = jnp.asarray(y0, dtype=jnp.float64)
+
+    @jax.jit
+    def solve(rtol):
+        sol = diffrax.diffeqsolve(term, diffrax.Dopri8(), t0=0.0, t1=float(T), dt0=None, y0=y0j,
+                                  stepsize_controller=diffrax.PIDController(rtol=rtol, atol=rtol),
+                                  saveat=diffrax.SaveAt(t1=True), max_steps=4_000_000)
+        return sol.ys[-1]
+
+    def run(rtol):
+        return np.asarray(solve(float(rtol)).block_until_ready())[:3]
+
+    run(1e-6)  # compile
+    return run
