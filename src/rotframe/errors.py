@@ -1,9 +1,9 @@
 """Exceptions raised by rotframe.
 
-Every error a user can cause is a :class:`RotframeError`. The ones that mean
-"your input was wrong" are also :class:`ValueError`, so code that already
+Every error a user can cause is a [`RotframeError`][rotframe.errors.RotframeError]. The ones that mean
+"your input was wrong" are also `ValueError`, so code that already
 catches ``ValueError`` keeps working; the command line turns them into exit
-code 2 with one line of text. :class:`IntegrationError` is a numerical failure
+code 2 with one line of text. [`IntegrationError`][rotframe.errors.IntegrationError] is a numerical failure
 (exit code 3) and carries the simulated time that was reached.
 """
 

@@ -4,7 +4,7 @@ This is the module behind ``rotframe.scenarios``, ``rotframe.load`` and
 ``rotframe.run`` (``import rotframe`` reaches it lazily, so the import stays
 cheap). A run goes the same way as ``rotframe run NAME`` on the command line:
 the scenario file is loaded and checked, the values are converted once to the
-documented units, the scene is simulated and analysed, and a :class:`Result`
+documented units, the scene is simulated and analysed, and a [`Result`][rotframe.app.api.Result]
 holds the summary (the same keys as ``rotframe run --json``) and the
 trajectory as plain float64 arrays in SI units.
 
@@ -16,7 +16,7 @@ Parameter values may be given as
 * the strings the command line takes (``"520 ft"``, ``"50d54m"``,
   ``"48d50m46s N"``, ``"0,1,1e-3"`` for vectors).
 
-Bad values raise :class:`rotframe.errors.ScenarioError` (a ``ValueError``)
+Bad values raise [`rotframe.errors.ScenarioError`][rotframe.errors.ScenarioError] (a ``ValueError``)
 naming the scenario, the key, the value and what is allowed.
 
 Examples
@@ -59,7 +59,7 @@ ProgressLike = Callable[[float], Any] | bool | None
 
 
 def scenarios() -> list[str]:
-    """Names of the built-in scenarios and of those registered with :func:`register_scene`.
+    """Names of the built-in scenarios and of those registered with [`register_scene`][rotframe.app.api.register_scene].
 
     Examples
     --------
@@ -75,9 +75,9 @@ def scenarios() -> list[str]:
 
 
 def load(name_or_path: str | Path):
-    """Load and check a scenario; returns a :class:`rotframe.app.scenario.Scenario`.
+    """Load and check a scenario; returns a `rotframe.app.scenario.Scenario`.
 
-    Its ``parameters`` map each name to a :class:`rotframe.app.scenario.Parameter`
+    Its ``parameters`` map each name to a `rotframe.app.scenario.Parameter`
     with ``name``, ``unit``, ``default`` (in that unit), ``bounds`` = ``(min, max)``
     (``exclusive_min``/``exclusive_max`` say whether they are allowed),
     ``choices`` and ``doc``. ``scenario.run`` holds the run settings
@@ -87,7 +87,7 @@ def load(name_or_path: str | Path):
     Parameters
     ----------
     name_or_path : str or path
-        A name from :func:`scenarios` or a path to a ``.toml`` file.
+        A name from [`scenarios`][rotframe.app.api.scenarios] or a path to a ``.toml`` file.
 
     Examples
     --------
@@ -109,12 +109,12 @@ def load(name_or_path: str | Path):
 
 def run(name_or_path: str | Path, method: str | None = None, *, progress: ProgressLike = None,
         threads: int | None = None, **params: Any) -> "Result":
-    """Run a scenario; returns a :class:`Result`.
+    """Run a scenario; returns a [`Result`][rotframe.app.api.Result].
 
     Parameters
     ----------
     name_or_path : str or path
-        A name from :func:`scenarios` or a path to a ``.toml`` scenario file.
+        A name from [`scenarios`][rotframe.app.api.scenarios] or a path to a ``.toml`` scenario file.
     method : str, optional
         Integrator (``rotframe.load(name)`` and ``rotframe show NAME`` list the
         scene's methods); default the scenario's.
@@ -135,10 +135,10 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     rotframe.errors.ScenarioError
         Unknown scenario, key or method, wrong unit, value out of range.
     rotframe.errors.IntegrationError
-        Numerical failure; ``exc.partial`` holds a :class:`Result` of what was
+        Numerical failure; ``exc.partial`` holds a [`Result`][rotframe.app.api.Result] of what was
         computed up to ``exc.t_reached``.
     rotframe.particles.integrators.RunInterrupted
-        Ctrl-C during the run; ``exc.partial`` holds a :class:`Result` of what was computed.
+        Ctrl-C during the run; ``exc.partial`` holds a [`Result`][rotframe.app.api.Result] of what was computed.
 
     Examples
     --------
@@ -329,7 +329,7 @@ class Result:
     ----------
     metrics, theory, diagnostics : dict
         Measured values, their closed-form theory, and checks (drifts,
-        conserved quantities); names end in their unit (:attr:`units`).
+        conserved quantities); names end in their unit (`units`).
     warnings : list of str
         What the run could not resolve or should be read with care (empty on a clean run).
     params : dict
@@ -394,19 +394,19 @@ class Result:
         return Path(final)
 
     def export(self, path: str | Path) -> Path:
-        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see :mod:`rotframe.app.export`)."""
+        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see [`rotframe.app.export`][rotframe.app.export])."""
         from rotframe.app.export import write_trajectory
 
         return write_trajectory(self.trajectory, path, summary=self.to_dict())
 
     def plot(self, path: str | Path | None = None):
-        """A matplotlib figure of the run (``path``: also save it as PNG); see :mod:`rotframe.app.plot`."""
+        """A matplotlib figure of the run (``path``: also save it as PNG); see `rotframe.app.plot`."""
         from rotframe.app.plot import plot_result
 
         return plot_result(self, path)
 
     def to_dataframe(self):
-        """The trajectory as a pandas DataFrame (:meth:`TrajectoryArrays.columns`); needs pandas."""
+        """The trajectory as a pandas DataFrame ([`TrajectoryArrays.columns`][rotframe.app.api.TrajectoryArrays.columns]); needs pandas."""
         try:
             import pandas as pd
         except ImportError:
@@ -495,7 +495,7 @@ def register_scene(name: str, scene: Any, scenario: str | Path | None = None) ->
     name : str
         The scene name that scenario files give as ``scene = "NAME"``.
     scene : module or object
-        Anything with the scene protocol (see :mod:`rotframe.scenes`):
+        Anything with the scene protocol (see `rotframe.scenes`):
         ``simulate(values, terms, method, run, progress) -> SceneResult``,
         ``analyse(values, result) -> {"metrics", "theory", "diagnostics", "notes"}``,
         ``record(recording, values, result)``, and optionally ``METHODS``.

@@ -6,11 +6,11 @@ simulated time reached; the recording keeps everything up to it); 130 / 143
 interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed); 1 an
 internal error (one line; ``ROTFRAME_DEBUG=1`` shows the traceback).
 
-Work is estimated before it starts (:mod:`rotframe.limits`: ``--max-steps``,
+Work is estimated before it starts (`rotframe.limits`: ``--max-steps``,
 ``--max-samples``, ``--max-rows``), outputs are checked before computing and
-written atomically (:mod:`rotframe.app.outputs`), signals are handled per command
-(:mod:`rotframe.app.signals`) and long work shows a progress line on a terminal
-(:mod:`rotframe.app.progress`). With ``--json`` only the JSON document reaches stdout.
+written atomically (`rotframe.app.outputs`), signals are handled per command
+(`rotframe.app.signals`) and long work shows a progress line on a terminal
+(`rotframe.app.progress`). With ``--json`` only the JSON document reaches stdout.
 
 This module imports only the standard library at start-up: numpy, astropy,
 numba and rerun are imported by the commands that need them, so that
@@ -220,7 +220,7 @@ def _limits(args):
 
 
 def _threads(args):
-    """The command's ``--threads`` in force for the command only (:func:`rotframe.particles.ensemble.threads_scope`)."""
+    """The command's ``--threads`` in force for the command only (`rotframe.particles.ensemble.threads_scope`)."""
     from rotframe.particles.ensemble import threads_scope
 
     return threads_scope(getattr(args, "threads", None))

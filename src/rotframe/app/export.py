@@ -3,7 +3,7 @@
 * ``.npz`` (numpy): the arrays in their natural shapes (``times`` (n,);
   ``r``, ``v`` (n, N, 3) for particles; ``L`` (n, 3), ``q`` (n, 4) for bodies),
   plus ``units`` and ``summary`` as JSON strings.
-* ``.csv``: the long table of :meth:`rotframe.app.api.TrajectoryArrays.columns`
+* ``.csv``: the long table of [`rotframe.app.api.TrajectoryArrays.columns`][rotframe.app.api.TrajectoryArrays.columns]
   (one row per sample and particle), units in the column names, a header
   line starting with ``#`` giving the scenario and frame.
 * ``.parquet`` (needs pyarrow, the ``export`` extra): the same table, with the
@@ -27,7 +27,7 @@ FORMATS = (".npz", ".csv", ".parquet")
 
 
 def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None = None) -> Path:
-    """Write ``traj`` (a :class:`rotframe.app.api.TrajectoryArrays`) to ``path``; the suffix picks the format.
+    """Write ``traj`` (a [`rotframe.app.api.TrajectoryArrays`][rotframe.app.api.TrajectoryArrays]) to ``path``; the suffix picks the format.
 
     Parameters
     ----------

@@ -15,7 +15,7 @@ __all__ = ["plot_result"]
 
 
 def plot_result(result, path: str | Path | None = None):
-    """Draw ``result`` (a :class:`rotframe.app.api.Result`); save as PNG when ``path`` is given.
+    """Draw ``result`` (a [`rotframe.app.api.Result`][rotframe.app.api.Result]); save as PNG when ``path`` is given.
 
     Returns the matplotlib Figure.
     """

@@ -9,7 +9,7 @@
 Nothing is written unless stderr is a terminal and the work has taken longer
 than ``delay`` seconds, so pipes, logs and ``--json`` output never see it
 (pass ``enabled=False`` for ``--json``). The line is redrawn at most every
-``interval`` seconds and erased by :meth:`close`.
+``interval`` seconds and erased by `close`.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 One parser for every value with a unit on the command line and in scenario files
 (``--set height='520 ft'``, ``rotframe section tube --set thickness='0.25 inch'``):
 a plain number is taken as already in the target unit; anything else is read by
-:class:`astropy.units.Quantity` with the imperial units enabled for this parse only
+`astropy.units.Quantity` with the imperial units enabled for this parse only
 and converted to the target unit. astropy is imported only when a string is not a
 plain number.
 """

@@ -17,7 +17,7 @@
 * Files are deterministic (fixed recording id, no ``log_time``). The recording
   is encoded into memory (rerun's binary stream) and the bytes are written by
   Python to a temporary file of this writer's own in the target folder, then
-  renamed (:mod:`rotframe.app.outputs`): an earlier complete recording is only ever
+  renamed (`rotframe.app.outputs`): an earlier complete recording is only ever
   replaced by a complete one, two writers never share a temporary file, and
   every I/O error (full disk, ``ulimit -f``) ends the run with one line and no
   file left behind. An interrupted or failed run is finalised as
@@ -81,12 +81,12 @@ def _time_column(times):
 
 
 class Recording:
-    """One run's recording; use as a context manager or call :meth:`finish`.
+    """One run's recording; use as a context manager or call [`finish`][rotframe.app.record.Recording.finish].
 
     Parameters
     ----------
     path : path-like
-        Final name (``.rrd``). Data is held in memory until :meth:`finish` writes it.
+        Final name (``.rrd``). Data is held in memory until [`finish`][rotframe.app.record.Recording.finish] writes it.
     application_id : str
         Shown in the viewer (the scenario name).
     """
@@ -194,7 +194,7 @@ class Recording:
         """A time series at ``entity`` (``diagnostics/<quantity>``).
 
         ``kind`` names the time-series view it goes to (default: from the name,
-        see :func:`series_kind`); ``label`` is its name in the plot legend.
+        see [`series_kind`][rotframe.app.record.series_kind]); ``label`` is its name in the plot legend.
         """
         import rerun as rr
 
@@ -269,7 +269,7 @@ class Recording:
         """3D view of ``world`` beside one time-series view per kind of quantity and the summary text.
 
         Also declares ``world`` right-handed and z-up (ENU) for the viewer.
-        The kinds are those given to (or inferred by) :meth:`scalars`; with no
+        The kinds are those given to (or inferred by) [`scalars`][rotframe.app.record.Recording.scalars]; with no
         series logged through it, one view per root in ``series``.
         """
         import rerun as rr
@@ -300,7 +300,7 @@ class Recording:
     def finish(self, complete: bool = True) -> Path:
         """Encode, write through a temporary file and rename to the final or partial name.
 
-        Raises :class:`rotframe.app.outputs.OutputError` (nothing left behind) when the
+        Raises `rotframe.app.outputs.OutputError` (nothing left behind) when the
         file cannot be written. If the write is interrupted, ``finish(complete=False)``
         may be called again: the encoded bytes are kept until a write succeeds.
         """

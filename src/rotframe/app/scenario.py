@@ -25,7 +25,7 @@ the parameter's documented unit (SI; angles in degrees), astropy quantity
 strings of the right dimension (``"520 ft"``, ``"50d54m"``, ``"48d50m46s N"``)
 or, for vectors, comma-separated numbers. Every value is checked: unknown keys
 get a did-you-mean, wrong dimensions and impossible values are refused with a
-:class:`~rotframe.errors.ScenarioError` naming the file, key, value and what is
+[`ScenarioError`][rotframe.errors.ScenarioError] naming the file, key, value and what is
 allowed. This module imports astropy only when a string has to be parsed, so
 listing scenarios stays instant.
 """
@@ -76,7 +76,7 @@ def scenario_dir() -> Path:
 
 
 def names() -> list[str]:
-    """Names of the scenarios in :func:`scenario_dir`, sorted."""
+    """Names of the scenarios in `scenario_dir`, sorted."""
     return sorted(p.stem for p in scenario_dir().glob("*.toml"))
 
 
@@ -145,7 +145,7 @@ class Parameter:
 
     @property
     def bounds(self) -> tuple:
-        """``(min, max)`` in :attr:`unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
+        """``(min, max)`` in `unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
         return (self.min, self.max)
 
 
@@ -167,7 +167,7 @@ class Scenario:
     def with_values(self, sets: dict | None = None) -> dict:
         """Parameter values (documented units) after applying ``--set`` overrides.
 
-        Run settings (:data:`RUN_KEYS`) may be set the same way; they are
+        Run settings (`RUN_KEYS`) may be set the same way; they are
         returned under the key ``"run"``.
         """
         values = {k: p.default for k, p in self.parameters.items()}
@@ -433,7 +433,7 @@ def _parse_quantity(p: Parameter, text: str, where: str) -> float:
 
 
 def _angle_value(p: Parameter, text: str, unit: str) -> float:
-    """An angle in ``unit`` (deg or rad): a number, or what :func:`rotframe.earth.read_angle_text` reads."""
+    """An angle in ``unit`` (deg or rad): a number, or what [`rotframe.earth.read_angle_text`][rotframe.earth.read_angle_text] reads."""
     try:
         return float(text)
     except ValueError:
@@ -473,7 +473,7 @@ def methods_for(scene: str | None) -> tuple:
     """Integrator names a ``[run] method`` or ``--set method=`` may take for ``scene``.
 
     One source: the scene module's ``METHODS`` (a
-    :class:`rotframe.scenes.base.MethodNames`, whose ``in`` accepts the old names
+    `rotframe.scenes.base.MethodNames`, whose ``in`` accepts the old names
     too), else every particle integrator; for ``scene=None`` every name of the
     built-in scenes. The scene module is imported here (a run imports it anyway).
     """
@@ -489,9 +489,9 @@ def methods_for(scene: str | None) -> tuple:
 
 
 def parse_run_value(key, raw, source, scene=None):
-    """Parse and check one run setting (a :data:`RUN_KEYS` key) from a file, ``--set`` or the Python API.
+    """Parse and check one run setting (a `RUN_KEYS` key) from a file, ``--set`` or the Python API.
 
-    ``method`` must be one of :func:`methods_for` ``(scene)``; ``step`` (s), ``rtol`` and ``samples``
+    ``method`` must be one of `methods_for` ``(scene)``; ``step`` (s), ``rtol`` and ``samples``
     (a whole number) must be finite and > 0.
     """
     kind = RUN_KEYS[key]

@@ -3,7 +3,7 @@
 Local ENU frame with the origin below the pivot at the bob's rest position,
 pivot at (0, 0, L). The full model is the spherical pendulum on the rotating
 Earth: effective gravity, Coriolis, the string kept exactly (the splitting on
-the sphere in :func:`rotframe.particles.kernels.step_sphere`). The bob is released from
+the sphere in `rotframe.particles.kernels.step_sphere`). The bob is released from
 rest in the rotating frame at ``amplitude`` east of the rest position, which
 gives a swing of tiny ellipticity and so negligible Airy precession
 (docs/physics/earth.md). ``small_angle = true`` uses instead the linearised

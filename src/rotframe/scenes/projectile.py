@@ -10,8 +10,8 @@ isothermal atmosphere, density exp(-z / H)). Range is measured along the
 ground (the great circle when ``curvature`` is on); the lateral deflection is
 positive to the right of the aim. Theory: flat Earth, vacuum, zeroth order in
 Omega for range and flight time, first order for the lateral deflection
-(:func:`rotframe.analytic.projectile_lateral_deflection_first_order`), each with
-its stated accuracy (:func:`theory_and_accuracy`).
+(`rotframe.analytic.projectile_lateral_deflection_first_order`), each with
+its stated accuracy (`theory_and_accuracy`).
 """
 
 from __future__ import annotations

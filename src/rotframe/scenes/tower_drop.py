@@ -188,16 +188,16 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model: each such group is one
     ``integrate_particles`` call with one particle per point and the ground event
-    (:func:`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
-    :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
+    (`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
+    `analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
     Parameters
     ----------
     values_list : list of dict
-        Resolved parameter values per point, as :func:`simulate` takes them.
+        Resolved parameter values per point, as `simulate` takes them.
     terms, method, run
-        As for :func:`simulate`.
+        As for `simulate`.
     tracks : dict, optional
         Keys are indices into ``values_list`` whose paths are wanted; on return each maps
         to ``(times, positions (n, 3))`` up to the landing.
@@ -229,7 +229,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
 
 @with_parameters(TowerDropParameters)
 def ensemble_theory(p):
-    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
+    """The closed forms of `analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
