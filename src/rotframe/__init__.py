@@ -48,6 +48,7 @@ _LAZY = {
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
+    "RotframeWarning": "rotframe.errors",
 }
 _SUBMODULES = ("analytic", "app", "earth", "errors", "frames", "limits", "numerics", "particles",
                "rigid", "scenes", "validation")

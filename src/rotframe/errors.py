@@ -15,6 +15,8 @@ __all__ = [
     "GimbalLockError",
     "ScenarioError",
     "IntegrationError",
+    "RotframeWarning",
+    "MissingExtraError",
 ]
 
 
@@ -52,3 +54,21 @@ class IntegrationError(RotframeError):
         super().__init__(message)
         self.t_reached = t_reached
         self.partial = partial
+
+
+class RotframeWarning(UserWarning):
+    """A run's result should be read with care (an entry of ``Result.warnings``).
+
+    ``rotframe.run`` emits one Python warning of this category for each entry of the
+    result's ``warnings`` list (which stays), so that notebooks and scripts show them.
+    Silence them with ``warnings.simplefilter("ignore", rotframe.RotframeWarning)``;
+    turn them into errors with ``warnings.simplefilter("error", rotframe.RotframeWarning)``.
+    """
+
+
+class MissingExtraError(RotframeError, ImportError):
+    """An optional dependency is not installed; the message names the extra that brings it.
+
+    For example pictures need matplotlib, the ``plot`` extra
+    (``pip install "rotframe[plot]"``). The command line exits with code 2.
+    """

@@ -120,7 +120,8 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
         scene's methods); default the scenario's.
     progress : callable or bool, optional
         ``progress(fraction)`` is called as the run advances (0 to 1);
-        ``True`` draws a bar on stderr.
+        ``True`` draws a bar: tqdm's (``tqdm.auto``: a widget in Jupyter) when
+        tqdm is installed, else a text line on stderr.
     threads : int, optional
         Threads for ensembles of particles during this run only (default:
         every core); the results do not depend on it. Not a whole number
@@ -129,6 +130,12 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
         Parameter values (numbers in the documented unit, astropy quantities or
         strings such as ``"520 ft"``), and the run settings ``step`` (s),
         ``rtol`` and ``samples``.
+
+    Warns
+    -----
+    rotframe.errors.RotframeWarning
+        One for each entry of the result's ``warnings`` (what the run could not
+        resolve or should be read with care); the list stays on the result.
 
     Raises
     ------
@@ -162,6 +169,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     scn = load(name_or_path)
     values = resolve_values(scn, params)
     scene = scenes.get(scn.scene)
+    method = method.lower() if isinstance(method, str) else method  # scipy's "DOP853" is dop853
     allowed = getattr(scene, "METHODS", None)
     if method is not None and allowed is not None and method not in allowed:
         raise ScenarioError(f"{scn.name}: method={method!r} is not one of {', '.join(allowed)}")
@@ -181,7 +189,19 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
             callback.close()
     simulate_s = time.perf_counter() - t0
     summary = runner.summarize(scn, values, scene_result, {"simulate_s": simulate_s}, given=params or ())
-    return Result(scn, values, scene_result, _finish_summary(scn, summary, scene_result, simulate_s, t_start))
+    result = Result(scn, values, scene_result, _finish_summary(scn, summary, scene_result, simulate_s, t_start))
+    _warn(result.warnings)
+    return result
+
+
+def _warn(texts) -> None:
+    """One `rotframe.errors.RotframeWarning` per entry of a result's ``warnings`` (the list stays)."""
+    import warnings
+
+    from rotframe.errors import RotframeWarning
+
+    for text in texts:
+        warnings.warn(text, RotframeWarning, stacklevel=3)  # points at the caller of rotframe.run
 
 
 def resolve_values(scn, params: Mapping[str, Any]) -> dict:
@@ -367,6 +387,33 @@ class Result:
         shown = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.metrics.items())
         return f"<rotframe.Result {self.scenario.name} ({self.method}): {shown}>"
 
+    def _repr_markdown_(self) -> str:
+        from rotframe.app.display import markdown, result_rows
+        return markdown(*result_rows(self))
+
+    def _repr_html_(self) -> str:
+        from rotframe.app.display import html_table, result_rows
+        return html_table(*result_rows(self))
+
+    def quantities(self) -> dict:
+        """Metrics, theory and diagnostics as astropy Quantities in their units (`units`).
+
+        Returns ``{"metrics": {...}, "theory": {...}, "diagnostics": {...}}``; a value
+        whose unit is not known stays a plain number, and so do non-numbers. The
+        plain floats of `metrics`, `theory` and `diagnostics` stay the default.
+
+        Examples
+        --------
+        >>> import rotframe
+        >>> q = rotframe.run("tower-drop").quantities()
+        >>> q["metrics"]["east_deflection_m"].to("mm").round(1)
+        <Quantity 27.6 mm>
+        """
+        from rotframe.app.quantities import as_quantities
+
+        return {part: as_quantities(getattr(self, part), self.units)
+                for part in ("metrics", "theory", "diagnostics")}
+
     def to_dict(self) -> dict:
         """The summary as a JSON-ready dict, with the keys of ``rotframe run --json`` (NaN -> None)."""
         return jsonable(self._summary)
@@ -470,11 +517,11 @@ def _python_scalars(obj):
 
 
 def _progress_callback(progress: ProgressLike):
-    from rotframe.app.progress import Progress
+    from rotframe.app.progress import auto_bar
 
     if progress is True:
-        # asked for: drawn on any stream (a notebook's stderr is no terminal), from the first report on
-        return Progress("run", "%", delay=0.0, tty_only=False)
+        # asked for: tqdm.auto's bar (a widget in Jupyter) if installed, else a line on any stream
+        return auto_bar("run")
     if progress is False or progress is None:
         return None
     if not callable(progress):

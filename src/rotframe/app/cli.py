@@ -438,6 +438,9 @@ def _check_outputs(args):
         check_output_file(export, "--export")
     if png is not None:
         check_output_file(png, "--png", ".png")
+        from rotframe.app.plot import require_matplotlib
+
+        require_matplotlib()  # before the run: a missing extra is a one-line error (exit 2), not a lost run
 
 
 def _units(scn, summary):
@@ -456,10 +459,7 @@ def _write_outputs(args, scn, values, result, summary):
     if args.export:
         summary["export"] = str(res.export(args.export))
     if args.png:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        res.plot(args.png)
+        res.plot(args.png)  # a pyplot-free Figure: no backend, no window
         summary["png"] = args.png
 
 

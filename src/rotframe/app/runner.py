@@ -45,6 +45,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
     scene = scenes.get(scn.scene)
     run_settings = dict(values["run"])
     method = method or run_settings.get("method")
+    method = method.lower() if isinstance(method, str) else method  # scipy's "DOP853" is dop853
     allowed = getattr(scene, "METHODS", None)
     if method is not None and allowed is not None and method not in allowed:
         raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}")

@@ -164,6 +164,18 @@ class Scenario:
     run: dict
     values: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        from rotframe.app.display import scenario_repr
+        return scenario_repr(self)
+
+    def _repr_markdown_(self) -> str:
+        from rotframe.app.display import markdown, scenario_rows
+        return markdown(*scenario_rows(self))
+
+    def _repr_html_(self) -> str:
+        from rotframe.app.display import html_table, scenario_rows
+        return html_table(*scenario_rows(self))
+
     def with_values(self, sets: dict | None = None) -> dict:
         """Parameter values (documented units) after applying ``--set`` overrides.
 
@@ -498,6 +510,7 @@ def parse_run_value(key, raw, source, scene=None):
     where = f"{source}: " if source else ""
     if kind is str:
         allowed = methods_for(scene)
+        raw = raw.lower() if isinstance(raw, str) else raw  # any case: scipy's "DOP853" is dop853
         if not isinstance(raw, str) or raw not in allowed:
             raise ScenarioError(f"{where}method = {raw!r}: allowed {', '.join(allowed)}"
                                 f"{_did_you_mean(str(raw), list(allowed))}")

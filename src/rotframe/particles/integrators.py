@@ -85,7 +85,7 @@ METHOD_NAMES = tuple(METHODS) + tuple(ALIASES)
 
 
 def canonical_method(name: str) -> str:
-    """The `METHODS` key of a particle method given by its name or an alias (`ALIASES`).
+    """The `METHODS` key of a particle method given by its name or an alias (`ALIASES`), in any case.
 
     Raises
     ------
@@ -94,9 +94,10 @@ def canonical_method(name: str) -> str:
 
     Examples
     --------
-    >>> canonical_method("splitting4"), canonical_method("dop853")
+    >>> canonical_method("splitting4"), canonical_method("DOP853")
     ('rotation-splitting4', 'dop853')
     """
+    name = name.lower() if isinstance(name, str) else name
     name = ALIASES.get(name, name)
     if name not in METHODS:
         raise ScenarioError(f"method: unknown {name!r}; allowed: {', '.join(METHOD_NAMES)}")

@@ -73,7 +73,7 @@ class PreparedBodyRun:
     def __init__(self, inertia, method, duration, *, step=None, rtol=1e-10, samples=1, top=None, mgl=None):
         from rotframe import limits
 
-        self.method = method = str(method)
+        self.method = method = str(method).lower()  # any case: scipy's "DOP853" is dop853
         duration = float(duration)
         if not (math.isfinite(duration) and duration > 0):
             raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0")

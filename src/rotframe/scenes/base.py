@@ -128,7 +128,8 @@ class MethodNames(tuple):
     A tuple of the canonical names (iterating, printing and ``len`` see only
     those, so messages and ``rotframe show`` list them), whose ``in`` also
     accepts an alias; `canonical` maps an alias to its name, which is the
-    name a run reports (the JSON ``method``).
+    name a run reports (the JSON ``method``). Names are matched without regard
+    to case (scipy's ``"DOP853"`` is ``dop853``).
     """
 
     def __new__(cls, names, aliases=None):
@@ -140,11 +141,17 @@ class MethodNames(tuple):
         return self
 
     def __contains__(self, name) -> bool:
-        return tuple.__contains__(self, name) or (isinstance(name, str) and name in self.aliases)
+        if not isinstance(name, str):
+            return False
+        name = name.lower()
+        return tuple.__contains__(self, name) or name in self.aliases
 
     def canonical(self, name):
-        """The canonical name of ``name`` (itself when it is one; None stays None)."""
-        return self.aliases.get(name, name) if isinstance(name, str) else name
+        """The canonical name of ``name`` (any case; itself when it is one; unknown names and None unchanged)."""
+        if not isinstance(name, str) or name not in self:
+            return name
+        name = name.lower()
+        return self.aliases.get(name, name)
 
 
 def particle_methods() -> MethodNames:

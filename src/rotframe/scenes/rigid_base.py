@@ -76,6 +76,7 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     from rotframe.rigid import dynamics as rigid
     from rotframe import limits
 
+    method = method.lower() if isinstance(method, str) else method  # any case: "DOP853" is dop853
     if top is not None:
         method = HEAVY_METHODS.canonical(method)
     duration = float(duration)
