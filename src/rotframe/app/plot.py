@@ -48,7 +48,33 @@ def new_figure(figsize=(11, 4.5)):
         from rotframe.errors import MissingExtraError
 
         raise MissingExtraError(MISSING) from None
+    _show_in_jupyter()
     return Figure(figsize=figsize)
+
+
+def _show_in_jupyter() -> None:
+    """In IPython, show a Figure returned by a cell as a PNG (once: nothing goes through pyplot).
+
+    pyplot's inline backend registers this display itself when pyplot is imported;
+    a pyplot-free figure needs it registered here. Outside IPython, nothing happens.
+    """
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
+        return
+    png = shell.display_formatter.formatters.get("image/png")
+    if png is not None:
+        png.for_type_by_name("matplotlib.figure", "Figure", _figure_png)
+
+
+def _figure_png(fig) -> bytes:
+    import io
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=90, bbox_inches="tight")
+    return buffer.getvalue()
 
 
 def plot_result(result, path: str | Path | None = None):

@@ -152,6 +152,13 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
 
     written = None
     if png:
+        from rotframe.app.plot import require_matplotlib
+        from rotframe.errors import MissingExtraError
+
+        try:
+            require_matplotlib()
+        except MissingExtraError as exc:
+            return _fail(str(exc))
         try:
             written = str(plot_section(section, png, title=f"{name}: " + _params_text(params)))
         except OSError as exc:

@@ -81,6 +81,10 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
 def main(args) -> int:
     from rotframe.app.progress import Progress
 
+    if getattr(args, "plots", None):
+        from rotframe.app.plot import require_matplotlib
+
+        require_matplotlib()  # the plot extra, checked before the bench runs
     bar = Progress("bench", "runs", enabled=not args.json)  # on a terminal only, never with --json
 
     def progress(done, total, label):
