@@ -111,7 +111,7 @@ class _TqdmFraction:
     """A tqdm bar fed fractions in [0, 1] (``tqdm.auto``: a widget in Jupyter, text elsewhere)."""
 
     def __init__(self, tqdm, label):
-        self._bar = tqdm(total=100, desc=label, unit="%", bar_format="{l_bar}{bar}| {n:.1f}/100% [{elapsed}<{remaining}]")
+        self._bar = tqdm(total=100, desc=label, unit="%", bar_format="{desc}: {percentage:5.1f}%|{bar}| [{elapsed}<{remaining}]")
 
     def __call__(self, fraction):
         self.update(float(fraction), 1.0)
