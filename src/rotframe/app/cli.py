@@ -360,7 +360,9 @@ def cmd_view(args) -> int:
         print(describe(path))
         return EXIT_OK
     if args.web:
-        return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, "--web-viewer", path])
+        from rotframe.app.web_view import serve
+
+        return serve(path, bind)  # the URL in one line; rerun's server stops with the command
     if not _has_display():
         from rotframe.app.recording_summary import describe
 
