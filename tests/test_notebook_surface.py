@@ -158,3 +158,20 @@ def test_projectile_picture_ends_at_the_landing(tmp_path):
     assert flight.get_xlim()[1] == pytest.approx(r.metrics["flight_time_s"], rel=1e-9)
     y = deflection.get_lines()[0].get_ydata()
     assert y[-1] == pytest.approx(r.metrics["lateral_deflection_m"], rel=1e-9)
+
+
+def test_heavy_top_picture_shows_the_tilt_between_the_turning_points():
+    pytest.importorskip("matplotlib")
+    r = rotframe.run("heavy-top", duration=2)
+    ax = r.plot().axes[0]
+    theta = ax.get_lines()[0].get_ydata()
+    # the simulated tilt stays between the turning points of Goldstein's cubic (an independent closed form)
+    assert theta.min() >= r.theory["theta_min_deg"] - 1e-3 and theta.max() <= r.theory["theta_max_deg"] + 1e-3
+    assert theta.max() - theta.min() > 0.9 * (r.theory["theta_max_deg"] - r.theory["theta_min_deg"])
+
+
+def test_tower_drop_picture_ends_at_the_landing():
+    pytest.importorskip("matplotlib")
+    r = rotframe.run("tower-drop")
+    ax = r.plot().axes[1]
+    assert ax.get_xlim()[1] <= r.metrics["fall_time_s"] * 1.01

@@ -109,7 +109,12 @@ def _generic(result, ax1, ax2) -> None:
 
     traj = result.trajectory
     if traj.kind == "particles":
-        r = traj.r
+        r, times = traj.r, traj.times
+        landed = [float(np.max(t)) for t in traj.event_times.get("ground", []) if np.size(t)]
+        if landed:  # after the ground the samples only repeat the landing: the picture ends there
+            keep = times <= max(landed)
+            keep[: int(np.argmin(keep)) + 1 if not keep.all() else len(keep)] = True  # the landing sample too
+            r, times = r[keep], times[keep]
         scale, unit = (1e3, "km") if np.nanmax(np.abs(r)) > 2e4 else (1.0, "m")
         for k in range(r.shape[1]):
             ax1.plot(r[:, k, 0] / scale, r[:, k, 1] / scale, lw=0.8)
@@ -119,17 +124,28 @@ def _generic(result, ax1, ax2) -> None:
         ax1.set_ylabel(f"y (north) [{unit}]")
         ax1.set_title("path seen from above (o start, s end)")
         ax1.set_aspect("equal", adjustable="datalim")
+        t_scale, t_unit = _time_unit(times)
         for k, axis in enumerate("xyz"):
-            ax2.plot(traj.times, r[:, 0, k] / scale, label=axis)
-        ax2.set_xlabel("t [s]")
+            ax2.plot(times / t_scale, r[:, 0, k] / scale, label=axis)
+        ax2.set_xlim(0.0, float(times[-1]) / t_scale)
+        ax2.set_xlabel(f"t [{t_unit}]" + (" (to the landing)" if landed else ""))
         ax2.set_ylabel(f"position [{unit}]")
         ax2.legend()
     elif traj.kind == "body":
         from scipy.spatial.transform import Rotation
 
-        for k in range(3):
-            ax1.plot(traj.times, traj.L[:, k], label=f"L{k + 1}")
-        ax1.set_xlabel("t [s]")
+        t_scale, t_unit = _time_unit(traj.times)
+        L = traj.L
+        across = float(np.max(np.abs(L[:, :2])))
+        if across < 1e-3 * float(np.max(np.abs(L[:, 2]))):
+            # a body spinning almost about its 3-axis: L3 would flatten the small L1, L2 that carry the motion
+            for k in range(2):
+                ax1.plot(traj.times / t_scale, L[:, k], label=f"L{k + 1}")
+            ax1.set_title(f"L1, L2 in the body (L3 = {float(np.mean(L[:, 2])):.4g}, on its own scale)", fontsize=9)
+        else:
+            for k in range(3):
+                ax1.plot(traj.times / t_scale, L[:, k], label=f"L{k + 1}")
+        ax1.set_xlabel(f"t [{t_unit}]")
         ax1.set_ylabel("L, body axes [kg m^2/s]")
         ax1.legend()
         e3 = Rotation.from_quat(traj.q).apply([0.0, 0.0, 1.0])
@@ -138,6 +154,48 @@ def _generic(result, ax1, ax2) -> None:
         ax2.set_ylabel("e3 y (space)")
         ax2.set_title("tip of the 3-axis seen from above")
         ax2.set_aspect("equal", adjustable="datalim")
+
+
+def _time_unit(times):
+    """(seconds per unit, unit name) for a time axis: days beyond two days, hours beyond two hours."""
+    end = float(times[-1]) if len(times) else 0.0
+    if end > 2 * 86400:
+        return 86400.0, "days"
+    if end > 2 * 3600:
+        return 3600.0, "h"
+    return 1.0, "s"
+
+
+def _heavy_top(result, ax1, ax2) -> bool:
+    """The tilt between the turning points of Goldstein's cubic (the nutation), and the tip's path."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    traj = result.trajectory
+    lo, hi = result.theory.get("theta_min_deg"), result.theory.get("theta_max_deg")
+    if traj.kind != "body" or not all(isinstance(x, (int, float)) for x in (lo, hi)):
+        return False
+    e3 = Rotation.from_quat(traj.q).apply([0.0, 0.0, 1.0])
+    theta = np.degrees(np.arccos(np.clip(e3[:, 2], -1.0, 1.0)))
+    period = result.metrics.get("nutation_period_s")
+    end = float(traj.times[-1])
+    if isinstance(period, (int, float)) and period == period and period > 0:
+        end = min(end, 6 * period)  # a few nutations, each one readable
+    keep = traj.times <= end
+    ax1.plot(traj.times[keep], theta[keep], color="C0", label="tilt theta (simulated)")
+    for value, text in ((lo, "theta_min"), (hi, "theta_max")):
+        ax1.axhline(value, color="C1", ls="--", lw=1.0)
+        ax1.annotate(f"{text} (Goldstein's cubic) {value:.4g}", (0.01, value), xycoords=("axes fraction", "data"),
+                     fontsize=7, color="C1", va="bottom")
+    ax1.set_xlabel("t [s]")
+    ax1.set_ylabel("tilt of the symmetry axis [deg]")
+    ax1.set_title("nutation between the turning points")
+    ax2.plot(e3[:, 0], e3[:, 1], lw=0.6)
+    ax2.set_xlabel("e3 x (space)")
+    ax2.set_ylabel("e3 y (space)")
+    ax2.set_title("tip of the 3-axis seen from above (precession)")
+    ax2.set_aspect("equal", adjustable="datalim")
+    return True
 
 
 def _foucault(result, ax1, ax2) -> bool:
@@ -212,4 +270,4 @@ def _projectile(result, ax1, ax2) -> bool:
 
 
 #: scene -> function drawing its two panels (False: fall back to the generic picture)
-_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile}
+_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top}
