@@ -175,3 +175,32 @@ def test_tower_drop_picture_ends_at_the_landing():
     r = rotframe.run("tower-drop")
     ax = r.plot().axes[1]
     assert ax.get_xlim()[1] <= r.metrics["fall_time_s"] * 1.01
+
+
+def test_sol_of_a_dop853_run_between_samples_against_the_closed_form():
+    """Dense output: between samples, sol(t) follows the closed-form motion under gravity and Coriolis."""
+    from rotframe.analytic import coriolis_uniform_gravity
+
+    r = rotframe.run("tower-drop", "DOP853", samples=20)
+    model = r._scene_result.extras["model"]
+    w, g = model.omega.vector(), model.g
+    times = r.trajectory.times
+    t_land = float(r.trajectory.event_times["ground"][0][0])
+    queries = np.array([0.37, 1.234, 3.3, 0.5 * (times[5] + times[6]), t_land - 1e-3])
+    pos, vel = r.sol(queries)
+    for t, p, q in zip(queries, pos, vel):
+        ref_r, ref_v = coriolis_uniform_gravity(w, g, r.trajectory.r[0, 0], r.trajectory.v[0, 0], t)
+        assert np.allclose(p[0], ref_r, rtol=0, atol=1e-9), t
+        assert np.allclose(q[0], ref_v, rtol=0, atol=1e-9), t
+    k = 7
+    assert np.array_equal(r.sol(times[k])[0], r.trajectory.r[k])  # a sample time gives the sample
+    after = r.sol(times[-1])[0]
+    assert np.array_equal(after, r.trajectory.r[-1])  # after the landing: the landing state
+    with pytest.raises(ScenarioError, match="allowed: 0 <= t"):
+        r.sol(times[-1] + 1)
+
+
+def test_sol_refuses_other_methods():
+    r = rotframe.run("tower-drop")  # exact
+    with pytest.raises(ScenarioError, match="allowed: a dop853 run"):
+        r.sol(1.0)

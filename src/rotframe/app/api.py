@@ -395,6 +395,21 @@ class Result:
         from rotframe.app.display import html_table, result_rows
         return html_table(*result_rows(self))
 
+    def sol(self, t):
+        """The state at any time ``t`` (s) of a finished ``dop853`` particle run, as ``solve_ivp``'s ``sol(t)``.
+
+        Returns ``(r, v)`` in the trajectory's frame and units: (N, 3) each for a
+        number ``t``, (m, N, 3) for an array of m times. Restarts the run's own
+        integrator and tolerances from the last sample before ``t``, so it is as
+        accurate as the samples (see `rotframe.app.dense`); a run of another
+        method, a rigid body or a frame whose rate changes raise ScenarioError.
+        """
+        from rotframe.app.dense import DenseSolution
+
+        if getattr(self, "_dense", None) is None:
+            self._dense = DenseSolution(self.scenario.name, self._scene_result, self._values.get("run", {}))
+        return self._dense(t)
+
     def quantities(self) -> dict:
         """Metrics, theory and diagnostics as astropy Quantities in their units (`units`).
 
