@@ -188,7 +188,7 @@ def test_export_formats_round_trip(tmp_path):
     npz = np.load(r.export(tmp_path / "t.npz"))
     assert np.array_equal(npz["r"], r.trajectory.r) and json.loads(str(npz["units"]))["r"] == "m"
     table = np.genfromtxt(tmp_path / "t.csv" if r.export(tmp_path / "t.csv") else None, delimiter=",",
-                          names=True, skip_header=1)
+                          names=True)
     assert np.array_equal(table["x_m"], r.trajectory.r[:, 0, 0])  # %.17g round-trips float64
     pq = pytest.importorskip("pyarrow.parquet")
     t = pq.read_table(r.export(tmp_path / "t.parquet"))
@@ -278,3 +278,18 @@ def test_ensemble_sweep_rows_carry_the_theory_of_single_runs(tmp_path, monkeypat
         single = rotframe.run("tower-drop", height=table["height"][i], latitude=table["latitude"][i])
         for key, value in single.theory.items():
             assert table["theory_" + key][i] == pytest.approx(value, rel=1e-14), key
+
+
+def test_csv_export_reads_back_with_pandas(tmp_path):
+    """The CSV's first line is a plain header: pandas.read_csv with no options gets the columns and values."""
+    pd = pytest.importorskip("pandas")
+    r = rotframe.run("tower-drop")
+    path = r.export(tmp_path / "t.csv")
+    assert not path.read_text().startswith("#")
+    df = pd.read_csv(path)
+    cols = r.trajectory.columns()
+    assert list(df.columns) == list(cols)
+    for name, values in cols.items():
+        assert np.array_equal(df[name].to_numpy(), np.asarray(values)), name  # %.17g round-trips float64
+    body = rotframe.run("dzhanibekov", duration=5).export(tmp_path / "b.csv")
+    assert list(pd.read_csv(body).columns) == ["time_s", "L1", "L2", "L3", "qx", "qy", "qz", "qw"]

@@ -100,3 +100,53 @@ def test_text_summary_of_a_recording(tmp_path):
     path = rotframe.run("tower-drop").record(tmp_path / "t.rrd")
     text = describe(path)
     assert "/world/body" in text and "Points3D" in text and "east_deflection_m" in text
+
+
+def _blueprint(path):
+    """{(entity, column): values} of the recording's blueprint store."""
+    from rerun.chunk import RrdReader
+
+    reader = RrdReader(str(path))
+    out = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        rb = chunk.to_record_batch()
+        for name in rb.schema.names:
+            out[(str(chunk.entity_path).rsplit("/", 1)[-1], name)] = rb.column(name).to_pylist()
+    return out
+
+
+@pytest.mark.parametrize("name, params, within_s", [("foucault", {}, 60.0), ("free-top", {}, 60.0),
+                                                    ("tower-drop", {}, 60.0)])
+def test_playback_shows_the_run_in_under_a_minute(name, params, within_s, tmp_path):
+    r = rotframe.run(name, **params)
+    bp = _blueprint(r.record(tmp_path / f"{name}.rrd"))
+    speed = bp[("time_panel", "TimePanelBlueprint:playback_speed")][0][0]
+    duration = float(r.trajectory.times[-1])
+    assert speed >= 1.0 and duration / speed <= within_s, (duration, speed)
+
+
+def test_foucault_eye_looks_down_on_the_swing(tmp_path):
+    r = rotframe.run("foucault", duration=600)
+    bp = _blueprint(r.record(tmp_path / "f.rrd"))
+    eye = np.array(bp[("EyeControls3D", "EyeControls3D:position")][0][0])
+    target = np.array(bp[("EyeControls3D", "EyeControls3D:look_target")][0][0])
+    down = target - eye
+    amplitude = r.params["amplitude"]
+    assert down[2] < 0 and abs(down[2]) > 2 * np.hypot(down[0], down[1])  # from above, steeper than 60 deg
+    assert np.linalg.norm(down) < 0.2 * r.params["length"]  # near the swing, not framing the 67 m string
+    assert np.linalg.norm(down) > amplitude
+
+
+def test_error_series_are_also_logged_as_log10_of_their_size(tmp_path):
+    r = rotframe.run("dzhanibekov", duration=40)
+    found = _read(r.record(tmp_path / "d.rrd"))
+    raw = np.concatenate([np.asarray(c.to_pylist(), dtype=object) for c in
+                          found["/diagnostics/energy_rel_error"]["columns"]["Scalars:scalars"]])
+    logs = np.concatenate([np.asarray(c.to_pylist(), dtype=object) for c in
+                           found["/diagnostics/log10_energy_rel_error"]["columns"]["Scalars:scalars"]])
+    raw = np.array([v[0] for v in raw], dtype=float)
+    logs = np.array([v[0] for v in logs], dtype=float)
+    nonzero = raw != 0
+    assert np.allclose(logs[nonzero], np.log10(np.abs(raw[nonzero])))
+    assert np.all(logs[~nonzero] == -18.0)
+    assert np.max(logs) < -12  # round-off of the exact solution: visible on a log axis, not 0.000 000 000 4

@@ -1,11 +1,11 @@
 """rotframe: dynamics seen from rotating frames.
 
 The centre of the package is the transport theorem,
-``(d/dt)_space = (d/dt)_body + omega x``. Importing :mod:`rotframe` is cheap:
+``(d/dt)_space = (d/dt)_body + omega x``. Importing `rotframe` is cheap:
 it imports none of numpy's heavy neighbours (astropy, numba, rerun, scipy);
 the functions below and the submodules are loaded when first used.
 
-Running scenarios (:mod:`rotframe.app.api`)::
+Running scenarios ([`rotframe.app.api`][rotframe.app.api])::
 
     import rotframe
     rotframe.scenarios()                        # names
@@ -18,15 +18,15 @@ The house, from the core up (each layer imports only the layers above it in
 this list; ``docs/architecture.md`` has the arrows):
 
 =============================  ====================================================
-:mod:`rotframe.errors`         the exceptions
-:mod:`rotframe.frames`         rotations, Euler angles in 12 sequences, transport theorem
-:mod:`rotframe.numerics`       tableaus, composition weights, rotation primitives
-:mod:`rotframe.particles`      force models, compiled kernels, integrators, ensembles
-:mod:`rotframe.rigid`          mass properties, free body, heavy top, sections
-:mod:`rotframe.earth`          Earth's rotation, radius, gravity, sites, ENU frames
-:mod:`rotframe.analytic`       closed forms the scenes are checked against
-:mod:`rotframe.scenes`         one module per scenario: model, simulate, analyse
-:mod:`rotframe.app`            scenario files, runner, recordings, CLI, sweep, bench
+[`rotframe.errors`][rotframe.errors]         the exceptions
+[`rotframe.frames`][rotframe.frames]         rotations, Euler angles in 12 sequences, transport theorem
+`rotframe.numerics`       tableaus, composition weights, rotation primitives
+`rotframe.particles`      force models, compiled kernels, integrators, ensembles
+`rotframe.rigid`          mass properties, free body, heavy top, sections
+[`rotframe.earth`][rotframe.earth]          Earth's rotation, radius, gravity, sites, ENU frames
+`rotframe.analytic`       closed forms the scenes are checked against
+`rotframe.scenes`         one module per scenario: model, simulate, analyse
+`rotframe.app`            scenario files, runner, recordings, CLI, sweep, bench
 =============================  ====================================================
 """
 
@@ -51,6 +51,7 @@ _LAZY = {
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
+    "RotframeWarning": "rotframe.errors",
 }
 _SUBMODULES = ("analytic", "app", "earth", "errors", "frames", "limits", "numerics", "particles",
                "problem", "rigid", "scenes", "validation")

@@ -3,7 +3,7 @@
 Pure numpy/scipy: plain floats in SI units and radians, no units objects, no I/O.
 scipy is imported inside the functions that use it (``expm``, ``brentq``),
 so importing this module costs numpy alone: a scene that never finds a root does not
-load :mod:`scipy.optimize`.
+load `scipy.optimize`.
 Local frame on the Earth: ENU, x east, y north, z up; Earth's angular velocity there is
 ``Omega (0, cos lat, sin lat)``. Pass ``g`` as the magnitude of the effective gravity
 (centrifugal term inside it) unless a function says otherwise. ``rotation_rate`` is the
@@ -112,7 +112,7 @@ def drop_north_deflection_second_order(height, latitude, g, rotation_rate):
     ``(-2 omega x v)_y = -2 Omega sin(lat) v_x``; integrating twice gives the formula.
     The changes of the fall time are of second order and multiply a zero north velocity.
 
-    Parameters and units as in :func:`drop_east_deflection_first_order`.
+    Parameters and units as in `drop_east_deflection_first_order`.
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
     d = -(rotation_rate**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 6.0
@@ -130,9 +130,9 @@ def drop_north_deflection_centrifugal_second_order(height, latitude, g, rotation
 
     ``d_north = -(5/24) Omega^2 g T^4 sin(lat) cos(lat)``,
 
-    5/4 of the Coriolis part (:func:`drop_north_deflection_second_order`), in the
+    5/4 of the Coriolis part (`drop_north_deflection_second_order`), in the
     same (equatorward) sense. Second order in Omega; the neglected terms are of
-    relative order Omega T. Parameters as in :func:`drop_east_deflection_first_order`.
+    relative order Omega T. Parameters as in `drop_east_deflection_first_order`.
     """
     t = np.sqrt(2.0 * np.asarray(height, dtype=float) / g)
     d = -5.0 * (rotation_rate**2) * g * t**4 * np.sin(latitude) * np.cos(latitude) / 24.0
@@ -167,7 +167,7 @@ def linear_rotating_propagator(
              [ 0,           0,            0 ]]
 
     (``W`` the skew matrix of ``w``, ``W v = w x v``; ``W^2 r = w x (w x r)``), and
-    ``s(t) = expm(M t) s(0)`` exactly, evaluated with :func:`scipy.linalg.expm`
+    ``s(t) = expm(M t) s(0)`` exactly, evaluated with `scipy.linalg.expm`
     (Pade approximation with scaling and squaring, accurate to round-off for these sizes)
     separately for each time, so errors do not accumulate along the time grid.
 
@@ -254,7 +254,7 @@ def coriolis_uniform_gravity(omega_vec, g_vec, r0, v0, t):
     ``v(t) = ((v0 . n) + (g . n) t) n + v0p cos x - 2 (w x v0) t a + gp t a - 2 (w x g) t^2 b``
 
     For small |w| t, ``-2 (w x g) t^3 c -> -(w x g) t^3 / 3``, the classic eastward deflection
-    (:func:`drop_east_deflection_first_order`). An independent oracle for the exact linear
+    (`drop_east_deflection_first_order`). An independent oracle for the exact linear
     flow (no matrix exponential); docs/physics/earth.md.
 
     Parameters
@@ -289,12 +289,12 @@ def drop_exact_linear(height, latitude, g, rotation_rate) -> DropResult:
     """Fall time and landing deflection of a body dropped from rest, exact linear solution.
 
     Solves ``r'' = (0, 0, -g) - 2 omega x v`` in ENU with ``omega = Omega (0, cos lat,
-    sin lat)``, ``r(0) = (0, 0, h)``, ``v(0) = 0`` by :func:`linear_rotating_propagator`
+    sin lat)``, ``r(0) = (0, 0, h)``, ``v(0) = 0`` by `linear_rotating_propagator`
     (uniform effective gravity, so no explicit centrifugal term), and finds the landing
-    time as the root of ``z(t) = 0`` with :func:`scipy.optimize.brentq`, bracketed around
+    time as the root of ``z(t) = 0`` with `scipy.optimize.brentq`, bracketed around
     the vacuum fall time ``sqrt(2 h / g)``. All orders in Omega are included; compare
-    :func:`drop_east_deflection_first_order` (agreement to relative order (Omega t)^2)
-    and :func:`drop_north_deflection_second_order`.
+    `drop_east_deflection_first_order` (agreement to relative order (Omega t)^2)
+    and `drop_north_deflection_second_order`.
 
     Parameters
     ----------
@@ -348,7 +348,7 @@ def foucault_precession_rate(latitude, rotation_rate):
 
     ``rate = Omega sin(lat)``: positive means clockwise seen from above, so it is positive
     in the north and negative (counter-clockwise) in the south. Pantheon (48.846 deg N):
-    11.3 deg per hour. Small-amplitude limit; add :func:`airy_precession` for a finite
+    11.3 deg per hour. Small-amplitude limit; add `airy_precession` for a finite
     elliptical swing.
     """
     r = rotation_rate * np.sin(latitude)
@@ -413,7 +413,7 @@ def airy_precession(length, g, a, b):
     ``a`` and ``b`` (m, small against L). The axes of the ellipse turn in the same sense
     as the bob goes round it: give ``b`` the sign of that sense (positive for
     counter-clockwise motion seen from above, which then gives a counter-clockwise,
-    positive rate; note that :func:`foucault_precession_rate` counts clockwise as positive).
+    positive rate; note that `foucault_precession_rate` counts clockwise as positive).
     Leading order in a/L and b/L.
     """
     w0 = np.sqrt(np.asarray(g, dtype=float) / length)

@@ -1,9 +1,9 @@
 """Exceptions raised by rotframe.
 
-Every error a user can cause is a :class:`RotframeError`. The ones that mean
-"your input was wrong" are also :class:`ValueError`, so code that already
+Every error a user can cause is a [`RotframeError`][rotframe.errors.RotframeError]. The ones that mean
+"your input was wrong" are also `ValueError`, so code that already
 catches ``ValueError`` keeps working; the command line turns them into exit
-code 2 with one line of text. :class:`IntegrationError` is a numerical failure
+code 2 with one line of text. [`IntegrationError`][rotframe.errors.IntegrationError] is a numerical failure
 (exit code 3) and carries the simulated time that was reached.
 """
 
@@ -15,6 +15,8 @@ __all__ = [
     "GimbalLockError",
     "ScenarioError",
     "IntegrationError",
+    "RotframeWarning",
+    "MissingExtraError",
 ]
 
 
@@ -73,3 +75,21 @@ class IntegrationError(RotframeError):
         super().__init__(message)
         self.t_reached = t_reached
         self.partial = partial
+
+
+class RotframeWarning(UserWarning):
+    """A run's result should be read with care (an entry of ``Result.warnings``).
+
+    ``rotframe.run`` emits one Python warning of this category for each entry of the
+    result's ``warnings`` list (which stays), so that notebooks and scripts show them.
+    Silence them with ``warnings.simplefilter("ignore", rotframe.RotframeWarning)``;
+    turn them into errors with ``warnings.simplefilter("error", rotframe.RotframeWarning)``.
+    """
+
+
+class MissingExtraError(RotframeError, ImportError):
+    """An optional dependency is not installed; the message names the extra that brings it.
+
+    For example pictures need matplotlib, the ``plot`` extra
+    (``pip install "rotframe[plot]"``). The command line exits with code 2.
+    """

@@ -1,15 +1,15 @@
 """Work limits: estimate a run's steps, samples and rows before starting; refuse what cannot finish.
 
 A run is refused, in one line with the estimate and the limit, when it would
-take more integration steps than :attr:`Limits.max_steps` (about a minute of
+take more integration steps than `Limits.max_steps` (about a minute of
 compiled work for one particle) or keep more output samples than
-:attr:`Limits.max_samples` (memory); a sweep when it has more rows than
-:attr:`Limits.max_rows`. The command line raises them with ``--max-steps``,
+`Limits.max_samples` (memory); a sweep when it has more rows than
+`Limits.max_rows`. The command line raises them with ``--max-steps``,
 ``--max-samples`` and ``--max-rows``.
 
-The limits in force are held in a :class:`contextvars.ContextVar` set for the
-duration of one command (:func:`applied`), so nothing outlives it; code that
-runs outside any command (the Python API, tests) gets :data:`DEFAULT`.
+The limits in force are held in a `contextvars.ContextVar` set for the
+duration of one command (`applied`), so nothing outlives it; code that
+runs outside any command (the Python API, tests) gets `DEFAULT`.
 """
 
 from __future__ import annotations

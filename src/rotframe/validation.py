@@ -1,19 +1,19 @@
 """Input validation shared by every layer: 3-vectors, and the guard of public functions.
 
-:func:`check_vector3` is the one check of a 3-vector (or a stack of them) for
+`check_vector3` is the one check of a 3-vector (or a stack of them) for
 every module; its error names the caller, the argument, the value and what is
 allowed, in the error class the caller gives.
 
 Public functions refuse text, complex and object input with a RotframeError.
 
-:func:`guard_public` wraps the plain-Python functions a module exports so that
+`guard_public` wraps the plain-Python functions a module exports so that
 
 * an argument holding complex numbers is refused before anything is computed
   (``np.asarray(z, dtype=float)`` would silently drop the imaginary part: a
   complex matrix is not a rotation);
 * a ``TypeError`` / ``ValueError`` / ``IndexError`` raised while numpy converts
   junk (a string, ``None``, an object, a ragged list) becomes the module's
-  :class:`~rotframe.errors.RotframeError` subclass, which is still a
+  [`RotframeError`][rotframe.errors.RotframeError] subclass, which is still a
   ``ValueError``, with one line naming the function; so does an arithmetic error
   (an integer too large for a float, a division by zero in object input);
 * a result holding a NaN (from a NaN or infinite input, an overflow, a degenerate
@@ -115,7 +115,7 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
     name : str
         Its name, as the caller's signature spells it.
     error_cls : type
-        Error raised (a :class:`~rotframe.errors.RotframeError` subclass in the
+        Error raised (a [`RotframeError`][rotframe.errors.RotframeError] subclass in the
         public API, so that the CLI exits with code 2).
     stack : bool
         Accept any leading shape ``(..., 3)`` instead of exactly ``(3,)``.

@@ -4,7 +4,7 @@ This is the module behind ``rotframe.scenarios``, ``rotframe.load`` and
 ``rotframe.run`` (``import rotframe`` reaches it lazily, so the import stays
 cheap). A run goes the same way as ``rotframe run NAME`` on the command line:
 the scenario file is loaded and checked, the values are converted once to the
-documented units, the scene is simulated and analysed, and a :class:`Result`
+documented units, the scene is simulated and analysed, and a [`Result`][rotframe.app.api.Result]
 holds the summary (the same keys as ``rotframe run --json``) and the
 trajectory as plain float64 arrays in SI units.
 
@@ -16,7 +16,7 @@ Parameter values may be given as
 * the strings the command line takes (``"520 ft"``, ``"50d54m"``,
   ``"48d50m46s N"``, ``"0,1,1e-3"`` for vectors).
 
-Bad values raise :class:`rotframe.errors.ScenarioError` (a ``ValueError``)
+Bad values raise [`rotframe.errors.ScenarioError`][rotframe.errors.ScenarioError] (a ``ValueError``)
 naming the scenario, the key, the value and what is allowed.
 
 Examples
@@ -59,7 +59,7 @@ ProgressLike = Callable[[float], Any] | bool | None
 
 
 def scenarios() -> list[str]:
-    """Names of the built-in scenarios and of those registered with :func:`register_scene`.
+    """Names of the built-in scenarios and of those registered with [`register_scene`][rotframe.app.api.register_scene].
 
     Examples
     --------
@@ -75,9 +75,9 @@ def scenarios() -> list[str]:
 
 
 def load(name_or_path: str | Path):
-    """Load and check a scenario; returns a :class:`rotframe.app.scenario.Scenario`.
+    """Load and check a scenario; returns a `rotframe.app.scenario.Scenario`.
 
-    Its ``parameters`` map each name to a :class:`rotframe.app.scenario.Parameter`
+    Its ``parameters`` map each name to a `rotframe.app.scenario.Parameter`
     with ``name``, ``unit``, ``default`` (in that unit), ``bounds`` = ``(min, max)``
     (``exclusive_min``/``exclusive_max`` say whether they are allowed),
     ``choices`` and ``doc``. ``scenario.run`` holds the run settings
@@ -87,7 +87,7 @@ def load(name_or_path: str | Path):
     Parameters
     ----------
     name_or_path : str or path
-        A name from :func:`scenarios` or a path to a ``.toml`` file.
+        A name from [`scenarios`][rotframe.app.api.scenarios] or a path to a ``.toml`` file.
 
     Examples
     --------
@@ -109,18 +109,19 @@ def load(name_or_path: str | Path):
 
 def run(name_or_path: str | Path, method: str | None = None, *, progress: ProgressLike = None,
         threads: int | None = None, **params: Any) -> "Result":
-    """Run a scenario; returns a :class:`Result`.
+    """Run a scenario; returns a [`Result`][rotframe.app.api.Result].
 
     Parameters
     ----------
     name_or_path : str or path
-        A name from :func:`scenarios` or a path to a ``.toml`` scenario file.
+        A name from [`scenarios`][rotframe.app.api.scenarios] or a path to a ``.toml`` scenario file.
     method : str, optional
         Integrator (``rotframe.load(name)`` and ``rotframe show NAME`` list the
         scene's methods); default the scenario's.
     progress : callable or bool, optional
         ``progress(fraction)`` is called as the run advances (0 to 1);
-        ``True`` draws a bar on stderr.
+        ``True`` draws a bar: tqdm's (``tqdm.auto``: a widget in Jupyter) when
+        tqdm is installed, else a text line on stderr.
     threads : int, optional
         Threads for ensembles of particles during this run only (default:
         every core); the results do not depend on it. Not a whole number
@@ -130,15 +131,21 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
         strings such as ``"520 ft"``), and the run settings ``step`` (s),
         ``rtol`` and ``samples``.
 
+    Warns
+    -----
+    rotframe.errors.RotframeWarning
+        One for each entry of the result's ``warnings`` (what the run could not
+        resolve or should be read with care); the list stays on the result.
+
     Raises
     ------
     rotframe.errors.ScenarioError
         Unknown scenario, key or method, wrong unit, value out of range.
     rotframe.errors.IntegrationError
-        Numerical failure; ``exc.partial`` holds a :class:`Result` of what was
+        Numerical failure; ``exc.partial`` holds a [`Result`][rotframe.app.api.Result] of what was
         computed up to ``exc.t_reached``.
     rotframe.particles.integrators.RunInterrupted
-        Ctrl-C during the run; ``exc.partial`` holds a :class:`Result` of what was computed.
+        Ctrl-C during the run; ``exc.partial`` holds a [`Result`][rotframe.app.api.Result] of what was computed.
 
     Examples
     --------
@@ -162,6 +169,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     scn = load(name_or_path)
     values = resolve_values(scn, params)
     scene = scenes.get(scn.scene)
+    method = method.lower() if isinstance(method, str) else method  # scipy's "DOP853" is dop853
     allowed = getattr(scene, "METHODS", None)
     if method is not None and allowed is not None and method not in allowed:
         raise ScenarioError(f"{scn.name}: method={method!r} is not one of {', '.join(allowed)}")
@@ -181,7 +189,19 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
             callback.close()
     simulate_s = time.perf_counter() - t0
     summary = runner.summarize(scn, values, scene_result, {"simulate_s": simulate_s}, given=params or ())
-    return Result(scn, values, scene_result, _finish_summary(scn, summary, scene_result, simulate_s, t_start))
+    result = Result(scn, values, scene_result, _finish_summary(scn, summary, scene_result, simulate_s, t_start))
+    _warn(result.warnings)
+    return result
+
+
+def _warn(texts) -> None:
+    """One `rotframe.errors.RotframeWarning` per entry of a result's ``warnings`` (the list stays)."""
+    import warnings
+
+    from rotframe.errors import RotframeWarning
+
+    for text in texts:
+        warnings.warn(text, RotframeWarning, stacklevel=3)  # points at the caller of rotframe.run
 
 
 def resolve_values(scn, params: Mapping[str, Any]) -> dict:
@@ -329,7 +349,7 @@ class Result:
     ----------
     metrics, theory, diagnostics : dict
         Measured values, their closed-form theory, and checks (drifts,
-        conserved quantities); names end in their unit (:attr:`units`).
+        conserved quantities); names end in their unit (`units`).
     warnings : list of str
         What the run could not resolve or should be read with care (empty on a clean run).
     params : dict
@@ -368,6 +388,48 @@ class Result:
         shown = ", ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.metrics.items())
         return f"<rotframe.Result {self.scenario.name} ({self.method}): {shown}>"
 
+    def _repr_markdown_(self) -> str:
+        from rotframe.app.display import markdown, result_rows
+        return markdown(*result_rows(self))
+
+    def _repr_html_(self) -> str:
+        from rotframe.app.display import html_table, result_rows
+        return html_table(*result_rows(self))
+
+    def sol(self, t):
+        """The state at any time ``t`` (s) of a finished ``dop853`` particle run, as ``solve_ivp``'s ``sol(t)``.
+
+        Returns ``(r, v)`` in the trajectory's frame and units: (N, 3) each for a
+        number ``t``, (m, N, 3) for an array of m times. Restarts the run's own
+        integrator and tolerances from the last sample before ``t``, so it is as
+        accurate as the samples (see `rotframe.app.dense`); a run of another
+        method, a rigid body or a frame whose rate changes raise ScenarioError.
+        """
+        from rotframe.app.dense import DenseSolution
+
+        if getattr(self, "_dense", None) is None:
+            self._dense = DenseSolution(self.scenario.name, self._scene_result, self._values.get("run", {}))
+        return self._dense(t)
+
+    def quantities(self) -> dict:
+        """Metrics, theory and diagnostics as astropy Quantities in their units (`units`).
+
+        Returns ``{"metrics": {...}, "theory": {...}, "diagnostics": {...}}``; a value
+        whose unit is not known stays a plain number, and so do non-numbers. The
+        plain floats of `metrics`, `theory` and `diagnostics` stay the default.
+
+        Examples
+        --------
+        >>> import rotframe
+        >>> q = rotframe.run("tower-drop").quantities()
+        >>> q["metrics"]["east_deflection_m"].to("mm").round(1)
+        <Quantity 27.6 mm>
+        """
+        from rotframe.app.quantities import as_quantities
+
+        return {part: as_quantities(getattr(self, part), self.units)
+                for part in ("metrics", "theory", "diagnostics")}
+
     def to_dict(self) -> dict:
         """The summary as a JSON-ready dict, with the keys of ``rotframe run --json`` (NaN -> None)."""
         return jsonable(self._summary)
@@ -395,19 +457,19 @@ class Result:
         return Path(final)
 
     def export(self, path: str | Path) -> Path:
-        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see :mod:`rotframe.app.export`)."""
+        """Write the trajectory to ``.npz``, ``.csv`` or ``.parquet`` (see [`rotframe.app.export`][rotframe.app.export])."""
         from rotframe.app.export import write_trajectory
 
         return write_trajectory(self.trajectory, path, summary=self.to_dict())
 
     def plot(self, path: str | Path | None = None):
-        """A matplotlib figure of the run (``path``: also save it as PNG); see :mod:`rotframe.app.plot`."""
+        """A matplotlib figure of the run (``path``: also save it as PNG); see `rotframe.app.plot`."""
         from rotframe.app.plot import plot_result
 
         return plot_result(self, path)
 
     def to_dataframe(self):
-        """The trajectory as a pandas DataFrame (:meth:`TrajectoryArrays.columns`); needs pandas."""
+        """The trajectory as a pandas DataFrame ([`TrajectoryArrays.columns`][rotframe.app.api.TrajectoryArrays.columns]); needs pandas."""
         try:
             import pandas as pd
         except ImportError:
@@ -471,11 +533,11 @@ def _python_scalars(obj):
 
 
 def _progress_callback(progress: ProgressLike):
-    from rotframe.app.progress import Progress
+    from rotframe.app.progress import auto_bar
 
     if progress is True:
-        # asked for: drawn on any stream (a notebook's stderr is no terminal), from the first report on
-        return Progress("run", "%", delay=0.0, tty_only=False)
+        # asked for: tqdm.auto's bar (a widget in Jupyter) if installed, else a line on any stream
+        return auto_bar("run")
     if progress is False or progress is None:
         return None
     if not callable(progress):
@@ -496,7 +558,7 @@ def register_scene(name: str, scene: Any, scenario: str | Path | None = None, ov
     name : str
         The scene name that scenario files give as ``scene = "NAME"``.
     scene : module or object
-        Anything with the scene protocol (see :mod:`rotframe.scenes`):
+        Anything with the scene protocol (see `rotframe.scenes`):
         ``simulate(values, terms, method, run, progress) -> SceneResult``,
         ``analyse(values, result) -> {"metrics", "theory", "diagnostics", "notes"}``,
         ``record(recording, values, result)``, and optionally ``METHODS``.

@@ -1,7 +1,7 @@
 """The ``rotframe`` command line's arguments: the parser, its sub-commands and value types.
 
 Standard library only, so that ``rotframe --help`` stays instant. The commands themselves
-live in :mod:`rotframe.app.cli`, which passes them in (:func:`build_parser`).
+live in `rotframe.app.cli`, which passes them in (`build_parser`).
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ def did_you_mean(word: str, options, cutoff: float = 0.6) -> str:
     options : iterable of str
         What is allowed.
     cutoff : float
-        :func:`difflib.get_close_matches` similarity threshold in [0, 1].
+        `difflib.get_close_matches` similarity threshold in [0, 1].
     """
     close = difflib.get_close_matches(word, list(options), n=1, cutoff=cutoff)
     return f" (did you mean {close[0]!r}?)" if close else ""

@@ -6,11 +6,11 @@ simulated time reached; the recording keeps everything up to it); 130 / 143
 interrupted by Ctrl-C / SIGTERM (the recording keeps what was computed); 1 an
 internal error (one line; ``ROTFRAME_DEBUG=1`` shows the traceback).
 
-Work is estimated before it starts (:mod:`rotframe.limits`: ``--max-steps``,
+Work is estimated before it starts (`rotframe.limits`: ``--max-steps``,
 ``--max-samples``, ``--max-rows``), outputs are checked before computing and
-written atomically (:mod:`rotframe.app.outputs`), signals are handled per command
-(:mod:`rotframe.app.signals`) and long work shows a progress line on a terminal
-(:mod:`rotframe.app.progress`). With ``--json`` only the JSON document reaches stdout.
+written atomically (`rotframe.app.outputs`), signals are handled per command
+(`rotframe.app.signals`) and long work shows a progress line on a terminal
+(`rotframe.app.progress`). With ``--json`` only the JSON document reaches stdout.
 
 This module imports only the standard library at start-up: numpy, astropy,
 numba and rerun are imported by the commands that need them, so that
@@ -245,7 +245,7 @@ def _limits(args):
 
 
 def _threads(args):
-    """The command's ``--threads`` in force for the command only (:func:`rotframe.particles.ensemble.threads_scope`)."""
+    """The command's ``--threads`` in force for the command only (`rotframe.particles.ensemble.threads_scope`)."""
     from rotframe.particles.ensemble import threads_scope
 
     return threads_scope(getattr(args, "threads", None))
@@ -385,7 +385,9 @@ def cmd_view(args) -> int:
         print(describe(path))
         return EXIT_OK
     if args.web:
-        return subprocess.call([sys.executable, "-m", "rerun", "--bind", bind, "--web-viewer", path])
+        from rotframe.app.web_view import serve
+
+        return serve(path, bind)  # the URL in one line; rerun's server stops with the command
     if not _has_display():
         from rotframe.app.recording_summary import describe
 
@@ -463,6 +465,9 @@ def _check_outputs(args):
         check_output_file(export, "--export")
     if png is not None:
         check_output_file(png, "--png", ".png")
+        from rotframe.app.plot import require_matplotlib
+
+        require_matplotlib()  # before the run: a missing extra is a one-line error (exit 2), not a lost run
 
 
 def _units(scn, summary):
@@ -481,10 +486,7 @@ def _write_outputs(args, scn, values, result, summary):
     if args.export:
         summary["export"] = str(res.export(args.export))
     if args.png:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        res.plot(args.png)
+        res.plot(args.png)  # a pyplot-free Figure: no backend, no window
         summary["png"] = args.png
 
 

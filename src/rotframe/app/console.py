@@ -3,15 +3,15 @@
 While rotframe starts (imports, argument parsing) nothing has been computed or
 written, so a signal then ends the process at once with one line and the shell's
 exit code (130 after Ctrl-C, 143 after SIGTERM) instead of a traceback from an
-import. :func:`rotframe.app.cli.main` then installs its own handlers for the command.
+import. `rotframe.app.cli.main` then installs its own handlers for the command.
 
 The garbage collector, tuned for one command in one process. Importing numba, scipy
 and astropy creates about a million objects, none of them garbage, and the collector's
 default young-generation threshold (700 allocations) makes it walk them again and
-again: :func:`main` raises that threshold to 100000 (measured: 0.07 to 0.17 s, 6 to
+again: `main` raises that threshold to 100000 (measured: 0.07 to 0.17 s, 6 to
 10 %, of a warm ``rotframe run``). Cyclic garbage is still collected, only in larger
 batches (at most that many objects wait). When the command is over the process only
-has to end: :func:`main` freezes the collector's objects (:func:`gc.freeze`) so that
+has to end: `main` freezes the collector's objects (`gc.freeze`) so that
 the interpreter's shutdown does not walk every object those libraries created
 (measured: 0.2 s of a 1 s ``rotframe run foucault``). Everything the command writes
 is written and flushed before it returns; ``atexit`` handlers still run.

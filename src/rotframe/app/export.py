@@ -3,14 +3,16 @@
 * ``.npz`` (numpy): the arrays in their natural shapes (``times`` (n,);
   ``r``, ``v`` (n, N, 3) for particles; ``L`` (n, 3), ``q`` (n, 4) for bodies),
   plus ``units`` and ``summary`` as JSON strings.
-* ``.csv``: the long table of :meth:`rotframe.app.api.TrajectoryArrays.columns`
-  (one row per sample and particle), units in the column names, a header
-  line starting with ``#`` giving the scenario and frame.
+* ``.csv``: the long table of [`rotframe.app.api.TrajectoryArrays.columns`][rotframe.app.api.TrajectoryArrays.columns]
+  (one row per sample and particle), units in the column names; the first
+  line is a plain header of the column names, so ``pandas.read_csv(path)``
+  and ``numpy.genfromtxt(path, delimiter=",", names=True)`` read it as it
+  is. (The frame and the summary live in ``.npz`` and ``.parquet``.)
 * ``.parquet`` (needs pyarrow, the ``export`` extra): the same table, with the
   units and the summary in the file's metadata.
 
-Read back with ``numpy.load``, ``numpy.genfromtxt(..., names=True)`` or
-``pyarrow.parquet.read_table``/``pandas.read_parquet``.
+Read back with ``numpy.load``, ``pandas.read_csv``, ``numpy.genfromtxt(...,
+names=True)`` or ``pyarrow.parquet.read_table``/``pandas.read_parquet``.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ FORMATS = (".npz", ".csv", ".parquet")
 
 
 def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None = None) -> Path:
-    """Write ``traj`` (a :class:`rotframe.app.api.TrajectoryArrays`) to ``path``; the suffix picks the format.
+    """Write ``traj`` (a [`rotframe.app.api.TrajectoryArrays`][rotframe.app.api.TrajectoryArrays]) to ``path``; the suffix picks the format.
 
     Parameters
     ----------
@@ -66,10 +68,10 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
             names = list(cols)
             table = np.column_stack([np.asarray(cols[k], dtype=float) for k in names])
             fmt = ["%d" if k == "particle" else "%.17g" for k in names]
-            header = f"{json.dumps(meta)}\n" + ",".join(names)
+            # a plain header line (no "# "): pandas.read_csv and spreadsheets take it as the column names
 
             def write(f):
-                np.savetxt(f, table, delimiter=",", fmt=fmt, header=header, comments="# ")
+                np.savetxt(f, table, delimiter=",", fmt=fmt, header=",".join(names), comments="")
         else:
             pa, pq = _pyarrow(path)
             table = pa.table({k: np.asarray(v) for k, v in cols.items()})

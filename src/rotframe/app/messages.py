@@ -1,7 +1,7 @@
 """Exit codes and the one-line error message of every command (standard library only).
 
 Exit codes: 0 done; 2 bad input; 3 numerical failure; 1 an internal error
-(130 / 143 after Ctrl-C / SIGTERM come from :mod:`rotframe.app.signals`).
+(130 / 143 after Ctrl-C / SIGTERM come from `rotframe.app.signals`).
 """
 
 from __future__ import annotations

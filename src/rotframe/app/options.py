@@ -26,7 +26,7 @@ def parse_sets(items, *, on_error=None) -> dict:
         The ``--set`` arguments, in order.
     on_error : callable(item) -> Exception, optional
         Builds the exception raised for an item without ``=``; by default a
-        :class:`rotframe.errors.ScenarioError` saying ``--set 'item': expected KEY=VALUE``.
+        [`rotframe.errors.ScenarioError`][rotframe.errors.ScenarioError] saying ``--set 'item': expected KEY=VALUE``.
     """
     sets = {}
     for item in items:

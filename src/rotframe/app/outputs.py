@@ -5,7 +5,7 @@ target folder (a unique name per writer, so two processes writing the same
 path never share one) and is renamed to its final name only when complete:
 a file under its final name is never truncated and never a mix of two writers.
 A write error (full disk, ``ulimit -f``, a folder that vanished) removes the
-temporary file and raises :class:`OutputError`, one line naming the path.
+temporary file and raises `OutputError`, one line naming the path.
 
 The ``check_*`` functions find, before computing starts, an output that could
 not be written: a path that is a folder, a folder that is a file, a folder
@@ -83,7 +83,7 @@ def _one_line(exc: Exception) -> str:
 def atomic_path(final, what: str = "file"):
     """Yield a unique temporary path beside ``final``; rename it to ``final`` if the block succeeds.
 
-    On any exception (an OSError becomes :class:`OutputError`) the temporary file is removed.
+    On any exception (an OSError becomes `OutputError`) the temporary file is removed.
     """
     final = Path(final)
     try:

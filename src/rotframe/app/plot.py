@@ -1,65 +1,93 @@
-"""A picture of a run (matplotlib, Agg): for a figure rather than a viewer.
+"""A picture of a run (matplotlib): for a figure rather than a viewer.
 
-Particles: the path seen from above (east against north, with the start and
-end marked) and the position components against time. Rigid bodies: the
-angular momentum in body axes against time and the path of the symmetry (3)
-axis's tip in space seen from above. The title carries the metrics beside
-their theory.
+Each picture shows the effect its scene exists to show, beside its theory:
+
+- ``foucault``: the path seen from above, and the swing plane's angle against
+  time beside ``-Omega sin(latitude) t`` (less Airy's correction): the
+  precession itself, not a block of swings;
+- ``projectile``: the lateral deflection against the downrange distance (each
+  on its own scale, so the deflection is not hidden by the range), and the
+  altitude and deflection against time, up to the landing;
+- other particle scenes: the path seen from above (east against north, start and
+  end marked) and the position components against time;
+- rigid bodies: the angular momentum in body axes against time and the path of
+  the symmetry (3) axis's tip in space seen from above.
+
+The title carries the metrics beside their theory. The figure is a
+`matplotlib.figure.Figure` made without pyplot: nothing is drawn through
+pyplot's global state, so Jupyter shows the returned figure once, and no
+window opens. matplotlib is the ``plot`` extra; without it a
+`rotframe.errors.MissingExtraError` names the extra.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["plot_result"]
+__all__ = ["plot_result", "new_figure", "require_matplotlib"]
+
+#: the one line a missing matplotlib gives (exit 2 on the command line)
+MISSING = 'pictures need matplotlib, the plot extra: python -m pip install "rotframe[plot]"'
 
 
-def plot_result(result, path: str | Path | None = None):
-    """Draw ``result`` (a :class:`rotframe.app.api.Result`); save as PNG when ``path`` is given.
+def require_matplotlib() -> None:
+    """Raise `rotframe.errors.MissingExtraError` (naming the ``plot`` extra) if matplotlib is not installed."""
+    import importlib.util
 
-    Returns the matplotlib Figure.
+    if importlib.util.find_spec("matplotlib") is None:
+        from rotframe.errors import MissingExtraError
+
+        raise MissingExtraError(MISSING)
+
+
+def new_figure(figsize=(11, 4.5)):
+    """A pyplot-free matplotlib Figure; a one-line error naming the ``plot`` extra when matplotlib is missing."""
+    try:
+        from matplotlib.figure import Figure
+    except ImportError:
+        from rotframe.errors import MissingExtraError
+
+        raise MissingExtraError(MISSING) from None
+    _show_in_jupyter()
+    return Figure(figsize=figsize)
+
+
+def _show_in_jupyter() -> None:
+    """In IPython, show a Figure returned by a cell as a PNG (once: nothing goes through pyplot).
+
+    pyplot's inline backend registers this display itself when pyplot is imported;
+    a pyplot-free figure needs it registered here. Outside IPython, nothing happens.
     """
     import sys
 
-    import matplotlib
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is None:
+        return
+    png = shell.display_formatter.formatters.get("image/png")
+    if png is not None:
+        png.for_type_by_name("matplotlib.figure", "Figure", _figure_png)
 
-    if path is not None and "matplotlib.pyplot" not in sys.modules:
-        matplotlib.use("Agg")  # a file is wanted: no window
-    import matplotlib.pyplot as plt
-    import numpy as np
 
-    traj = result.trajectory
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
-    if traj.kind == "particles":
-        r = traj.r
-        scale, unit = (1e3, "km") if np.nanmax(np.abs(r)) > 2e4 else (1.0, "m")
-        for k in range(r.shape[1]):
-            ax1.plot(r[:, k, 0] / scale, r[:, k, 1] / scale, lw=0.8)
-            ax1.plot(r[0, k, 0] / scale, r[0, k, 1] / scale, "o", color="green", ms=4)
-            ax1.plot(r[-1, k, 0] / scale, r[-1, k, 1] / scale, "s", color="red", ms=4)
-        ax1.set_xlabel(f"x (east) [{unit}]")
-        ax1.set_ylabel(f"y (north) [{unit}]")
-        ax1.set_title("path seen from above (o start, s end)")
-        ax1.set_aspect("equal", adjustable="datalim")
-        for k, axis in enumerate("xyz"):
-            ax2.plot(traj.times, r[:, 0, k] / scale, label=axis)
-        ax2.set_ylabel(f"position [{unit}]")
-        ax2.legend()
-    elif traj.kind == "body":
-        from scipy.spatial.transform import Rotation
+def _figure_png(fig) -> bytes:
+    import io
 
-        for k in range(3):
-            ax1.plot(traj.times, traj.L[:, k], label=f"L{k + 1}")
-        ax1.set_xlabel("t [s]")
-        ax1.set_ylabel("L, body axes [kg m^2/s]")
-        ax1.legend()
-        e3 = Rotation.from_quat(traj.q).apply([0.0, 0.0, 1.0])
-        ax2.plot(e3[:, 0], e3[:, 1], lw=0.6)
-        ax2.set_xlabel("e3 x (space)")
-        ax2.set_ylabel("e3 y (space)")
-        ax2.set_title("tip of the 3-axis seen from above")
-        ax2.set_aspect("equal", adjustable="datalim")
-    ax2.set_xlabel(ax2.get_xlabel() or "t [s]")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=90, bbox_inches="tight")
+    return buffer.getvalue()
+
+
+def plot_result(result, path: str | Path | None = None):
+    """Draw ``result`` (a [`rotframe.app.api.Result`][rotframe.app.api.Result]); save as PNG when ``path`` is given.
+
+    Returns the matplotlib Figure (made without pyplot; in Jupyter it shows once,
+    as the cell's value).
+    """
+    fig = new_figure()
+    ax1, ax2 = fig.subplots(1, 2)
+    draw = _SCENE_PICTURES.get(result.scenario.scene)
+    if draw is None or not draw(result, ax1, ax2):
+        _generic(result, ax1, ax2)
     lines = []
     for key, value in result.metrics.items():
         theory = result.theory.get(key)
@@ -76,3 +104,172 @@ def plot_result(result, path: str | Path | None = None):
         fmt = path.suffix.lower().lstrip(".") or "png"
         write_atomic(path, lambda f: fig.savefig(f, dpi=110, format=fmt), what="picture")
     return fig
+
+
+def _generic(result, ax1, ax2) -> None:
+    import numpy as np
+
+    traj = result.trajectory
+    if traj.kind == "particles":
+        r, times = traj.r, traj.times
+        landed = [float(np.max(t)) for t in traj.event_times.get("ground", []) if np.size(t)]
+        if landed:  # after the ground the samples only repeat the landing: the picture ends there
+            keep = times <= max(landed)
+            keep[: int(np.argmin(keep)) + 1 if not keep.all() else len(keep)] = True  # the landing sample too
+            r, times = r[keep], times[keep]
+        scale, unit = (1e3, "km") if np.nanmax(np.abs(r)) > 2e4 else (1.0, "m")
+        for k in range(r.shape[1]):
+            ax1.plot(r[:, k, 0] / scale, r[:, k, 1] / scale, lw=0.8)
+            ax1.plot(r[0, k, 0] / scale, r[0, k, 1] / scale, "o", color="green", ms=4)
+            ax1.plot(r[-1, k, 0] / scale, r[-1, k, 1] / scale, "s", color="red", ms=4)
+        ax1.set_xlabel(f"x (east) [{unit}]")
+        ax1.set_ylabel(f"y (north) [{unit}]")
+        ax1.set_title("path seen from above (o start, s end)")
+        ax1.set_aspect("equal", adjustable="datalim")
+        t_scale, t_unit = _time_unit(times)
+        for k, axis in enumerate("xyz"):
+            ax2.plot(times / t_scale, r[:, 0, k] / scale, label=axis)
+        ax2.set_xlim(0.0, float(times[-1]) / t_scale)
+        ax2.set_xlabel(f"t [{t_unit}]" + (" (to the landing)" if landed else ""))
+        ax2.set_ylabel(f"position [{unit}]")
+        ax2.legend()
+    elif traj.kind == "body":
+        from scipy.spatial.transform import Rotation
+
+        t_scale, t_unit = _time_unit(traj.times)
+        L = traj.L
+        across = float(np.max(np.abs(L[:, :2])))
+        if across < 1e-3 * float(np.max(np.abs(L[:, 2]))):
+            # a body spinning almost about its 3-axis: L3 would flatten the small L1, L2 that carry the motion
+            for k in range(2):
+                ax1.plot(traj.times / t_scale, L[:, k], label=f"L{k + 1}")
+            ax1.set_title(f"L1, L2 in the body (L3 = {float(np.mean(L[:, 2])):.4g}, on its own scale)", fontsize=9)
+        else:
+            for k in range(3):
+                ax1.plot(traj.times / t_scale, L[:, k], label=f"L{k + 1}")
+        ax1.set_xlabel(f"t [{t_unit}]")
+        ax1.set_ylabel("L, body axes [kg m^2/s]")
+        ax1.legend()
+        e3 = Rotation.from_quat(traj.q).apply([0.0, 0.0, 1.0])
+        ax2.plot(e3[:, 0], e3[:, 1], lw=0.6)
+        ax2.set_xlabel("e3 x (space)")
+        ax2.set_ylabel("e3 y (space)")
+        ax2.set_title("tip of the 3-axis seen from above")
+        ax2.set_aspect("equal", adjustable="datalim")
+
+
+def _time_unit(times):
+    """(seconds per unit, unit name) for a time axis: days beyond two days, hours beyond two hours."""
+    end = float(times[-1]) if len(times) else 0.0
+    if end > 2 * 86400:
+        return 86400.0, "days"
+    if end > 2 * 3600:
+        return 3600.0, "h"
+    return 1.0, "s"
+
+
+def _heavy_top(result, ax1, ax2) -> bool:
+    """The tilt between the turning points of Goldstein's cubic (the nutation), and the tip's path."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    traj = result.trajectory
+    lo, hi = result.theory.get("theta_min_deg"), result.theory.get("theta_max_deg")
+    if traj.kind != "body" or not all(isinstance(x, (int, float)) for x in (lo, hi)):
+        return False
+    e3 = Rotation.from_quat(traj.q).apply([0.0, 0.0, 1.0])
+    theta = np.degrees(np.arccos(np.clip(e3[:, 2], -1.0, 1.0)))
+    period = result.metrics.get("nutation_period_s")
+    end = float(traj.times[-1])
+    if isinstance(period, (int, float)) and period == period and period > 0:
+        end = min(end, 6 * period)  # a few nutations, each one readable
+    keep = traj.times <= end
+    ax1.plot(traj.times[keep], theta[keep], color="C0", label="tilt theta (simulated)")
+    for value, text in ((lo, "theta_min"), (hi, "theta_max")):
+        ax1.axhline(value, color="C1", ls="--", lw=1.0)
+        ax1.annotate(f"{text} (Goldstein's cubic) {value:.4g}", (0.01, value), xycoords=("axes fraction", "data"),
+                     fontsize=7, color="C1", va="bottom")
+    ax1.set_xlabel("t [s]")
+    ax1.set_ylabel("tilt of the symmetry axis [deg]")
+    ax1.set_title("nutation between the turning points")
+    ax2.plot(e3[:, 0], e3[:, 1], lw=0.6)
+    ax2.set_xlabel("e3 x (space)")
+    ax2.set_ylabel("e3 y (space)")
+    ax2.set_title("tip of the 3-axis seen from above (precession)")
+    ax2.set_aspect("equal", adjustable="datalim")
+    return True
+
+
+def _foucault(result, ax1, ax2) -> bool:
+    """The path from above, and the swing plane's angle against its theory (the precession)."""
+    import math
+
+    import numpy as np
+
+    from rotframe.scenes.foucault import swing_angle
+
+    traj = result.trajectory
+    g = (getattr(result, "_scene_result", None) and result._scene_result.extras.get("g")) or None
+    rate_theory = result.theory.get("precession_rate_deg_per_hour")
+    if traj.kind != "particles" or g is None or not isinstance(rate_theory, (int, float)):
+        return False
+    r, v, t = traj.r[:, 0], traj.v[:, 0], traj.times
+    length = float(result.params["length"])
+    angle = np.degrees(swing_angle(r, v, math.sqrt(g / length)))
+    hours = t / 3600.0
+    ax1.plot(r[:, 0], r[:, 1], lw=0.3, color="0.55")
+    ends = {"start": (0, "green"), "end": (-1, "red")}
+    for label, (k, color) in ends.items():
+        # the swing plane at the start and at the end: the turn seen from above
+        d = np.array([math.cos(math.radians(angle[k])), math.sin(math.radians(angle[k]))]) * result.params["amplitude"]
+        ax1.plot([-d[0], d[0]], [-d[1], d[1]], color=color, lw=2, label=f"swing plane at the {label}")
+    ax1.set_aspect("equal", adjustable="datalim")
+    ax1.set_xlabel("x (east) [m]")
+    ax1.set_ylabel("y (north) [m]")
+    ax1.set_title("the bob seen from above")
+    ax1.legend(fontsize=7, loc="upper right")
+    ax2.plot(hours, angle, color="C0", lw=1.5, label="swing plane (measured)")
+    ax2.plot(hours, angle[0] - rate_theory * hours, "--", color="C1", lw=1.2,
+             label=f"theory: {-rate_theory:+.4g} deg/h (clockwise < 0)")
+    ax2.set_xlabel("t [h]")
+    ax2.set_ylabel("swing-plane angle from east [deg]")
+    ax2.set_title("the swing plane turns")
+    ax2.legend(fontsize=7)
+    return True
+
+
+def _projectile(result, ax1, ax2) -> bool:
+    """Lateral deflection against downrange (separate scales) and the flight up to the landing."""
+    import numpy as np
+
+    from rotframe.scenes.base import landing
+    from rotframe.scenes.projectile import ground_track
+
+    scene_result = getattr(result, "_scene_result", None)
+    model = scene_result.extras.get("model") if scene_result is not None else None
+    if model is None:
+        return False
+    times, r, _, landed = landing(scene_result.trajectory)
+    rng, lateral = ground_track(result.params, r, model)
+    ax1.plot(rng / 1000.0, lateral, color="C0", lw=1.5, label="simulated")
+    theory = result.theory.get("lateral_deflection_m")
+    if isinstance(theory, (int, float)):
+        ax1.plot([rng[-1] / 1000.0], [theory], "x", color="C1", ms=9, mew=2, label="theory at the landing")
+    ax1.axhline(0.0, color="0.6", lw=0.8)
+    ax1.set_xlabel("downrange [km]")
+    ax1.set_ylabel("deflection right of the aim [m]")
+    ax1.set_title("the Coriolis deflection (its own scale)")
+    ax1.legend(fontsize=7)
+    ax2.plot(times, r[:, 2] / 1000.0, color="C2", label="altitude [km]")
+    ax2.set_xlabel("t [s]" + (" (to the landing)" if landed else ""))
+    ax2.set_ylabel("altitude [km]", color="C2")
+    ax2.set_xlim(0.0, float(times[-1]))
+    twin = ax2.twinx()
+    twin.plot(times, lateral, color="C0", label="deflection [m]")
+    twin.set_ylabel("deflection [m]", color="C0")
+    ax2.set_title("flight")
+    return True
+
+
+#: scene -> function drawing its two panels (False: fall back to the generic picture)
+_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top}

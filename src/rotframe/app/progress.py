@@ -9,7 +9,7 @@
 Nothing is written unless stderr is a terminal and the work has taken longer
 than ``delay`` seconds, so pipes, logs and ``--json`` output never see it
 (pass ``enabled=False`` for ``--json``). The line is redrawn at most every
-``interval`` seconds and erased by :meth:`close`.
+``interval`` seconds and erased by `close`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import time
 
-__all__ = ["Progress"]
+__all__ = ["Progress", "auto_bar"]
 
 
 class Progress:
@@ -105,6 +105,37 @@ class Progress:
     def __exit__(self, *exc):
         self.close()
         return False
+
+
+class _TqdmFraction:
+    """A tqdm bar fed fractions in [0, 1] (``tqdm.auto``: a widget in Jupyter, text elsewhere)."""
+
+    def __init__(self, tqdm, label):
+        self._bar = tqdm(total=100, desc=label, unit="%", bar_format="{desc}: {percentage:5.1f}%|{bar}| [{elapsed}<{remaining}]")
+
+    def __call__(self, fraction):
+        self.update(float(fraction), 1.0)
+
+    def update(self, done, total):
+        frac = min(max(done / total, 0.0), 1.0) if total else 0.0
+        self._bar.update(100.0 * frac - self._bar.n)
+
+    def close(self):
+        self._bar.close()
+
+
+def auto_bar(label: str = "run"):
+    """A progress bar that suits where it is drawn, fed fractions: ``bar(fraction)``, then ``bar.close()``.
+
+    With tqdm installed (the ``notebook`` extra), ``tqdm.auto``'s bar: a widget in
+    Jupyter, a text bar on a terminal. Without it, a `Progress` line on stderr,
+    drawn on any stream (a notebook's stderr is no terminal).
+    """
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return Progress(label, "%", delay=0.0, tty_only=False)
+    return _TqdmFraction(tqdm, label)
 
 
 def _duration(seconds: float) -> str:

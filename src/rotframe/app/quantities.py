@@ -3,14 +3,14 @@
 One parser for every value with a unit on the command line and in scenario files
 (``--set height='520 ft'``, ``rotframe section tube --set thickness='0.25 inch'``):
 a plain number is taken as already in the target unit; anything else is read by
-:class:`astropy.units.Quantity` with the imperial units enabled for this parse only
+`astropy.units.Quantity` with the imperial units enabled for this parse only
 and converted to the target unit. astropy is imported only when a string is not a
 plain number.
 """
 
 from __future__ import annotations
 
-__all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line"]
+__all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities"]
 
 
 class NotAQuantity(ValueError):
@@ -65,3 +65,28 @@ def first_line(exc) -> str:
     """The first sentence of an exception's message (astropy's run to several lines of advice)."""
     text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     return text.split(". ")[0].rstrip(".")
+
+
+#: unit strings of the summary (`rotframe.app.units`) that astropy spells otherwise
+_ASTROPY_SPELLING = {"sidereal day": "sday"}
+
+
+def as_quantities(values, units) -> dict:
+    """``{name: value}`` with each number as an astropy Quantity in ``units[name]``.
+
+    A name without a known unit, and a value that is not a number (a bool, None,
+    a string), stay as they are; ``""`` gives a dimensionless Quantity.
+    """
+    import astropy.units as u
+
+    out = {}
+    for name, value in values.items():
+        unit = units.get(name)
+        if unit is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+            out[name] = value
+            continue
+        try:
+            out[name] = u.Quantity(float(value), u.Unit(_ASTROPY_SPELLING.get(unit, unit)) if unit else u.one)
+        except ValueError:
+            out[name] = value
+    return out

@@ -12,12 +12,20 @@
   x east, y north, z up). A blueprint opens a 3D view beside one time-series
   view per kind of quantity (angles, lengths, errors and drifts, ...), so that
   numbers of different sizes do not share an axis.
+* Error and drift series (names with ``error`` or ``drift``) near round-off would
+  print as ``0.000 000 000 4`` on an axis: beside each, ``diagnostics/log10_<name>``
+  holds the base-10 logarithm of its size (exact zeros drawn at
+  `LOG10_FLOOR`), and the blueprint's error view shows those.
+* Playback: the blueprint's time panel plays the run in about
+  `PLAYBACK_TARGET_S` seconds (an hour of Foucault's pendulum, 304 days of the
+  free top), and a scene may set the 3D view's eye and contents (`view`) so
+  that its first frame frames the effect.
 * Bulk data goes by columns (``send_columns``); nothing is logged step by step.
   Positions are float32 in rerun, so scenes log them in a local frame (ENU, body).
 * Files are deterministic (fixed recording id, no ``log_time``). The recording
   is encoded into memory (rerun's binary stream) and the bytes are written by
   Python to a temporary file of this writer's own in the target folder, then
-  renamed (:mod:`rotframe.app.outputs`): an earlier complete recording is only ever
+  renamed (`rotframe.app.outputs`): an earlier complete recording is only ever
   replaced by a complete one, two writers never share a temporary file, and
   every I/O error (full disk, ``ulimit -f``) ends the run with one line and no
   file left behind. An interrupted or failed run is finalised as
@@ -32,7 +40,32 @@ import numpy as np
 
 from rotframe.numerics.sampling import decimate
 
-__all__ = ["Recording", "default_path", "series_kind"]
+__all__ = ["Recording", "default_path", "series_kind", "is_error_series", "playback_speed",
+           "PLAYBACK_TARGET_S", "LOG10_FLOOR"]
+
+#: seconds of viewing a run's whole timeline takes at the blueprint's playback speed (at least 1x)
+PLAYBACK_TARGET_S = 30.0
+#: where log10 of an error series draws an exact zero (below float64 round-off, 1e-16)
+LOG10_FLOOR = -18.0
+
+
+def playback_speed(duration_s: float, target_s: float = PLAYBACK_TARGET_S) -> float:
+    """Playback speed that shows ``duration_s`` of simulated time in ``target_s`` seconds (never below 1x).
+
+    >>> playback_speed(3600.0), playback_speed(5.7)
+    (120.0, 1.0)
+    """
+    return max(1.0, float(duration_s) / target_s) if duration_s > 0 else 1.0
+
+
+def is_error_series(entity: str) -> bool:
+    """Whether a series is an error or a drift (drawn as log10 of its size).
+
+    >>> is_error_series("diagnostics/energy_rel_error"), is_error_series("diagnostics/theta_deg")
+    (True, False)
+    """
+    name = entity.rstrip("/").rsplit("/", 1)[-1]
+    return "error" in name or "drift" in name
 
 
 def default_path(scenario_name: str) -> Path:
@@ -81,12 +114,12 @@ def _time_column(times):
 
 
 class Recording:
-    """One run's recording; use as a context manager or call :meth:`finish`.
+    """One run's recording; use as a context manager or call [`finish`][rotframe.app.record.Recording.finish].
 
     Parameters
     ----------
     path : path-like
-        Final name (``.rrd``). Data is held in memory until :meth:`finish` writes it.
+        Final name (``.rrd``). Data is held in memory until [`finish`][rotframe.app.record.Recording.finish] writes it.
     application_id : str
         Shown in the viewer (the scenario name).
     """
@@ -104,8 +137,29 @@ class Recording:
         self._series: list[tuple[str, str]] = []  # (entity, kind) of the scalar series, for the blueprint
         self._data = None
         self.final = None
+        self._t_end = 0.0  # the latest time logged: the timeline the blueprint plays
+        self._view: dict = {}  # the 3D view's eye and contents, set by the scene (`view`)
 
     # -- logging -------------------------------------------------------------
+
+    def _time(self, times):
+        """The ``sim_time`` column of ``times``; remembers the latest time for the playback speed."""
+        times = np.asarray(times, dtype=np.float64)
+        if times.size:
+            last = float(np.nanmax(times))
+            if last == last:
+                self._t_end = max(self._t_end, last)
+        return _time_column(times)
+
+    def view(self, eye=None, look_at=None, up=(0.0, 0.0, 1.0), contents=None, playback_s=None):
+        """How the 3D view opens: an orbital eye at ``eye`` looking at ``look_at`` (world coordinates).
+
+        ``contents`` (entity paths under ``world``, rerun's ``+ path`` / ``- path``
+        expressions) limits what the view shows; ``playback_s`` is the simulated
+        time the phenomenon takes, played in `PLAYBACK_TARGET_S` seconds (default:
+        the whole timeline).
+        """
+        self._view = {"eye": eye, "look_at": look_at, "up": up, "contents": contents, "playback_s": playback_s}
 
     def points(self, entity, times, positions, radius=None, color=None, trail=True):
         """Points per sample at ``entity``; ``positions`` (n, 3) or (n, N, 3), m."""
@@ -117,7 +171,7 @@ class Recording:
         n, count, _ = pos.shape
         flat = pos.reshape(n * count, 3).astype(np.float32)
         cols = rr.Points3D.columns(positions=flat).partition(np.full(n, count))
-        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=cols)
+        self.rec.send_columns(entity, indexes=[self._time(times)], columns=cols)
         static = {}
         if radius is not None:
             static["radii"] = [float(radius)]
@@ -149,7 +203,7 @@ class Recording:
             for j in range(count):
                 strips.append(pos[lo:k + 1, j, :].astype(np.float32))
         cols = rr.LineStrips3D.columns(strips=strips).partition(np.full(len(keys), count))
-        self.rec.send_columns(entity, indexes=[_time_column(np.asarray(times)[keys])], columns=cols)
+        self.rec.send_columns(entity, indexes=[self._time(np.asarray(times)[keys])], columns=cols)
         if color is not None:
             self.rec.log(entity, rr.LineStrips3D.from_fields(colors=[color]), static=True)
 
@@ -166,7 +220,7 @@ class Recording:
         starts = np.asarray(starts, dtype=np.float32)
         vectors = (np.asarray(ends, dtype=np.float64) - starts).astype(np.float32)
         cols = rr.Arrows3D.columns(origins=starts, vectors=vectors)
-        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=cols)
+        self.rec.send_columns(entity, indexes=[self._time(times)], columns=cols)
         if color is not None:
             self.rec.log(entity, rr.Arrows3D.from_fields(colors=[color]), static=True)
 
@@ -182,7 +236,7 @@ class Recording:
         kwargs = {"quaternion": q.astype(np.float32)}
         if translation is not None:
             kwargs["translation"] = np.asarray(translation, dtype=np.float32)
-        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Transform3D.columns(**kwargs))
+        self.rec.send_columns(entity, indexes=[self._time(times)], columns=rr.Transform3D.columns(**kwargs))
         if axis_length is None:
             return
         L = float(axis_length)
@@ -194,15 +248,35 @@ class Recording:
         """A time series at ``entity`` (``diagnostics/<quantity>``).
 
         ``kind`` names the time-series view it goes to (default: from the name,
-        see :func:`series_kind`); ``label`` is its name in the plot legend.
+        see [`series_kind`][rotframe.app.record.series_kind]); ``label`` is its name in the plot legend.
         """
         import rerun as rr
 
         vals = np.asarray(values, dtype=np.float64)
-        self.rec.send_columns(entity, indexes=[_time_column(times)], columns=rr.Scalars.columns(scalars=vals))
+        self.rec.send_columns(entity, indexes=[self._time(times)], columns=rr.Scalars.columns(scalars=vals))
         if label is not None:
             self.rec.log(entity, rr.SeriesLines(names=[label]), static=True)
+        if kind is None and is_error_series(entity):
+            self._log10(entity, times, vals)
+            return
         self._series.append((entity, kind or series_kind(entity)))
+
+    def _log10(self, entity, times, vals):
+        """``diagnostics/log10_<name>``: log10 of the size of an error series, shown in place of it."""
+        import rerun as rr
+
+        from rotframe.app.units import quantity_unit
+
+        head, _, name = entity.rstrip("/").rpartition("/")
+        size = np.abs(vals)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            logs = np.where(size > 0, np.log10(np.where(size > 0, size, 1.0)), LOG10_FLOOR)
+        logs = np.where(np.isfinite(vals), np.maximum(logs, LOG10_FLOOR), np.nan)
+        path = f"{head}/log10_{name}" if head else f"log10_{name}"
+        self.rec.send_columns(path, indexes=[self._time(times)], columns=rr.Scalars.columns(scalars=logs))
+        self.rec.log(path, rr.SeriesLines(names=[f"log10 |{name}|"]), static=True)
+        unit = quantity_unit(name) or ""
+        self._series.append((path, f"errors: log10 of their size{' in ' + unit if unit else ' (relative)'}"))
 
     def reference(self, entity, times, values, label="theory", name="theory"):
         """The closed-form value of the series at ``entity``, logged beside it at ``<entity>/<name>``.
@@ -215,7 +289,7 @@ class Recording:
         if vals.ndim == 0:
             vals = np.full(len(times), float(vals))
         path = f"{entity}/{name}"
-        self.rec.send_columns(path, indexes=[_time_column(times)], columns=rr.Scalars.columns(scalars=vals))
+        self.rec.send_columns(path, indexes=[self._time(times)], columns=rr.Scalars.columns(scalars=vals))
         self.rec.log(path, rr.SeriesLines(colors=[[150, 150, 150]], widths=[1.0], names=[label]), static=True)
 
     def frame_axes(self, entity, length, labels=("E", "N", "U"), omega=None):
@@ -269,7 +343,7 @@ class Recording:
         """3D view of ``world`` beside one time-series view per kind of quantity and the summary text.
 
         Also declares ``world`` right-handed and z-up (ENU) for the viewer.
-        The kinds are those given to (or inferred by) :meth:`scalars`; with no
+        The kinds are those given to (or inferred by) [`scalars`][rotframe.app.record.Recording.scalars]; with no
         series logged through it, one view per root in ``series``.
         """
         import rerun as rr
@@ -284,12 +358,25 @@ class Recording:
                      for kind, entities in groups.items()]
         else:
             views = [rrb.TimeSeriesView(origin=f"/{s}", name=s) for s in series]
+        view = self._view
+        eye = None
+        if view.get("eye") is not None:
+            target = view.get("look_at")
+            up = view.get("up")
+            eye = rrb.EyeControls3D(kind=rrb.Eye3DKind.Orbital, position=[float(x) for x in view["eye"]],
+                                    look_target=[float(x) for x in (target if target is not None else (0, 0, 0))],
+                                    eye_up=[float(x) for x in (up if up is not None else (0, 0, 1))])
+        world = rrb.Spatial3DView(origin="/world", name="world", contents=view.get("contents") or "$origin/**",
+                                  eye_controls=eye)
+        span = view.get("playback_s") or self._t_end
         bp = rrb.Blueprint(
             rrb.Horizontal(
-                rrb.Spatial3DView(origin="/world", name="world"),
+                world,
                 rrb.Vertical(*views, rrb.TextDocumentView(origin="/scenario", name="summary")),
                 column_shares=[3, 2],
             ),
+            rrb.TimePanel(state="collapsed", timeline="sim_time", playback_speed=playback_speed(span),
+                          play_state=rrb.components.PlayState.Playing, loop_mode=rrb.components.LoopMode.All),
             collapse_panels=True,
         )
         self.rec.send_blueprint(bp)
@@ -300,7 +387,7 @@ class Recording:
     def finish(self, complete: bool = True) -> Path:
         """Encode, write through a temporary file and rename to the final or partial name.
 
-        Raises :class:`rotframe.app.outputs.OutputError` (nothing left behind) when the
+        Raises `rotframe.app.outputs.OutputError` (nothing left behind) when the
         file cannot be written. If the write is interrupted, ``finish(complete=False)``
         may be called again: the encoded bytes are kept until a write succeeds.
         """

@@ -1,8 +1,8 @@
 """Run a scenario: values in, summary and result out (no printing, no recording).
 
-The command line (:mod:`rotframe.app.cli`) and the Python convenience function
-:func:`run` share this path; recording is downstream of a finished or
-interrupted run (:func:`record_result`).
+The command line (`rotframe.app.cli`) and the Python convenience function
+`run` share this path; recording is downstream of a finished or
+interrupted run (`record_result`).
 """
 
 from __future__ import annotations
@@ -45,6 +45,7 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
     scene = scenes.get(scn.scene)
     run_settings = dict(values["run"])
     method = method or run_settings.get("method")
+    method = method.lower() if isinstance(method, str) else method  # scipy's "DOP853" is dop853
     allowed = getattr(scene, "METHODS", None)
     if method is not None and allowed is not None and method not in allowed:
         raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}")
@@ -64,7 +65,7 @@ def summarize(scn, values, result, timing, given=()):
     accuracy for an exact theory, the approximation's accuracy otherwise; a metric
     with no tolerance is compared with an indicative theory only), plus the
     scene's own warnings, plus one for each run setting in ``given`` (the keys the
-    caller set) that the method does not read (:func:`unused_settings`).
+    caller set) that the method does not read (`unused_settings`).
     """
     from rotframe import scenes
 

@@ -25,7 +25,7 @@ the parameter's documented unit (SI; angles in degrees), astropy quantity
 strings of the right dimension (``"520 ft"``, ``"50d54m"``, ``"48d50m46s N"``)
 or, for vectors, comma-separated numbers. Every value is checked: unknown keys
 get a did-you-mean, wrong dimensions and impossible values are refused with a
-:class:`~rotframe.errors.ScenarioError` naming the file, key, value and what is
+[`ScenarioError`][rotframe.errors.ScenarioError] naming the file, key, value and what is
 allowed. This module imports astropy only when a string has to be parsed, so
 listing scenarios stays instant.
 """
@@ -77,7 +77,7 @@ def scenario_dir() -> Path:
 
 
 def names() -> list[str]:
-    """Names of the scenarios in :func:`scenario_dir`, sorted."""
+    """Names of the scenarios in `scenario_dir`, sorted."""
     return sorted(p.stem for p in scenario_dir().glob("*.toml"))
 
 
@@ -146,7 +146,7 @@ class Parameter:
 
     @property
     def bounds(self) -> tuple:
-        """``(min, max)`` in :attr:`unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
+        """``(min, max)`` in `unit`, None where unbounded; ``exclusive_min``/``exclusive_max`` say if excluded."""
         return (self.min, self.max)
 
 
@@ -165,10 +165,22 @@ class Scenario:
     run: dict
     values: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        from rotframe.app.display import scenario_repr
+        return scenario_repr(self)
+
+    def _repr_markdown_(self) -> str:
+        from rotframe.app.display import markdown, scenario_rows
+        return markdown(*scenario_rows(self))
+
+    def _repr_html_(self) -> str:
+        from rotframe.app.display import html_table, scenario_rows
+        return html_table(*scenario_rows(self))
+
     def with_values(self, sets: dict | None = None) -> dict:
         """Parameter values (documented units) after applying ``--set`` overrides.
 
-        Run settings (:data:`RUN_KEYS`) may be set the same way; they are
+        Run settings (`RUN_KEYS`) may be set the same way; they are
         returned under the key ``"run"``.
         """
         values = {k: p.default for k, p in self.parameters.items()}
@@ -487,7 +499,7 @@ def _parse_quantity(p: Parameter, text: str, where: str) -> float:
 
 
 def _angle_value(p: Parameter, text: str, unit: str) -> float:
-    """An angle in ``unit`` (deg or rad): a number, or what :func:`rotframe.earth.read_angle_text` reads."""
+    """An angle in ``unit`` (deg or rad): a number, or what [`rotframe.earth.read_angle_text`][rotframe.earth.read_angle_text] reads."""
     try:
         return float(text)
     except ValueError:
@@ -527,7 +539,7 @@ def methods_for(scene: str | None) -> tuple:
     """Integrator names a ``[run] method`` or ``--set method=`` may take for ``scene``.
 
     One source: the scene module's ``METHODS`` (a
-    :class:`rotframe.scenes.base.MethodNames`, whose ``in`` accepts the old names
+    `rotframe.scenes.base.MethodNames`, whose ``in`` accepts the old names
     too), else every particle integrator; for ``scene=None`` every name of the
     built-in scenes. The scene module is imported here (a run imports it anyway).
     """
@@ -543,15 +555,16 @@ def methods_for(scene: str | None) -> tuple:
 
 
 def parse_run_value(key, raw, source, scene=None):
-    """Parse and check one run setting (a :data:`RUN_KEYS` key) from a file, ``--set`` or the Python API.
+    """Parse and check one run setting (a `RUN_KEYS` key) from a file, ``--set`` or the Python API.
 
-    ``method`` must be one of :func:`methods_for` ``(scene)``; ``step`` (s), ``rtol`` and ``samples``
+    ``method`` must be one of `methods_for` ``(scene)``; ``step`` (s), ``rtol`` and ``samples``
     (a whole number) must be finite and > 0.
     """
     kind = RUN_KEYS[key]
     where = f"{source}: " if source else ""
     if kind is str:
         allowed = methods_for(scene)
+        raw = raw.lower() if isinstance(raw, str) else raw  # any case: scipy's "DOP853" is dop853
         if not isinstance(raw, str) or raw not in allowed:
             raise ScenarioError(f"{where}method = {raw!r}: allowed {', '.join(allowed)}"
                                 f"{_did_you_mean(str(raw), list(allowed))}")

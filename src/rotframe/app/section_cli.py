@@ -4,7 +4,7 @@
 
     rotframe section SHAPE [--set KEY=VALUE]... [--png PATH] [--json]
 
-SHAPE is one of :data:`SHAPES`; each parameter has a default, so
+SHAPE is one of `SHAPES`; each parameter has a default, so
 ``rotframe section i-beam`` alone describes the default I-beam. VALUE is a
 number in metres or an astropy quantity string of dimension length
 (``"120 mm"``, ``"4.5 inch"``, ``"0.5 ft"``). The polygon takes its vertices as
@@ -127,7 +127,7 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
     Parameters
     ----------
     shape : str
-        One of :data:`SHAPES` (case and ``_``/``-`` are not significant).
+        One of `SHAPES` (case and ``_``/``-`` are not significant).
     sets : list of str
         ``KEY=VALUE`` overrides of the shape's parameters.
     png : str or None
@@ -153,6 +153,13 @@ def run_section(shape: str, sets: list[str], png: str | None = None, as_json: bo
 
     written = None
     if png:
+        from rotframe.app.plot import require_matplotlib
+        from rotframe.errors import MissingExtraError
+
+        try:
+            require_matplotlib()
+        except MissingExtraError as exc:
+            return _fail(str(exc))
         try:
             written = str(plot_section(section, png, title=f"{name}: " + _params_text(params)))
         except OutputError as exc:  # the one writer's error: one line naming the path

@@ -1,7 +1,7 @@
 """Ctrl-C and SIGTERM for one command, as a context object.
 
-:class:`InterruptScope` installs a SIGTERM handler that raises
-:class:`Terminated` (a :class:`KeyboardInterrupt`, so every ``except
+`InterruptScope` installs a SIGTERM handler that raises
+`Terminated` (a `KeyboardInterrupt`, so every ``except
 KeyboardInterrupt`` that finalises a partial result handles both) and restores
 the previous handlers when the command ends. Nothing outlives the ``with``
 block: a second command in the same process starts with a clean scope.

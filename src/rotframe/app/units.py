@@ -2,7 +2,7 @@
 
 Parameters carry their unit in the scenario file. Metric, theory and
 diagnostic names end in their unit (``east_deflection_m``,
-``precession_rate_deg_per_hour``, ``energy_rel_drift``); :func:`quantity_unit`
+``precession_rate_deg_per_hour``, ``energy_rel_drift``); [`quantity_unit`][rotframe.app.units.quantity_unit]
 reads it from the name. Pure standard library: importing this module is free.
 
 Examples

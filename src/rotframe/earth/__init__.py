@@ -5,25 +5,25 @@ import X`` for every name below; each module is imported when one of its names i
 first used, so ``from rotframe.earth import omega_enu`` imports neither astropy nor
 scipy):
 
-* :mod:`rotframe.earth.constants`: ``OMEGA_EARTH``, ``R_EARTH``, ``GM_EARTH``, ``G0``,
+* `rotframe.earth.constants`: ``OMEGA_EARTH``, ``R_EARTH``, ``GM_EARTH``, ``G0``,
   ``ERA_RATE_RATIO``, ``WGS84_E2``;
-* :mod:`rotframe.earth.offline`: :func:`astropy_offline`;
-* :mod:`rotframe.earth.parsing`: angles and lengths from user input
-  (:func:`parse_angle`, :func:`parse_latitude`, :func:`parse_longitude`,
-  :func:`parse_azimuth`, :func:`read_angle_text`, :func:`angle_kind`,
-  ``HEMISPHERE_LETTERS``, :func:`parse_length`);
-* :mod:`rotframe.earth.sites`: :class:`Site`, ``SITES``;
-* :mod:`rotframe.earth.local_frame`: :func:`omega_enu`, :func:`normal_gravity`,
-  :func:`geocentric_latitude`, :func:`ecef_to_enu_matrix`;
-* :mod:`rotframe.earth.gravity`: :func:`effective_gravity_enu`, :func:`plumb_tilt`,
-  :func:`gravity_uniform`, :func:`gravity_altitude`, :func:`gravity_central`;
-* :mod:`rotframe.earth.ecef`: :func:`enu_to_ecef`, :func:`ecef_to_enu`.
+* `rotframe.earth.offline`: [`astropy_offline`][rotframe.earth.astropy_offline];
+* `rotframe.earth.parsing`: angles and lengths from user input
+  ([`parse_angle`][rotframe.earth.parse_angle], [`parse_latitude`][rotframe.earth.parse_latitude], [`parse_longitude`][rotframe.earth.parse_longitude],
+  [`parse_azimuth`][rotframe.earth.parse_azimuth], [`read_angle_text`][rotframe.earth.read_angle_text], [`angle_kind`][rotframe.earth.angle_kind],
+  ``HEMISPHERE_LETTERS``, [`parse_length`][rotframe.earth.parse_length]);
+* `rotframe.earth.sites`: [`Site`][rotframe.earth.Site], ``SITES``;
+* `rotframe.earth.local_frame`: [`omega_enu`][rotframe.earth.omega_enu], [`normal_gravity`][rotframe.earth.normal_gravity],
+  [`geocentric_latitude`][rotframe.earth.geocentric_latitude], [`ecef_to_enu_matrix`][rotframe.earth.ecef_to_enu_matrix];
+* `rotframe.earth.gravity`: [`effective_gravity_enu`][rotframe.earth.effective_gravity_enu], [`plumb_tilt`][rotframe.earth.plumb_tilt],
+  [`gravity_uniform`][rotframe.earth.gravity_uniform], [`gravity_altitude`][rotframe.earth.gravity_altitude], [`gravity_central`][rotframe.earth.gravity_central];
+* `rotframe.earth.ecef`: [`enu_to_ecef`][rotframe.earth.enu_to_ecef], [`ecef_to_enu`][rotframe.earth.ecef_to_enu].
 
 Conventions
 -----------
 * Core values are plain floats (or float64 arrays) in SI units and radians. The
-  parsing helpers (:func:`parse_angle`, :func:`parse_latitude`, :func:`parse_longitude`,
-  :func:`parse_length`, :meth:`Site.from_any`) are the edge: they accept numbers,
+  parsing helpers ([`parse_angle`][rotframe.earth.parse_angle], [`parse_latitude`][rotframe.earth.parse_latitude], [`parse_longitude`][rotframe.earth.parse_longitude],
+  [`parse_length`][rotframe.earth.parse_length], [`Site.from_any`][rotframe.earth.Site.from_any]) are the edge: they accept numbers,
   astropy quantities and strings, check dimensions and convert once.
 * Local frame: ENU, x east, y north, z up, origin on the surface at the site.
   Earth's angular velocity in it is ``Omega (0, cos lat, sin lat)``.
@@ -33,23 +33,23 @@ Conventions
   angle ``lat`` with the equatorial plane: the geocentric latitude for the radial up of
   a spherical Earth, the geodetic latitude for the ellipsoid normal, the astronomical
   latitude for the plumb line. The spherical-Earth functions here
-  (:func:`effective_gravity_enu` with ``model="spherical"``, :func:`plumb_tilt`,
-  :func:`ecef_to_enu_matrix`, :func:`enu_to_ecef`, :func:`ecef_to_enu`,
-  :func:`gravity_central`) take the GEOCENTRIC latitude (on a sphere it is also the
-  geodetic one); :func:`normal_gravity` (WGS84 Somigliana) takes the GEODETIC latitude.
-  The coordinates in :data:`SITES` are geodetic (map) coordinates;
-  :func:`geocentric_latitude` converts on the WGS84 ellipsoid (difference at most
+  ([`effective_gravity_enu`][rotframe.earth.effective_gravity_enu] with ``model="spherical"``, [`plumb_tilt`][rotframe.earth.plumb_tilt],
+  [`ecef_to_enu_matrix`][rotframe.earth.ecef_to_enu_matrix], [`enu_to_ecef`][rotframe.earth.enu_to_ecef], [`ecef_to_enu`][rotframe.earth.ecef_to_enu],
+  [`gravity_central`][rotframe.earth.gravity_central]) take the GEOCENTRIC latitude (on a sphere it is also the
+  geodetic one); [`normal_gravity`][rotframe.earth.normal_gravity] (WGS84 Somigliana) takes the GEODETIC latitude.
+  The coordinates in `SITES` are geodetic (map) coordinates;
+  [`geocentric_latitude`][rotframe.earth.geocentric_latitude] converts on the WGS84 ellipsoid (difference at most
   0.19 deg, at 45 deg).
 
 astropy offline, and only when needed
 -------------------------------------
 astropy computes the constants and parses inputs. It is imported when first needed:
-:mod:`astropy.units` and :mod:`astropy.constants` when ``R_EARTH``, ``GM_EARTH`` or
-``G0`` is first read (also by importing :mod:`~rotframe.earth.gravity` or
-:mod:`~rotframe.earth.ecef`, whose defaults they are), :mod:`astropy.coordinates`
+`astropy.units` and `astropy.constants` when ``R_EARTH``, ``GM_EARTH`` or
+``G0`` is first read (also by importing `gravity` or
+`ecef`, whose defaults they are), `astropy.coordinates`
 when a parser reads an angle. Nothing here calls what needs the
 network or the IERS tables (no ``EarthLocation.of_site``, ``Time.ut1``, GCRS); the
-parsers run inside :func:`astropy_offline`, which sets ``allow_internet`` and
+parsers run inside [`astropy_offline`][rotframe.earth.astropy_offline], which sets ``allow_internet`` and
 ``iers.conf.auto_download`` to False only for the duration of the call, so the user's
 global astropy configuration is never changed.
 """

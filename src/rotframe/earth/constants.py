@@ -1,7 +1,7 @@
 """Earth constants: rotation rate, radius, GM, standard gravity, the WGS84 eccentricity.
 
 Plain floats in SI units. ``R_EARTH``, ``GM_EARTH`` and ``G0`` are read from
-:mod:`astropy.constants` (no network, no IERS tables) the first time one of them is
+`astropy.constants` (no network, no IERS tables) the first time one of them is
 used, once per process (module ``__getattr__``, PEP 562): importing this module does
 not import astropy, so a scene that never needs them does not pay for astropy's units.
 ``OMEGA_EARTH``, ``ERA_RATE_RATIO`` and ``WGS84_E2`` are defining numbers of the IERS
@@ -44,7 +44,7 @@ _FROM_ASTROPY = {"R_EARTH": ("R_earth", "m"), "GM_EARTH": ("GM_earth", "m3 / s2"
 
 
 def _read_astropy_constants() -> dict[str, float]:
-    """``R_EARTH``, ``GM_EARTH``, ``G0`` as plain floats from :mod:`astropy.constants` (offline)."""
+    """``R_EARTH``, ``GM_EARTH``, ``G0`` as plain floats from `astropy.constants` (offline)."""
     import astropy.constants as const
     import astropy.units as u
 

@@ -2,7 +2,7 @@
 
 ENU: x east, y north, z up, origin on the surface at the site. ECEF: x towards
 (lat 0, lon 0), z towards the north pole. The sphere's radius defaults to astropy's
-``R_EARTH`` (:mod:`rotframe.earth.constants`); formulas in docs/physics/earth.md.
+``R_EARTH`` (`rotframe.earth.constants`); formulas in docs/physics/earth.md.
 """
 
 from __future__ import annotations
@@ -21,12 +21,12 @@ def enu_to_ecef(site, enu, *, vector: bool = False, radius: float = R_EARTH) -> 
 
     Position: ``r_ecef = (R + h) up + M.T @ r_enu`` (origin of ENU at the site, on the
     sphere of radius ``R`` raised by the site's height ``h``; ``M`` from
-    :func:`ecef_to_enu_matrix` at the site's latitude, used as geocentric).
+    [`ecef_to_enu_matrix`][rotframe.earth.ecef_to_enu_matrix] at the site's latitude, used as geocentric).
     With ``vector=True`` only the rotation is applied (velocities, accelerations).
 
     Parameters
     ----------
-    site : Site or anything :meth:`Site.from_any` accepts as a single argument
+    site : Site or anything [`Site.from_any`][rotframe.earth.Site.from_any] accepts as a single argument
     enu : array_like, shape (..., 3)
         ENU coordinates, m (or vector components).
     vector : bool
@@ -50,12 +50,12 @@ def enu_to_ecef(site, enu, *, vector: bool = False, radius: float = R_EARTH) -> 
 def ecef_to_enu(site, ecef, *, vector: bool = False, radius: float = R_EARTH) -> np.ndarray:
     """Map ECEF coordinates to local ENU coordinates at a site (spherical Earth).
 
-    Inverse of :func:`enu_to_ecef`: ``r_enu = M @ (r_ecef - (R + h) up)``; with
+    Inverse of [`enu_to_ecef`][rotframe.earth.enu_to_ecef]: ``r_enu = M @ (r_ecef - (R + h) up)``; with
     ``vector=True`` only ``M @ v_ecef``.
 
     Parameters
     ----------
-    site : Site or anything :meth:`Site.from_any` accepts as a single argument
+    site : Site or anything [`Site.from_any`][rotframe.earth.Site.from_any] accepts as a single argument
     ecef : array_like, shape (..., 3)
         ECEF coordinates, m.
     vector : bool

@@ -1,10 +1,10 @@
 """Gravity in the local ENU frame: the rotating Earth's effective gravity and plumb tilt; uniform, altitude and central models.
 
-:func:`effective_gravity_enu` and :func:`plumb_tilt` give the effective gravity of the
-rotating Earth at a latitude; :func:`gravity_uniform`, :func:`gravity_altitude` and
-:func:`gravity_central` are the numpy references for the compiled force kernels.
+[`effective_gravity_enu`][rotframe.earth.effective_gravity_enu] and [`plumb_tilt`][rotframe.earth.plumb_tilt] give the effective gravity of the
+rotating Earth at a latitude; [`gravity_uniform`][rotframe.earth.gravity_uniform], [`gravity_altitude`][rotframe.earth.gravity_altitude] and
+[`gravity_central`][rotframe.earth.gravity_central] are the numpy references for the compiled force kernels.
 Formulas in docs/physics/earth.md. Their defaults are astropy's ``R_EARTH``,
-``GM_EARTH``, ``G0`` (:mod:`rotframe.earth.constants`), read when this module is imported.
+``GM_EARTH``, ``G0`` (`rotframe.earth.constants`), read when this module is imported.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def effective_gravity_enu(
         ``g_eff = g_grav - omega x (omega x R)
         = (0, -Omega^2 R cos(lat) sin(lat), -GM/R^2 + Omega^2 R cos^2(lat))``.
         The centrifugal part pushes away from the axis, so ``g_eff`` leans towards the
-        equator (southward in the north): see :func:`plumb_tilt`.
+        equator (southward in the north): see [`plumb_tilt`][rotframe.earth.plumb_tilt].
     ``"wgs84"``
         ``(0, 0, -normal_gravity(lat))`` in the GEODETIC ENU frame (up along the ellipsoid
         normal, which is the direction of normal gravity on the ellipsoid).
@@ -84,7 +84,7 @@ def plumb_tilt(
     """Angle between the plumb line and the radial direction on a spherical Earth, rad.
 
     ``tilt = atan2(Omega^2 R cos(lat) sin(lat), GM/R^2 - Omega^2 R cos^2(lat))``: the
-    apparent up ``-g_eff`` (:func:`effective_gravity_enu`, "spherical") leans from the
+    apparent up ``-g_eff`` ([`effective_gravity_enu`][rotframe.earth.effective_gravity_enu], "spherical") leans from the
     radial up towards the nearer pole by this angle, so the astronomical latitude is
     ``lat + tilt``. Positive in the north, negative in the south, zero on the equator and
     at the poles; largest (about 0.1 deg) near 45 deg.
@@ -115,7 +115,7 @@ def gravity_uniform(g=G0, r=None) -> np.ndarray:
     ----------
     g : float or array_like of shape (3,)
         A magnitude (m/s^2), giving ``(0, 0, -g)`` (straight down), or a full vector such
-        as :func:`effective_gravity_enu` returns.
+        as [`effective_gravity_enu`][rotframe.earth.effective_gravity_enu] returns.
     r : array_like of shape (..., 3), optional
         Positions, m; only their shape is used (the field is the same everywhere).
 
@@ -134,7 +134,7 @@ def gravity_altitude(r, g0: float = G0, radius: float = R_EARTH) -> np.ndarray:
     """Gravity that weakens with altitude, pointing straight down, m/s^2.
 
     ``g(r) = (0, 0, -g0 (R / (R + z))^2)`` in the local ENU frame (origin on the surface,
-    z up); it ignores the curvature of the field lines (see :func:`gravity_central`).
+    z up); it ignores the curvature of the field lines (see [`gravity_central`][rotframe.earth.gravity_central]).
 
     Parameters
     ----------

@@ -2,10 +2,10 @@
 
 ENU: x east, y north, z up, origin on the surface at the site. ECEF: x towards
 (lat 0, lon 0), z towards the north pole. Which latitude each function takes
-(geocentric or geodetic) is stated in :mod:`rotframe.earth` and in each docstring;
+(geocentric or geodetic) is stated in [`rotframe.earth`][rotframe.earth] and in each docstring;
 formulas in docs/physics/earth.md. Nothing here needs astropy's constants (the
 spherical-Earth models that take ``R_EARTH`` and ``GM_EARTH`` as defaults are in
-:mod:`rotframe.earth.gravity` and :mod:`rotframe.earth.ecef`), so the scenes that
+`rotframe.earth.gravity` and `rotframe.earth.ecef`), so the scenes that
 only need the rotation and normal gravity do not import astropy.
 """
 

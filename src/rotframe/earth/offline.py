@@ -1,8 +1,8 @@
 """astropy offline: a context in which astropy may not reach the network or download IERS tables.
 
-Nothing in :mod:`rotframe.earth` calls what needs the network or the IERS tables (no
+Nothing in [`rotframe.earth`][rotframe.earth] calls what needs the network or the IERS tables (no
 ``EarthLocation.of_site``, ``Time.ut1``, GCRS); the parsers run inside
-:func:`astropy_offline` all the same, so that a future astropy default cannot make
+[`astropy_offline`][rotframe.earth.astropy_offline] all the same, so that a future astropy default cannot make
 them reach out.
 """
 

@@ -1,14 +1,14 @@
 """Reading user input (the edge): numbers, astropy quantities and strings -> SI floats and radians.
 
 Plain numbers are degrees (angles) or metres (lengths); strings are read by astropy
-(:class:`astropy.coordinates.Angle`, :class:`astropy.units.Quantity` with the imperial
-units enabled for the call), inside :func:`~rotframe.earth.offline.astropy_offline`.
+(`astropy.coordinates.Angle`, `astropy.units.Quantity` with the imperial
+units enabled for the call), inside [`astropy_offline`][rotframe.earth.astropy_offline].
 astropy is imported by the parsers when they run, not with this module, so importing
-it (and the core's :func:`as_radians`) loads neither :mod:`astropy.units` nor
-:mod:`astropy.coordinates`.
+it (and the core's `as_radians`) loads neither `astropy.units` nor
+`astropy.coordinates`.
 A hemisphere letter may follow an angle (S and W negate); each kind of angle takes
-only its own letters (:data:`HEMISPHERE_LETTERS`). Every refusal is a
-:class:`~rotframe.errors.ScenarioError` naming the parameter, the value and what is
+only its own letters (`HEMISPHERE_LETTERS`). Every refusal is a
+[`ScenarioError`][rotframe.errors.ScenarioError] naming the parameter, the value and what is
 allowed.
 """
 
@@ -53,7 +53,7 @@ def parse_angle(value, name: str = "angle") -> float:
     ----------
     value : float, int, str, astropy Angle or Quantity
         Plain numbers and bare numeric strings (``"-33.9"``) are degrees. Strings are read
-        by :class:`astropy.coordinates.Angle` (``"48d50m46s N"``, ``"50d53m"``,
+        by `astropy.coordinates.Angle` (``"48d50m46s N"``, ``"50d53m"``,
         ``"48.846 deg"``, ``"0.8 rad"``; a trailing S or W makes the angle negative).
         Quantities must have angular units.
     name : str
@@ -78,7 +78,7 @@ def parse_angle(value, name: str = "angle") -> float:
 def parse_latitude(value, name: str = "latitude") -> float:
     """Parse a latitude and return it in radians, in [-pi/2, pi/2].
 
-    Accepts the same forms as :func:`parse_angle` (numbers are degrees, north positive;
+    Accepts the same forms as [`parse_angle`][rotframe.earth.parse_angle] (numbers are degrees, north positive;
     ``"33.9 S"`` is -33.9 deg). A trailing E or W is refused.
 
     Raises
@@ -105,7 +105,7 @@ def parse_latitude(value, name: str = "latitude") -> float:
 def parse_longitude(value, name: str = "longitude") -> float:
     """Parse a longitude (east positive) and return it in radians, wrapped to [-pi, pi).
 
-    Accepts the same forms as :func:`parse_angle`; a trailing N or S is refused.
+    Accepts the same forms as [`parse_angle`][rotframe.earth.parse_angle]; a trailing N or S is refused.
     """
     import astropy.units as u
     from astropy.coordinates import Longitude
@@ -119,7 +119,7 @@ def parse_longitude(value, name: str = "longitude") -> float:
 def parse_azimuth(value, name: str = "azimuth") -> float:
     """Parse an azimuth or heading (clockwise from north) and return it in radians (not wrapped).
 
-    Accepts the same forms as :func:`parse_angle`; a trailing E or W reads as
+    Accepts the same forms as [`parse_angle`][rotframe.earth.parse_angle]; a trailing E or W reads as
     east or west of north (``"30 W"`` is -30 deg, astropy's sign), N or S is refused.
     """
     import astropy.units as u
@@ -146,14 +146,14 @@ def angle_kind(name: str) -> str:
 def read_angle_text(text: str, name: str = "angle", kind: str = "angle"):
     """Read an angle string as astropy does, with hemisphere letters checked for ``kind``.
 
-    Every string that :class:`astropy.coordinates.Angle` reads (with degrees as
+    Every string that `astropy.coordinates.Angle` reads (with degrees as
     the default unit) means what astropy says: ``"48d50m46s"`` is +48.846 deg
     (the ``s`` is seconds), ``"48 50 46"``, ``"48:50:46"``, ``"48°50′46″"``,
     ``"0.8 rad"``, ``"12h30m"``; also any astropy Quantity string with an
     angular unit (``"3e1 deg"``, ``"100 arcmin"``). An upper-case hemisphere
     letter may follow the value, after a plain number too (``"33.9 S"``,
     ``"45N"``, ``"48d50m46s N"``): S and W negate. Refused with
-    :class:`ScenarioError` naming ``name``, the value and what is allowed: a
+    [`ScenarioError`][rotframe.errors.ScenarioError] naming ``name``, the value and what is allowed: a
     letter the kind does not take (N/S only for latitudes, E/W only for
     longitudes and azimuths, none for other named angles, any for ``kind="any"``,
     as astropy does) and a minus sign together
@@ -230,7 +230,7 @@ def parse_length(value, name: str = "length", *, positive: bool = False) -> floa
     ----------
     value : float, int, str or astropy Quantity
         Plain numbers and bare numeric strings are metres; strings with a unit are read by
-        :class:`astropy.units.Quantity` with the imperial units enabled for the call
+        `astropy.units.Quantity` with the imperial units enabled for the call
         (``"520 ft"``, ``"1.2 km"``); Quantities must have the dimension of length.
     name : str
         Name of the parameter, used in error messages.
@@ -285,7 +285,7 @@ def as_radians(x):
     """Plain radians (float, or float64 array) from a float/array, or from an astropy angle Quantity.
 
     Core functions call it, so it does not import astropy: a Quantity can only exist once
-    :mod:`astropy.units` has been imported by whoever made it.
+    `astropy.units` has been imported by whoever made it.
     """
     u = sys.modules.get("astropy.units")
     if u is not None and isinstance(x, u.Quantity):

@@ -1,4 +1,4 @@
-"""Sites: places on the Earth (geodetic latitude, longitude, height) and the named table :data:`SITES`."""
+"""Sites: places on the Earth (geodetic latitude, longitude, height) and the named table `SITES`."""
 
 from __future__ import annotations
 
@@ -52,14 +52,14 @@ class Site:
         Parameters
         ----------
         lat : Site, str, float, astropy Angle/Quantity
-            A :class:`Site` (returned as is), the name of an entry of :data:`SITES`
+            A [`Site`][rotframe.earth.Site] (returned as is), the name of an entry of `SITES`
             (case-insensitive, ``"Pantheon Paris"`` = ``"pantheon-paris"``; then ``lon`` and
-            ``height`` are ignored), or a latitude as read by :func:`parse_latitude`
+            ``height`` are ignored), or a latitude as read by [`parse_latitude`][rotframe.earth.parse_latitude]
             (numbers in degrees).
         lon : float, str, astropy Angle/Quantity
-            Longitude as read by :func:`parse_longitude` (numbers in degrees, east positive).
+            Longitude as read by [`parse_longitude`][rotframe.earth.parse_longitude] (numbers in degrees, east positive).
         height : float, str, astropy Quantity
-            Height as read by :func:`parse_length` (numbers in metres).
+            Height as read by [`parse_length`][rotframe.earth.parse_length] (numbers in metres).
         """
         if isinstance(lat, Site):
             return lat

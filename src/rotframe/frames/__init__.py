@@ -1,14 +1,14 @@
 """Frames: direction cosines, rotation matrices, Euler angles, the transport theorem.
 
 A package of one concept per module, every public name re-exported here
-(``from rotframe.frames import X``): :mod:`rotframe.frames.dcm` (direction cosines,
-elemental rotations, :func:`check_rotation`, :func:`orthonormalize`,
-:func:`from_scipy`, :func:`to_scipy`), :mod:`rotframe.frames.euler` (``SEQUENCES``,
-``GIMBAL_ATOL``, :func:`euler_to_dcm`, :func:`dcm_to_euler`),
-:mod:`rotframe.frames.rates` (:func:`euler_rates_to_omega`,
-:func:`omega_to_euler_rates`), :mod:`rotframe.frames.transport`
-(:func:`space_derivative`, :func:`fictitious_accelerations`); argument checks in
-:mod:`rotframe.frames.arguments`. numpy and scipy only (no numba, no astropy).
+(``from rotframe.frames import X``): `rotframe.frames.dcm` (direction cosines,
+elemental rotations, [`check_rotation`][rotframe.frames.check_rotation], [`orthonormalize`][rotframe.frames.orthonormalize],
+[`from_scipy`][rotframe.frames.from_scipy], [`to_scipy`][rotframe.frames.to_scipy]), `rotframe.frames.euler` (``SEQUENCES``,
+``GIMBAL_ATOL``, [`euler_to_dcm`][rotframe.frames.euler_to_dcm], [`dcm_to_euler`][rotframe.frames.dcm_to_euler]),
+`rotframe.frames.rates` ([`euler_rates_to_omega`][rotframe.frames.euler_rates_to_omega],
+[`omega_to_euler_rates`][rotframe.frames.omega_to_euler_rates]), `rotframe.frames.transport`
+([`space_derivative`][rotframe.frames.space_derivative], [`fictitious_accelerations`][rotframe.frames.fictitious_accelerations]); argument checks in
+`rotframe.frames.arguments`. numpy and scipy only (no numba, no astropy).
 
 Conventions
 -----------
@@ -34,13 +34,13 @@ Euler-angle sequences
     ``A = elemental(K, a3) @ elemental(J, a2) @ elemental(I, a1)`` (for ``ZXZ``
     with ``(phi, theta, psi)`` that is ``A = B C D``), and for extrinsic ``"ijk"``
     ``A = elemental(i, a1) @ elemental(j, a2) @ elemental(k, a3)``.
-    Angles returned by :func:`dcm_to_euler` lie in ``[-pi, pi]`` for the first and
+    Angles returned by [`dcm_to_euler`][rotframe.frames.dcm_to_euler] lie in ``[-pi, pi]`` for the first and
     third angle, in ``[0, pi]`` for the middle angle of a proper Euler sequence and in
     ``[-pi/2, pi/2]`` for a Tait-Bryan sequence (scipy's ranges).
 Gimbal lock
     The first and third angles are not unique, and the Euler-rate map is singular,
     where ``g = |sin(middle)|`` (proper Euler) or ``g = |cos(middle)|`` (Tait-Bryan)
-    vanishes. Both :func:`dcm_to_euler` and :func:`omega_to_euler_rates` treat
+    vanishes. Both [`dcm_to_euler`][rotframe.frames.dcm_to_euler] and [`omega_to_euler_rates`][rotframe.frames.omega_to_euler_rates] treat
     ``g < gimbal_atol`` (default ``1e-7``) as locked.
 Angular velocity
     ``omega`` in the ``"body"`` frame has body-axis components,

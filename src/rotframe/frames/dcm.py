@@ -1,6 +1,6 @@
 """Direction-cosine matrices: direction cosines, elemental rotations, the rotation check, orthonormalization, scipy conversion.
 
-``A`` is passive: ``x_body = A @ x_space`` (conventions in :mod:`rotframe.frames`).
+``A`` is passive: ``x_body = A @ x_space`` (conventions in [`rotframe.frames`][rotframe.frames]).
 scipy's ``Rotation.as_matrix()`` is the active matrix ``A.T``.
 """
 
@@ -24,7 +24,7 @@ __all__ = [
     "passive_matrix",
 ]
 
-#: The public functions of this module (wrapped by :func:`~rotframe.validation.guard_public`).
+#: The public functions of this module (wrapped by `guard_public`).
 _GUARDED = ("direction_cosines", "elemental", "check_rotation", "orthonormalize", "from_scipy", "to_scipy")
 
 
@@ -208,7 +208,7 @@ def to_scipy(A: ArrayLike, atol: float = 1e-9) -> Rotation:
     Parameters
     ----------
     A : array_like, shape (..., 3, 3), or scipy Rotation
-        Checked with :func:`check_rotation` (``atol``); a ``Rotation`` is returned as is.
+        Checked with [`check_rotation`][rotframe.frames.check_rotation] (``atol``); a ``Rotation`` is returned as is.
 
     Returns
     -------
@@ -231,7 +231,7 @@ def _axis_index(axis):
 def passive_matrix(axis, angle):
     """Passive elemental matrix about axis index ``axis`` (0, 1, 2); angle is a float64 array, rad.
 
-    The unchecked kernel of :func:`elemental`, shape ``angle.shape + (3, 3)``.
+    The unchecked kernel of [`elemental`][rotframe.frames.elemental], shape ``angle.shape + (3, 3)``.
     """
     c, s = np.cos(angle), np.sin(angle)
     p, q = (axis + 1) % 3, (axis + 2) % 3

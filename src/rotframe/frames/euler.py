@@ -1,6 +1,6 @@
 """Euler-angle sequences: the 24 sequence strings, angles -> matrix, matrix -> angles, gimbal lock.
 
-Sequences and ranges as in scipy (conventions in :mod:`rotframe.frames`): UPPER case
+Sequences and ranges as in scipy (conventions in [`rotframe.frames`][rotframe.frames]): UPPER case
 intrinsic, lower case extrinsic; angles in the order the rotations are applied.
 """
 
@@ -45,7 +45,7 @@ def euler_to_dcm(angles: ArrayLike, seq: str = "ZXZ", degrees: bool = False) -> 
         Angles ``(a1, a2, a3)`` in the order the rotations are applied
         (``(phi, theta, psi)`` for ``"ZXZ"``).
     seq : str, optional
-        One of :data:`SEQUENCES`; upper case intrinsic, lower case extrinsic.
+        One of `SEQUENCES`; upper case intrinsic, lower case extrinsic.
     degrees : bool, optional
         ``angles`` are in degrees.
 
@@ -85,13 +85,13 @@ def dcm_to_euler(
     ----------
     A : array_like, shape (..., 3, 3), or scipy Rotation
         Direction-cosine matrix, ``x_body = A @ x_space``. A ``Rotation`` is
-        converted with ``as_matrix().T``. Checked with :func:`check_rotation`.
+        converted with ``as_matrix().T``. Checked with [`check_rotation`][rotframe.frames.check_rotation].
     seq : str, optional
-        One of :data:`SEQUENCES`; upper case intrinsic, lower case extrinsic.
+        One of `SEQUENCES`; upper case intrinsic, lower case extrinsic.
     degrees : bool, optional
         Return angles in degrees.
     on_gimbal_lock : {"raise", "mask"}, optional
-        ``"raise"``: raise :class:`GimbalLockError` if any entry is locked.
+        ``"raise"``: raise [`GimbalLockError`][rotframe.errors.GimbalLockError] if any entry is locked.
         ``"mask"``: return ``(angles, mask)``; at locked entries the third angle is
         set to 0 and the first angle carries the whole turn about the (coinciding)
         first/third axis, so ``euler_to_dcm(angles, seq)`` reproduces ``A`` to within
@@ -101,7 +101,7 @@ def dcm_to_euler(
         is below this. Above it, the first and third angles carry an error of about
         ``1e-16 / |sin(middle)|`` (resp. ``|cos|``) each, while their matrix stays exact.
     atol : float, optional
-        Orthogonality tolerance passed to :func:`check_rotation`.
+        Orthogonality tolerance passed to [`check_rotation`][rotframe.frames.check_rotation].
 
     Returns
     -------
@@ -150,7 +150,7 @@ def dcm_to_euler(
 
 
 def parse_sequence(seq):
-    """Axis indices (i, j, k) and extrinsic flag of a sequence string; FrameInputError if not one of :data:`SEQUENCES`."""
+    """Axis indices (i, j, k) and extrinsic flag of a sequence string; FrameInputError if not one of `SEQUENCES`."""
     if not isinstance(seq, str) or seq not in SEQUENCES:
         raise FrameInputError(
             f"unknown sequence {seq!r}: use three axes from x, y, z with no two consecutive"

@@ -1,7 +1,7 @@
 """Euler-angle rates and angular velocity: the rate map, its inverse, its singularity (gimbal lock).
 
 ``omega`` in the ``"body"`` frame has body-axis components, in the ``"space"`` frame
-space-axis components (conventions in :mod:`rotframe.frames`).
+space-axis components (conventions in [`rotframe.frames`][rotframe.frames]).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ def euler_rates_to_omega(
     rates : array_like, shape (..., 3)
         Their time derivatives ``(a1', a2', a3')``.
     seq : str, optional
-        One of :data:`SEQUENCES`.
+        One of `SEQUENCES`.
     frame : {"body", "space"}, optional
         Axes of the returned components: ``"body"`` gives
         ``skew(omega) = A dA/dt^T``, ``"space"`` gives ``skew(omega) = dA/dt^T A``.
@@ -81,7 +81,7 @@ def omega_to_euler_rates(
     *,
     gimbal_atol: float = GIMBAL_ATOL,
 ) -> np.ndarray:
-    """Euler-angle rates from an angular velocity (inverse of :func:`euler_rates_to_omega`).
+    """Euler-angle rates from an angular velocity (inverse of [`euler_rates_to_omega`][rotframe.frames.euler_rates_to_omega]).
 
     Parameters
     ----------
@@ -90,7 +90,7 @@ def omega_to_euler_rates(
     omega : array_like, shape (..., 3)
         Angular velocity, components in the axes named by ``frame``.
     seq : str, optional
-        One of :data:`SEQUENCES`.
+        One of `SEQUENCES`.
     frame : {"body", "space"}, optional
         Axes of the components of ``omega``.
     degrees : bool, optional

@@ -2,5 +2,5 @@
 
 Pure functions on float64 arrays, no physics of their own: Runge-Kutta tableaus
 and error norms, composition weights, rotation primitives, sample decimation.
-Nothing here imports from any other part of rotframe except :mod:`rotframe.errors`.
+Nothing here imports from any other part of rotframe except [`rotframe.errors`][rotframe.errors].
 """

@@ -13,7 +13,7 @@ point unboxes every argument from Python objects, and for a kernel that takes th
 19-field packed model it is most of the kernel's code, and so of the time a first run
 spends compiling it (a three-line kernel: 524 lines of LLVM IR with it, 25 without;
 its compile 0.2 s -> 0.03 s). Called from Python, such a kernel raises
-:class:`TypeError` (numba alone would crash the interpreter); its ``py_func`` is the
+`TypeError` (numba alone would crash the interpreter); its ``py_func`` is the
 plain Python function.
 """
 
@@ -40,7 +40,7 @@ class CompiledOnlyDispatcher(CPUDispatcher):
 
 
 def jit_internal(func):
-    """:data:`jit_kernel` for a kernel called only from compiled code (see the module docstring)."""
+    """`jit_kernel` for a kernel called only from compiled code (see the module docstring)."""
     dispatcher = _jit_without_entry_point(func)
     dispatcher.__class__ = CompiledOnlyDispatcher
     return dispatcher

@@ -133,7 +133,7 @@ def dop853_error_norm(K, h, y, y_new, rtol, atol, E3, E5):
     weighted zero), ``atol`` (n,) one absolute tolerance per component of ``y``;
     the scale of component j is ``atol[j] + rtol max(|y[j]|, |y_new[j]|)``. The
     particle and rigid-body kernels share this function (docs/physics/dop853.md).
-    Compiled for compiled callers only (:func:`rotframe.numerics.compiled.jit_internal`);
+    Compiled for compiled callers only (`rotframe.numerics.compiled.jit_internal`);
     from Python, call ``dop853_error_norm.py_func``.
     """
     n = y.shape[0]

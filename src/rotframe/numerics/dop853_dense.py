@@ -8,9 +8,9 @@ three more stages
     k_i = f(t + C[i] h, y + h sum_j A[i, j] k_j)     i = 14, 15, 16
 
 and four rows of weights ``D`` give the coefficients of the interpolant (docs/physics/dop853.md;
-:mod:`rotframe.rigid.adaptive` evaluates it). The constants are the decimal strings published
+`rotframe.rigid.adaptive` evaluates it). The constants are the decimal strings published
 with ``dop853.f`` (as scipy's ``solve_ivp`` ships them), rounded to float64 once; the 12-stage
-tableau itself is :mod:`rotframe.numerics.dop853`. Kept here rather than read from scipy so that
+tableau itself is `rotframe.numerics.dop853`. Kept here rather than read from scipy so that
 a first run does not import ``scipy.integrate`` (0.2 s).
 """
 

@@ -1,6 +1,6 @@
 """The hat map of so(3): the skew matrix of a 3-vector (numpy only, no numba: cheap to import).
 
-``skew(w) @ v == np.cross(w, v)``. Re-exported by :mod:`rotframe.numerics.rotation` beside the
+``skew(w) @ v == np.cross(w, v)``. Re-exported by `rotframe.numerics.rotation` beside the
 compiled rotation primitives.
 """
 

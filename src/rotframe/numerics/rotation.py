@@ -7,15 +7,15 @@ Conventions
   axis ``a`` (right-hand rule): ``v c + (a x v) s + a (a . v)(1 - c)`` with
   ``c = cos(angle)``, ``s = sin(angle)``; it is ``exp(angle skew(a)) @ v``.
 * Quaternions are SCALAR-LAST ``(x, y, z, w)``, as in scipy's ``Rotation``;
-  :func:`quat_mul` is Hamilton's product, so ``R(a * b) = R(a) @ R(b)``, and
-  :func:`quat_about_axis` is the quaternion of Rodrigues' rotation,
+  `quat_mul` is Hamilton's product, so ``R(a * b) = R(a) @ R(b)``, and
+  `quat_about_axis` is the quaternion of Rodrigues' rotation,
   ``(sin(angle/2) a, cos(angle/2))``.
 
-The compiled kernels (:func:`rodrigues_rotate`, :func:`quat_mul`) take scalar
+The compiled kernels (`rodrigues_rotate`, `quat_mul`) take scalar
 components so that numba callers pay no array allocation; the array forms
-(:func:`rotate_about`, :func:`quat_mul_arrays`) evaluate the same kernels, so
+(`rotate_about`, `quat_mul_arrays`) evaluate the same kernels, so
 every caller gets the same formula in the same operation order: up to
-:data:`NUMPY_ROWS` rows the kernel's Python source on numpy arrays (elementwise
+`NUMPY_ROWS` rows the kernel's Python source on numpy arrays (elementwise
 IEEE operations, the same numbers to the last bit, and nothing to compile on a
 first run), above it a compiled loop over the kernel. The
 formulas are in ``docs/physics/rigid-bodies.md`` (quaternion kinematics) and

@@ -1,14 +1,14 @@
 """The one driver of the compiled particle kernels: set up once, run in chunks, interruptible.
 
-:class:`KernelSetup` holds what does not change between runs of one model,
+`KernelSetup` holds what does not change between runs of one model,
 method, duration and sample count (the packed model, the schedule, the sample
 times, the step or the DOP853 tableau, the event table) and makes every call of
-the compiled drivers (:mod:`rotframe.particles.drivers`) with the same
-arguments. :func:`run_chunked` is the run of
-:func:`rotframe.particles.integrators.integrate_particles`: calls of a bounded
+the compiled drivers (`rotframe.particles.drivers`) with the same
+arguments. `run_chunked` is the run of
+[`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles]: calls of a bounded
 amount of work, so that progress is shown, Ctrl-C and SIGTERM interrupt cleanly
 and a numerical failure returns everything computed before it.
-:class:`rotframe.particles.prepared.PreparedRun` calls the same setup once per
+[`rotframe.particles.prepared.PreparedRun`][rotframe.particles.prepared.PreparedRun] calls the same setup once per
 run, so its results are bitwise those of ``integrate_particles``.
 """
 
@@ -58,18 +58,18 @@ class KernelSetup:
     ----------
     model : ParticleModel
     info : MethodInfo
-        A fixed-step or adaptive entry of :data:`rotframe.particles.integrators.METHODS`.
+        A fixed-step or adaptive entry of `rotframe.particles.integrators.METHODS`.
     duration : float
         Simulated time (s), > 0.
     samples : int
         Output samples after t = 0 (uniform in time; the last one at ``duration`` exactly).
     step : float, optional
         Fixed-step methods: the requested step (s), default 1/20 of the sample
-        interval; the step used, :attr:`h`, divides the sample interval (``sps``
+        interval; the step used, `h`, divides the sample interval (``sps``
         steps a sample) and is never larger.
     rtol, atol : float
         DOP853 tolerances; a falsy ``atol`` means ``rtol`` times the initial
-        state's scale (:meth:`abs_tol`).
+        state's scale (`abs_tol`).
     events : sequence of Event
 
     Raises
@@ -145,12 +145,12 @@ class KernelSetup:
     def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
-        ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` (:class:`EventBuffers`)
+        ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
         the events; ``atol``, ``h_state`` (N,) and ``h0`` are DOP853's. Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
         of particle 0). ``t0`` (default the sample time ``first``) lets a fixed-step
-        call start inside a sample interval (:meth:`one_sample_in_pieces`).
+        call start inside a sample interval (`one_sample_in_pieces`).
         """
         start = self.times[first] if t0 is None else t0
         kernel = self.kernel()
@@ -200,7 +200,7 @@ class KernelSetup:
     def one_sample_in_pieces(self, r, v, alive, first, out_r, out_v, evb, n):
         """One sample interval of ``sps`` fixed steps as several calls of about 4e6 step-evaluations.
 
-        Returns ``(n_done, bad, nfev, steps)`` as :meth:`call` for that one sample.
+        Returns ``(n_done, bad, nfev, steps)`` as `call` for that one sample.
         """
         piece = max(1, int(4e6 // (n * self.evals_per_step)))
         scratch_r, scratch_v = np.empty((1, n, 3)), np.empty((1, n, 3))
@@ -227,7 +227,7 @@ class KernelSetup:
 def _adaptive_chunk(info, per_sample, samples, n):
     """Samples per call of an adaptive kernel that took ``per_sample`` steps over its first sample.
 
-    The run's total is projected from that rate and refused (:mod:`rotframe.limits`) when it
+    The run's total is projected from that rate and refused (`rotframe.limits`) when it
     is over the work limit; a call is kept under about 2e5 particle-steps (a tenth of a
     second), so that Python regains control (signals, progress) that often.
     """
@@ -240,10 +240,10 @@ def _adaptive_chunk(info, per_sample, samples, n):
 
 
 def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
-    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
+    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a [`Trajectory`][rotframe.particles.trajectory.Trajectory].
 
     ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
-    (:meth:`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
+    (`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
     driver in this call, 0.0 when it was already loaded).
 
     Raises
@@ -351,7 +351,7 @@ def _energy_guard(model, r0, v0):
     A particle under the fictitious forces alone (Coriolis, centrifugal, and
     Euler when the rate varies) moves on a straight line at constant speed in
     inertial space; drag only slows it. So its inertial speed |v + w x r| never
-    grows, whatever the frame does, and a growth beyond :data:`GROWTH_LIMIT`
+    grows, whatever the frame does, and a growth beyond `GROWTH_LIMIT`
     is the mark of an unstable step (docs/physics/stability.md). Models with a
     real force that can add energy (gravity, springs, a pendulum) return None.
     """

@@ -1,6 +1,6 @@
 """DOP853 specialised to the steady models: three compiled functions instead of fourteen.
 
-The general driver :func:`rotframe.particles.drivers.run_dop853` handles every
+The general driver `rotframe.particles.drivers.run_dop853` handles every
 term, rotation schedule and event, and a first run compiles it with its force,
 step, schedule and event helpers in 3 to 4 s (numba's typing and lowering of
 about fourteen functions). Most scenes that run DOP853 need much less:
@@ -10,7 +10,7 @@ about fourteen functions). Most scenes that run DOP853 need much less:
 - any of **Coriolis**, **centrifugal** and a **pendulum** string;
 - no drag, no spring, no events.
 
-For such a model :func:`run_dop853_steady` is the same algorithm with the force
+For such a model `run_dop853_steady` is the same algorithm with the force
 written in place: the same stages, error norm, step control, sample steps and
 failure checks, in the same floating-point order, so that its results are
 bitwise those of the general driver (``tests/test_dop853_steady.py`` checks
@@ -18,7 +18,7 @@ this on random models). It is three compiled functions instead of about
 fourteen, and a first ``rotframe run foucault`` compiles for about 2.5 s instead of 3.3 to 4 s
 on the 2-core machine (numba's own start, about 0.5 s, included).
 
-:func:`steady_parameters` packs the model for it; :func:`is_steady_model` says
+`steady_parameters` packs the model for it; `is_steady_model` says
 whether a model qualifies.
 """
 
@@ -50,10 +50,10 @@ _N = 13
 
 
 def is_steady_model(model, events=(), packed=None):
-    """Whether ``model`` (and a run with ``events``) can run :func:`run_dop853_steady`.
+    """Whether ``model`` (and a run with ``events``) can run `run_dop853_steady`.
 
     True for a constant rotation rate, uniform gravity (or none) and no term
-    outside :data:`STEADY_TERMS`, without events. ``packed`` is ``model.pack()``
+    outside `STEADY_TERMS`, without events. ``packed`` is ``model.pack()``
     where the caller has it.
     """
     from rotframe.particles.packed import I_GMODE
@@ -65,7 +65,7 @@ def is_steady_model(model, events=(), packed=None):
 
 
 def steady_parameters(model, packed=None):
-    """The parameter vector (13,) of :func:`run_dop853_steady` for a model that qualifies.
+    """The parameter vector (13,) of `run_dop853_steady` for a model that qualifies.
 
     The values are those of ``model.pack()`` (the same floats, so the same results;
     ``packed`` where the caller has it): uniform gravity (zero when off), the unit
@@ -91,7 +91,7 @@ def steady_parameters(model, packed=None):
 def steady_tableau():
     """The DOP853 tableau as one (16, 13) array: rows 0-11 ``A``, 12 ``B``, 13 ``C``, 14 ``E3``, 15 ``E5``.
 
-    The same floats as :func:`rotframe.numerics.dop853.coefficients` (made once; read-only).
+    The same floats as `rotframe.numerics.dop853.coefficients` (made once; read-only).
     """
     A, B, C, E3, E5 = coefficients()
     tab = np.zeros((16, 13))
@@ -106,7 +106,7 @@ def steady_tableau():
 
 @jit_internal
 def _acceleration(x, y, z, vx, vy, vz, q):
-    """The steady model's acceleration, in the order of :func:`rotframe.particles.forces.state_acceleration`."""
+    """The steady model's acceleration, in the order of `rotframe.particles.forces.state_acceleration`."""
     ax = q[_G]
     ay = q[_G + 1]
     az = q[_G + 2]
@@ -169,8 +169,8 @@ def _step(y, h, q, tab, K, y_new, tmp):
 def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_r, out_v, h_state):
     """Adaptive DOP853 for an ensemble under a steady model (see the module docstring).
 
-    Parameters and results as :func:`rotframe.particles.drivers.run_dop853`, with
-    ``q`` from :func:`steady_parameters`, ``tab`` from :func:`steady_tableau` and
+    Parameters and results as `rotframe.particles.drivers.run_dop853`, with
+    ``q`` from `steady_parameters`, ``tab`` from `steady_tableau` and
     ``work`` (31, 6) scratch from the caller. There are no events, so every
     particle stays alive. Returns ``(n_done, bad, nfev, steps)`` (cost of particle 0).
     """

@@ -1,4 +1,4 @@
-"""One step of Dormand-Prince 8(5,3) for a particle (the tableau: :mod:`rotframe.numerics.dop853`)."""
+"""One step of Dormand-Prince 8(5,3) for a particle (the tableau: `rotframe.numerics.dop853`)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,10 @@
 """Compiled ensemble drivers: many steps, output samples and events, for many particles.
 
-:func:`run_fixed` runs a fixed-step method (:mod:`rotframe.particles.kernels`),
-:func:`run_dop853` the adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner
+`run_fixed` runs a fixed-step method (`rotframe.particles.kernels`),
+`run_dop853` the adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner
 II.10). Both advance ``r, v`` (N, 3) in place, fill output samples, record
-events (:mod:`rotframe.particles.events`) and report a non-finite state instead
-of raising; the Python side (:mod:`rotframe.particles.integrators`) calls them in
+events (`rotframe.particles.events`) and report a non-finite state instead
+of raising; the Python side ([`rotframe.particles.integrators`][rotframe.particles.integrators]) calls them in
 chunks of output samples, so that progress, Ctrl-C and a numerical failure are
 handled between chunks without losing data.
 """
@@ -55,7 +55,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         Whether the method is RK4 (method 2) and the model a pendulum: None where it is
         not, pruned at compile time (a free particle's splitting compiles neither RK4
         nor the splitting on the sphere), else a boolean
-        (:func:`rotframe.particles.kernels.method_steps`).
+        (`rotframe.particles.kernels.method_steps`).
 
     Returns
     -------
@@ -140,11 +140,11 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     located the same way, by bisection on the length of that extra step.
     ``h_state`` (N,) carries each particle's step size between calls.
     ``events`` None (no event table) prunes the event code at compile time,
-    as in :func:`run_fixed`; so does ``wt`` None (a steady rotation rate).
+    as in `run_fixed`; so does ``wt`` None (a steady rotation rate).
     ``K``, ``Kt`` (13, 6) and ``rows`` (5, 6) are work arrays from the caller (a
     kernel that allocates compiles numpy's allocators on a first run).
 
-    Returns (n_done, bad, nfev, steps) like :func:`run_fixed` (cost of particle 0).
+    Returns (n_done, bad, nfev, steps) like `run_fixed` (cost of particle 0).
     """
     m = unpack(P, wt, wv)
     n = r.shape[0]

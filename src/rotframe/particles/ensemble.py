@@ -2,16 +2,16 @@
 
 A scene's ``simulate_ensemble`` integrates many particles that share one model
 (for example drops from different heights) in vectorised calls of the compiled
-core. The particles are cut into fixed blocks of :data:`BLOCK` particles, and
+core. The particles are cut into fixed blocks of `BLOCK` particles, and
 the blocks run on a pool of threads (the compiled kernels release the GIL).
 The cut does not depend on the number of threads, and every particle is
 integrated on its own inside a block, so the results are bitwise identical
 for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``).
 
-``threads=None`` means the count in force: the one set by :func:`threads_scope`
+``threads=None`` means the count in force: the one set by `threads_scope`
 for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
 threads=N)``), else every core (``os.cpu_count()``). The count is held in a
-:class:`contextvars.ContextVar`, like :mod:`rotframe.limits`, so nothing
+`contextvars.ContextVar`, like `rotframe.limits`, so nothing
 outlives the command that set it.
 """
 
@@ -31,12 +31,12 @@ __all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope",
 
 #: at most this many samples per kept path
 MAX_TRACK_SAMPLES = 500
-#: particle-samples held at once by :func:`integrate_ensemble` (13 floats each)
+#: particle-samples held at once by `integrate_ensemble` (13 floats each)
 PATH_BUDGET = 2_000_000
 #: particles per block; fixed, so that the cut never depends on the number of threads
 BLOCK = 4096
 
-#: threads in force (None: every core); set per command by :func:`threads_scope`
+#: threads in force (None: every core); set per command by `threads_scope`
 _THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
 
 
@@ -67,7 +67,7 @@ def threads_scope(threads):
 
 
 def threads_in_force() -> int | None:
-    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
+    """The count set by the innermost `threads_scope`; None where none was set (every core)."""
     return _THREADS.get()
 
 
@@ -82,7 +82,7 @@ def resolve_threads(threads=None) -> int:
 
 @dataclass
 class EnsembleRun:
-    """What :func:`integrate_ensemble` returns.
+    """What `integrate_ensemble` returns.
 
     Attributes
     ----------
@@ -119,11 +119,11 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         Terminal event (kinds ``r`` and ``v`` with ``exact``).
     method : str
     run : dict
-        Run settings (``step``, ``rtol``, ``samples``: at most :data:`MAX_TRACK_SAMPLES` are kept in paths).
+        Run settings (``step``, ``rtol``, ``samples``: at most `MAX_TRACK_SAMPLES` are kept in paths).
     keep : sequence of int
         Particles whose paths are wanted.
     threads : int, optional
-        Threads for the compiled methods (None: :func:`resolve_threads`). The
+        Threads for the compiled methods (None: `resolve_threads`). The
         result does not depend on it. ``exact`` runs in one vectorised call.
     """
     r0 = np.asarray(r0, dtype=np.float64)

@@ -1,14 +1,14 @@
 """Events of the compiled particle drivers: event functions, crossings and their location.
 
 An event row is ``(kind, component, value, direction, terminal)``
-(:data:`rotframe.particles.packed.N_EVENT_FIELDS`; kind 0 position, 1 velocity,
+(`rotframe.particles.packed.N_EVENT_FIELDS`; kind 0 position, 1 velocity,
 2 altitude above the curved ground). A crossing found over a step is located by
 bisection on the length of a re-step from the step's start with the method's own
 one-step map, so the event time is exact for the method's discrete trajectory
 (docs/physics/events.md). The fixed-step drivers re-step with their method
-(:func:`locate_event`), the DOP853 driver with DOP853 (:func:`locate_event_dop853`),
+(`locate_event`), the DOP853 driver with DOP853 (`locate_event_dop853`),
 so that neither compiles the other's steps; both bisect by one rule
-(:func:`bisection_midpoint`, :func:`narrow`) and record by :func:`record_event`.
+(`bisection_midpoint`, `narrow`) and record by `record_event`.
 """
 
 from __future__ import annotations
@@ -118,7 +118,7 @@ def narrow(lo, hi, g_lo, mid, g_mid):
 def fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere):
     """The state one step of length ``tau`` after ``start`` (at time t) of fixed-step ``method`` (0, 1, 2).
 
-    ``rk4``, ``sphere``: as in :func:`rotframe.particles.kernels.method_steps`.
+    ``rk4``, ``sphere``: as in `rotframe.particles.kernels.method_steps`.
     """
     return method_steps(method, start, int(1), tau, m, make_plan(method, t, tau, m, wt, wv, wint), rk4,
                         sphere)  # int64 1
@@ -128,10 +128,10 @@ def fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere):
 def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, sphere):
     """Sub-step tau in (0, h] at which event ``e`` of the fixed-step map from ``start`` vanishes.
 
-    Bisection on tau of g(:func:`fixed_trial` (start, tau)), halving until the
-    bracket cannot shrink (:func:`bisection_midpoint`, :func:`narrow`).
+    Bisection on tau of g(`fixed_trial` (start, tau)), halving until the
+    bracket cannot shrink (`bisection_midpoint`, `narrow`).
     ``g_start`` is the event function at ``start`` as used for the crossing test
-    (its sign just after the start when it is zero there, :func:`start_value`).
+    (its sign just after the start when it is zero there, `start_value`).
     Returns tau and the state at the event (a 6-tuple).
     """
     lo = 0.0
@@ -148,11 +148,11 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, 
 
 @jit_internal
 def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, tmp, y_out):
-    """:func:`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
+    """`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
 
     The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, B, C`` are the
     tableau, ``K`` (13, 6) and ``tmp`` (6,) scratch, and ``y_out`` (6,) receives the
-    state (:func:`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
+    state (`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
     the state at the event (a 6-tuple).
     """
     lo = 0.0

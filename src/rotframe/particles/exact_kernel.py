@@ -1,8 +1,8 @@
 """The prepared exact flow's call, compiled: every sample's state from the kept matrices in one loop.
 
-:class:`rotframe.particles.prepared.PreparedRun` with method ``exact`` keeps the
+[`rotframe.particles.prepared.PreparedRun`][rotframe.particles.prepared.PreparedRun] with method ``exact`` keeps the
 flow's matrices ``phi_t`` (K, 7, 6), ``phi_t[k, i, j] = Phi_k[j, i]``
-(:class:`rotframe.particles.linear.ExactFlow`). Each call multiplies them into the
+(`rotframe.particles.linear.ExactFlow`). Each call multiplies them into the
 initial states ``s0 = (r0, v0, 1)``; numpy spent most of a call's few microseconds
 on the calls around one tiny product, so the product and the finiteness check are
 one compiled loop. (``integrate_particles`` stays numpy: a first exact run compiles

@@ -8,9 +8,9 @@ with ``w(t) = w_hat * w(t)``, a fixed unit axis times a magnitude that is
 piecewise linear in time (a constant is a one-node table). Each term is
 switched by a flag in ``P``; a term that is off costs one branch.
 
-The step kernels (:mod:`rotframe.particles.kernels`), the DOP853 stages
-(:mod:`rotframe.particles.dop853_steps`) and the event rules
-(:mod:`rotframe.particles.events`) all evaluate forces here.
+The step kernels (`rotframe.particles.kernels`), the DOP853 stages
+(`rotframe.particles.dop853_steps`) and the event rules
+(`rotframe.particles.events`) all evaluate forces here.
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ def position_acceleration(x, y, z, m, w, wd):
 
 @jit_internal
 def state_acceleration(state, m, w, wd):
-    """Total acceleration in the rotating frame at ``state``; see :func:`acceleration`."""
+    """Total acceleration in the rotating frame at ``state``; see `acceleration`."""
     x, y, z, vx, vy, vz = state
     ax, ay, az = position_acceleration(x, y, z, m, w, wd)
     if m.coriolis:
@@ -140,7 +140,7 @@ def drag_flow(vx, vy, vz, k1, k2, h):
 
 @jit_internal
 def drag_coefficients(z, m):
-    """Drag coefficients (k1 (1/s), k2 (1/m)) at height z: the sea-level ones times :func:`air_density`."""
+    """Drag coefficients (k1 (1/s), k2 (1/m)) at height z: the sea-level ones times `air_density`."""
     air = air_density(z, m)
     return m.k1 * air, m.k2 * air
 

@@ -1,10 +1,10 @@
 """Integrators for particles in a rotating frame, chosen by name.
 
 Every method honours one contract (as REBOUND's integrators do): it takes a
-:class:`~rotframe.particles.model.ParticleModel`, initial positions and velocities of an
+[`ParticleModel`][rotframe.particles.model.ParticleModel], initial positions and velocities of an
 ensemble ``(N, 3)`` in the rotating frame, a duration and a number of output
-samples, and returns a :class:`Trajectory`. The work is done by compiled
-kernels (:mod:`rotframe.particles.kernels`) called in chunks, so that progress can be
+samples, and returns a [`Trajectory`][rotframe.particles.trajectory.Trajectory]. The work is done by compiled
+kernels (`rotframe.particles.kernels`) called in chunks, so that progress can be
 shown, Ctrl-C and SIGTERM interrupt cleanly, and a numerical failure returns
 everything computed before it.
 
@@ -30,9 +30,9 @@ Methods
     The exact flow, to round-off (docs/physics/earth.md, the exact linear flow and the exact
     flow of a force-free particle): the matrix exponential of the augmented linear system
     (r, v, 1) when the model is linear with constant coefficients
-    (:attr:`ParticleModel.is_linear`; then the default), or the inertial straight line
+    (`ParticleModel.is_linear`; then the default), or the inertial straight line
     seen from the turning frame when the model is force-free under a varying rate
-    (:attr:`ParticleModel.is_force_free`; events are not located on that one).
+    (`ParticleModel.is_force_free`; events are not located on that one).
 """
 
 from __future__ import annotations
@@ -77,15 +77,15 @@ METHODS = {
 }
 
 #: Former names of particle methods, still accepted everywhere a particle method is named:
-#: alias -> the :data:`METHODS` key. (The heavy top's ``splitting``/``splitting4`` are other methods.)
+#: alias -> the `METHODS` key. (The heavy top's ``splitting``/``splitting4`` are other methods.)
 ALIASES = {"splitting": "rotation-splitting", "splitting4": "rotation-splitting4"}
 
-#: Every name a particle method may be given by: the :data:`METHODS` keys, then the :data:`ALIASES`.
+#: Every name a particle method may be given by: the `METHODS` keys, then the `ALIASES`.
 METHOD_NAMES = tuple(METHODS) + tuple(ALIASES)
 
 
 def canonical_method(name: str) -> str:
-    """The :data:`METHODS` key of a particle method given by its name or an alias (:data:`ALIASES`).
+    """The `METHODS` key of a particle method given by its name or an alias (`ALIASES`), in any case.
 
     Raises
     ------
@@ -94,9 +94,10 @@ def canonical_method(name: str) -> str:
 
     Examples
     --------
-    >>> canonical_method("splitting4"), canonical_method("dop853")
+    >>> canonical_method("splitting4"), canonical_method("DOP853")
     ('rotation-splitting4', 'dop853')
     """
+    name = name.lower() if isinstance(name, str) else name
     name = ALIASES.get(name, name)
     if name not in METHODS:
         raise ScenarioError(f"method: unknown {name!r}; allowed: {', '.join(METHOD_NAMES)}")
@@ -129,8 +130,8 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     duration : float
         Simulated time (s), > 0.
     method : str, optional
-        A key of :data:`METHODS` or an alias (:data:`ALIASES`); default :func:`default_method`.
-        The trajectory's ``method`` is the canonical name (the :data:`METHODS` key).
+        A key of `METHODS` or an alias (`ALIASES`); default [`default_method`][rotframe.particles.integrators.default_method].
+        The trajectory's ``method`` is the canonical name (the `METHODS` key).
     step : float, optional
         Step size (s) for fixed-step methods (the step used divides the output
         interval exactly and is never larger). Default: 1/20 of the output interval.
@@ -184,7 +185,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
 
 
 def _check_work(info, duration, step, samples, n, model):
-    """Refuse, before allocating anything, a run over the work limits (:mod:`rotframe.limits`)."""
+    """Refuse, before allocating anything, a run over the work limits (`rotframe.limits`)."""
     from rotframe import limits
 
     steps = 0.0
@@ -223,10 +224,10 @@ def fastest_rate(model) -> float:
 
 
 def _integrate_exact(model, r0, v0, duration, samples, events, progress):
-    """The exact flow (:class:`rotframe.particles.linear.ExactFlow`): s(t_k) = Phi_k s(0), s = (r, v, 1).
+    """The exact flow (`rotframe.particles.linear.ExactFlow`): s(t_k) = Phi_k s(0), s = (r, v, 1).
 
     Events are located on the exact flow of a linear model for all particles at
-    once (:func:`rotframe.particles.linear.locate_crossings`).
+    once (`rotframe.particles.linear.locate_crossings`).
     """
     from rotframe.particles.linear import ExactFlow, locate_crossings
 

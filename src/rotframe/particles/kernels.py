@@ -6,12 +6,12 @@ state is the tuple ``(x, y, z, vx, vy, vz)``, kept in registers: the step
 kernels take and return it and take no array. What a step needs from the
 schedule (the rate and its derivative at each stage, the angle turned over each
 sub-step and the cosine and sine of the Coriolis rotation) is its plan
-(:func:`make_plan`). At a steady rate the plan is the same for every step and
+(`make_plan`). At a steady rate the plan is the same for every step and
 particle, so it is made once per call and the steps between two samples are
-one loop (:func:`_free_steps`, for a free particle, is the throughput path); a
+one loop (`_free_steps`, for a free particle, is the throughput path); a
 varying schedule is read once per step. The drivers that call these maps over
-an ensemble are in :mod:`rotframe.particles.drivers`; the forces in
-:mod:`rotframe.particles.forces`.
+an ensemble are in `rotframe.particles.drivers`; the forces in
+`rotframe.particles.forces`.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ __all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_spher
 
 @jit_internal
 def _stage(t, wt, wv):
-    """Rotation data of a Runge-Kutta stage at time t, laid out as :func:`_sub`: ``(w, w', 0, 1, 0)``."""
+    """Rotation data of a Runge-Kutta stage at time t, laid out as `_sub`: ``(w, w', 0, 1, 0)``."""
     return omega_magnitude(t, wt, wv), omega_rate(t, wt, wv), 0.0, 1.0, 0.0
 
 
@@ -59,7 +59,7 @@ def _lookup(t, h, wt, wv, wint):
 
 @jit_internal
 def _sub(looked_up, m):
-    """Rotation data ``(w, w', turn, cos, sin)`` of a splitting sub-step from its :func:`_lookup`.
+    """Rotation data ``(w, w', turn, cos, sin)`` of a splitting sub-step from its `_lookup`.
 
     ``cos`` and ``sin`` are those of the Coriolis rotation angle ``-2 turn`` of
     a free particle (1 and 0 when there is none).
@@ -76,7 +76,7 @@ def _sub(looked_up, m):
 
 @jit_internal
 def make_plan(method, t, h, m, wt, wv, wint):
-    """The rotation data a step [t, t + h] of ``method`` needs: three tuples laid out as :func:`_sub`.
+    """The rotation data a step [t, t + h] of ``method`` needs: three tuples laid out as `_sub`.
 
     Splitting: the step (three times); splitting4: its three sub-steps; rk4:
     the rates at t, t + h/2 and t + h (turn 0, cos 1, sin 0). At a steady
@@ -100,7 +100,7 @@ def make_plan(method, t, h, m, wt, wv, wint):
 
 @jit_internal
 def _steady_plan(method, h, m):
-    """:func:`make_plan` at the steady rate ``m.w``."""
+    """`make_plan` at the steady rate ``m.w``."""
     if method == 1:
         h1, h0 = _sub_steps(method, h)[1][:2]
         outer = _sub((m.w, 0.0, m.w * h1), m)
@@ -123,7 +123,7 @@ def _sub_steps(method, h):
 
 @jit_internal
 def _free_steps(state, n, method, h, m, plan):
-    """Exact-rotation splitting of a free particle; see :func:`step_splitting`.
+    """Exact-rotation splitting of a free particle; see `step_splitting`.
 
     Per sub-step: drift r += v h/2; kick v += a_pos(r) h/2 and exact drag;
     rotate v about w_hat by -2 turn (cos and sin from the plan); drag and kick
@@ -167,7 +167,7 @@ def _free_steps(state, n, method, h, m, plan):
 
 @jit_internal
 def _sphere_steps(state, n, method, h, m, plan):
-    """Splitting on the sphere |r - pivot| = L; see :func:`step_sphere`."""
+    """Splitting on the sphere |r - pivot| = L; see `step_sphere`."""
     n_sub, lengths = _sub_steps(method, h)
     for _ in range(n):
         for i in range(n_sub):
@@ -177,7 +177,7 @@ def _sphere_steps(state, n, method, h, m, plan):
 
 @jit_internal
 def _sphere_step(state, h, m, sub):
-    """One sub-step of :func:`_sphere_steps` with the rotation data ``sub``."""
+    """One sub-step of `_sphere_steps` with the rotation data ``sub``."""
     x, y, z, vx, vy, vz = state
     hh = 0.5 * h
     x, y, z, vx, vy, vz = _great_circle(x, y, z, vx, vy, vz, hh, m)
@@ -242,7 +242,7 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
 
 @jit_internal
 def _rk4_steps(state, n, h, m, plan):
-    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see :func:`step_rk4`."""
+    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see `step_rk4`."""
     x, y, z, vx, vy, vz = state
     hh = 0.5 * h
     h6 = h / 6.0
@@ -305,10 +305,10 @@ def method_steps(method, state, n, h, m, plan, rk4, sphere):
 def advance(method, state, t0, k0, n, h, m, wt, wv, wint, plan, rk4, sphere):
     """Steps k0 .. k0 + n - 1 of size h from t0 (step k starts at t0 + k h).
 
-    ``plan`` is the :func:`make_plan` of every step when the rate is steady; a
+    ``plan`` is the `make_plan` of every step when the rate is steady; a
     varying schedule is sampled here, once per step, so that the step
     kernels take no array. ``wt = None`` is a steady schedule known at compile time;
-    ``rk4`` and ``sphere`` as in :func:`method_steps`.
+    ``rk4`` and ``sphere`` as in `method_steps`.
     """
     if wt is None:
         return method_steps(method, state, n, h, m, plan, rk4, sphere)
@@ -339,7 +339,7 @@ def step_splitting(r, v, t, h, P, wt, wv, wint, a):
     w_hat by -2 * integral of w over the step (the exact Coriolis flow, no
     tan() as in Boris); drag and kick again; drift h/2. Explicit, symmetric
     (time-reversible), volume-preserving; one force evaluation per step.
-    For a pendulum the constrained version :func:`step_sphere` is used.
+    For a pendulum the constrained version `step_sphere` is used.
 
     ``r`` and ``v`` (3,) are updated in place; ``a`` (3,) is unused (the
     kernels keep their scratch in registers). Returns the force evaluations.
@@ -359,7 +359,7 @@ def step_sphere(r, v, t, h, P, wt, wv, wint, a):
        -2 (w . n) times the elapsed angle (the normal part is taken by the string).
     Composition A(h/2) B(h/2) C(h) B(h/2) A(h/2): symmetric, second order, the
     constraint kept to round-off (n is renormalised after every great-circle move).
-    Arguments and result as :func:`step_splitting`.
+    Arguments and result as `step_splitting`.
     """
     m = unpack(P, wt, wv)
     state = _sphere_step((r[0], r[1], r[2], v[0], v[1], v[2]), h, m, make_plan(0, t, h, m, wt, wv, wint)[0])
@@ -369,7 +369,7 @@ def step_sphere(r, v, t, h, P, wt, wv, wint, a):
 
 @jit_kernel
 def step_splitting4(r, v, t, h, P, wt, wv, wint, a):
-    """Fourth-order symmetric composition (Yoshida 1990) of :func:`step_splitting`."""
+    """Fourth-order symmetric composition (Yoshida 1990) of `step_splitting`."""
     return _step_in_place(1, r, v, t, h, P, wt, wv, wint)
 
 

@@ -13,7 +13,7 @@ exact flow of a force-free particle):
   frame turned by the schedule's exact angle theta(t):
   r(t) = R(n, -theta) r_in(t), v(t) = R(n, -theta) (v0 + w(0) x r0) - w(t) x r(t).
 
-Both are linear maps of s(0), so :class:`ExactFlow` holds the matrices Phi_k for a
+Both are linear maps of s(0), so `ExactFlow` holds the matrices Phi_k for a
 sample grid and applies them to any initial states (a prepared run applies them many
 times). This module also holds M, a vectorised propagator for many states over many
 different times at once, and the location of event crossings on the linear flow,
@@ -48,7 +48,7 @@ def _power_of_two(x):
 
 
 def flow_at(M, t):
-    """expm(M t) (7, 7) for the matrix M of :func:`flow_matrix`: scipy's ``expm`` on a similarity-scaled M t.
+    """expm(M t) (7, 7) for the matrix M of `flow_matrix`: scipy's ``expm`` on a similarity-scaled M t.
 
     ``expm`` (scaling and squaring, Al-Mohy & Higham 2009) squares as often as the norm of
     M t asks, and two blocks of M make that norm grow with t where the motion has nothing
@@ -179,7 +179,7 @@ def turned_angle(omega, t):
     """Angle (rad) the frame has turned from t = 0 to each time ``t``, exact for the schedule (vectorised).
 
     The schedule's rate is piecewise linear through its nodes and held outside them
-    (:class:`rotframe.particles.model.OmegaSchedule`), so the angle is piecewise
+    ([`rotframe.particles.model.OmegaSchedule`][rotframe.particles.model.OmegaSchedule]), so the angle is piecewise
     quadratic: the node integrals plus the part of the current segment.
     """
     t = np.atleast_1d(np.asarray(t, dtype=np.float64))
@@ -237,9 +237,9 @@ class ExactFlow:
     Phi_k, for a run that applies them many times (a prepared run).
 
     Linear models that are not force-free: expm is evaluated directly at the first sample of every block
-    (the anchor, :func:`flow_at`) and the samples between are reached by powers of the one-interval
+    (the anchor, `flow_at`) and the samples between are reached by powers of the one-interval
     propagator, so round-off stays at a few tens of ulps however long the run.
-    Force-free models (a steady rate too, though it is linear): :func:`free_flow_matrices`,
+    Force-free models (a steady rate too, though it is linear): `free_flow_matrices`,
     exact at every sample.
 
     Parameters

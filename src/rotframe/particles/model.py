@@ -1,13 +1,13 @@
 """What a particle scene is: its force terms and their constants.
 
-A :class:`ParticleModel` lists the terms a scene includes, and nothing else is
+A [`ParticleModel`][rotframe.particles.model.ParticleModel] lists the terms a scene includes, and nothing else is
 computed (a term that is absent costs one branch in the compiled kernel). It
 is constant during a run; the state (positions and velocities) lives apart, in
 the arrays the integrators advance, as MuJoCo keeps ``mjModel`` apart from
 ``mjData``.
 
 All values are SI floats in the rotating frame's axes; units are converted at
-the edge (:mod:`rotframe.app.scenario`).
+the edge (`rotframe.app.scenario`).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ TERMS = (
 )
 
 #: Terms that make r'' nonlinear in (r, v): a model naming one has no exact linear flow
-#: (:attr:`ParticleModel.is_linear`). ``curvature`` makes the ground a sphere (events on altitude).
+#: ([`ParticleModel.is_linear`][rotframe.particles.model.ParticleModel.is_linear]). ``curvature`` makes the ground a sphere (events on altitude).
 NONLINEAR_TERMS = ("altitude-gravity", "central-gravity", "quadratic-drag", "pendulum", "curvature")
 
 
@@ -138,7 +138,7 @@ class ParticleModel:
     Parameters
     ----------
     terms : tuple of str
-        Names from :data:`TERMS`. Only these are computed.
+        Names from `TERMS`. Only these are computed.
     omega : OmegaSchedule
         Rotation of the frame (used by coriolis, centrifugal and euler).
     g : (3,) array
@@ -203,7 +203,7 @@ class ParticleModel:
 
         That is Coriolis and centrifugal, and Euler's too when the rate varies (named or not
         when it is steady, where it is zero), and nothing else. The particle then moves on a
-        straight inertial line, which :mod:`rotframe.particles.linear` gives exactly for any
+        straight inertial line, which `rotframe.particles.linear` gives exactly for any
         rotation schedule.
         """
         frame = {"coriolis", "centrifugal"} if self.omega.is_constant else {"coriolis", "centrifugal", "euler"}
@@ -211,13 +211,13 @@ class ParticleModel:
 
     @property
     def has_exact_flow(self) -> bool:
-        """True when method ``exact`` applies: a linear model (:attr:`is_linear`) or a force-free one."""
+        """True when method ``exact`` applies: a linear model ([`is_linear`][rotframe.particles.model.ParticleModel.is_linear]) or a force-free one."""
         return self.is_linear or self.is_force_free
 
     def nonlinear_reasons(self) -> list:
         """Why the model is not linear with constant coefficients (empty when it is).
 
-        One phrase per cause, for error messages: the :data:`NONLINEAR_TERMS` it
+        One phrase per cause, for error messages: the `NONLINEAR_TERMS` it
         names, linear drag in a stratified atmosphere, a rotation rate that varies.
         """
         reasons = []
@@ -232,7 +232,7 @@ class ParticleModel:
         return reasons
 
     def pack(self) -> np.ndarray:
-        """The flat parameter vector of :mod:`rotframe.particles.packed` (made once per model, returned as a copy)."""
+        """The flat parameter vector of `rotframe.particles.packed` (made once per model, returned as a copy)."""
         cached = self.__dict__.get("_packed")
         if cached is None:
             cached = self._pack()
@@ -269,7 +269,7 @@ class ParticleModel:
         return P
 
     def linear_matrices(self):
-        """(K, C, b) with r'' = K r + C v + b, for a linear model (see :attr:`is_linear`)."""
+        """(K, C, b) with r'' = K r + C v + b, for a linear model (see [`is_linear`][rotframe.particles.model.ParticleModel.is_linear])."""
         from rotframe.numerics.hat import skew  # numba-free callers stay cheap to import
 
         w = self.omega.vector(0.0)

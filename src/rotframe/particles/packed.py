@@ -1,11 +1,11 @@
 """The packed model and the state as the compiled particle kernels see them.
 
-A :class:`rotframe.particles.model.ParticleModel` is packed (``ParticleModel.pack``)
+A [`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel] is packed (``ParticleModel.pack``)
 into a flat float64 parameter vector ``P``; the drivers unpack it once per call
-into a :class:`PackedModel` of scalars. A particle's state is the tuple
+into a `PackedModel` of scalars. A particle's state is the tuple
 ``(x, y, z, vx, vy, vz)`` (rotating frame, SI), kept in registers.
 
-Layout of ``P`` (see ``pack`` in :mod:`rotframe.particles.model`)::
+Layout of ``P`` (see ``pack`` in [`rotframe.particles.model`][rotframe.particles.model])::
 
     0:3   uniform gravity vector g (m/s^2)          [used when gravity mode == 0]
     3:6   unit rotation axis w_hat
@@ -27,7 +27,7 @@ The rotation-rate magnitude table is ``wt`` (node times, increasing) and
 holds the integral of w from ``wt[0]`` to each node, so the rotation angle
 over any interval is exact for the piecewise-linear schedule.
 
-Every kernel of :mod:`rotframe.particles` is compiled with :data:`jit_kernel`.
+Every kernel of `rotframe.particles` is compiled with `jit_kernel`.
 """
 
 from __future__ import annotations
@@ -85,7 +85,7 @@ class PackedModel(NamedTuple):
 
 @jit_internal
 def unpack(P, wt, wv):
-    """The :class:`PackedModel` of the parameter vector ``P`` and the schedule ``(wt, wv)``."""
+    """The `PackedModel` of the parameter vector ``P`` and the schedule ``(wt, wv)``."""
     gmode = P[I_GMODE]
     g = (P[I_G], P[I_G + 1], P[I_G + 2]) if gmode == 0.0 else (0.0, 0.0, 0.0)
     axis = (P[I_AXIS], P[I_AXIS + 1], P[I_AXIS + 2])

@@ -1,16 +1,16 @@
 """Repeated particle runs with everything prepared once (a few microseconds of overhead a run).
 
-:func:`rotframe.particles.integrators.integrate_particles` checks its input, packs the
+[`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles] checks its input, packs the
 model, allocates output and event buffers and loads the kernel on every call:
 some 70 microseconds, more than the integration of a short run costs. A
-:class:`PreparedRun` does that once for a model, method, duration and sample
-count (a :class:`rotframe.particles.chunked.KernelSetup`, the one set-up of
+[`PreparedRun`][rotframe.particles.prepared.PreparedRun] does that once for a model, method, duration and sample
+count (a `rotframe.particles.chunked.KernelSetup`, the one set-up of
 ``integrate_particles`` too), and each call then only copies the initial state
 in and makes one call of the compiled driver with the same arguments, so the
 results are bitwise those of ``integrate_particles``. Method ``exact`` (a linear or
 force-free model) keeps the matrices of the exact flow for the sample grid, made
 once, and each call multiplies them into the initial states in one compiled loop
-(:mod:`rotframe.particles.exact_kernel`): it agrees with ``integrate_particles`` to
+(`rotframe.particles.exact_kernel`): it agrees with ``integrate_particles`` to
 round-off (the products are grouped differently). For optimisation loops,
 shooting, Monte Carlo over single particles and the bench. No events; a
 non-finite state raises ``IntegrationError``.
@@ -31,7 +31,7 @@ class PreparedRun:
     model : ParticleModel
     method : str
         ``rotation-splitting``, ``rotation-splitting4``, ``rk4``, ``dop853`` (or an alias,
-        :data:`rotframe.particles.integrators.ALIASES`), or ``exact`` for a model with an
+        `rotframe.particles.integrators.ALIASES`), or ``exact`` for a model with an
         exact flow (linear or force-free: ``ParticleModel.has_exact_flow``). ``exact``
         makes the flow's matrices for the sample grid once, here; each call then only
         multiplies them into the initial states.

@@ -4,7 +4,7 @@ The magnitude table is ``wt`` (node times, increasing) and ``wv`` (values,
 rad/s); w(t) is piecewise linear between the nodes and held constant outside
 them. ``wint`` holds the integral of w from ``wt[0]`` to each node, so the
 rotation angle over any interval is exact for the piecewise-linear schedule
-(:meth:`rotframe.particles.model.OmegaSchedule.cumulative`).
+([`rotframe.particles.model.OmegaSchedule.cumulative`][rotframe.particles.model.OmegaSchedule.cumulative]).
 
 A steady schedule (one value at every node) is passed to the drivers as
 ``wt = None``: numba prunes every branch under ``if wt is None`` at compile

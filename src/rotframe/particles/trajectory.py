@@ -1,9 +1,9 @@
 """What a particle run returns: samples, events, cost; and the records the kernels fill.
 
-:class:`Trajectory` is the one result type of every particle method (fixed-step,
+[`Trajectory`][rotframe.particles.trajectory.Trajectory] is the one result type of every particle method (fixed-step,
 adaptive, exact); a run cut short keeps what it computed in
-:class:`RunInterrupted` or :class:`rotframe.errors.IntegrationError`
-(``partial``, a truncated :class:`Trajectory`).
+[`RunInterrupted`][rotframe.particles.trajectory.RunInterrupted] or [`rotframe.errors.IntegrationError`][rotframe.errors.IntegrationError]
+(``partial``, a truncated [`Trajectory`][rotframe.particles.trajectory.Trajectory]).
 """
 
 from __future__ import annotations
@@ -81,7 +81,7 @@ class RunInterrupted(Exception):
 
 
 def event_table(events):
-    """The events as the (E, 5) table of the compiled drivers (:mod:`rotframe.particles.events`)."""
+    """The events as the (E, 5) table of the compiled drivers (`rotframe.particles.events`)."""
     if not events:
         return np.zeros((0, 5))
     return np.array([e.row() for e in events], dtype=np.float64)

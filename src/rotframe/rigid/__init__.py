@@ -1,13 +1,13 @@
 """Rigid bodies: mass properties, principal axes, free and torqued motion, sections.
 
 Layer 2 of the house (see ``docs/architecture.md``): imports only
-:mod:`rotframe.numerics`, :mod:`rotframe.frames`, :mod:`rotframe.validation`,
-:mod:`rotframe.errors` and :mod:`rotframe.limits`; never ``particles``, ``scenes`` or ``app``.
+`rotframe.numerics`, [`rotframe.frames`][rotframe.frames], `rotframe.validation`,
+[`rotframe.errors`][rotframe.errors] and `rotframe.limits`; never ``particles``, ``scenes`` or ``app``.
 
 Modules, one concept each:
 
 * ``mass_properties``, ``principal``: inertia tensors and principal axes;
-* ``checks``: :class:`InvalidStateError` and the input checks of the solvers;
+* ``checks``: [`InvalidStateError`][rotframe.rigid.checks.InvalidStateError] and the input checks of the solvers;
 * ``elliptic``: Jacobi ``sn, cn, dn`` and Carlson's integrals (one source);
 * ``kernels``: compiled steps, the one Euler right-hand side ``euler_rates``;
 * ``drivers``: sample arrays and the splitting driver;
@@ -15,7 +15,7 @@ Modules, one concept each:
   ``torqued`` (Lie-Poisson splitting, RK4), ``heavy_top``, ``observables``,
   ``adaptive`` (DOP853);
 * ``section_geometry``, ``cross_section``, ``section_shapes``: plane sections
-  (``sections`` gathers them; drawing is in :mod:`rotframe.app.section_plot`);
+  (``sections`` gathers them; drawing is in `rotframe.app.section_plot`);
 * ``dynamics``: the former single module's names, gathered.
 
 Every name of the former ``rotframe.rigid.dynamics.__all__`` is also reachable as

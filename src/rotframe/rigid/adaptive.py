@@ -2,7 +2,7 @@
 
 The state is ``y = (L_body, q)``: angular momentum in principal body axes
 (kg m^2/s) and the body -> space orientation quaternion, scalar-last. The
-equations are those of :func:`rotframe.rigid.torqued.rigid_rhs` (docs/physics.md,
+equations are those of [`rotframe.rigid.torqued.rigid_rhs`][rotframe.rigid.torqued.rigid_rhs] (docs/physics.md,
 rigid bodies): Euler's equations ``dL/dt = L x omega + N_body``,
 ``omega = L / I``, and the kinematics ``dq/dt = q * (omega, 0) / 2``, with the
 torque of a heavy symmetric top ``mgl (z_b[1], -z_b[0], 0)``, a constant body
@@ -19,7 +19,7 @@ with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
 not projected during the run (the exact flow keeps ``|q| = 1``, and the drift
 is of the order of the tolerance); outputs are normalised.
 
-Every step and every sample is one compiled call (:func:`_steps`, the tableau
+Every step and every sample is one compiled call (`_steps`, the tableau
 passed as arrays); the checks, sample 0 and the first step run in Python (a few
 microseconds), so that the kernel a first run compiles is as small as it can be
 (docs/architecture.md, "What a first run compiles").
@@ -56,10 +56,10 @@ class RigidRun:
 def _tableau():
     """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output.
 
-    Rows 0..11 of ``A`` are the stages of :func:`rotframe.numerics.dop853.coefficients`,
+    Rows 0..11 of ``A`` are the stages of `rotframe.numerics.dop853.coefficients`,
     row 12 its order-8 weights ``B`` (so that "stage 12" of the stage loop forms
     ``y_new = y + h sum B_q k_q`` and ``f(y_new)``), rows 13..15 the dense-output
-    stages of :func:`rotframe.numerics.dop853_dense.dense_tables`.
+    stages of `rotframe.numerics.dop853_dense.dense_tables`.
     """
     A12, B, _, E3, E5 = coefficients()
     A_extra, D = dense_tables()
@@ -76,14 +76,14 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
 
     Samples ``k_out..`` of ``times`` go to ``out_L`` and ``out_q`` (normalised);
     ``y_new``, ``tmp`` (7,) and ``F`` (7, 7) are work arrays.
-    ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``; ``A`` as :func:`_tableau`
+    ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``; ``A`` as `_tableau`
     returns it. Returns (samples done, right-hand sides evaluated, accepted steps);
     samples done < len(times) when the step size collapsed or the state became
     non-finite.
 
     The kernel a run waits for on its first call is compiled from this function,
     whose cost grows with its number of statements: everything that runs once per
-    call (checks, first step) is in :func:`rigid_dop853`, and the right-hand side
+    call (checks, first step) is in `rigid_dop853`, and the right-hand side
     is called from one place (every stage, ``f(y_new)`` and the dense-output stages).
     """
     n_out = times.shape[0]
@@ -229,7 +229,7 @@ def dop853_kernel(y0, p, times, rtol, atol, h_max, out_L, out_q):
     ``y0[3:]`` is normalised in place. Returns (samples done, nfev, accepted
     steps); samples done < len(times) when the step size collapsed or the
     state became non-finite, -1 for invalid input. The checks here, the rest
-    in :func:`dop853_from`.
+    in `dop853_from`.
     """
     n_out = times.shape[0]
     if n_out < 1 or times.ndim != 1 or not np.all(times[1:] > times[:-1]):
@@ -242,12 +242,12 @@ def dop853_kernel(y0, p, times, rtol, atol, h_max, out_L, out_q):
 
 
 def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
-    """:func:`dop853_kernel` after its checks: ``times`` increasing, ``p[:3]`` the inverse moments (not changed).
+    """`dop853_kernel` after its checks: ``times`` increasing, ``p[:3]`` the inverse moments (not changed).
 
     ``y0[3:]`` is normalised in place. Sample 0 and the first step in Python
     (Python floats: the same IEEE double operations as float64 scalars, in the
-    order of Hairer's code), the steps in :func:`_steps`. For callers that check
-    once and run many times (:class:`rotframe.rigid.prepared.PreparedBodyRun`).
+    order of Hairer's code), the steps in `_steps`. For callers that check
+    once and run many times ([`rotframe.rigid.prepared.PreparedBodyRun`][rotframe.rigid.prepared.PreparedBodyRun]).
     """
     n_out = times.shape[0]
     y = y0.tolist()

@@ -1,9 +1,9 @@
 """Input checks shared by the rigid-body solvers, and the error they raise.
 
-Conventions as in :mod:`rotframe.rigid.free_body`: principal moments along body
+Conventions as in [`rotframe.rigid.free_body`][rotframe.rigid.free_body]: principal moments along body
 axes 1, 2, 3 (kg m^2), angular momentum and torque in body axes, quaternions
 scalar-last ``(x, y, z, w)``. Each check returns the validated value as float64
-or raises :class:`InvalidStateError` / :class:`~rotframe.rigid.mass_properties.InvalidBodyError`
+or raises [`InvalidStateError`][rotframe.rigid.checks.InvalidStateError] / [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError]
 with one line naming the argument, its value and what is allowed.
 """
 

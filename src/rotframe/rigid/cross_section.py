@@ -1,11 +1,11 @@
 """A plane cross-section (outer region minus holes): area, centroid, second moments, bending.
 
-:class:`Section` holds the regions of :mod:`rotframe.rigid.section_geometry` and
+`Section` holds the regions of `rotframe.rigid.section_geometry` and
 derives its properties (second moments about the centroid or any point,
-principal moments and axes from :func:`rotframe.rigid.principal.principal_axes`,
+principal moments and axes from [`rotframe.rigid.principal.principal_axes`][rotframe.rigid.principal.principal_axes],
 radii of gyration) and the linear elastic bending stress and neutral axis under
 a bending moment ``(Mx, My)`` (Hibbeler 6.5). Conventions and references in
-:mod:`rotframe.rigid.sections`.
+`rotframe.rigid.sections`.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from rotframe.rigid.section_geometry import (
 
 __all__ = ["Section", "NeutralAxis", "PROPERTY_UNITS"]
 
-#: Units of the entries of :meth:`Section.properties`.
+#: Units of the entries of `Section.properties`.
 PROPERTY_UNITS = {
     "area": "m^2",
     "centroid_x": "m",
@@ -343,7 +343,7 @@ class Section:
 
         For Ixy = 0 this reduces to ``sigma = -Mx v / Ixx + My u / Iyy``.
         The neutral axis (sigma = 0) passes through the centroid; see
-        :meth:`neutral_axis`.
+        `neutral_axis`.
         """
         b, c = self._stress_gradient(mx, my)
         u = np.asarray(x, dtype=float) - self.centroid[0]
@@ -355,7 +355,7 @@ class Section:
         """The neutral axis (sigma = 0) under the bending moment (Mx, My) N m.
 
         It passes through the centroid with direction ``(c, -b)`` where
-        ``sigma = b u + c v`` (see :meth:`bending_stress`); its angle from +x
+        ``sigma = b u + c v`` (see `bending_stress`); its angle from +x
         is in (-90, 90] degrees. In unsymmetric bending (Ixy != 0, or a moment
         not along a principal axis) it is not perpendicular to the plane of
         loading.
@@ -396,7 +396,7 @@ class Section:
     # -- summary ---------------------------------------------------------------
 
     def properties(self) -> dict[str, float]:
-        """All scalar properties as plain floats in SI units (see :data:`PROPERTY_UNITS`)."""
+        """All scalar properties as plain floats in SI units (see `PROPERTY_UNITS`)."""
         return {
             "area": self.area,
             "centroid_x": self.centroid[0],

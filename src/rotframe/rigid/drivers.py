@@ -1,12 +1,12 @@
 """Python drivers shared by the fixed-step rigid-body integrators.
 
 Output arrays and sample times (steps ``0, s, 2s, ...`` and always the last), the
-composition weights (:func:`rotframe.numerics.composition.composition_weights`,
-refused orders as :class:`~rotframe.rigid.checks.InvalidStateError`; the order of a
-method name's suffix in :data:`SPLITTING_ORDERS`), the end of
-a run (an :class:`~rotframe.errors.IntegrationError` that keeps the finite
-samples), and the drivers of the compiled splitting :func:`run_splitting` and
-:func:`splitting_stepper` (the body checked once, for runs in chunks).
+composition weights (`rotframe.numerics.composition.composition_weights`,
+refused orders as [`InvalidStateError`][rotframe.rigid.checks.InvalidStateError]; the order of a
+method name's suffix in `SPLITTING_ORDERS`), the end of
+a run (an [`IntegrationError`][rotframe.errors.IntegrationError] that keeps the finite
+samples), and the drivers of the compiled splitting `run_splitting` and
+`splitting_stepper` (the body checked once, for runs in chunks).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def composition_weights(order):
     """Fractions of the order-2 step in the composition of ``order`` (2, 4, 6 or 8).
 
     Yoshida's triple jump for order 4, Kahan & Li's 9- and 17-stage methods for 6
-    and 8 (:func:`rotframe.numerics.composition.composition_weights`).
+    and 8 (`rotframe.numerics.composition.composition_weights`).
     """
     if order not in composition.COMPOSITION_ORDERS:
         raise InvalidStateError(f"order = {order!r}; allowed: 2, 4, 6 or 8")
@@ -64,7 +64,7 @@ def splitting_stepper(inv_i, sym, mgl, torque_body, torque_space, order):
     functions check them) and the composition weights of ``order`` are fixed
     once, so a driver that calls ``step`` again and again (a run in chunks) pays
     only the checks of the state and the steps (a quaternion normalised, as
-    :func:`run_splitting` does).
+    `run_splitting` does).
     """
     weights = composition_weights(order)
 

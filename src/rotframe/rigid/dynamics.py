@@ -2,19 +2,19 @@
 
 Each function lives in a module of one concept; this module only gathers them:
 
-* :mod:`rotframe.rigid.free_body`: :func:`free_body_exact`, :func:`elliptic_period`
+* [`rotframe.rigid.free_body`][rotframe.rigid.free_body]: [`free_body_exact`][rotframe.rigid.free_body.free_body_exact], [`elliptic_period`][rotframe.rigid.free_body.elliptic_period]
   (exact free motion; conventions of the whole rigid layer in its docstring);
-* :mod:`rotframe.rigid.torqued`: :func:`lie_poisson`, :func:`torqued_splitting`,
-  :func:`rigid_rhs`, :func:`rigid_rk4`;
-* :mod:`rotframe.rigid.heavy_top`: :func:`heavy_top_splitting`,
-  :func:`heavy_top_turning_points`, :func:`sleeping_top_threshold`,
-  :func:`symmetric_top_euler_energy`, :func:`free_symmetric_precession`;
-* :mod:`rotframe.rigid.observables`: :func:`energy`, :func:`omega_body`,
-  :func:`body_to_space`, :func:`angular_momentum_space`;
-* :mod:`rotframe.rigid.checks`: :class:`InvalidStateError` and the input checks;
-* :mod:`rotframe.rigid.elliptic`: Jacobi and Carlson functions;
-  :mod:`rotframe.rigid.kernels`: the compiled steps;
-  :mod:`rotframe.rigid.drivers`: output arrays and the splitting driver.
+* [`rotframe.rigid.torqued`][rotframe.rigid.torqued]: [`lie_poisson`][rotframe.rigid.torqued.lie_poisson], [`torqued_splitting`][rotframe.rigid.torqued.torqued_splitting],
+  [`rigid_rhs`][rotframe.rigid.torqued.rigid_rhs], [`rigid_rk4`][rotframe.rigid.torqued.rigid_rk4];
+* [`rotframe.rigid.heavy_top`][rotframe.rigid.heavy_top]: [`heavy_top_splitting`][rotframe.rigid.heavy_top.heavy_top_splitting],
+  [`heavy_top_turning_points`][rotframe.rigid.heavy_top.heavy_top_turning_points], [`sleeping_top_threshold`][rotframe.rigid.heavy_top.sleeping_top_threshold],
+  [`symmetric_top_euler_energy`][rotframe.rigid.heavy_top.symmetric_top_euler_energy], [`free_symmetric_precession`][rotframe.rigid.heavy_top.free_symmetric_precession];
+* [`rotframe.rigid.observables`][rotframe.rigid.observables]: [`energy`][rotframe.rigid.observables.energy], [`omega_body`][rotframe.rigid.observables.omega_body],
+  [`body_to_space`][rotframe.rigid.observables.body_to_space], [`angular_momentum_space`][rotframe.rigid.observables.angular_momentum_space];
+* [`rotframe.rigid.checks`][rotframe.rigid.checks]: [`InvalidStateError`][rotframe.rigid.checks.InvalidStateError] and the input checks;
+* [`rotframe.rigid.elliptic`][rotframe.rigid.elliptic]: Jacobi and Carlson functions;
+  `rotframe.rigid.kernels`: the compiled steps;
+  `rotframe.rigid.drivers`: output arrays and the splitting driver.
 """
 
 from __future__ import annotations

@@ -1,16 +1,16 @@
 """Jacobi elliptic functions and Carlson's symmetric integrals, one source for the rigid layer.
 
-* :func:`jacobi_reduced` (with :func:`sncndn_landen`, :func:`complete_pair`):
+* [`jacobi_reduced`][rotframe.rigid.elliptic.jacobi_reduced] (with [`sncndn_landen`][rotframe.rigid.elliptic.sncndn_landen], [`complete_pair`][rotframe.rigid.elliptic.complete_pair]):
   ``sn, cn, dn(u | m)`` with ``m1 = 1 - m`` supplied exactly, by reduction modulo
   ``4K`` (A&S 16.8) and descending Landen transformations (A&S 16.12-16.13); keeps
   relative accuracy near the separatrix ``m -> 1``, where ``scipy.special.ellipj``
-  does not (scipy issue 8480). :func:`jacobi_reduced_into` fills given arrays and
-  :func:`jacobi_reduced_arrays` is its numpy-allocating front for Python callers (a first
+  does not (scipy issue 8480). [`jacobi_reduced_into`][rotframe.rigid.elliptic.jacobi_reduced_into] fills given arrays and
+  [`jacobi_reduced_arrays`][rotframe.rigid.elliptic.jacobi_reduced_arrays] is its numpy-allocating front for Python callers (a first
   run then compiles no array allocation).
-* :func:`carlson_rf`, :func:`carlson_rj`, :func:`carlson_rc`: Carlson's duplication
+* [`carlson_rf`][rotframe.rigid.elliptic.carlson_rf], [`carlson_rj`][rotframe.rigid.elliptic.carlson_rj], [`carlson_rc`][rotframe.rigid.elliptic.carlson_rc]: Carlson's duplication
   algorithm (Carlson 1995, Numer. Algorithms 10, 13; DLMF 19.16), compiled.
-* :func:`ellipk_agm`: the complete ``K(m)`` from ``m1`` by the arithmetic-geometric mean (A&S 17.6).
-* :func:`incomplete_pi` (compiled, scalars) and :func:`incomplete_pi_arrays` (scipy's
+* [`ellipk_agm`][rotframe.rigid.elliptic.ellipk_agm]: the complete ``K(m)`` from ``m1`` by the arithmetic-geometric mean (A&S 17.6).
+* [`incomplete_pi`][rotframe.rigid.elliptic.incomplete_pi] (compiled, scalars) and [`incomplete_pi_arrays`][rotframe.rigid.elliptic.incomplete_pi_arrays] (scipy's
   ``elliprf``/``elliprj``, arrays): the incomplete integral of the third kind
   ``Pi(nu; am | m) = s R_F(c^2, d^2, 1) + nu/3 s^3 R_J(c^2, d^2, 1, 1 - nu s^2)``
   from ``s = sin am``, ``c = |cos am|``, ``d = dn`` (A&S 17.2; DLMF 19.25.14).
@@ -103,7 +103,7 @@ def jacobi_reduced(u, m, m1, K):
 
     Returns ``sn_w, cn_w, dn_w`` at ``w in [0, K]``, the sign ``sgn`` of the
     reduced argument, whether ``w = 2K - |ur|`` (``refl``) and the period count
-    ``j`` (``u = ur + 4K j``): the arrays :func:`jacobi_reduced_into` fills.
+    ``j`` (``u = ur + 4K j``): the arrays [`jacobi_reduced_into`][rotframe.rigid.elliptic.jacobi_reduced_into] fills.
     """
     n = u.size
     sn_w, cn_w, dn_w = np.empty(n), np.empty(n), np.empty(n)
@@ -113,8 +113,8 @@ def jacobi_reduced(u, m, m1, K):
 
 
 def jacobi_reduced_arrays(u, m, m1, K):
-    """:func:`jacobi_reduced` from Python: the arrays allocated by numpy, so that a first run
-    compiles only :func:`jacobi_reduced_into` and :func:`sncndn_landen` (no allocation)."""
+    """[`jacobi_reduced`][rotframe.rigid.elliptic.jacobi_reduced] from Python: the arrays allocated by numpy, so that a first run
+    compiles only [`jacobi_reduced_into`][rotframe.rigid.elliptic.jacobi_reduced_into] and [`sncndn_landen`][rotframe.rigid.elliptic.sncndn_landen] (no allocation)."""
     n = u.size
     sn_w, cn_w, dn_w = np.empty(n), np.empty(n), np.empty(n)
     sgn, refl, jj = np.empty(n), np.empty(n, dtype=np.bool_), np.empty(n)
@@ -125,7 +125,7 @@ def jacobi_reduced_arrays(u, m, m1, K):
 
 @njit(cache=True)
 def jacobi_reduced_into(u, m, m1, K, sn_w, cn_w, dn_w, sgn, refl, jj, ks, kps):
-    """:func:`jacobi_reduced` into given arrays (``ks``, ``kps``: scratch of 48 for :func:`sncndn_landen`).
+    """[`jacobi_reduced`][rotframe.rigid.elliptic.jacobi_reduced] into given arrays (``ks``, ``kps``: scratch of 48 for [`sncndn_landen`][rotframe.rigid.elliptic.sncndn_landen]).
 
     On ``[K/2, K]`` the quarter-period shift
     ``sn(K - v) = cn v / dn v``, ``cn(K - v) = k' sn v / dn v``,

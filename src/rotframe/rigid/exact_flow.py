@@ -1,14 +1,14 @@
 """The exact free asymmetric rigid body in one compiled call (a fast path of ``rigid.free_body_exact``).
 
-:func:`rotframe.rigid.free_body.free_body_exact` evaluates the closed-form motion (Jacobi
+[`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] evaluates the closed-form motion (Jacobi
 elliptic functions for the momentum, Carlson's integrals for the angle about
 ``L``; docs/physics.md, rigid bodies) with numpy and scipy on arrays: right for
 many time points, but a few hundred microseconds of setup and small-array calls
-for one. :func:`free_body_flow` computes the same formulas, setup included, in
+for one. [`free_body_flow`][rotframe.rigid.exact_flow.free_body_flow] computes the same formulas, setup included, in
 one numba function: the ordered frame, ``K(m)`` by the arithmetic-geometric
 mean (A&S 17.6), ``R_F``, ``R_J``, ``R_C`` by Carlson's duplication algorithm
 (Carlson 1995, Numer. Algorithms 10, 13) and ``sn, cn, dn`` by descending Landen
-transformations, all from :mod:`rotframe.rigid.elliptic`, and the attitude as the product
+transformations, all from [`rotframe.rigid.elliptic`][rotframe.rigid.elliptic], and the attitude as the product
 ``q = S0 Rz(psi) Ry(-theta) Rz(-phi) P``. Symmetric bodies, the separatrix,
 rotation about the middle axis and ``L = 0`` go to ``free_body_exact``.
 """
@@ -169,12 +169,12 @@ def _flow(moments, L0, q0, t, out_L, out_q):
 
 
 def free_body_flow(inertia, L0_body, q0, times):
-    """The exact torque-free motion at ``times``, as :func:`rotframe.rigid.free_body.free_body_exact` returns it.
+    """The exact torque-free motion at ``times``, as [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] returns it.
 
     The same closed form, evaluated in one compiled call for the asymmetric
     body (a few microseconds for a few time points); other cases (two equal
     moments, the separatrix, rotation about the middle axis, ``L = 0``) and
-    invalid input are passed to :func:`rotframe.rigid.free_body.free_body_exact`.
+    invalid input are passed to [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact].
 
     Returns
     -------

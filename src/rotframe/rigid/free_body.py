@@ -15,9 +15,9 @@ Conventions (the whole rigid layer uses them)
   body angular velocity is ``omega_body = L_body / I``. Euler's equations read
   ``dL/dt = L x omega + N_body`` and the attitude ``dq/dt = q * (omega, 0) / 2``.
 
-:func:`free_body_exact` keeps ``L`` to about ``1e-14 |L|`` over many flips, also
+[`free_body_exact`][rotframe.rigid.free_body.free_body_exact] keeps ``L`` to about ``1e-14 |L|`` over many flips, also
 beside the separatrix, and the attitude to about ``1e-12`` rad.
-:func:`rotframe.rigid.exact_flow.free_body_flow` is the same closed form in one
+[`rotframe.rigid.exact_flow.free_body_flow`][rotframe.rigid.exact_flow.free_body_flow] is the same closed form in one
 compiled call.
 
 References

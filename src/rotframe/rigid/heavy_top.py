@@ -4,10 +4,10 @@ Space axes: ``z`` is up, gravity is ``-g z``; the centre of mass sits at
 ``length * e3`` on the body symmetry axis (``length`` from the fixed point), so
 the Euler angle ``theta`` is the angle between ``e3`` and ``z``. Euler angles
 appear only as inputs/outputs of the check formulas
-(:func:`symmetric_top_euler_energy`, :func:`heavy_top_turning_points`: ZXZ,
+([`symmetric_top_euler_energy`][rotframe.rigid.heavy_top.symmetric_top_euler_energy], [`heavy_top_turning_points`][rotframe.rigid.heavy_top.heavy_top_turning_points]: ZXZ,
 Goldstein's phi, theta, psi); they are never integrated.
 
-:func:`heavy_top_splitting`: Strang splitting gravity kick / exact symmetric free
+[`heavy_top_splitting`][rotframe.rigid.heavy_top.heavy_top_splitting]: Strang splitting gravity kick / exact symmetric free
 flow, order 2, 4, 6 or 8; keeps ``p_phi = L . z`` and ``p_psi = L3`` to round-off.
 Not stiff in the spin: spin and nutation are exact rotations, so no step-size
 limit comes from them (RK4 needs ``h < 2.8 / omega``). Accuracy is
@@ -67,7 +67,7 @@ def heavy_top_splitting(
     ``L_body += (h/2) l e3 x (-m g z_body)``, ``z_body = R(q)^T (0, 0, 1)``;
     then the exact free symmetric flow over ``h``; then the kick again
     (docs/physics/rigid-bodies.md). Order 4 by Yoshida's triple jump, 6 and 8 by Kahan & Li's
-    compositions (:func:`rotframe.numerics.composition.composition_weights`). ``p_phi = L . z``
+    compositions (`rotframe.numerics.composition.composition_weights`). ``p_phi = L . z``
     and ``p_psi = L3`` are kept to round-off (the kick is horizontal and normal
     to ``e3``). Spin and nutation enter only through exact rotations, so no
     stability limit on ``h`` comes from the spin; the error is ``O(h^order)``
@@ -87,7 +87,7 @@ def heavy_top_splitting(
     g : float
         Gravitational acceleration (m/s^2) along ``-z``.
     L0_body, q0, h, n_steps, order, sample_every
-        As in :func:`lie_poisson`.
+        As in `lie_poisson`.
 
     Returns
     -------

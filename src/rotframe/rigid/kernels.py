@@ -4,13 +4,13 @@ State: ``L`` (3,) angular momentum in principal body axes (kg m^2/s) and ``q``
 (4,) the body -> space quaternion, scalar-last. ``inv_i`` holds ``1/I_i`` (0 for
 a zero moment). A torque is a constant body part, a constant space part turned
 into body axes by ``R(q)^T``, and the gravity torque ``mgl (z_b[1], -z_b[0], 0)``
-of a heavy symmetric top (see :func:`rotframe.rigid.torqued.rigid_rhs`).
+of a heavy symmetric top (see [`rotframe.rigid.torqued.rigid_rhs`][rotframe.rigid.torqued.rigid_rhs]).
 
-* :func:`free_step`: the exact free flow of a symmetric body, or the 1,2,3,2,1
+* `free_step`: the exact free flow of a symmetric body, or the 1,2,3,2,1
   Lie-Poisson splitting (McLachlan 1993).
-* :func:`split_run`: the Strang composition kick / free / kick over many steps.
-* :func:`euler_rhs`: Euler's equations plus quaternion kinematics.
-* :func:`rk4_run`: classical RK4 on :func:`euler_rhs`.
+* `split_run`: the Strang composition kick / free / kick over many steps.
+* `euler_rhs`: Euler's equations plus quaternion kinematics.
+* `rk4_run`: classical RK4 on `euler_rhs`.
 """
 
 from __future__ import annotations
@@ -111,9 +111,9 @@ def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1
 
     ``dL/dt = L x omega + N_body``, ``omega = L / I`` (``i0, i1, i2 = 1/I``, 0 for a
     zero moment), ``dq/dt = q * (omega, 0) / 2`` (Hamilton product, scalar-last,
-    ``q`` not normalised), ``N_body`` from :func:`body_torque`. Returns the 7-tuple
-    ``(dL0, dL1, dL2, dx, dy, dz, dw)``. Used by :func:`euler_rhs` (RK4,
-    ``rigid_rhs``) and by the adaptive DOP853 of :mod:`rotframe.rigid.adaptive`.
+    ``q`` not normalised), ``N_body`` from `body_torque`. Returns the 7-tuple
+    ``(dL0, dL1, dL2, dx, dy, dz, dw)``. Used by `euler_rhs` (RK4,
+    ``rigid_rhs``) and by the adaptive DOP853 of `rotframe.rigid.adaptive`.
     """
     o0, o1, o2 = L0 * i0, L1 * i1, L2 * i2
     t0, t1, t2 = body_torque(x, y, z, w, mgl, nb0, nb1, nb2, ns0, ns1, ns2)
@@ -124,7 +124,7 @@ def euler_rates(L0, L1, L2, x, y, z, w, i0, i1, i2, mgl, nb0, nb1, nb2, ns0, ns1
 
 @njit(cache=True)
 def _kick(L, q, c, mgl, torque_body, torque_space):
-    """``L += c N_body(q)`` (``c`` = half the step) with :func:`body_torque`, element by element.
+    """``L += c N_body(q)`` (``c`` = half the step) with `body_torque`, element by element.
 
     Scalars, not the array expression ``L += c * N``: the same operations, without
     numba's array machinery to compile on a first run.
@@ -184,7 +184,7 @@ def split_run(inv_i, sym, mgl, torque_body, torque_space, L0, q0, h, n_steps, we
 
 @njit(cache=True)
 def euler_rhs(y, inv_i, mgl, torque_body, torque_space):
-    """:func:`euler_rates` on the state ``y = (L_body, q)`` (7,); see ``rigid_rhs``."""
+    """`euler_rates` on the state ``y = (L_body, q)`` (7,); see ``rigid_rhs``."""
     tb, ts = torque_body, torque_space
     dy = np.empty(7)
     dy[0], dy[1], dy[2], dy[3], dy[4], dy[5], dy[6] = euler_rates(

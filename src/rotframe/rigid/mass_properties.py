@@ -10,8 +10,8 @@ Conventions
   ``I_xy = -sum m x y`` and cyclically (Goldstein ch. 5.3; the rigid-body lecture's
   "Angular momentum, moment of inertia" section).
 * Principal moments are returned ascending with the principal axes as the
-  columns of a proper rotation, by :func:`rotframe.rigid.principal.principal_axes`.
-* What cannot be a body is refused with :class:`InvalidBodyError` (a
+  columns of a proper rotation, by [`rotframe.rigid.principal.principal_axes`][rotframe.rigid.principal.principal_axes].
+* What cannot be a body is refused with [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError] (a
   ``ValueError``): non-positive or non-finite mass, a tensor that is not
   finite, not symmetric or not positive semi-definite, or principal moments
   that violate the triangle inequality ``I1 + I2 >= I3`` (true of every mass
@@ -116,7 +116,7 @@ def solid_sphere(mass: float, radius: float) -> np.ndarray:
 def spherical_shell(mass: float, radius: float) -> np.ndarray:
     """Thin spherical shell about its centre: ``(2/3) m R^2`` on each axis.
 
-    Parameters and result as in :func:`solid_sphere`.
+    Parameters and result as in [`solid_sphere`][rotframe.rigid.mass_properties.solid_sphere].
     """
     return _isotropic(mass, radius, 2.0 / 3.0)
 
@@ -301,9 +301,9 @@ def combine(parts: Iterable) -> tuple[float, np.ndarray, np.ndarray]:
 def principal_moments(tensor: ArrayLike, *, rtol: float = RTOL) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments and axes of a physical inertia tensor.
 
-    The tensor is validated (:func:`check_tensor`: finite, symmetric, positive
+    The tensor is validated ([`check_tensor`][rotframe.rigid.mass_properties.check_tensor]: finite, symmetric, positive
     semi-definite, triangle inequality) and diagonalised by
-    :func:`rotframe.rigid.principal.principal_axes`.
+    [`rotframe.rigid.principal.principal_axes`][rotframe.rigid.principal.principal_axes].
 
     Parameters
     ----------
@@ -338,7 +338,7 @@ def principal_moments(tensor: ArrayLike, *, rtol: float = RTOL) -> tuple[np.ndar
 
 
 def check_mass(mass: float, name: str = "mass") -> float:
-    """Return ``mass`` as a float, or raise :class:`InvalidBodyError`.
+    """Return ``mass`` as a float, or raise [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError].
 
     Parameters
     ----------
@@ -363,7 +363,7 @@ def check_mass(mass: float, name: str = "mass") -> float:
 
 
 def check_tensor(tensor: ArrayLike, *, rtol: float = RTOL) -> np.ndarray:
-    """Return a physical inertia tensor (symmetrised), or raise :class:`InvalidBodyError`.
+    """Return a physical inertia tensor (symmetrised), or raise [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError].
 
     Checks, each relative to the trace ``tr``: finite entries; symmetric
     (``max |T - T^T| <= rtol tr``); positive semi-definite (smallest eigenvalue
@@ -400,7 +400,7 @@ def check_tensor(tensor: ArrayLike, *, rtol: float = RTOL) -> np.ndarray:
 
 
 def check_moments(moments: ArrayLike, *, rtol: float = RTOL) -> np.ndarray:
-    """Return principal moments as an array, or raise :class:`InvalidBodyError`.
+    """Return principal moments as an array, or raise [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError].
 
     Allowed: three finite moments ``>= 0`` (to ``-rtol * sum``) whose two smaller
     ones add up to at least the largest (to ``rtol * sum``). A zero tensor (a
@@ -449,7 +449,7 @@ def _steiner(mass, d):
 
 
 def _length(v, name):
-    """A finite length >= 0 as float, or :class:`InvalidBodyError` naming it."""
+    """A finite length >= 0 as float, or [`InvalidBodyError`][rotframe.rigid.mass_properties.InvalidBodyError] naming it."""
     x = float(v)
     if not np.isfinite(x) or x < 0.0:
         raise InvalidBodyError(f"{name} = {x!r} m; allowed: a finite length >= 0 m")

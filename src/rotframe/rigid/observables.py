@@ -1,6 +1,6 @@
 """Quantities of a rigid-body state: energy, angular velocity, body -> space rotation.
 
-Conventions as in :mod:`rotframe.rigid.free_body`: principal body axes,
+Conventions as in [`rotframe.rigid.free_body`][rotframe.rigid.free_body]: principal body axes,
 quaternions scalar-last ``(x, y, z, w)``, active rotation body -> space.
 """
 

@@ -1,10 +1,10 @@
 """Repeated rigid-body runs with everything prepared once (microseconds of overhead a run).
 
 ``rotframe.scenes.rigid_base.integrate_body`` and
-:func:`rotframe.rigid.adaptive.rigid_dop853` check the body, the method and the
+`rotframe.rigid.adaptive.rigid_dop853` check the body, the method and the
 step, build the step's constants and allocate output on every call: some 50 to
 200 microseconds, more than a short run's integration costs. A
-:class:`PreparedBodyRun` does all of that once for one body, method, duration,
+[`PreparedBodyRun`][rotframe.rigid.prepared.PreparedBodyRun] does all of that once for one body, method, duration,
 step (or rtol) and sample count; each call then checks only that ``L0`` and
 ``q0`` are finite vectors of the right shape, copies them in and makes one call
 of the same compiled kernel with the same arguments, so the results are bitwise
@@ -37,7 +37,7 @@ class PreparedBodyRun:
     inertia : (3,) array_like
         Principal moments (kg m^2), body axes.
     method : str
-        A name of :data:`FIXED_METHODS` (splitting of order 2, 4, 6 or 8; the free
+        A name of `FIXED_METHODS` (splitting of order 2, 4, 6 or 8; the free
         body or, with ``top``, the heavy symmetric top), or ``dop853``.
     duration : float
         Simulated time (s), finite and > 0.
@@ -58,7 +58,7 @@ class PreparedBodyRun:
     -----
     Checked once, at set-up (with the plain functions' own checks, by one run from
     a zero momentum): the moments, the top, the method, the duration, the step or
-    rtol and the run's size (:func:`rotframe.limits.check_run`); the kernel is
+    rtol and the run's size (`rotframe.limits.check_run`); the kernel is
     loaded or compiled then. Checked every call: ``L0`` three finite numbers,
     ``q0`` four finite numbers not all zero (else ``ScenarioError`` naming the
     key and value). ``run(L0, q0)`` returns ``(L, q)``, arrays (samples + 1, 3)
@@ -73,7 +73,7 @@ class PreparedBodyRun:
     def __init__(self, inertia, method, duration, *, step=None, rtol=1e-10, samples=1, top=None, mgl=None):
         from rotframe import limits
 
-        self.method = method = str(method)
+        self.method = method = str(method).lower()  # any case: scipy's "DOP853" is dop853
         duration = float(duration)
         if not (math.isfinite(duration) and duration > 0):
             raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0")

@@ -1,8 +1,8 @@
 """Principal axes of a symmetric second-moment tensor, in 2D or 3D.
 
 One routine serves the 3x3 inertia tensor of a rigid body
-(:mod:`rotframe.rigid.mass_properties`) and the 2x2 second-moment-of-area tensor of a
-cross-section (:mod:`rotframe.rigid.sections`).
+([`rotframe.rigid.mass_properties`][rotframe.rigid.mass_properties]) and the 2x2 second-moment-of-area tensor of a
+cross-section (`rotframe.rigid.sections`).
 
 Conventions
 -----------
@@ -10,7 +10,7 @@ Conventions
   axes are returned as the *columns* of ``axes`` in those reference axes, so
   ``T = axes @ diag(moments) @ axes.T`` and ``axes.T`` maps reference
   components to principal components (a direction-cosine matrix in the sense
-  of :mod:`rotframe.frames`).
+  of [`rotframe.frames`][rotframe.frames]).
 * Moments are sorted ascending (``I1 <= I2 <= I3``).
 * ``axes`` is a proper rotation (det +1, right-handed), and each axis has its
   sign fixed so that its largest-magnitude component is positive (the last

@@ -1,12 +1,12 @@
 """Regions of a plane cross-section (polygons and exact circles) and the checks of their placement.
 
-A :class:`PolygonRegion` is a simple polygon stored counter-clockwise; its
+A `PolygonRegion` is a simple polygon stored counter-clockwise; its
 second moments come from sums over its edges (Green's theorem; Steger 1996,
-see :mod:`rotframe.rigid.sections`). A :class:`CircleRegion` is an exact circle.
+see `rotframe.rigid.sections`). A `CircleRegion` is an exact circle.
 The checks refuse degenerate, self-intersecting, touching or ill-placed
-boundaries with a :class:`SectionError` that says what was wrong and what is
-allowed; geometric tests use a relative tolerance :data:`GEOM_RTOL` of the size
-of the outer boundary. Conventions as in :mod:`rotframe.rigid.sections`.
+boundaries with a `SectionError` that says what was wrong and what is
+allowed; geometric tests use a relative tolerance `GEOM_RTOL` of the size
+of the outer boundary. Conventions as in `rotframe.rigid.sections`.
 """
 
 from __future__ import annotations
@@ -179,7 +179,7 @@ class CircleRegion:
     def moments(self, about=(0.0, 0.0)) -> np.ndarray:
         """Raw moments about a point, exact: ``pi r^4 / 4`` about a diameter
         plus the parallel-axis terms. Same layout as
-        :meth:`PolygonRegion.moments`."""
+        `PolygonRegion.moments`."""
         dx = self.center[0] - float(about[0])
         dy = self.center[1] - float(about[1])
         a = math.pi * self.radius**2

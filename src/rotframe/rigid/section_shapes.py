@@ -1,9 +1,9 @@
 """Named cross-section shapes: polygon, rectangle, circle, tube, I-beam, angle, channel.
 
-Each builds a :class:`~rotframe.rigid.cross_section.Section` centred as its
+Each builds a `Section` centred as its
 docstring says, after checking its dimensions (positive, and the thicknesses
 smaller than what they cut into) with a
-:class:`~rotframe.rigid.section_geometry.SectionError` naming the shape, the key
+`SectionError` naming the shape, the key
 and the value. Dimensions in m.
 """
 

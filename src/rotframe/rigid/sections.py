@@ -1,8 +1,8 @@
 """Geometric properties of plane cross-sections, and linear elastic bending.
 
-A :class:`Section` is one outer region minus zero or more holes. A region is a
-simple polygon (:class:`PolygonRegion`) or an exact circle
-(:class:`CircleRegion`), so circles and tubes are exact rather than polygons
+A `Section` is one outer region minus zero or more holes. A region is a
+simple polygon (`PolygonRegion`) or an exact circle
+(`CircleRegion`), so circles and tubes are exact rather than polygons
 with many sides. From the section come its area, centroid, second moments of
 area about the centroid or any point, principal moments and axes (the major
 axis is the strongest in bending, the minor the weakest; see the end of the
@@ -25,7 +25,7 @@ Conventions
   The second-moment tensor, with the tensor sign convention of the inertia
   tensor, is ``J = [[Ixx, -Ixy], [-Ixy, Iyy]]``: the second moment about the
   centroidal axis of unit direction ``e`` is ``e @ J @ e``. Its eigenpairs,
-  from :func:`rotframe.rigid.principal.principal_axes` (the routine that also serves
+  from [`rotframe.rigid.principal.principal_axes`][rotframe.rigid.principal.principal_axes] (the routine that also serves
   the 3D inertia tensor), are the principal moments and axes.
 * Principal angle: the angle of the major principal axis, measured from +x
   counter-clockwise, in (-90, 90] degrees. It satisfies
@@ -33,13 +33,13 @@ Conventions
   equal (relative difference below ``1e-9``; circles, squares, regular
   polygons) every centroidal axis is principal and the angle is reported as 0.
 * Boundaries: polygons are accepted in either orientation and every
-  :class:`PolygonRegion` is stored counter-clockwise. Holes are subtracted,
+  `PolygonRegion` is stored counter-clockwise. Holes are subtracted,
   which is Green's theorem with each hole boundary traversed clockwise
   (material always on the left of the boundary). Holes must lie strictly
   inside the outer boundary and be disjoint from each other (no shared
   points, to a relative tolerance of 1e-12 of the section size: model a
   notch as part of the outer polygon).
-* Bending: see :meth:`Section.bending_stress` for the sign convention of the
+* Bending: see `Section.bending_stress` for the sign convention of the
   moments and its derivation.
 
 References
@@ -54,11 +54,11 @@ References
 
 Modules
 -------
-This module gathers the public names of :mod:`rotframe.rigid.section_geometry`
-(regions, :class:`SectionError`), :mod:`rotframe.rigid.cross_section`
-(:class:`Section`, :class:`NeutralAxis`, bending) and
-:mod:`rotframe.rigid.section_shapes` (named shapes). Drawing is
-:func:`rotframe.app.section_plot.plot_section`.
+This module gathers the public names of `rotframe.rigid.section_geometry`
+(regions, `SectionError`), `rotframe.rigid.cross_section`
+(`Section`, `NeutralAxis`, bending) and
+`rotframe.rigid.section_shapes` (named shapes). Drawing is
+`rotframe.app.section_plot.plot_section`.
 """
 
 from __future__ import annotations

@@ -1,15 +1,15 @@
 """Free and torqued rigid body by Lie-Poisson splitting, and the plain right-hand side with RK4.
 
-* :func:`lie_poisson`: symmetric splitting into exact rotations about body axes
+* [`lie_poisson`][rotframe.rigid.torqued.lie_poisson]: symmetric splitting into exact rotations about body axes
   (McLachlan 1993; Dullweber, Leimkuhler & McLachlan 1997), order 2, 4, 6 or 8:
   ``|L|`` kept to round-off, energy error bounded without trend; a constant torque
   in body or space axes.
-* :func:`torqued_splitting`: a torque that depends on time and state, Strang
+* [`torqued_splitting`][rotframe.rigid.torqued.torqued_splitting]: a torque that depends on time and state, Strang
   splitting around the same exact free flow.
-* :func:`rigid_rhs` (for ``solve_ivp``) and :func:`rigid_rk4`: classical RK4, for
+* [`rigid_rhs`][rotframe.rigid.torqued.rigid_rhs] (for ``solve_ivp``) and [`rigid_rk4`][rotframe.rigid.torqued.rigid_rk4]: classical RK4, for
   comparison. It does not keep ``|L|``, the energy or ``|q|``: all drift like ``h^4 t``.
 
-Conventions as in :mod:`rotframe.rigid.free_body`.
+Conventions as in [`rotframe.rigid.free_body`][rotframe.rigid.free_body].
 
 References
 ----------
@@ -127,17 +127,17 @@ def torqued_splitting(
 
     ``torque(t, L_body, q) -> (3,)`` (N m) in body or space axes. Each step of
     the symmetric composition is kick(tau/2), the exact free flow (as in
-    :func:`lie_poisson`), kick(tau/2), with the orientation frozen during the
+    [`lie_poisson`][rotframe.rigid.torqued.lie_poisson]), kick(tau/2), with the orientation frozen during the
     kicks; a kick evaluates the torque at its midpoint in L (explicit midpoint
     rule), so a torque that depends on L (damping, say) keeps the step second
-    order. Orders 4, 6 and 8 as in :func:`lie_poisson`. The loop runs in Python and
+    order. Orders 4, 6 and 8 as in [`lie_poisson`][rotframe.rigid.torqued.lie_poisson]. The loop runs in Python and
     calls the compiled free flow (about a microsecond a step): for constant
-    torques use :func:`lie_poisson`, which is compiled throughout.
+    torques use [`lie_poisson`][rotframe.rigid.torqued.lie_poisson], which is compiled throughout.
 
     Parameters
     ----------
     inertia, L0_body, q0, h, n_steps, order, sample_every
-        As in :func:`lie_poisson`.
+        As in [`lie_poisson`][rotframe.rigid.torqued.lie_poisson].
     torque : callable
         ``torque(t, L_body, q)``: time (s), angular momentum (body axes,
         kg m^2/s), orientation (scalar-last, body -> space) -> torque (N m).
@@ -147,7 +147,7 @@ def torqued_splitting(
     Returns
     -------
     L_body, q, times
-        As in :func:`lie_poisson`.
+        As in [`lie_poisson`][rotframe.rigid.torqued.lie_poisson].
     """
     inertia, inv_i = check_inertia(inertia)
     L = check_vector3(L0_body, "L0_body", InvalidStateError).copy()
@@ -243,7 +243,7 @@ def rigid_rk4(
     torque_frame: str = "body",
     sample_every: int = 1,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Classical fixed-step RK4 on :func:`rigid_rhs` (compiled), for comparison.
+    """Classical fixed-step RK4 on [`rigid_rhs`][rotframe.rigid.torqued.rigid_rhs] (compiled), for comparison.
 
     RK4 keeps none of the invariants: ``|L|``, the energy and ``|q|`` drift like
     ``h^4 t``; ``q`` is not renormalised (only the rotation matrix used for the
@@ -252,16 +252,16 @@ def rigid_rk4(
     Parameters
     ----------
     inertia, L0_body, q0, h, n_steps, sample_every
-        As in :func:`lie_poisson`.
+        As in [`lie_poisson`][rotframe.rigid.torqued.lie_poisson].
     mgl, torque, torque_frame
-        As in :func:`rigid_rhs`.
+        As in [`rigid_rhs`][rotframe.rigid.torqued.rigid_rhs].
 
     Returns
     -------
     L_body : ndarray, shape (k, 3)
     q : ndarray, shape (k, 4)
     times : ndarray, shape (k,)
-        As in :func:`lie_poisson`.
+        As in [`lie_poisson`][rotframe.rigid.torqued.lie_poisson].
     """
     inertia, inv_i = check_inertia(inertia)
     L0 = check_vector3(L0_body, "L0_body", InvalidStateError)

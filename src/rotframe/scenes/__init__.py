@@ -19,19 +19,19 @@ A scene is a module (or any object) with::
 scenario file's), ``terms`` is the list of model terms, ``method`` a name or
 None (choose a default), ``run`` the run settings (``step``, ``rtol``,
 ``samples``), ``progress`` None or a callable taking the fraction done.
-:class:`~rotframe.scenes.base.SceneResult` wraps a trajectory with ``times``
+`SceneResult` wraps a trajectory with ``times``
 and either ``r``, ``v`` (n, N, 3) for particles or ``L`` (n, 3), ``q`` (n, 4)
-for a rigid body. ``record`` logs to a :class:`rotframe.app.record.Recording`
+for a rigid body. ``record`` logs to a [`rotframe.app.record.Recording`][rotframe.app.record.Recording]
 (passed in: scenes never import rerun nor anything from ``rotframe.app``).
 
-``METHODS`` may be a :class:`~rotframe.scenes.base.MethodNames` (canonical names
+``METHODS`` may be a `MethodNames` (canonical names
 plus old names still accepted; a run reports the canonical one). The built-in
 scenes declare ``PARAMETERS``, a frozen dataclass, and read ``values`` through
-:func:`~rotframe.scenes.base.with_parameters`, which builds it once per call
+`with_parameters`, which builds it once per call
 and refuses a key the dataclass does not have (exit 2).
 
-Your own scene is registered with :func:`rotframe.register_scene` (which calls
-:func:`register`). The command line imports the modules listed in the
+Your own scene is registered with [`rotframe.register_scene`][rotframe.app.api.register_scene] (which calls
+`register`). The command line imports the modules listed in the
 environment variable ``ROTFRAME_PLUGINS`` (comma-separated module names or
 paths to ``.py`` files) the first time it looks a scene up, so a module that
 registers its scene at import is visible to ``rotframe run``.

@@ -65,7 +65,7 @@ def scene_parameters(cls, values):
     """An instance of the scene's frozen parameter dataclass ``cls`` from the validated ``values``.
 
     ``values`` maps parameter names to values in their documented units (what
-    :meth:`rotframe.app.scenario.Scenario.with_values` resolves; a ``"run"`` key,
+    `rotframe.app.scenario.Scenario.with_values` resolves; a ``"run"`` key,
     the run settings, is not a parameter and is skipped). Each field is
     converted to its declared type (``float``, ``int``, ``bool``, ``str`` or
     ``tuple[float, ...]``); a field missing from ``values`` takes its default.
@@ -127,8 +127,9 @@ class MethodNames(tuple):
 
     A tuple of the canonical names (iterating, printing and ``len`` see only
     those, so messages and ``rotframe show`` list them), whose ``in`` also
-    accepts an alias; :meth:`canonical` maps an alias to its name, which is the
-    name a run reports (the JSON ``method``).
+    accepts an alias; `canonical` maps an alias to its name, which is the
+    name a run reports (the JSON ``method``). Names are matched without regard
+    to case (scipy's ``"DOP853"`` is ``dop853``).
     """
 
     def __new__(cls, names, aliases=None):
@@ -140,11 +141,17 @@ class MethodNames(tuple):
         return self
 
     def __contains__(self, name) -> bool:
-        return tuple.__contains__(self, name) or (isinstance(name, str) and name in self.aliases)
+        if not isinstance(name, str):
+            return False
+        name = name.lower()
+        return tuple.__contains__(self, name) or name in self.aliases
 
     def canonical(self, name):
-        """The canonical name of ``name`` (itself when it is one; None stays None)."""
-        return self.aliases.get(name, name) if isinstance(name, str) else name
+        """The canonical name of ``name`` (any case; itself when it is one; unknown names and None unchanged)."""
+        if not isinstance(name, str) or name not in self:
+            return name
+        name = name.lower()
+        return self.aliases.get(name, name)
 
 
 def particle_methods() -> MethodNames:
@@ -223,7 +230,7 @@ def until_event(traj, name, particle=0):
 
 
 def landing(traj, name="ground", particle=0):
-    """``(times, r, v, landed)``: :func:`until_event` of the ``name`` event, and whether it happened."""
+    """``(times, r, v, landed)``: `until_event` of the ``name`` event, and whether it happened."""
     times, r, v = until_event(traj, name, particle)
     return times, r, v, len(traj.event_times[name][particle]) > 0
 
@@ -257,7 +264,7 @@ def earth_model_constants(latitude_deg, g_model="wgs84"):
 def energy_in_rotating_frame(r, v, g, omega=None, centrifugal=False):
     """Jacobi energy per unit mass 1/2 |v|^2 + g z [- 1/2 |omega x r|^2]: conserved without drag.
 
-    Uniform gravity only; :func:`jacobi_energy` builds the energy from any model's terms.
+    Uniform gravity only; `jacobi_energy` builds the energy from any model's terms.
     """
     e = 0.5 * np.sum(v * v, axis=1) + g * r[:, 2]
     if centrifugal and omega is not None:
@@ -283,7 +290,7 @@ def potential_energy(model, r):
     - ``spring`` (a = -w0^2 (x, y, 0)): V = 1/2 w0^2 (x^2 + y^2).
 
     Coriolis, the pendulum string and the curved ground do no work. Drag and the
-    Euler force (a spin rate that changes) have no potential: see :func:`jacobi_energy`.
+    Euler force (a spin rate that changes) have no potential: see `jacobi_energy`.
 
     Parameters
     ----------
@@ -312,7 +319,7 @@ def potential_energy(model, r):
 def jacobi_energy(model, r, v):
     """Jacobi energy per unit mass 1/2 |v|^2 + V(r) in the rotating frame, or None if not conserved.
 
-    It is conserved when every term of the model is in :data:`CONSERVATIVE_TERMS`
+    It is conserved when every term of the model is in `CONSERVATIVE_TERMS`
     and the frame turns at a constant rate; otherwise (drag, a spin-up) there is
     no invariant to check and None is returned.
     """

@@ -80,7 +80,7 @@ def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):
     The interval is (last - first) / (n - 1), so two crossing errors count. A
     relative 1e-9 covers round-off of the exact flow; fixed-step methods add
     (lambda h)^2 relative (order 2, factor 10 of margin), the adaptive ``dop853``
-    :func:`rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
+    `rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
     """
     dt = float(traj.times[1] - traj.times[0])
     w = traj.L / np.where(inertia > 0, inertia, np.inf)

@@ -3,7 +3,7 @@
 Local ENU frame with the origin below the pivot at the bob's rest position,
 pivot at (0, 0, L). The full model is the spherical pendulum on the rotating
 Earth: effective gravity, Coriolis, the string kept exactly (the splitting on
-the sphere in :func:`rotframe.particles.kernels.step_sphere`). The bob is released from
+the sphere in `rotframe.particles.kernels.step_sphere`). The bob is released from
 rest in the rotating frame at ``amplitude`` east of the rest position, which
 gives a swing of tiny ellipticity and so negligible Airy precession
 (docs/physics/earth.md). ``small_angle = true`` uses instead the linearised
@@ -240,3 +240,17 @@ def record(rec, p, result):
                   label="-Omega sin(lat) t (clockwise in the north)")
     if model.has("pendulum"):
         rec.scalars("diagnostics/constraint_error_m", t, np.linalg.norm(r - [0, 0, L], axis=1) - L)
+    # the swing plane at the start and at the end, static: the first frame already shows the turn
+    turned = float(np.degrees(angle[-1] - angle[0]))
+    for name, k, color, text in (("start", 0, [60, 200, 90], "t = 0"),
+                                 ("end", -1, [230, 60, 60], f"t = {t[-1] / 3600:.3g} h: turned {abs(turned):.3g} deg "
+                                  + ("clockwise" if turned < 0 else "anticlockwise"))):
+        rec.static(f"world/swing_plane_{name}", "LineStrips3D", strips=[np.stack([-d[k], d[k]]).astype(np.float32)],
+                   colors=[color], radii=[0.02])
+        # the label at the line's end (a strip's label sits at its middle, where the two would overlap)
+        rec.static(f"world/swing_plane_{name}/label", "Points3D", positions=[(1.08 * d[k]).astype(np.float32)],
+                   colors=[color], labels=[text], radii=[0.04])
+    # the eye above the bob, tilted a little to the south: the swing and its turning plane fill the
+    # view (the string, L up, is out of it); the hour plays in half a minute
+    rec.view(eye=(0.0, -0.9 * a, 2.6 * a), look_at=(0.0, 0.0, 0.0),
+             contents=["+ /world/**", "- /world/string_at_rest"])

@@ -100,7 +100,7 @@ def _tolerance(method, rate, traj):
     are exact) measure a uniform rotation, fitted over many samples: a relative
     1e-9 covers the round-off of angles of up to 1e7 rad. RK4 adds its truncation
     error, (rate h)^4 per unit time in relative terms, with a factor 100 of margin. The adaptive
-    ``dop853`` is good to :func:`rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
+    ``dop853`` is good to `rotframe.scenes.rigid_base.adaptive_rel_error` of its ``rtol`` and steps.
     """
     tol = 1e-9 * abs(rate)
     h = traj.extras.get("step")

@@ -119,7 +119,7 @@ def tilt(traj):
 def euler_angles(q, seq="ZXZ"):
     """Euler angles (rad, any of the twelve sequences) of body -> space quaternions, as an output.
 
-    The direction-cosine matrix of :mod:`rotframe.frames` maps space to body, the
+    The direction-cosine matrix of [`rotframe.frames`][rotframe.frames] maps space to body, the
     transpose of the quaternion's matrix. Where the angles are not unique (the
     sleeping top at theta = 0) the third angle is set to 0 (``on_gimbal_lock="mask"``).
     """

@@ -156,3 +156,9 @@ def record(rec, p, result):
         rec.scalars("diagnostics/velocity_direction_deg", traj.times, direction, label="direction of v (from east)")
         rec.reference("diagnostics/velocity_direction_deg", traj.times, direction[0] - np.degrees(f * traj.times),
                       label="turns at -2 Omega sin(lat) (clockwise in the north)")
+    # the eye above the middle of the circle (km), tilted a little to the south: the whole loop in view
+    rec.line("world/path", traj.r[:, 0] / 1000.0, color=[110, 110, 110])  # the whole loop from the first frame
+    xy = traj.r[:, 0, :2] / 1000.0
+    centre = np.append((xy.min(axis=0) + xy.max(axis=0)) / 2, 0.0)
+    size = max(float(np.max(xy.max(axis=0) - xy.min(axis=0))), 1e-3)
+    rec.view(eye=centre + np.array([0.0, -0.5 * size, 1.4 * size]), look_at=centre)

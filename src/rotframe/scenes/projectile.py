@@ -10,8 +10,8 @@ isothermal atmosphere, density exp(-z / H)). Range is measured along the
 ground (the great circle when ``curvature`` is on); the lateral deflection is
 positive to the right of the aim. Theory: flat Earth, vacuum, zeroth order in
 Omega for range and flight time, first order for the lateral deflection
-(:func:`rotframe.analytic.projectile_lateral_deflection_first_order`), each with
-its stated accuracy (:func:`theory_and_accuracy`).
+(`rotframe.analytic.projectile_lateral_deflection_first_order`), each with
+its stated accuracy (`theory_and_accuracy`).
 """
 
 from __future__ import annotations
@@ -220,3 +220,13 @@ def record(rec, p, result):
     shown = (np.outer(rng, aim) + magnify * np.outer(lateral, right)) / 1000.0
     shown[:, 2] = r[:, 2] / 1000.0
     rec.points("world/deflection_magnified", times, shown, radius=0.4, color=[40, 160, 230])
+    # the whole path and its magnified deflection, static and faint: the first frame shows the flight
+    rec.line("world/path", r / 1000.0, color=[120, 120, 120])
+    rec.line("world/deflection_magnified_path", shown, color=[40, 110, 170])
+    rec.static("world/deflection_magnified_path", "LineStrips3D",
+               labels=[f"deflection x{magnify:g}: {lateral[-1]:.0f} m right of the aim at the landing"])
+    # the eye beside and above the middle of the path, left of the aim: the whole path in view
+    # (not the muzzle among the axis arrows), the deflection to the right seen across it
+    span = max(float(rng[-1]), float(np.max(r[:, 2])), 1.0) / 1000.0
+    middle = aim * span / 2 + np.array([0.0, 0.0, float(np.max(r[:, 2])) / 2000.0])
+    rec.view(eye=middle - 0.9 * span * right + np.array([0.0, 0.0, 0.45 * span]), look_at=middle)

@@ -14,7 +14,7 @@ from rotframe.scenes.base import MethodNames
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6|8]`` the
 #: Lie-Poisson splitting of orders 2, 4, 6, 8, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
-#: (:func:`rotframe.rigid.adaptive.rigid_dop853`, relative tolerance ``rtol`` of the run).
+#: (`rotframe.rigid.adaptive.rigid_dop853`, relative tolerance ``rtol`` of the run).
 FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "rk4",
                             "dop853"))
 #: Methods of the heavy top: ``top-splitting[4|6|8]`` (exact free symmetric-top flow and gravity kick,
@@ -69,7 +69,7 @@ class BodyTrajectory:
 def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     """Integrate a free body, or a heavy symmetric top (``top = (mass, length, g)``), by a named method.
 
-    ``method`` is a name of :data:`FREE_METHODS`, or of :data:`HEAVY_METHODS`
+    ``method`` is a name of `FREE_METHODS`, or of `HEAVY_METHODS`
     (an old name too, run and reported under its canonical name) with ``top``.
     Fixed-step methods use ``run["step"]`` and keep ``run["samples"]`` samples;
     the work is done in chunks so that progress shows, Ctrl-C interrupts and a
@@ -78,6 +78,7 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     from rotframe.rigid import dynamics as rigid
     from rotframe import limits
 
+    method = method.lower() if isinstance(method, str) else method  # any case: "DOP853" is dop853
     if top is not None:
         method = HEAVY_METHODS.canonical(method)
     duration = float(duration)
@@ -169,8 +170,8 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
 
 
 def _integrate_adaptive(inertia, L0, q0, times, rtol, mgl, progress, steps_estimate=0.0):
-    """The ``dop853`` run at ``times`` (``rtol`` and moments checked by :func:`_check_adaptive`): compiled
-    adaptive DOP853, at most :data:`SAMPLES_PER_CALL` samples and about :data:`STEPS_PER_CALL` steps a call
+    """The ``dop853`` run at ``times`` (``rtol`` and moments checked by `_check_adaptive`): compiled
+    adaptive DOP853, at most `SAMPLES_PER_CALL` samples and about `STEPS_PER_CALL` steps a call
     (from ``steps_estimate``, the run's estimated steps), so that a signal is answered within a fraction
     of a second however long a sample interval is: one that needs more is advanced in pieces.
 
@@ -276,7 +277,7 @@ def free_body_state(inertia, omega_body):
     """``(inertia, L0, q0)`` of a free body: principal moments (checked), L = I omega in body axes, q0 identity.
 
     Raises ScenarioError for moments that no body has (see
-    :func:`rotframe.rigid.mass_properties.check_moments`).
+    [`rotframe.rigid.mass_properties.check_moments`][rotframe.rigid.mass_properties.check_moments]).
     """
     from rotframe.rigid import mass_properties
 
@@ -314,7 +315,7 @@ def _stepper(method, inertia, top):
 
     ``checked`` is the public function (every input checked); ``fast`` runs the
     same compiled driver with the body's constants checked once
-    (:func:`rotframe.rigid.drivers.splitting_stepper`), for the chunks after a
+    (`rotframe.rigid.drivers.splitting_stepper`), for the chunks after a
     first checked call. Both give the same numbers.
     """
     from rotframe.rigid import dynamics as rigid
@@ -401,7 +402,7 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
                 L_label="L in space (fixed: no torque acts)"):
     """Body transform, its axes, a box of the same principal moments, L in space per sample, the polhode.
 
-    Logged to ``rec``, the :class:`rotframe.app.record.Recording` passed in.
+    Logged to ``rec``, the [`rotframe.app.record.Recording`][rotframe.app.record.Recording] passed in.
 
     ``world/angular_momentum`` is an arrow along L (space frame) at each
     sample, scaled to 1.5 ``axis_length``: fixed for a free body, turning for

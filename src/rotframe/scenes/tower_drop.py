@@ -180,6 +180,12 @@ def record(rec, p, result):
     if e is not None:
         rec.scalars("diagnostics/energy_rel_error", times, (e - e[0]) / abs(e[0]))
     rec.exact_values("world/body/landing", state=np.concatenate([r[-1], v[-1]]), time=[times[-1]])
+    # the eye to the south of the tower, level with its middle: the tower and the magnified fall east of it
+    rec.line("world/deflection_magnified_path", shown, color=[40, 110, 170])  # the whole fall from the first frame
+    rec.static("world/deflection_magnified_path", "LineStrips3D",
+               labels=[f"east x{magnify:g}: {1e3 * r[-1, 0]:.1f} mm at the foot"])
+    east = float(shown[-1, 0])
+    rec.view(eye=(east / 2, -1.6 * h, 0.6 * h), look_at=(east / 2, 0.0, 0.45 * h))
 
 
 def simulate_ensemble(values_list, terms, method, run, tracks=None):
@@ -188,16 +194,16 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model: each such group is one
     ``integrate_particles`` call with one particle per point and the ground event
-    (:func:`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
-    :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
+    (`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
+    `analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
     Parameters
     ----------
     values_list : list of dict
-        Resolved parameter values per point, as :func:`simulate` takes them.
+        Resolved parameter values per point, as `simulate` takes them.
     terms, method, run
-        As for :func:`simulate`.
+        As for `simulate`.
     tracks : dict, optional
         Keys are indices into ``values_list`` whose paths are wanted; on return each maps
         to ``(times, positions (n, 3))`` up to the landing.
@@ -229,7 +235,7 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
 
 @with_parameters(TowerDropParameters)
 def ensemble_theory(p):
-    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
+    """The closed forms of `analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),

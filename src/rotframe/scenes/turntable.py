@@ -5,7 +5,7 @@ puck starts at (start_radius, 0, 0) on the turntable, shoved towards the centre
 at ``speed`` relative to the turntable. In inertial space it moves on a straight
 line; seen from the turntable it feels Coriolis, centrifugal and (while the
 turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md,
-:func:`rotframe.analytic.turntable_inertial_line`): the inertial
+`rotframe.analytic.turntable_inertial_line`): the inertial
 line mapped into the rotating frame, r_rot(t) = R_z(-theta(t)) (r0 + v_in t),
 theta(t) = integral of w.
 """
@@ -104,7 +104,7 @@ def inertial_line(omega, r0, v0, times):
 
     ``r0``, ``v0`` are the puck's position and velocity in the turntable's frame
     at t = 0; its inertial velocity is ``v0 + w(0) x r0``, and the line is
-    :func:`rotframe.analytic.turntable_inertial_line` turned by the schedule's
+    `rotframe.analytic.turntable_inertial_line` turned by the schedule's
     exact angle.
     """
     times = np.asarray(times, dtype=float)

@@ -2,7 +2,7 @@
 
 For each problem (a scenario's equations, initial state and horizon) every
 rotframe method runs over a ladder of step sizes or tolerances, and so do the
-peers (:mod:`rotframe.app.bench.peers`): scipy's ``solve_ivp`` (RK45, DOP853, Radau,
+peers (`rotframe.app.bench.peers`): scipy's ``solve_ivp`` (RK45, DOP853, Radau,
 LSODA) with an expert's scalar right-hand side, scipy DOP853 with a
 numba-compiled right-hand side, and diffrax (Dopri8, Tsit5; whole solve
 jit-compiled, CPU, 64-bit) where the ``bench`` extra is installed. Each row
@@ -17,11 +17,11 @@ Everything is measured in one run on one machine, and claims are ratios:
 fastest rotframe run reaching that error, the fastest peer run reaching it,
 and their ratio; ``speedup`` (text output) compares with plain scipy as before.
 
-Modules: :mod:`~rotframe.app.bench.problems` (the problems and ladders),
-:mod:`~rotframe.app.bench.measure` (timing rotframe and the scipy baselines),
-:mod:`~rotframe.app.bench.peers` (the peers' right-hand sides), :mod:`~rotframe.app.bench.summary`
-(error levels, speed-ups), :mod:`~rotframe.app.bench.throughput` (ensemble, sweep, start-up,
-recording) and :mod:`~rotframe.app.bench.report` (table, plots, JSON).
+Modules: `problems` (the problems and ladders),
+`measure` (timing rotframe and the scipy baselines),
+`peers` (the peers' right-hand sides), `summary`
+(error levels, speed-ups), `throughput` (ensemble, sweep, start-up,
+recording) and `report` (table, plots, JSON).
 """
 
 from __future__ import annotations
@@ -83,6 +83,10 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
 def main(args) -> int:
     from rotframe.app.progress import Progress
 
+    if getattr(args, "plots", None):
+        from rotframe.app.plot import require_matplotlib
+
+        require_matplotlib()  # the plot extra, checked before the bench runs
     bar = Progress("bench", "runs", enabled=not args.json)  # on a terminal only, never with --json
 
     def progress(done, total, label):

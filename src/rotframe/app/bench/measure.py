@@ -32,7 +32,7 @@ MIN_REPEAT_S = 0.02
 def timed(fn, budget=2.0, max_repeats=5):
     """(median wall time of one call, last result) over repeats that fit in ``budget`` seconds.
 
-    At most ``max_repeats`` repeats. A run shorter than :data:`MIN_REPEAT_S` (judged from its
+    At most ``max_repeats`` repeats. A run shorter than `MIN_REPEAT_S` (judged from its
     first call) is called ``k`` times a repeat, enough to fill that, and each repeat's time is
     divided by ``k`` -- the same rule for rotframe and for every peer.
     """
@@ -81,7 +81,7 @@ class Plan:
 
 
 def planned_units(p, quick, peers_ok):
-    """How many timed units :func:`run_problem` will do for ``p`` (for the progress bar)."""
+    """How many timed units `run_problem` will do for ``p`` (for the progress bar)."""
     n = sum(len(s) for s in p.runs.values())
     n += len(SCIPY_METHODS_QUICK if quick else SCIPY_METHODS) * len(_scipy_rtols(p, quick))
     if not quick:

@@ -1,6 +1,6 @@
 """The benchmark problems: each scenario's equations, initial state, horizon, reference and method ladders.
 
-A :class:`Problem` carries the equations for scipy (``rhs``, ``y0``), the exact or
+A `Problem` carries the equations for scipy (``rhs``, ``y0``), the exact or
 reference final state, the error and invariant measures, and for every rotframe
 method a ladder of step sizes or tolerances (short ones with ``quick``).
 """
@@ -27,7 +27,7 @@ class Problem:
     error as a function to call after the timing (or None). A runner with
     prepared methods also carries ``run.prepared_call(method, setting) -> (call,
     finish)``, so that the bench times the prepared call alone
-    (:func:`rotframe.app.bench.measure.timed_call`).
+    (`rotframe.app.bench.measure.timed_call`).
     """
 
     scenario: str

@@ -86,7 +86,7 @@ def level_summary(rows, levels=LEVELS):
 
 
 def shortfall_reason(mine, peer):
-    """Why the fastest rotframe run ``mine`` is less than :data:`GOAL` times faster than the ``peer`` row.
+    """Why the fastest rotframe run ``mine`` is less than `GOAL` times faster than the ``peer`` row.
 
     The time ratio is split into the work ratio (``nfev``: right-hand-side
     evaluations, or steps of a fixed-step method) and the cost of one unit of

@@ -19,10 +19,10 @@ __all__ = ["ensemble_rows", "same_work", "sweep_rows", "startup_rows", "record_r
 def ensemble_rows(quick):
     """Particle-steps per second of the tower-drop ensemble path on one core and on all, beside hand-written loops.
 
-    rotframe: :func:`rotframe.particles.ensemble.integrate_ensemble` (gravity + Coriolis,
+    rotframe: `rotframe.particles.ensemble.integrate_ensemble` (gravity + Coriolis,
     exact-rotation splitting, the ground event watched every step) with
     ``threads=1`` and with every core (or ``--threads N``). Ceiling: the same
-    splitting written out by hand (:mod:`rotframe.app.bench.ceiling`, no event),
+    splitting written out by hand (`rotframe.app.bench.ceiling`, no event),
     serial and with ``prange`` on as many numba threads. ``parallel_efficiency``
     is the N-core rate over ``N x`` the single-core rate; ``goal_ratio`` that rate
     over ``0.7 x N x`` the single-core rate (1 or more meets the goal);
@@ -234,7 +234,7 @@ def _timed_runs(cmd, repeats=1, env=None):
     """Median wall time and median import time (s) of ``repeats`` runs of ``cmd`` in new processes.
 
     ``cmd[0]`` is the interpreter; each run has ``-X importtime``, so that its own imports
-    (:func:`import_seconds`) are measured in the same process as its wall time.
+    (`import_seconds`) are measured in the same process as its wall time.
     """
     walls, imports = [], []
     for _ in range(repeats):
@@ -250,9 +250,9 @@ def startup_rows(scenarios=None):
     """``rotframe run NAME --no-record`` in new processes, for every scenario: warm cache, then empty.
 
     ``import_s`` is the time that run spent importing modules, measured in its own process
-    (``python -X importtime``, :func:`import_seconds`: numpy, scipy, numba, astropy, whatever
+    (``python -X importtime``, `import_seconds`: numpy, scipy, numba, astropy, whatever
     that scene imports, when it imports them); ``beyond_imports_s = wall_s - import_s`` is what
-    the goal of a first run counts (:data:`STARTUP_GOALS`: cold 3 s beyond imports, warm 1 s in
+    the goal of a first run counts (`STARTUP_GOALS`: cold 3 s beyond imports, warm 1 s in
     all). The warm time is the median of three runs after one that fills the cache; the cold
     one is a run with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new folder), as in a
     fresh environment.

@@ -17,8 +17,8 @@ the ensemble next to it.
 
 Execution. A scene module with ``simulate_ensemble(values_list, terms, method,
 run, tracks=None)`` integrates a whole batch of points in one vectorised call
-of the compiled core (:func:`rotframe.particles.ensemble.integrate_ensemble` helps it); otherwise each
-point goes through :func:`rotframe.app.runner.run`. Points are cut into batches
+of the compiled core (`rotframe.particles.ensemble.integrate_ensemble` helps it); otherwise each
+point goes through `rotframe.app.runner.run`. Points are cut into batches
 (about 0.2 s to 30 s of work each, at most about four per worker); batches run
 in this process, or as Dask tasks on a ``LocalCluster`` (``--workers N``) or an
 existing scheduler (``--scheduler ADDRESS``), retried when a worker is lost.
@@ -28,10 +28,10 @@ interrupted sweep keeps its finished batches and ``--resume`` computes only
 the missing rows.
 
 Dask and pyarrow are imported only when needed (``pip install
-rotframe[sweep]``). Modules: :mod:`~rotframe.app.sweep.spec` (what is swept),
-:mod:`~rotframe.app.sweep.batch` (one batch of rows), :mod:`~rotframe.app.sweep.execute`
-(batches here or on Dask), :mod:`~rotframe.app.sweep.store` (Parquet parts, merge, resume,
-lock), :mod:`~rotframe.app.sweep.plots` and :mod:`~rotframe.app.sweep.recording`; this
+rotframe[sweep]``). Modules: `spec` (what is swept),
+`batch` (one batch of rows), `execute`
+(batches here or on Dask), `store` (Parquet parts, merge, resume,
+lock), `plots` and `recording`; this
 module is the ``rotframe sweep`` command.
 """
 
@@ -59,7 +59,7 @@ def main(args) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        As built by :mod:`rotframe.app.cli` (``name, sets, grid, log_grid, samples, vary, seed, method,
+        As built by `rotframe.app.cli` (``name, sets, grid, log_grid, samples, vary, seed, method,
         workers, scheduler, out, resume, json``).
 
     Returns

@@ -2,8 +2,8 @@
 
 A scene module with ``simulate_ensemble(values_list, terms, method, run, tracks=None)``
 integrates the whole batch in one vectorised call of the compiled core (through
-:func:`rotframe.particles.ensemble.integrate_ensemble`); otherwise each row goes
-through :func:`rotframe.app.runner.run`. A failed row is data (its ``error``), never
+`rotframe.particles.ensemble.integrate_ensemble`); otherwise each row goes
+through `rotframe.app.runner.run`. A failed row is data (its ``error``), never
 the end of the sweep.
 """
 
@@ -41,7 +41,7 @@ class BatchTask:
 
 @dataclass
 class BatchOutput:
-    """Rows computed by :func:`run_batch`; ``tracks`` maps a row to (times, positions) for the recording."""
+    """Rows computed by `run_batch`; ``tracks`` maps a row to (times, positions) for the recording."""
 
     index: int
     rows: list
@@ -108,7 +108,7 @@ def _ensemble_batch(task, scn, scene, base):
 
 
 def _runs_batch(task, scn, base):
-    """One :func:`rotframe.app.runner.run` per row; a failure goes to the row's ``error``."""
+    """One `rotframe.app.runner.run` per row; a failure goes to the row's ``error``."""
     from rotframe.app import runner
     from rotframe.particles.integrators import RunInterrupted
 

@@ -165,7 +165,7 @@ class _Context:
     path: str
     points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
-    threads: int | None = None  # threads of each vectorised batch (:func:`batch_threads`)
+    threads: int | None = None  # threads of each vectorised batch (`batch_threads`)
 
     @classmethod
     def create(cls, spec, files, meta):
@@ -195,7 +195,7 @@ def batch_threads(local_workers=None, here=False):
     over a ``LocalCluster`` of ``local_workers`` single-threaded processes, so
     that the workers do not oversubscribe the machine; None (every core of that
     worker) on an existing scheduler, whose machines this process cannot see.
-    The results do not depend on it (:mod:`rotframe.particles.ensemble`).
+    The results do not depend on it (`rotframe.particles.ensemble`).
     """
     from rotframe.particles.ensemble import resolve_threads, threads_in_force
 
@@ -281,7 +281,7 @@ def check_scheduler(address, timeout=None):
     """A Dask scheduler address: ``tcp://HOST:PORT`` (or ``tls://``), reachable within ``timeout`` seconds.
 
     Only the TCP connection is tried here; the Dask handshake itself is bounded in
-    :func:`_connect`. Raises ScenarioError in one line.
+    `_connect`. Raises ScenarioError in one line.
     """
     import socket
     from urllib.parse import urlsplit

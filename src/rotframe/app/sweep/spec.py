@@ -46,7 +46,7 @@ class Vary:
 
 @dataclass
 class SweepSpec:
-    """What to sweep: validated by :func:`parse_spec`, turned into rows by :func:`sweep_points`.
+    """What to sweep: validated by `parse_spec`, turned into rows by `sweep_points`.
 
     Attributes
     ----------
@@ -100,7 +100,7 @@ class SweepSpec:
 
 
 def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=(), seed=0, method=None):
-    """Validate the sweep's command-line pieces into a :class:`SweepSpec`.
+    """Validate the sweep's command-line pieces into a `SweepSpec`.
 
     Parameters
     ----------
@@ -143,7 +143,7 @@ def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=
 
 
 def sweep_points(spec: SweepSpec) -> np.ndarray:
-    """The swept values, one row per point: a (rows, keys) float array in :attr:`SweepSpec.keys` order.
+    """The swept values, one row per point: a (rows, keys) float array in `SweepSpec.keys` order.
 
     Grid rows are the Cartesian product of the axes (last axis fastest); Monte Carlo
     rows are drawn from ``default_rng(seed)``, one distribution after the other, so the
@@ -159,7 +159,7 @@ def sweep_points(spec: SweepSpec) -> np.ndarray:
 
 
 def points_of(spec: SweepSpec, rows) -> np.ndarray:
-    """The swept values of the given ``rows`` only (as :func:`sweep_points` would give them).
+    """The swept values of the given ``rows`` only (as `sweep_points` would give them).
 
     Grid points are computed from their row index, so a large grid is never held
     whole; Monte Carlo rows are drawn in order from the seed.
