@@ -35,7 +35,7 @@ def readable(message: str, limit: int = MAX_MESSAGE) -> str:
 class RotframeError(Exception):
     """Base class of every error rotframe raises on purpose.
 
-    The one door for messages: a message longer than :data:`MAX_MESSAGE` characters
+    The one door for messages: a message longer than `MAX_MESSAGE` characters
     (a huge value echoed back) is cut to a readable length here, for every subclass.
     """
 

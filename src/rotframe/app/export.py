@@ -37,9 +37,9 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
         The samples.
     path : path-like
         Ends in ``.npz``, ``.csv`` or ``.parquet``. Written through
-        :func:`rotframe.app.outputs.write_atomic` (a temporary file of its own, then a
+        `rotframe.app.outputs.write_atomic` (a temporary file of its own, then a
         rename), so an existing file is only replaced by a complete one; a write error
-        is an :class:`~rotframe.app.outputs.OutputError`.
+        is an `OutputError`.
     summary : mapping, optional
         The run summary (JSON-ready) to store beside the arrays.
     """

@@ -111,8 +111,8 @@ def write_atomic(final, write, what: str = "file") -> Path:
     ``pq.write_table(table, f)``, ``f.write(data)``). Only when it returns is the file
     flushed, synced and renamed to ``final``; on any failure the temporary file is
     removed, an earlier file under ``final`` is left as it was, and an OSError (full
-    disk, ``ulimit -f``, no permission, a folder in the way) becomes :class:`OutputError`,
-    one line naming the path (a :class:`~rotframe.errors.RotframeError`, exit 2).
+    disk, ``ulimit -f``, no permission, a folder in the way) becomes `OutputError`,
+    one line naming the path (a [`RotframeError`][rotframe.errors.RotframeError], exit 2).
     Two writers of the same path at once each publish a whole file of their own.
 
     Returns
@@ -129,7 +129,7 @@ def write_atomic(final, write, what: str = "file") -> Path:
 
 
 def write_bytes_atomic(final, data: bytes, what: str = "file") -> Path:
-    """Write ``data`` to ``final`` through :func:`write_atomic`."""
+    """Write ``data`` to ``final`` through `write_atomic`."""
 
     def write(f):
         view = memoryview(data)
@@ -140,7 +140,7 @@ def write_bytes_atomic(final, data: bytes, what: str = "file") -> Path:
 
 
 def write_text_atomic(final, text: str, what: str = "file") -> Path:
-    """Write ``text`` (UTF-8) to ``final`` through :func:`write_atomic`."""
+    """Write ``text`` (UTF-8) to ``final`` through `write_atomic`."""
     return write_bytes_atomic(final, text.encode("utf-8"), what)
 
 

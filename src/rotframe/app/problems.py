@@ -1,7 +1,7 @@
-"""``rotframe.simulate`` and ``rotframe.simulate_body``: your own problem, as a :class:`Result`.
+"""``rotframe.simulate`` and ``rotframe.simulate_body``: your own problem, as a `Result`.
 
-The numerical work is :mod:`rotframe.problem` (the numerical core's layer); this edge wraps
-what it returns in the same :class:`rotframe.app.api.Result` as ``rotframe.run``: arrays,
+The numerical work is `rotframe.problem` (the numerical core's layer); this edge wraps
+what it returns in the same [`rotframe.app.api.Result`][rotframe.app.api.Result] as ``rotframe.run``: arrays,
 diagnostics, warnings, ``record()``, ``export()``, ``to_dataframe()``, ``to_json()``.
 Arguments are keyword-only, SI units, vectors in the frame's axes (DESIGN, "Python: your own
 problem").
@@ -28,7 +28,7 @@ __all__ = ["simulate", "simulate_body", "ProblemScenario"]
 
 @dataclass
 class ProblemScenario:
-    """What a :class:`Result` needs of a scenario, for a problem posed in Python."""
+    """What a `Result` needs of a scenario, for a problem posed in Python."""
 
     name: str
     scene: str
@@ -77,7 +77,7 @@ def _result(scn, scene, scene_result, summary):
 def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(), method=None,
              rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None, jit=True,
              progress=None):
-    """Particles under your forces in any rotating frame; returns a :class:`rotframe.Result`.
+    """Particles under your forces in any rotating frame; returns a [`rotframe.Result`][rotframe.app.api.Result].
 
     Solves ``r'' = sum f(t, r, v) - 2 w x v - w x (w x r) - w' x r - a0(t)`` in the frame's
     axes (the fictitious forces are rotframe's; never add them yourself).
@@ -92,7 +92,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         Initial positions (m) and velocities (m/s) in the frame; N particles at once.
     duration : float
         Seconds.
-    forces : sequence of callables or :class:`rotframe.problem.particles.Force`
+    forces : sequence of callables or `rotframe.problem.particles.Force`
         ``f(t, r, v, *params) -> (ax, ay, az)``, m/s^2, frame axes (``Force(f, axes="inertial")``
         for inertial axes; ``potential=U`` for the energy or Jacobi diagnostic).
     params : tuple
@@ -167,7 +167,7 @@ def _particle_result(run, forces, origin_acceleration, duration, simulate_s):
 
 def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
                   samples=None, jit=True, progress=None):
-    """A rigid body under your torque; returns a :class:`rotframe.Result` (``trajectory.L``, ``.q``).
+    """A rigid body under your torque; returns a [`rotframe.Result`][rotframe.app.api.Result] (``trajectory.L``, ``.q``).
 
     Parameters
     ----------
@@ -183,8 +183,11 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
         Any case; ``exact`` only without a torque (principal axes). The built-in splittings
         refuse a torque by name.
 
-    The result carries ``inertia`` (3, 3), so that it can be the frame of ``rotframe.simulate``
-    (``omega=result``: the body's axes).
+    Returns
+    -------
+    Result
+        ``trajectory.L`` (n, 3), ``trajectory.q`` (n, 4); it also carries ``inertia`` (3, 3), so
+        that it can be the frame of ``rotframe.simulate`` (``omega=result``: the body's axes).
     """
     import numpy as np
 

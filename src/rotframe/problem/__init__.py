@@ -13,8 +13,8 @@ Modules, one concept each:
 * ``codegen``: the generated, disk-cached driver module of a problem;
 * ``evaluators``: source of the frame's compiled evaluators;
 * ``particle_driver``, ``body_driver``: source of the compiled drivers;
-* ``particles``: :func:`simulate_particles`, :class:`Force`;
-* ``body``: :func:`simulate_rigid_body`;
+* ``particles``: `simulate_particles`, `Force`;
+* ``body``: `simulate_rigid_body`;
 * ``forces``: the built-in forces as ordinary members of the same system.
 """
 

@@ -1,8 +1,8 @@
 """A rigid body of the user's own: any inertia tensor, a torque of the user's, DOP853 or RK4.
 
-:func:`simulate_rigid_body` is the numerical core of ``rotframe.simulate_body``. The torque
+`simulate_rigid_body` is the numerical core of ``rotframe.simulate_body``. The torque
 is a function ``tau(t, L, q, *params) -> (3,)`` in body axes (N m), compiled with numba into
-a driver generated for it (:mod:`rotframe.problem.codegen`, cached on disk), as the forces of
+a driver generated for it (`rotframe.problem.codegen`, cached on disk), as the forces of
 a particle problem are. A torque-free body may also take ``exact``, the closed-form flow of
 ``rotframe.rigid.free_body_exact`` (principal axes).
 
@@ -35,7 +35,7 @@ SPLITTING_NAMES = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8"
 
 
 class BodyRun:
-    """What :func:`simulate_rigid_body` returns: samples of L and q, diagnostics, warnings."""
+    """What `simulate_rigid_body` returns: samples of L and q, diagnostics, warnings."""
 
     def __init__(self, times, L, q, method, steps, nfev, complete, inertia, diagnostics, warnings, notes,
                  torque_samples=None, compile_s=0.0):
@@ -83,7 +83,7 @@ _FREE_HEADER = "\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n    return 0
 
 def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
                         samples=None, jit=True, progress=None) -> BodyRun:
-    """Integrate a rigid body under the user's torque; see :func:`rotframe.simulate_body`."""
+    """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
     import time
 
     from rotframe import limits

@@ -8,7 +8,7 @@ convention of ``rotframe.rigid`` and scipy's ``Rotation.from_quat``). With ``ome
     L' = L x omega + tau(t, L, q)          (Euler's equations in body axes)
     q' = q (omega, 0) / 2
 
-``F = (I^-1,)``. The stepping (DOP853, RK4) is :mod:`rotframe.problem.stepping`'s; a body
+``F = (I^-1,)``. The stepping (DOP853, RK4) is `rotframe.problem.stepping`'s; a body
 has no events (``NE = 0``).
 """
 

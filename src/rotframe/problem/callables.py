@@ -1,12 +1,12 @@
 """The user's functions: a fingerprint for the compile cache, numba compilation, checks in one line.
 
 A user function (a force, a torque, an event, omega(t), a potential) is compiled with numba
-inside a driver generated for the problem (:mod:`rotframe.problem.codegen`). The driver is
+inside a driver generated for the problem (`rotframe.problem.codegen`). The driver is
 cached on disk under a name made from the fingerprints of the functions it calls, so a second
 run (in any process) of the same functions compiles nothing, and an edited function gets a
 new driver.
 
-The fingerprint (:func:`fingerprint`) covers the function's code object (bytecode, constants,
+The fingerprint (`fingerprint`) covers the function's code object (bytecode, constants,
 names, nested code), its defaults and closure values, and, recursively, every global it
 names that is a function, a numba dispatcher or a plain value (number, string, tuple, array);
 numba's version too. A module the function reaches through an attribute (``np.sin``) is

@@ -3,10 +3,10 @@
 numba caches a compiled function under its module's file, and a function that takes another
 compiled function as an argument is compiled anew in every process (the argument's type is
 the function object itself). So each problem gets a small module of its own: a generated
-header binds the user's functions to global names (read from :data:`ENTRIES` when the module
+header binds the user's functions to global names (read from `ENTRIES` when the module
 is imported) and defines the frame's evaluators, followed by a fixed driver source
-(:mod:`rotframe.problem.particle_driver`, :mod:`rotframe.problem.body_driver`). Its file name
-is a fingerprint of everything it is made of (:func:`rotframe.problem.callables.fingerprint`),
+(`rotframe.problem.particle_driver`, `rotframe.problem.body_driver`). Its file name
+is a fingerprint of everything it is made of (`rotframe.problem.callables.fingerprint`),
 so the same functions find the same file, compiled, in the next process, and an edited
 function makes a new one.
 

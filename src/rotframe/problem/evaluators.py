@@ -1,8 +1,8 @@
 """Generated source of the frame's evaluators: omega(t), omega'(t) and a0(t) for the compiled drivers.
 
-Each form of :class:`rotframe.problem.frame.FrameSpec` has its evaluator written out here as
-source text, so that a generated driver (:mod:`rotframe.problem.codegen`) compiles only the
-form its problem uses. The numpy twins used for analysis are in :mod:`rotframe.problem.frame`;
+Each form of `rotframe.problem.frame.FrameSpec` has its evaluator written out here as
+source text, so that a generated driver (`rotframe.problem.codegen`) compiles only the
+form its problem uses. The numpy twins used for analysis are in `rotframe.problem.frame`;
 ``tests/test_simulate.py`` checks both against each other and against closed forms.
 """
 
@@ -41,7 +41,7 @@ def interval(knots, t):
 def vector_source(name: str, kind: str, derivative: bool, fn: str = "", fn_dot: str = "") -> str:
     """Source of ``name(t, F)`` returning a 3-vector's components (and its derivative's, if ``derivative``).
 
-    ``kind`` is a :data:`rotframe.problem.frame.KINDS` form or ``"zero"``; ``fn``/``fn_dot`` name
+    ``kind`` is a `rotframe.problem.frame.KINDS` form or ``"zero"``; ``fn``/``fn_dot`` name
     the bound user functions of the ``function`` form (``fn_dot`` empty: derived).
     """
     ret = "x, y, z, dx, dy, dz" if derivative else "x, y, z"

@@ -1,10 +1,10 @@
 """The built-in forces as ordinary user forces: one way to add a force.
 
-Each factory returns a :class:`rotframe.problem.particles.Force` whose function is written
+Each factory returns a `rotframe.problem.particles.Force` whose function is written
 exactly as a user would write one (plain arithmetic on ``t, r, v``), with its potential where
 it has one, so that ``rotframe.simulate(forces=[uniform_gravity(g), quadratic_drag(k)])``
 composes them with the user's own forces and the frame's fictitious terms. The physics is
-that of the scenes' model terms (:class:`rotframe.particles.model.ParticleModel`);
+that of the scenes' model terms ([`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel]);
 ``tests/test_problem_forces.py`` checks each against the scenes' compiled kernels.
 
 The constants are captured by the function (a closure), so numba compiles them in as

@@ -7,7 +7,7 @@ origin that accelerates at ``a0(t)``, obeys (all vectors in the frame's own axes
     r'' = f(t, r, v) - 2 omega x v - omega x (omega x r) - omega' x r - a0(t)
 
 where ``omega'`` is the derivative of omega (the same in the frame's axes and in inertial
-axes, since omega x omega = 0). :class:`FrameSpec` turns the forms a user may give into
+axes, since omega x omega = 0). `FrameSpec` turns the forms a user may give into
 arrays that the compiled drivers read:
 
 ==========  =========================================================================
@@ -50,9 +50,9 @@ class FrameSpec:
     Attributes
     ----------
     kind : str
-        One of :data:`KINDS` (``"zero"`` for a missing origin acceleration).
+        One of `KINDS` (``"zero"`` for a missing origin acceleration).
     data : tuple of float64 arrays
-        The kind's arrays (see :func:`frame_spec`); for ``function``, ``([h, 0, 0],)``: the step of a derived omega'.
+        The kind's arrays (see `frame_spec`); for ``function``, ``([h, 0, 0],)``: the step of a derived omega'.
     funcs : tuple of callables
         For ``function``: the user's ``omega(t)`` and, if given, ``omega_dot(t)``.
     t_range : (float, float)
@@ -217,7 +217,7 @@ def _body(result, what):
 
 
 def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
-    """Normalise a frame's angular velocity (rad/s, frame axes) to a :class:`FrameSpec`.
+    """Normalise a frame's angular velocity (rad/s, frame axes) to a `FrameSpec`.
 
     Parameters
     ----------

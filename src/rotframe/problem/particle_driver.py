@@ -1,8 +1,8 @@
 """Source of the compiled particle driver of a user's problem (DOP853 and RK4, events, energy).
 
-:mod:`rotframe.problem.codegen` writes a module made of a generated header (the user's
+`rotframe.problem.codegen` writes a module made of a generated header (the user's
 functions bound to names, the frame's evaluators, the state size ``D``, the event count
-``NE``) followed by :data:`SOURCE`, and numba compiles it with ``cache=True``. The header
+``NE``) followed by `SOURCE`, and numba compiles it with ``cache=True``. The header
 defines, besides ``jit``, ``math``, ``np`` and the DOP853
 tableau ``A, B, C, E3, E5`` and error norm ``error_norm``::
 

@@ -1,8 +1,8 @@
 """Particles of the user's own problem: their forces, their events, any rotating frame.
 
-:func:`simulate_particles` is the numerical core of ``rotframe.simulate``: float64 arrays in
+`simulate_particles` is the numerical core of ``rotframe.simulate``: float64 arrays in
 SI units, no printing, no files. It builds (or finds in the cache) a driver compiled for the
-problem's functions (:mod:`rotframe.problem.codegen`), integrates every particle on its own
+problem's functions (`rotframe.problem.codegen`), integrates every particle on its own
 (DOP853 with Hairer's step control, or RK4 at a fixed step), locates the events by bisection
 on the method's own re-steps, and reports the energy or the Jacobi integral where the forces
 give their potentials.
@@ -10,7 +10,7 @@ give their potentials.
 A force is a function ``f(t, r, v, *params) -> (ax, ay, az)`` (m/s^2; ``r``, ``v`` arrays of
 3 in the frame's axes). Attach ``axes="inertial"`` (its result is then turned into frame
 axes by the frame's attitude, integrated with the particle) or ``potential=U`` with
-``U(t, r, *params)`` (J/kg) by wrapping it in :class:`Force`, or by setting attributes of
+``U(t, r, *params)`` (J/kg) by wrapping it in `Force`, or by setting attributes of
 those names on the function. An event is ``g(t, r, v, *params) -> float`` with optional
 attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 """
@@ -67,7 +67,7 @@ class Force:
 
 @dataclass
 class ProblemRun:
-    """What :func:`simulate_particles` returns: the trajectory and what was measured on it."""
+    """What `simulate_particles` returns: the trajectory and what was measured on it."""
 
     trajectory: Trajectory
     diagnostics: dict
@@ -256,12 +256,12 @@ def _scales(r, v, duration, rtol, atol, D):
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
                        frame_attitude=None, jit=True, progress=None, max_events=256) -> ProblemRun:
-    """Integrate particles of the user's problem; see :func:`rotframe.simulate` for the arguments.
+    """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
     -------
     ProblemRun
-        ``trajectory`` (a :class:`rotframe.particles.trajectory.Trajectory`: ``times`` (n,),
+        ``trajectory`` (a [`rotframe.particles.trajectory.Trajectory`][rotframe.particles.trajectory.Trajectory]: ``times`` (n,),
         ``r``, ``v`` (n, N, 3), ``event_times``/``event_states`` by event name, ``extras``
         with ``frame_q`` (n, 4) where the attitude was integrated and ``energy`` (n, N) where
         it is conserved), ``diagnostics``, ``warnings``, ``notes``.
@@ -438,7 +438,7 @@ def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, tim
 
     The call is replayed from the state saved before it, one step per call, particle by particle
     (the drivers are deterministic), up to the step where the exception comes again; the force that
-    raises there in plain Python is named. Raises :class:`UserFunctionError` (``.t_reached`` and
+    raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
     ``.partial`` keep the samples up to that step).
     """
     y[...] = saved["Y"]

@@ -1,7 +1,7 @@
 """Source of the stepping shared by the generated drivers: DOP853 and RK4 steps, events, the loop.
 
-Appended to a driver's ``rhs`` (:mod:`rotframe.problem.particle_driver`,
-:mod:`rotframe.problem.body_driver`) by :mod:`rotframe.problem.codegen`. It needs from the
+Appended to a driver's ``rhs`` (`rotframe.problem.particle_driver`,
+`rotframe.problem.body_driver`) by `rotframe.problem.codegen`. It needs from the
 header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
 ``event_value(k, t, y, P)``, the DOP853 tableau ``A, B, C, E3, E5`` and ``error_norm``.
 

@@ -35,7 +35,7 @@ class InvalidStateError(RotframeError, ValueError):
 
 def check_inertia(inertia):
     """Principal moments as float64 (3,) and their inverses (4,): ``1/I_i`` (0 for a zero moment), then
-    ``1/I_s - 1/I_p`` of a symmetric body (``s`` its :func:`symmetry_axis`, ``p`` an equal one; 0 if none).
+    ``1/I_s - 1/I_p`` of a symmetric body (``s`` its [`symmetry_axis`][rotframe.rigid.checks.symmetry_axis], ``p`` an equal one; 0 if none).
 
     The difference is computed as ``(I_p - I_s) / (I_p I_s)``: ``1/I_s - 1/I_p`` of the two rounded
     inverses cancels, losing five digits for a nearly spherical top (I3/I1 - 1 = 1e-12). The kernels

@@ -84,7 +84,7 @@ def register(name: str, scene: Any, scenario: str | Path | None = None, override
     ``scenario``, a scenario file whose ``scene`` is ``name``, makes the
     scenario findable by its name (its file's ``name``, else its stem).
 
-    The fence every plugin passes (one :class:`~rotframe.errors.ScenarioError` line naming
+    The fence every plugin passes (one [`ScenarioError`][rotframe.errors.ScenarioError] line naming
     it, exit 2 on the command line): a module name is imported now (a missing module, or
     one that raises on import, is refused); the scene must have the protocol's functions;
     the scenario file must be TOML; a name that is a built-in scene or scenario is refused
@@ -173,7 +173,7 @@ def _import_plugin(item: str, who: str):
 def load_plugins() -> None:
     """Import the modules in ``$ROTFRAME_PLUGINS`` once (module names or ``.py`` paths, comma-separated).
 
-    Each goes through :func:`_import_plugin`: any failure is one ScenarioError naming the plugin.
+    Each goes through `_import_plugin`: any failure is one ScenarioError naming the plugin.
     """
     for item in filter(None, (s.strip() for s in os.environ.get("ROTFRAME_PLUGINS", "").split(","))):
         if item in _PLUGINS_LOADED:

@@ -7,7 +7,7 @@ omega = (0, 0, 1). The small body obeys (Szebehely, *Theory of Orbits*, 1967, ch
     r'' = -(1 - mu) (r - r1) / |r - r1|^3 - mu (r - r2) / |r - r2|^3 - 2 w x v - w x (w x r)
 
 The gravity is an ordinary user force with its potential U = -(1 - mu)/r1 - mu/r2; the frame's
-terms are rotframe's (:func:`rotframe.problem.particles.simulate_particles`): this scene is
+terms are rotframe's (`rotframe.problem.particles.simulate_particles`): this scene is
 built only on the public API for your own problems. The Jacobi constant is
 C = 2 Omega - v^2 with Omega = (x^2 + y^2)/2 + (1 - mu)/r1 + mu/r2 (C = -2 J, J the Jacobi
 integral rotframe reports as ``jacobi_rel_drift``).

@@ -2,11 +2,11 @@
 
 The body is a torque-free rigid body (principal moments ``i1, i2, i3``) started near a spin
 about its intermediate axis; its exact motion is rotframe's closed form
-(:func:`rotframe.problem.body.simulate_rigid_body` with ``method="exact"``, Jacobi elliptic
+(`rotframe.problem.body.simulate_rigid_body` with ``method="exact"``, Jacobi elliptic
 functions). Its solution is the frame (``omega=`` a rigid-body solution: omega = I^-1 L and
 omega' from Euler's equations at each sample, quintic Hermite between them;
-:mod:`rotframe.problem.frame`) in which a free ball is integrated by
-:func:`rotframe.problem.particles.simulate_particles`: built only on the public API.
+`rotframe.problem.frame`) in which a free ball is integrated by
+`rotframe.problem.particles.simulate_particles`: built only on the public API.
 
 Oracle: the body's centre of mass is at rest, so in space the ball moves on the straight line
 r_s(t) = R0 r0 + t R0 (v0 + w0 x r0), and in body axes r(t) = R(t)^T r_s(t) with R(t) the

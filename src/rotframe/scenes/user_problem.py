@@ -3,7 +3,7 @@
 Not a scenario: ``rotframe.simulate`` has no parameters file. This module gives the problem's
 ``Result`` the scene protocol's ``record`` so that ``Result.record(path)`` writes the same
 layout as a scene's recording (DESIGN, "Recording layout"): particles as points with trails
-in the frame's axes (``world/particle_<i>``, at most :data:`MAX_SHOWN` of them), event
+in the frame's axes (``world/particle_<i>``, at most `MAX_SHOWN` of them), event
 locations, the energy or Jacobi drift under ``diagnostics/``; a body as a transform with its
 axes, L in space and the polhode.
 """
