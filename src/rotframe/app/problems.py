@@ -61,6 +61,20 @@ def _summary(name, params, terms, method, steps, diagnostics, warnings, notes, t
     return summary
 
 
+def _si(value, unit, key):
+    """An astropy Quantity converted to ``unit`` (a plain value passes through: SI already)."""
+    if value is None or not (hasattr(value, "unit") and hasattr(value, "to_value")):
+        return value
+    from astropy import units as u
+
+    from rotframe.errors import ScenarioError
+
+    try:
+        return value.to_value(u.Unit(unit), equivalencies=u.dimensionless_angles())
+    except u.UnitConversionError:
+        raise ScenarioError(f"{key}: {value} cannot be converted to {unit}") from None
+
+
 def _describe(f):
     from rotframe.problem.callables import display_name
 
@@ -89,9 +103,10 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         constant; a table (a C2 cubic spline through it); a function ``t -> (3,)`` (with
         ``omega_dot`` or derived); or a rigid-body ``Result`` (the frame of that tumbling body).
     r0, v0 : (3,) or (N, 3)
-        Initial positions (m) and velocities (m/s) in the frame; N particles at once.
+        Initial positions (m) and velocities (m/s) in the frame; N particles at once (one of
+        them may be (3,), shared by all).
     duration : float
-        Seconds.
+        Seconds. Each length, speed, time and rate may also be an astropy Quantity (converted).
     forces : sequence of callables or `rotframe.problem.particles.Force`
         ``f(t, r, v, *params) -> (ax, ay, az)``, m/s^2, frame axes (``Force(f, axes="inertial")``
         for inertial axes; ``potential=U`` for the energy or Jacobi diagnostic).
@@ -124,9 +139,15 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     from rotframe.problem.particles import ProblemRun, simulate_particles
 
     t0 = time.perf_counter()
-    forces = list(forces)
-    events = list(events)
+    from rotframe.problem.particles import sequence_of_callables
+
+    forces = sequence_of_callables(forces, "forces")
+    events = sequence_of_callables(events, "events")
     try:
+        omega = _si(omega, "rad/s", "omega")
+        r0, v0 = _si(r0, "m", "r0"), _si(v0, "m/s", "v0")
+        duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
+        origin_acceleration = _si(origin_acceleration, "m/s2", "origin_acceleration")
         run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
                                  origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol,
                                  step=step, samples=samples, omega_dot=omega_dot, atol=atol,
@@ -195,6 +216,8 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     from rotframe.scenes.user_problem import BodyProblemScene
 
     t0 = time.perf_counter()
+    inertia, L0 = _si(inertia, "kg m2", "inertia"), _si(L0, "kg m2/s", "L0")
+    duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
     run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,
                               method=method, rtol=rtol, step=step, samples=samples, jit=jit, progress=progress)
     simulate_s = time.perf_counter() - t0

@@ -55,7 +55,10 @@ class BodyRun:
 
 
 def _inertia(inertia):
-    I = np.asarray(inertia, dtype=float)
+    try:
+        I = np.asarray(inertia, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"inertia: {str(inertia)[:80]!r} is not numbers (kg m^2)") from None
     if I.shape == (3,):
         I = np.diag(I)
     if I.shape != (3, 3) or not np.all(np.isfinite(I)):
@@ -87,7 +90,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     import time
 
     from rotframe import limits
-    from rotframe.problem.particles import check_params
+    from rotframe.problem.particles import check_params, number
 
     if torque is None and isinstance(method, str) and method.lower() in SPLITTING_NAMES:
         raise ScenarioError(f"method={method!r} is a built-in scene's splitting; simulate_body takes "
@@ -97,15 +100,18 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                             "closed-form flow to split with (or compose into the exact free flow); use dop853 or rk4")
     method = canonical_method(method, BODY_METHODS, "dop853")
     I = _inertia(inertia)
-    L = np.asarray(L0, dtype=float)
-    q = np.asarray(q0, dtype=float)
+    try:
+        L = np.asarray(L0, dtype=float)
+        q = np.asarray(q0, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"L0, q0: {str(L0)[:40]!r}, {str(q0)[:40]!r} are not numbers") from None
     if L.shape != (3,) or q.shape != (4,) or not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
         raise ScenarioError(f"L0, q0: expected finite (3,) and (4,), got shapes {L.shape} and {q.shape}")
     nq = float(np.linalg.norm(q))
     if abs(nq - 1.0) > 1e-6:
         raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
     q = q / nq
-    duration = float(duration)
+    duration = number(duration, "duration", "s")
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
     if torque is not None and not callable(torque):
@@ -116,14 +122,14 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
     samples = int(samples)
     times = np.linspace(0.0, duration, samples + 1)
-    rtol = DEFAULT_RTOL if rtol is None else float(rtol)
+    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
     if not (1e-15 <= rtol < 1):
         raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
     if method == "exact":
         return _exact(I, L, q, times)
     hfix = 0.0
     if method == "rk4":
-        step = duration / samples / 20 if step is None else float(step)
+        step = duration / samples / 20 if step is None else number(step, "step", "s")
         if not (math.isfinite(step) and step > 0) or step < 1e-300:
             raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
         per = max(1, math.ceil((duration / samples) / step - 1e-9))

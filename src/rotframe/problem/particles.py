@@ -30,7 +30,8 @@ from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
-__all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params"]
+__all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params",
+           "number", "sequence_of_callables"]
 
 #: Methods of a user's particle problem (names are case-insensitive)
 PARTICLE_METHODS = ("dop853", "rk4")
@@ -113,9 +114,41 @@ def check_params(params):
     return tuple(out)
 
 
+def number(value, key, unit):
+    """``value`` as a float, or a one-line ScenarioError naming ``key`` and the unit expected."""
+    if isinstance(value, bool):
+        raise ScenarioError(f"{key}={value!r}: a number ({unit}) is expected")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{key}={value!r}: a number ({unit}) is expected") from None
+
+
+def sequence_of_callables(value, key):
+    """``forces=f`` or ``events=g`` alone is taken as a list of one."""
+    if value is None:
+        return []
+    if callable(value):
+        return [value]
+    try:
+        return list(value)
+    except TypeError:
+        raise ScenarioError(f"{key}={value!r}: a list of functions is expected") from None
+
+
+def _array(value, key):
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{key}: {str(value)[:80]!r} is not numbers") from None
+
+
 def _states(r0, v0):
-    r = np.atleast_2d(np.asarray(r0, dtype=float))
-    v = np.atleast_2d(np.asarray(v0, dtype=float))
+    r = np.atleast_2d(_array(r0, "r0"))
+    v = np.atleast_2d(_array(v0, "v0"))
+    if r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and 1 in (r.shape[0], v.shape[0]):
+        n = max(r.shape[0], v.shape[0])  # one start position with N velocities, or the other way round
+        r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
     if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
         raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
@@ -271,7 +304,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     from rotframe import limits
 
     method = canonical_method(method, PARTICLE_METHODS, "dop853")
-    duration = float(duration)
+    duration = number(duration, "duration", "s")
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
     r, v = _states(r0, v0)
@@ -282,13 +315,13 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if spec.t_range[1] < duration or spec.t_range[0] > 0.0:
             raise ScenarioError(f"{what}: defined for t in [{spec.t_range[0]:g}, {spec.t_range[1]:g}] s, "
                                 f"not over the run's [0, {duration:g}] s")
-    forces = [_as_force(f, k) for k, f in enumerate(forces)]
-    events = list(events)
+    forces = [_as_force(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
+    events = sequence_of_callables(events, "events")
     for k, g in enumerate(events):
         if not callable(g):
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
-    rtol = DEFAULT_RTOL if rtol is None else float(rtol)
+    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
     if not (1e-15 <= rtol < 1):
         raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
     samples = DEFAULT_SAMPLES if samples is None else samples
@@ -298,7 +331,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     times = np.linspace(0.0, duration, samples + 1)
     hfix = 0.0
     if method == "rk4":
-        step = duration / samples / 20 if step is None else float(step)
+        step = duration / samples / 20 if step is None else number(step, "step", "s")
         if not (math.isfinite(step) and step > 0) or step < 1e-300:
             raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
         per = max(1, math.ceil((duration / samples) / step - 1e-9))
