@@ -75,6 +75,21 @@ def _si(value, unit, key):
         raise ScenarioError(f"{key}: {value} cannot be converted to {unit}") from None
 
 
+def _progress(progress, label):
+    """``progress=True``: a bar that suits where it is drawn; a callable passes through; None/False: none."""
+    from rotframe.errors import ScenarioError
+
+    if progress is True:
+        from rotframe.app.progress import auto_bar
+
+        return auto_bar(label)
+    if progress is None or progress is False:
+        return None
+    if not callable(progress):
+        raise ScenarioError(f"progress={progress!r}: expected a callable(fraction), True or None")
+    return progress
+
+
 def _describe(f):
     from rotframe.problem.callables import display_name
 
@@ -90,7 +105,7 @@ def _result(scn, scene, scene_result, summary):
 
 def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(), method=None,
              rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None, jit=True,
-             progress=None):
+             progress=None, threads=None):
     """Particles under your forces in any rotating frame; returns a [`rotframe.Result`][rotframe.app.api.Result].
 
     Solves ``r'' = sum f(t, r, v) - 2 w x v - w x (w x r) - w' x r - a0(t)`` in the frame's
@@ -123,6 +138,11 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         DOP853's tolerance; RK4's step (s); samples kept (default 1000 intervals).
     jit : bool
         False runs the forces and the integrator in plain Python (slow; for what numba cannot compile).
+    progress : bool or callable, optional
+        True draws a bar (a widget in Jupyter with tqdm); a callable gets the fraction done.
+    threads : int, optional
+        Threads for many particles during this call (default every core); the numbers do not
+        depend on it.
 
     Raises
     ------
@@ -143,15 +163,19 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
 
     forces = sequence_of_callables(forces, "forces")
     events = sequence_of_callables(events, "events")
+    from rotframe.particles.ensemble import threads_scope
+
+    bar = _progress(progress, "simulate")
     try:
         omega = _si(omega, "rad/s", "omega")
         r0, v0 = _si(r0, "m", "r0"), _si(v0, "m/s", "v0")
         duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
         origin_acceleration = _si(origin_acceleration, "m/s2", "origin_acceleration")
-        run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
-                                 origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol,
-                                 step=step, samples=samples, omega_dot=omega_dot, atol=atol,
-                                 frame_attitude=frame_attitude, jit=jit, progress=progress)
+        with threads_scope(threads):
+            run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
+                                     origin_acceleration=origin_acceleration, events=events, method=method,
+                                     rtol=rtol, step=step, samples=samples, omega_dot=omega_dot, atol=atol,
+                                     frame_attitude=frame_attitude, jit=jit, progress=bar)
     except (IntegrationError, RunInterrupted) as exc:  # what was computed, as a Result like rotframe.run's
         partial = getattr(exc, "partial", None)
         if partial is not None and hasattr(partial, "r"):
@@ -161,6 +185,9 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
             exc.partial = _particle_result(stopped, forces, origin_acceleration, duration,
                                            time.perf_counter() - t0)
         raise
+    finally:
+        if progress is True:  # the bar is ours to end
+            bar.close()
     return _particle_result(run, forces, origin_acceleration, duration, time.perf_counter() - t0)
 
 
@@ -218,8 +245,13 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     t0 = time.perf_counter()
     inertia, L0 = _si(inertia, "kg m2", "inertia"), _si(L0, "kg m2/s", "L0")
     duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
-    run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,
-                              method=method, rtol=rtol, step=step, samples=samples, jit=jit, progress=progress)
+    bar = _progress(progress, "simulate_body")
+    try:
+        run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,
+                                  method=method, rtol=rtol, step=step, samples=samples, jit=jit, progress=bar)
+    finally:
+        if progress is True:
+            bar.close()
     simulate_s = time.perf_counter() - t0
     terms = ["euler equations"] + ([f"torque {_describe(torque)}"] if torque is not None else [])
     timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
