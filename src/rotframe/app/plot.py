@@ -271,5 +271,76 @@ def _projectile(result, ax1, ax2) -> bool:
     return True
 
 
+def _cr3bp(result, ax1, ax2) -> bool:
+    """The orbit in the co-rotating frame with the primaries, the Lagrange points and the zero-velocity
+    curve of its Jacobi constant; the Jacobi constant's relative error against time."""
+    import numpy as np
+
+    from rotframe.scenes.cr3bp import jacobi_constant, lagrange_points, zero_velocity_curve
+
+    traj = result.trajectory
+    if traj.kind != "particles":
+        return False
+    mu = float(result.params["mu"])
+    r, v, t = traj.r[:, 0], traj.v[:, 0], traj.times
+    C = jacobi_constant(r, v, mu)
+    for seg in zero_velocity_curve(mu, float(C[0])):
+        ax1.plot(seg[:, 0], seg[:, 1], color="C2", lw=0.8)
+    ax1.plot(r[:, 0], r[:, 1], color="C0", lw=0.5, label="orbit")
+    pts = lagrange_points(mu)
+    ax1.plot(pts[:, 0], pts[:, 1], "k+", ms=8, label="L1..L5")
+    for k, (x, y, _) in enumerate(pts):
+        ax1.annotate(f"L{k + 1}", (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    ax1.plot([-mu, 1 - mu], [0, 0], "o", color="C3", ms=5, label="primaries")
+    ax1.plot([], [], color="C2", lw=0.8, label=f"zero-velocity curve, C = {C[0]:.6g}")
+    ax1.set_aspect("equal", adjustable="datalim")
+    ax1.set_xlabel("x [primaries' distance]")
+    ax1.set_ylabel("y [primaries' distance]")
+    ax1.set_title("co-rotating frame")
+    ax1.legend(fontsize=7, loc="lower left")
+    err = np.maximum.accumulate(np.abs(C - C[0]) / abs(C[0]))
+    ax2.semilogy(t / (2 * np.pi), np.maximum(err, 1e-18), lw=1.2)
+    ax2.axhline(1e-12, color="C3", lw=0.8, ls="--", label="1e-12")
+    ax2.set_xlabel("t [synodic periods]")
+    ax2.set_ylabel("largest |C - C(0)| / |C(0)| so far")
+    ax2.set_title("Jacobi constant's drift")
+    ax2.legend(fontsize=7)
+    return True
+
+
+def _tumbling_ball(result, ax1, ax2) -> bool:
+    """The ball's curl in the body's axes beside its straight line in space, and the error against it."""
+    import numpy as np
+
+    from rotframe.scenes.tumbling_ball import oracle
+
+    scene_result = getattr(result, "_scene_result", None)
+    ex = scene_result.extras if scene_result is not None else {}
+    if "body" not in ex:
+        return False
+    traj = result.trajectory
+    exact, line = oracle(ex["body"], traj.times, ex["r0"], ex["v0"], ex["w0"])
+    r = traj.r[:, 0]
+    ax1.plot(r[:, 0], r[:, 1], color="C1", lw=1.0, label="in the body's axes (curls)")
+    ax1.plot(line[:, 0], line[:, 1], color="C0", lw=1.5, label="in space (straight)")
+    ax1.set_aspect("equal", adjustable="datalim")
+    ax1.set_xlabel("x [m]")
+    ax1.set_ylabel("y [m]")
+    ax1.set_title("the ball, seen along axis 3")
+    ax1.legend(fontsize=7)
+    err = np.linalg.norm(r - exact, axis=1)
+    ax2.semilogy(traj.times, np.maximum(err, 1e-18), lw=0.8, label="|simulated - exact| (floor 1e-18 m)")
+    w2 = ex["body"].L[:, 1] / float(result.params["i2"])
+    twin = ax2.twinx()
+    twin.plot(ex["body"].times, w2, color="C3", lw=0.6, label="omega_2 (flips)")
+    twin.set_ylabel("omega_2 [rad/s]", color="C3")
+    ax2.set_xlabel("t [s]")
+    ax2.set_ylabel("position error [m]")
+    ax2.set_title("error against the inertial line, and the body's flips")
+    ax2.legend(fontsize=7, loc="upper left")
+    return True
+
+
 #: scene -> function drawing its two panels (False: fall back to the generic picture)
-_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top}
+_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top, "cr3bp": _cr3bp,
+                   "tumbling-ball": _tumbling_ball}
