@@ -211,3 +211,4 @@ def record(rec, p, result):
     Cs = jacobi_constant(r, traj.v[:, 0], mu)
     rec.scalars("diagnostics/jacobi_rel_error", traj.times, (Cs - Cs[0]) / abs(Cs[0]))
     rec.scalars("diagnostics/distance_from_L4", traj.times, np.linalg.norm(r - pts[3], axis=1))
+    rec.view(eye=(0.0, -0.6, 3.2), look_at=(0.0, 0.0, 0.0))  # from above the plane: all five points and the orbit

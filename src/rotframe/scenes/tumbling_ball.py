@@ -140,3 +140,5 @@ def record(rec, p, result):
     rec.body("world/space/body", body.times, body.q, axis_length=0.8)
     rec.scalars("diagnostics/position_error_m", traj.times, np.linalg.norm(traj.r[:, 0] - exact, axis=1))
     rec.scalars("diagnostics/omega_body/2", body.times, body.L[:, 1] / p.i2)
+    size = max(float(np.max(np.abs(traj.r[:, 0]))), float(np.max(np.abs(line))), 1.0)
+    rec.view(eye=(1.2 * size, -1.6 * size, 1.0 * size), look_at=(0.0, 0.0, 0.0))
