@@ -48,6 +48,7 @@ _LAZY = {
     "simulate": "rotframe.app.problems",
     "simulate_body": "rotframe.app.problems",
     "Force": "rotframe.problem.particles",
+    "Torque": "rotframe.problem.body",
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",

@@ -227,9 +227,10 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
         Attitude, a scalar-last unit quaternion rotating body components into space components.
     torque : callable, optional
         ``tau(t, L, q, *params) -> (3,)``, N m, body axes, compiled with numba as the forces are.
-    method : {"dop853", "rk4", "exact"}, optional
-        Any case; ``exact`` only without a torque (principal axes). The built-in splittings
-        refuse a torque by name.
+    method : {"dop853", "rk4", "lie-poisson", "lie-poisson4", "exact"}, optional
+        Any case. The Lie-Poisson splittings (principal axes, ``step``) take a torque of
+        ``(t, q)`` alone, marked ``rotframe.Torque(f, attitude_only=True)``, as a kick; ``exact``
+        takes none. Other torques with a splitting are refused by name.
 
     Returns
     -------

@@ -15,6 +15,7 @@ by name.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,13 +26,37 @@ from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import build_module
 from rotframe.problem.particles import DEFAULT_RTOL, DEFAULT_SAMPLES, STATUS, canonical_method
 
-__all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES"]
+__all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES", "Torque"]
 
-#: Methods of a user's rigid body (names are case-insensitive)
-BODY_METHODS = ("dop853", "rk4", "exact")
-#: Splitting methods of the built-in scenes that cannot take a user's torque
-SPLITTING_NAMES = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "rotation-splitting",
+#: Methods of a user's rigid body (names are case-insensitive) and their driver codes
+BODY_METHODS = ("dop853", "rk4", "exact", "lie-poisson", "lie-poisson4")
+_CODES = {"dop853": 0, "rk4": 1, "lie-poisson": 2, "lie-poisson4": 3}
+#: Lie-Poisson splittings: the torque as a kick at fixed attitude (a torque of (t, q) alone)
+KICK_METHODS = ("lie-poisson", "lie-poisson4")
+#: Splitting methods of the built-in scenes that a user's body does not have
+SPLITTING_NAMES = ("lie-poisson6", "lie-poisson8", "rotation-splitting",
                    "top-splitting", "top-splitting4", "top-splitting6", "top-splitting8")
+
+
+@dataclass(frozen=True)
+class Torque:
+    """A user torque with what rotframe should know about it.
+
+    Attributes
+    ----------
+    func : callable
+        ``tau(t, L, q, *params) -> (3,)``, N m, body axes.
+    attitude_only : bool
+        True when ``tau`` depends on ``t`` and ``q`` alone (gravity gradient, a field fixed in
+        space, a thruster's schedule), not on ``L``: its flow at fixed attitude is a kick, and
+        the Lie-Poisson splittings take it.
+    """
+
+    func: object
+    attitude_only: bool = False
+
+    def __call__(self, *args):
+        return self.func(*args)
 
 
 class BodyRun:
@@ -92,14 +117,25 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     from rotframe import limits
     from rotframe.problem.particles import check_params, number
 
-    if torque is None and isinstance(method, str) and method.lower() in SPLITTING_NAMES:
+    attitude_only = bool(getattr(torque, "attitude_only", False))
+    if isinstance(torque, Torque):
+        torque = torque.func
+    name = method.lower() if isinstance(method, str) else None
+    if name in SPLITTING_NAMES:
         raise ScenarioError(f"method={method!r} is a built-in scene's splitting; simulate_body takes "
                             f"{', '.join(BODY_METHODS)}")
-    if torque is not None and isinstance(method, str) and method.lower() in SPLITTING_NAMES + ("exact",):
-        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: a user's torque has no "
-                            "closed-form flow to split with (or compose into the exact free flow); use dop853 or rk4")
+    if torque is not None and name == "exact":
+        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: the exact flow is the "
+                            "free body's; use dop853, rk4, or a Lie-Poisson splitting for a torque of (t, q) alone")
+    if torque is not None and name in KICK_METHODS and not attitude_only:
+        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: it splits the torque as a "
+                            "kick at fixed attitude, exact only for a torque of (t, q) alone; mark such a torque "
+                            "rotframe.Torque(f, attitude_only=True), or use dop853 or rk4")
     method = canonical_method(method, BODY_METHODS, "dop853")
     I = _inertia(inertia)
+    if method in KICK_METHODS and np.any(I != np.diag(np.diag(I))):
+        raise ScenarioError(f"method={method!r} turns about the principal axes: give the 3 principal moments (a "
+                            "diagonal inertia), or use dop853 or rk4")
     try:
         L = np.asarray(L0, dtype=float)
         q = np.asarray(q0, dtype=float)
@@ -128,13 +164,13 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if method == "exact":
         return _exact(I, L, q, times)
     hfix = 0.0
-    if method == "rk4":
+    if method != "dop853":
         step = duration / samples / 20 if step is None else number(step, "step", "s")
         if not (math.isfinite(step) and step > 0) or step < 1e-300:
             raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
         per = max(1, math.ceil((duration / samples) / step - 1e-9))
         hfix = (duration / samples) / per
-        limits.check_run(steps=per * samples, samples=samples + 1, what="method rk4")
+        limits.check_run(steps=per * samples, samples=samples + 1, what=f"method {method}")
     else:
         limits.check_run(steps=samples, samples=samples + 1, what="method dop853")
     if torque is not None:
@@ -160,7 +196,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
     GPREV = np.zeros((1, 1))
     EDIR, ETERM = np.zeros(1), np.zeros(1, dtype=bool)
-    code = 0 if method == "dop853" else 1
+    code = _CODES[method]
     t0 = time.perf_counter()
     compile_s = None
     def call(budget):
@@ -199,7 +235,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         t_bad = float(TC[0])
         blame = ""
         if torque is not None:  # a torque that turns non-finite at a time: probe it inside the failed step
-            dt = hfix if method == "rk4" else 10.0 * float(H[0])
+            dt = hfix if method != "dop853" else 10.0 * float(H[0])
             for tp in (t_bad, t_bad + 1e-3 * dt, t_bad + 0.5 * dt, t_bad + dt):
                 a = np.asarray(uf.plain_function(torque)(tp, y[0, :3].copy(), y[0, 3:].copy(), *params), float)
                 if a.shape == (3,) and not np.all(np.isfinite(a)):

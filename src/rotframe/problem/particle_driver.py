@@ -78,6 +78,13 @@ def rhs(t, y, dy, P, F, G):
 
 
 @jit
+def own_step(method, t, y, h, yn, P, F, G):
+    """A particle has no method of its own beyond DOP853 and RK4 (never called)."""
+    for j in range(D):
+        yn[j] = y[j]
+
+
+@jit
 def energies(T, OUT, P, F, rotating):
     """Energy (rotating = False) or the Jacobi integral (rotating = True) per sample and particle, per unit mass."""
     n = OUT.shape[0]

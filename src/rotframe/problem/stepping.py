@@ -8,7 +8,8 @@ header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
 * DOP853: Hairer's step control (dop853.f: safety 0.9, growth at most 1/0.333, shrink at
   most 6, no growth right after a rejection) and starting step (hinit); a step never passes
   the next sample time, so every sample is a step's end.
-* RK4: a fixed step that divides each sample interval.
+* RK4 (method 1), and a driver's own fixed-step methods (``own_step``, methods 2 and up: the
+  rigid body's Lie-Poisson splittings): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
   length, each trial a re-step from the step's start by the same method, to round-off in
   time on the method's own discrete trajectory (as the built-in ground event,
@@ -67,8 +68,10 @@ def rk4_step(t, y, h, K, yt, yn, P, F, G):
 def take_step(method, t, y, h, t_end, K, yt, yn, P, F, G):
     if method == 0:
         dop853_step(t, y, h, t_end, K, yt, yn, P, F, G)
-    else:
+    elif method == 1:
         rk4_step(t, y, h, K, yt, yn, P, F, G)
+    else:  # a driver's own fixed-step method (the body's splittings, 2 and 4)
+        own_step(method, t, y, h, yn, P, F, G)
 
 
 @jit
@@ -185,7 +188,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         take_step(method, t, y, hh, T[idx] if landing else t + hh, K, yt, yn, P, F, G)
         steps += 1
         NSTEP[i] += 1
-        NFEV[i] += 12 if method == 0 else 3
+        NFEV[i] += 12 if method == 0 else 3 if method == 1 else 2
         ok = all_finite(yn)
         err = 0.0
         if method == 0:
