@@ -434,8 +434,8 @@ def test_force_becomes_nan_later_keeps_partial():
     msg = _one_line(exc)
     assert "nan_after_one_second" in msg and "non-finite" in msg
     assert 0.9 <= exc.t_reached <= 1.1
-    part = exc.partial
-    assert part is not None and not part.complete
+    assert exc.partial is not None and not exc.partial.complete  # a Result, as rotframe.run's
+    part = exc.partial.trajectory
     assert 0.9 <= part.times[-1] <= 1.0 + 1e-12
     assert np.all(np.isfinite(part.r)) and np.all(np.isfinite(part.v))
     assert part.r.shape == (part.times.size, 1, 3)
@@ -456,8 +456,8 @@ def test_force_raises_later_gives_time_and_state():
     msg = _one_line(exc)
     assert "raise_after_one_second" in msg and "ValueError" in msg and "too late" in msg
     assert "t = 1 s" in msg and "r = [" in msg and "v = [" in msg
-    assert exc.partial is not None and 0.9 <= exc.partial.times[-1] <= 1.0
-    assert np.all(np.isfinite(exc.partial.r))
+    assert exc.partial is not None and 0.9 <= exc.partial.trajectory.times[-1] <= 1.0
+    assert np.all(np.isfinite(exc.partial.trajectory.r))
 
 
 def test_omega_table_not_increasing():

@@ -150,11 +150,12 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         Bad input, or a user function that raises, returns the wrong shape or NaN at the start,
         or cannot be compiled (the message names it and numba's reason).
     rotframe.errors.IntegrationError
-        A non-finite state during the run (``exc.partial``: a ``Result`` of what was computed).
+        A non-finite state during the run (``exc.partial``: a ``Result`` of what was computed; so
+        too for a user function that raises mid-run, a ``ScenarioError``).
     rotframe.particles.trajectory.RunInterrupted
         Ctrl-C or SIGTERM during the run (``exc.partial``: a ``Result`` of what was computed).
     """
-    from rotframe.errors import IntegrationError
+    from rotframe.errors import IntegrationError, ScenarioError
     from rotframe.particles.trajectory import RunInterrupted
     from rotframe.problem.particles import ProblemRun, simulate_particles
 
@@ -176,7 +177,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
                                      origin_acceleration=origin_acceleration, events=events, method=method,
                                      rtol=rtol, step=step, samples=samples, omega_dot=omega_dot, atol=atol,
                                      frame_attitude=frame_attitude, jit=jit, progress=bar)
-    except (IntegrationError, RunInterrupted) as exc:  # what was computed, as a Result like rotframe.run's
+    except (IntegrationError, RunInterrupted, ScenarioError) as exc:  # what was computed, as rotframe.run's Result
         partial = getattr(exc, "partial", None)
         if partial is not None and hasattr(partial, "r"):
             from rotframe.problem.frame import frame_spec

@@ -122,7 +122,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         torque = torque.func
     name = method.lower() if isinstance(method, str) else None
     if name in SPLITTING_NAMES:
-        raise ScenarioError(f"method={method!r} is a built-in scene's splitting; simulate_body takes "
+        what = f" and cannot take torque={uf.display_name(torque)}" if torque is not None else ""
+        raise ScenarioError(f"method={method!r} is a built-in scene's splitting{what}; simulate_body takes "
                             f"{', '.join(BODY_METHODS)}")
     if torque is not None and name == "exact":
         raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: the exact flow is the "
