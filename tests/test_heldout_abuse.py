@@ -165,12 +165,19 @@ def test_the_command_line_prints_no_numpy_warnings():
     import subprocess
     import sys
 
+    # issue 27: a rate whose energy overflows a float64 (1e200) is now refused up front, in one line; one just
+    # below it (1e153: energy 1.5e306) runs, with its analysis near float64's end
     proc = subprocess.run([sys.executable, "-m", "rotframe", "run", "dzhanibekov", "--no-record", "--json",
-                           "--set", "omega=1e200,1e200,1e200"], capture_output=True, text=True, timeout=120,
+                           "--set", "omega=1e153,1e153,1e153"], capture_output=True, text=True, timeout=120,
                           env={**os.environ, "PYTHONWARNINGS": ""})
     assert proc.returncode == 0, proc.stderr
     assert "RuntimeWarning" not in proc.stderr
     json.loads(proc.stdout)
+    proc = subprocess.run([sys.executable, "-m", "rotframe", "run", "dzhanibekov", "--no-record", "--json",
+                           "--set", "omega=1e200,1e200,1e200"], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONWARNINGS": ""})
+    assert proc.returncode == 2 and "RuntimeWarning" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "omega" in proc.stderr
 
 
 @pytest.mark.parametrize("sig,code", [("SIGINT", 130), ("SIGTERM", 143)])

@@ -4,7 +4,6 @@
 as ``(I1 - I3) / (I1 I3)``. The oracle: mpmath at 50 digits from the same float moments.
 """
 
-import math
 
 import mpmath
 import numpy as np

@@ -7,8 +7,8 @@ import os
 
 import numpy as np
 
+from rotframe.app import outputs
 from rotframe.app.bench.summary import is_peer, problem_keys
-from rotframe.app.outputs import write_atomic
 
 __all__ = ["environment", "plot", "table", "json_rows"]
 
@@ -59,7 +59,7 @@ def plot(rows, folder):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
         path = os.path.join(folder, f"bench-{scenario}-{len(paths)}.png")
-        write_atomic(path, lambda f, fig=fig: fig.savefig(f, dpi=110, bbox_inches="tight", format="png"),
+        outputs.write_atomic(path, lambda f, fig=fig: fig.savefig(f, dpi=110, bbox_inches="tight", format="png"),
                      what="bench plot")
         paths.append(path)
     return paths
