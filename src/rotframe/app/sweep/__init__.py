@@ -41,15 +41,15 @@ import json
 import os
 
 from rotframe.app.sweep.batch import MAX_TRACK_SAMPLES, BatchOutput, BatchTask, run_batch
-from rotframe.app.sweep.execute import (CONNECT_TIMEOUT_S, MAX_TRACKS, SweepInterrupted, SweepResult, check_scheduler,
-                                        run_sweep)
+from rotframe.app.sweep.execute import (CONNECT_TIMEOUT_S, MAX_TRACKS, SweepInterrupted, SweepLost, SweepResult,
+                                        check_scheduler, run_sweep, scheduler_from_env)
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.spec import Axis, SweepSpec, Vary, parse_spec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, check_outputs, metric_columns, read_table
 from rotframe.errors import ScenarioError
 from rotframe.particles.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (old home)
 
-__all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "parse_spec", "sweep_points", "points_of",
+__all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "SweepLost", "parse_spec", "sweep_points", "points_of",
            "run_sweep", "read_table", "run_batch", "BatchTask", "BatchOutput", "write_plots", "check_outputs",
            "check_scheduler", "format_result", "main", "MAX_TRACKS", "MAX_TRACK_SAMPLES", "CONNECT_TIMEOUT_S"]
 
@@ -87,13 +87,24 @@ def main(args) -> int:
         raise ScenarioError(f"--workers {args.workers}: at most {most} local processes on this machine "
                             f"({os.cpu_count()} CPUs); use --scheduler for a larger cluster")
     check_outputs(spec, args.out, args.resume)
-    if args.scheduler is not None:
-        check_scheduler(args.scheduler)
+    scheduler_file = getattr(args, "scheduler_file", None)
+    task_timeout = getattr(args, "task_timeout", None)
+    if task_timeout is not None and not task_timeout > 0:
+        raise ScenarioError(f"--task-timeout {task_timeout:g}: must be > 0 seconds")
+    scheduler = args.scheduler
+    if scheduler is None and scheduler_file is None and args.workers is None:
+        scheduler = scheduler_from_env()
+    if scheduler is not None:
+        check_scheduler(scheduler)
     scope = getattr(args, "scope", None) or InterruptScope()
     progress = Progress("sweep", "rows", enabled=not args.json)
     try:
-        result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                           on_batch=progress.update)
+        result = run_sweep(spec, args.out, workers=args.workers, scheduler=scheduler, resume=args.resume,
+                           on_batch=progress.update, scheduler_file=scheduler_file, task_timeout=task_timeout)
+    except SweepLost as exc:
+        progress.close()
+        messages.error(f"sweep: {exc}")
+        return 1
     except SweepInterrupted as exc:
         progress.close()
         scope.interrupted = True
