@@ -191,6 +191,7 @@ class _Context:
     points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
     threads: int | None = None  # threads of each vectorised batch (:func:`batch_threads`)
+    seconds: list = None  # seconds per row of the last batch written (the probe's timing)
 
     @classmethod
     def create(cls, spec, files, meta, source):
@@ -245,6 +246,7 @@ def _compute(ctx, pending, n_done, where, batch_rows, on_batch):
 
     def finished(output):
         write_part(ctx.files, output, ctx.spec.keys, ctx.meta)
+        ctx.seconds = [float(t) for t, e in zip(output.seconds, output.errors) if not e]
         state["done"] += len(output.rows)
         state["computed"] += len(output.rows)
         state["batches"] += 1
@@ -274,21 +276,23 @@ def _execute(ctx, pending, where, batch_rows, finished):
         n_workers = max(1, sum(client.nthreads().values())) if client is not None else 1
         local = workers if (own is not None and not (scheduler or scheduler_file)) else None
         ctx.threads = batch_threads(local_workers=local, here=client is None)
+        def run(tasks):
+            if client is None:  # one batch generated at a time
+                for task in tasks:
+                    finished(run_batch(task))
+            else:
+                with quiet_dask_logs():
+                    cluster.run_on_dask(client, list(tasks), finished, split=ctx.path == "runs",
+                                        task_timeout=where["task_timeout"])
+
         if ctx.path == "ensemble":
             size = batch_rows or _ensemble_batch_size(len(pending), n_workers, client is not None)
             batches = _chunk_aligned(pending, size)
         else:
             if batch_rows is None:
-                pending, batch_rows = _probe(ctx, pending, n_workers, finished)
+                pending, batch_rows = _probe(ctx, pending, n_workers, run)
             batches = (pending[s:s + batch_rows] for s in range(0, len(pending), batch_rows))
-        tasks = (ctx.task(i, rows) for i, rows in enumerate(batches))
-        if client is None:  # one batch generated at a time
-            for task in tasks:
-                finished(run_batch(task))
-        else:
-            with quiet_dask_logs():
-                cluster.run_on_dask(client, list(tasks), finished, split=ctx.path == "runs",
-                                    task_timeout=where["task_timeout"])
+        run(ctx.task(i, rows) for i, rows in enumerate(batches, start=1))
     finally:
         if own is not None:
             cluster.close_bounded(own)
@@ -303,12 +307,15 @@ def _chunk_aligned(pending, size):
         yield pending[starts[i]:starts[min(i + per, len(starts) - 1)]]
 
 
-def _probe(ctx, pending, n_workers, finished):
-    """Run the first two rows here to time them; returns the rest and the rows per batch."""
-    output = run_batch(ctx.task(0, pending[:2]))
-    finished(output)
+def _probe(ctx, pending, n_workers, run):
+    """Run the first two rows where the batches run (on Dask: never here) to time them.
+
+    Returns the rest and the rows per batch.
+    """
+    ctx.seconds = []
+    run([ctx.task(0, pending[:2])])
     rest = pending[2:]
-    per_row = max(float(np.min(output.seconds)) if len(output.seconds) else 0.0, 1e-4)
+    per_row = max(min(ctx.seconds) if ctx.seconds else 0.01, 1e-4)  # a probe that failed: a guess of 10 ms
     total = per_row * len(rest)
     target = min(max(total / (BATCHES_PER_WORKER * n_workers), MIN_BATCH_S), MAX_BATCH_S)
     return rest, max(1, int(math.ceil(target / per_row)))
@@ -370,10 +377,31 @@ def _connect(workers, scheduler, scheduler_file=None):
         return _client_bounded(Client, None, scheduler_file, scheduler_file=_scheduler_file(scheduler_file))
     if scheduler:
         return _client_bounded(Client, check_scheduler(scheduler), scheduler)
-    with quiet_dask_logs():
+    with quiet_dask_logs(), _children_ignore_sigint():
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
+                               silence_logs=logging.CRITICAL)
         return Client(cluster, set_as_default=False)
+
+
+def _children_ignore_sigint():
+    """Worker processes started inside ignore Ctrl-C (a terminal sends it to the whole group): this
+    process handles it and closes them, without a traceback from each."""
+    import contextlib
+    import signal
+    import threading
+
+    @contextlib.contextmanager
+    def ignoring():
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+    return ignoring()
 
 
 def _scheduler_file(path):
