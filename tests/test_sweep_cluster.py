@@ -33,7 +33,10 @@ pq = pytest.importorskip("pyarrow.parquet")
 from rotframe.app import sweep  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-ENV = dict(os.environ, PYTHONPATH=str(REPO / "src"), DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES="1")
+# a task may see one worker die under it (a second death is KilledWorker), and a worker holds one task at a time,
+# so that a row that kills its worker takes no other batch with it
+ENV = dict(os.environ, PYTHONPATH=str(REPO / "src"), DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES="1",
+           DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION="1.0")
 ENV.pop("ROTFRAME_PLUGINS", None)
 ENV.pop("DASK_SCHEDULER_ADDRESS", None)
 
@@ -147,28 +150,36 @@ def load_plugin(path):
     return module
 
 
-def table(res):
-    return res.table
+def same(a, b):
+    """Two sweep tables equal bitwise (NaN rows too, which Arrow's ``equals`` calls unequal)."""
+    assert a.column_names == b.column_names
+    for name in a.column_names:
+        x, y = a.column(name).to_numpy(zero_copy_only=False), b.column(name).to_numpy(zero_copy_only=False)
+        if x.dtype == np.float64:
+            x, y = x.view(np.uint64), y.view(np.uint64)
+        assert np.array_equal(x, y), name
+    return True
 
 
 # ---------------------------------------------------------------------------
 
 
 def test_the_table_does_not_depend_on_how_the_work_is_cut(cluster, tmp_path, monkeypatch):
-    """Tower-drop Monte Carlo across ensemble chunks: in-process (every core, one thread, small batches),
+    """Tower-drop Monte Carlo over several ensemble chunks (with failed rows): in-process (every core, one thread,
+    small batches),
     an interrupted and resumed run, a LocalCluster and the external scheduler give one table, bitwise."""
     from rotframe.particles.ensemble import threads_scope
 
     monkeypatch.chdir(tmp_path)
     n = 2 * sweep.batch.ENSEMBLE_CHUNK + 300
-    spec = sweep.parse_spec("tower-drop", samples=n, vary=["height=uniform(0.5,3000)", "latitude=normal(45,20)"],
-                            seed=5)
+    spec = sweep.parse_spec("tower-drop", samples=n, vary=["height=uniform(-10,3000)"], seed=5)
     quiet = {"plots": False, "recording": False}
     ref = sweep.run_sweep(spec, "ref.parquet", **quiet).table
-    assert ref.num_rows == n and not any(ref.column("error").to_pylist()[:3])
+    errors = ref.column("error").to_pylist()
+    assert ref.num_rows == n and 0 < sum(bool(e) for e in errors) < 100  # a few heights <= 0 are failed rows
     with threads_scope(1):
         small = sweep.run_sweep(spec, "small.parquet", batch_rows=sweep.batch.ENSEMBLE_CHUNK, **quiet).table
-    assert small.equals(ref)
+    assert same(small, ref)
 
     def stop(done, total):
         raise KeyboardInterrupt
@@ -176,16 +187,16 @@ def test_the_table_does_not_depend_on_how_the_work_is_cut(cluster, tmp_path, mon
     with pytest.raises(sweep.SweepInterrupted):
         sweep.run_sweep(spec, "cut.parquet", batch_rows=sweep.batch.ENSEMBLE_CHUNK, on_batch=stop, **quiet)
     resumed = sweep.run_sweep(spec, "cut.parquet", resume=True, **quiet)
-    assert resumed.computed == n - sweep.batch.ENSEMBLE_CHUNK and resumed.table.equals(ref)
+    assert resumed.computed == n - sweep.batch.ENSEMBLE_CHUNK and same(resumed.table, ref)
     external = sweep.run_sweep(spec, "external.parquet", scheduler=cluster.address, **quiet)
-    assert external.table.equals(ref) and external.batches >= 2
+    assert same(external.table, ref) and external.batches >= 2
     local = sweep.run_sweep(spec, "local.parquet", workers=2, **quiet)
-    assert local.table.equals(ref)
+    assert same(local.table, ref)
     # a scene run row by row (projectile): the external cluster gives the in-process table
     spec = sweep.parse_spec("projectile", samples=12, vary=["speed=normal(1600,5)"], seed=2)
     here = sweep.run_sweep(spec, "p-here.parquet", **quiet).table
     there = sweep.run_sweep(spec, "p-there.parquet", scheduler=cluster.address, batch_rows=3, **quiet).table
-    assert there.equals(here) and not any(here.column("error").to_pylist())
+    assert same(there, here) and not any(here.column("error").to_pylist())
 
 
 def test_a_worker_killed_mid_sweep_costs_no_rows(cluster, tmp_path, monkeypatch):
@@ -209,7 +220,7 @@ def test_a_worker_killed_mid_sweep_costs_no_rows(cluster, tmp_path, monkeypatch)
                           plots=False, recording=False)
     assert killed and res.rows == 16 and res.failed == 0, res.table.column("error").to_pylist()
     ref = sweep.run_sweep(spec, "here.parquet", batch_rows=5, plots=False, recording=False)
-    assert res.table.equals(ref.table)
+    assert same(res.table, ref.table)
     client.wait_for_workers(2, timeout=90)  # the nanny starts a new worker for the next test
 
 
@@ -274,4 +285,4 @@ def test_the_scheduler_killed_mid_sweep_ends_with_the_hint_and_resume_finishes(t
     full = subprocess.run([*argv[:-3], "--out", "full.parquet", "--json"], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=240)
     assert full.returncode == 0, full.stderr
-    assert pq.read_table(tmp_path / "s.parquet").equals(pq.read_table(tmp_path / "full.parquet"))
+    assert same(pq.read_table(tmp_path / "s.parquet"), pq.read_table(tmp_path / "full.parquet"))

@@ -329,9 +329,9 @@ def _ensemble_batch(task, scn, scene, base):
     if threads > 1:
         from concurrent.futures import ThreadPoolExecutor
 
-        one(chunks[0][:1])  # compile (or load) the kernels once, so that the pool does not wait on the compiler
+        results = [one(chunks[0])]  # compiles (or loads) the kernels once, so that the pool does not wait on them
         with ThreadPoolExecutor(max_workers=threads) as pool:
-            results = list(pool.map(one, chunks))
+            results += list(pool.map(one, chunks[1:]))
     else:
         results = [one(c) for c in chunks]
     theory = getattr(scene, "ensemble_theory", None)  # the theory columns single runs have

@@ -68,9 +68,11 @@ def run_on_dask(client, tasks, finished, *, split=False, task_timeout=None):
     last = time.monotonic()
     stall_said = last
     lost_since = None
+    threads, counted = 1, 0.0
     try:
         while queue or inflight:
-            threads = _threads(client)
+            if time.monotonic() - counted > 1.0 and getattr(client, "status", "running") == "running":
+                threads, counted = _threads(client), time.monotonic()  # a call to the scheduler: once a second
             while queue and len(inflight) < max(2, 2 * threads):
                 task = queue.popleft()
                 future = client.submit(run_batch, task, pure=False, retries=0,
@@ -85,17 +87,15 @@ def run_on_dask(client, tasks, finished, *, split=False, task_timeout=None):
                 status = future.status
                 if status == "pending":
                     continue
-                task = inflight[future][0]
-                if status == "finished":
-                    output = _fetch(future)
-                    _forget(future, inflight, order)
-                    finished(output)
-                elif status == "error":
-                    exc = _exception(future)
-                    _forget(future, inflight, order)
-                    queue.extendleft(reversed(_after_failure(task, exc, split, finished)))
-                else:  # cancelled or lost: the scheduler forgot it (a lost connection), checked below
+                if status not in ("finished", "error"):  # cancelled or lost: a lost connection, checked below
                     continue
+                task = inflight[future][0]
+                output, exc = _outcome(client, future)
+                _forget(future, inflight, order)
+                if exc is None:
+                    finished(output)
+                else:
+                    queue.extendleft(reversed(_after_failure(task, exc, split, finished)))
                 progressed = True
             if progressed:
                 last = stall_said = time.monotonic()
@@ -134,20 +134,21 @@ def _forget(future, inflight, order):
         pass
 
 
-def _fetch(future):
+def _outcome(client, future):
+    """(output, None) of a finished batch, or (None, the exception it raised on the cluster).
+
+    A connection that failed while the rows were on their way is a lost scheduler, not a failed batch.
+    """
     from rotframe.app.sweep.execute import SweepLost
 
     try:
-        return future.result(timeout=FETCH_S)
-    except Exception as exc:  # noqa: BLE001 -- the connection went while the rows were on their way
-        raise SweepLost(f"lost the Dask scheduler while fetching a finished batch ({_why(exc)})") from None
-
-
-def _exception(future):
-    try:
-        return future.exception(timeout=FETCH_S)
-    except Exception as exc:  # noqa: BLE001
-        return exc
+        return future.result(timeout=FETCH_S), None
+    except Exception as exc:  # noqa: BLE001 -- KilledWorker, a worker's exception, or a lost connection
+        lost = type(exc).__name__ in ("CommClosedError", "CancelledError", "TimeoutError", "FutureCancelledError") \
+            or isinstance(exc, (OSError, TimeoutError)) or getattr(client, "status", "running") != "running"
+        if lost:
+            raise SweepLost(f"lost the Dask scheduler while fetching a finished batch ({_why(exc)})") from None
+        return None, exc
 
 
 def _after_failure(task, exc, split, finished):

@@ -369,6 +369,7 @@ def check_scheduler(address, timeout=None):
 
 def _connect(workers, scheduler, scheduler_file=None):
     import logging
+    import warnings
 
     require("distributed", "--scheduler" if (scheduler or scheduler_file) else "--workers")
     from distributed import Client, LocalCluster
@@ -377,8 +378,10 @@ def _connect(workers, scheduler, scheduler_file=None):
         return _client_bounded(Client, None, scheduler_file, scheduler_file=_scheduler_file(scheduler_file))
     if scheduler:
         return _client_bounded(Client, check_scheduler(scheduler), scheduler)
-    with quiet_dask_logs(), _children_ignore_sigint():
-        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None,
+    with quiet_dask_logs(), _children_ignore_sigint(), warnings.catch_warnings():
+        # no dashboard wanted; its HTTP server (health checks) takes any free port, and says nothing about 8787
+        warnings.filterwarnings("ignore", message=".*already in use", category=UserWarning)
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=":0",
                                silence_logs=logging.CRITICAL)
         return Client(cluster, set_as_default=False)
 

@@ -188,14 +188,6 @@ def _rows_table(output, keys, meta):
     return pa.table(cols).replace_schema_metadata({META_KEY: json.dumps(meta)})
 
 
-def _ordered_union(dicts):
-    seen = {}
-    for d in dicts:
-        for k in d:
-            seen.setdefault(k, None)
-    return list(seen)
-
-
 def merge(files, meta, spec, include_out):
     """Every part (and, resuming, the earlier ``out``) into ``out``: one row per point, sorted, atomically."""
     import pyarrow as pa
