@@ -54,7 +54,7 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     ------
     rotframe.errors.ScenarioError
         Bad input, in one line naming the argument, key and value.
-    rotframe.app.sweep.execute.SweepLost
+    rotframe.app.sweep.cluster.SweepLost
         The Dask scheduler went away (the finished batches stay in ``<out>.parts/``).
     KeyboardInterrupt
         Ctrl-C (a :class:`~rotframe.app.sweep.execute.SweepInterrupted` saying what was kept).

@@ -17,7 +17,7 @@ polled (no Dask default client is needed, and Ctrl-C or SIGTERM is seen within
 - No batch finishes for :data:`STALL_S` seconds: a line on stderr says so (and how many
   workers the scheduler has); the sweep keeps waiting.
 - The scheduler goes away: after :data:`LOST_S` seconds without it the sweep ends with
-  :class:`~rotframe.app.sweep.execute.SweepLost` (exit 1, the finished batches kept for
+  :class:`SweepLost` (exit 1, the finished batches kept for
   ``--resume``).
 """
 
@@ -28,7 +28,9 @@ import threading
 import time
 from collections import deque
 
-__all__ = ["run_on_dask", "close_bounded", "POLL_S", "LOST_S", "STALL_S"]
+from rotframe.errors import RotframeError
+
+__all__ = ["SweepLost", "run_on_dask", "close_bounded", "quiet_dask_logs", "POLL_S", "LOST_S", "STALL_S"]
 
 #: seconds between looks at the futures
 POLL_S = 0.02
@@ -38,6 +40,15 @@ LOST_S = 10.0
 STALL_S = 60.0
 #: seconds allowed to fetch a finished batch's rows from its worker
 FETCH_S = 60.0
+
+
+class SweepLost(RotframeError):
+    """The Dask scheduler went away during a sweep; every finished batch is kept in ``parts``."""
+
+    def __init__(self, why: str, saved: int = 0, total: int = 0, parts: str = ""):
+        super().__init__(f"{why}; {saved} of {total} rows are saved in {parts}; run the same command with "
+                         "--resume once the scheduler is back")
+        self.why, self.saved, self.total, self.parts = why, saved, total, parts
 
 
 def run_on_dask(client, tasks, finished, *, split=False, task_timeout=None):
@@ -139,8 +150,6 @@ def _outcome(client, future):
 
     A connection that failed while the rows were on their way is a lost scheduler, not a failed batch.
     """
-    from rotframe.app.sweep.execute import SweepLost
-
     try:
         return future.result(timeout=FETCH_S), None
     except Exception as exc:  # noqa: BLE001 -- KilledWorker, a worker's exception, or a lost connection
@@ -178,8 +187,6 @@ def _sub(task, part):
 
 def _check_connection(client, lost_since):
     """None while the scheduler is there; the time it went; SweepLost after :data:`LOST_S`."""
-    from rotframe.app.sweep.execute import SweepLost
-
     status = getattr(client, "status", "running")
     if status == "running":
         return None
@@ -242,11 +249,32 @@ def close_bounded(client, seconds=10.0):
     cluster = getattr(client, "cluster", None)
 
     def close():
-        from rotframe.app.sweep.execute import quiet_dask_logs
-
         with quiet_dask_logs():
             client.close(timeout=seconds / 2)
             if cluster is not None:
                 cluster.close(timeout=seconds / 2)
 
     _bounded(close, seconds)
+
+
+def quiet_dask_logs():
+    """A context in which Dask's and tornado's loggers print nothing (the sweep reports faults itself)."""
+    import contextlib
+    import logging
+
+    @contextlib.contextmanager
+    def quiet():
+        loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
+                                                  "distributed.client", "distributed.node", "tornado")]
+        levels = [lg.level for lg in loggers]
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+        try:
+            yield
+        finally:
+            for lg, level in zip(loggers, levels):
+                lg.setLevel(level)
+
+    return quiet()
+
+

@@ -21,11 +21,12 @@ import numpy as np
 
 from rotframe.app.messages import one_line as _one_line
 from rotframe.app.sweep.batch import ENSEMBLE_CHUNK, BatchTask, ScenarioSource, run_batch
+from rotframe.app.sweep.cluster import SweepLost, quiet_dask_logs
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.recording import write_recording
 from rotframe.app.sweep.spec import SweepSpec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, require, write_part
-from rotframe.errors import RotframeError, ScenarioError
+from rotframe.errors import ScenarioError
 
 __all__ = ["SweepResult", "SweepInterrupted", "SweepLost", "run_sweep", "check_scheduler", "scheduler_from_env",
            "quiet_dask_logs", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
@@ -89,15 +90,6 @@ class SweepInterrupted(KeyboardInterrupt):
     def __init__(self, saved: int, total: int, parts: str):
         super().__init__(f"{saved} of {total} rows saved")
         self.saved, self.total, self.parts = saved, total, parts
-
-
-class SweepLost(RotframeError):
-    """The Dask scheduler went away during a sweep; every finished batch is kept in ``parts``."""
-
-    def __init__(self, why: str, saved: int = 0, total: int = 0, parts: str = ""):
-        super().__init__(f"{why}; {saved} of {total} rows are saved in {parts}; run the same command with "
-                         "--resume once the scheduler is back")
-        self.why, self.saved, self.total, self.parts = why, saved, total, parts
 
 
 def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client=None, resume=False,
@@ -469,26 +461,3 @@ def _quiet_dask_unraisable():
 
     hook._rotframe_quiet = True
     sys.unraisablehook = hook
-
-
-def quiet_dask_logs():
-    """A context in which Dask's and tornado's loggers print nothing (the sweep reports faults itself)."""
-    import contextlib
-    import logging
-
-    @contextlib.contextmanager
-    def quiet():
-        loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
-                                                  "distributed.client", "distributed.node", "tornado")]
-        levels = [lg.level for lg in loggers]
-        for lg in loggers:
-            lg.setLevel(logging.CRITICAL)
-        try:
-            yield
-        finally:
-            for lg, level in zip(loggers, levels):
-                lg.setLevel(level)
-
-    return quiet()
-
-
