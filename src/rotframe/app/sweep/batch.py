@@ -235,26 +235,29 @@ def _worker_threads():
         return None
 
 
-_CONTROLLER = []
-
-
 def blas_single_thread():
     """A context holding BLAS to one thread (threadpoolctl where installed; else nothing to do).
 
     A sweep's parallelism is its batches and ensemble chunks; BLAS threads on top of
-    them (small ``expm`` and products) only oversubscribe the cores.
+    them (small ``expm`` and products) only oversubscribe the cores: 5 to 20 times
+    slower rows on a busy machine. The libraries are looked up once, after
+    ``scipy.linalg`` (which brings its own BLAS) is loaded, so none escapes the limit.
     """
     if not _CONTROLLER:
         try:
+            import scipy.linalg  # noqa: F401 -- its BLAS must be loaded to be limited
             from threadpoolctl import ThreadpoolController
 
-            _CONTROLLER.append(ThreadpoolController())
+            _CONTROLLER.append(ThreadpoolController())  # (tens of ms: once per process)
         except Exception:  # noqa: BLE001 -- not installed, or a library it cannot inspect: no limit
             _CONTROLLER.append(None)
-    controller = _CONTROLLER[0]
-    if controller is None:
+    if _CONTROLLER[0] is None:
         return contextlib.nullcontext()
-    return controller.limit(limits=1, user_api="blas")
+    return _CONTROLLER[0].limit(limits=1, user_api="blas")
+
+
+#: the process's threadpoolctl controller (made after numpy's and scipy's BLAS are loaded), or None
+_CONTROLLER: list = []
 
 
 def _run_batch(task):
