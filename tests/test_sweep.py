@@ -107,8 +107,8 @@ def test_tower_drop_monte_carlo_is_one_ensemble_call(tmp_path, monkeypatch, caps
     elapsed = time.perf_counter() - t0
     assert out["path"] == "ensemble" and out["rows"] == 100000 and out["failed"] == 0 and out["batches"] == 1
     # the Monte Carlo in vectorised calls of the compiled core, one per fixed chunk of rows (and fall-time class),
-    # each particle once (the recorded paths come from the same calls)
-    assert sum(sizes) == 100000 and max(sizes) <= sweep.batch.ENSEMBLE_CHUNK and len(sizes) < 100000 / 500
+    # each particle once (and the recorded ones again, for their paths)
+    assert 100000 <= sum(sizes) <= 100000 + sweep.MAX_TRACKS and max(sizes) <= sweep.batch.ENSEMBLE_CHUNK
     assert elapsed < 45, elapsed
     table = pq.read_table(out["out"]).to_pydict()
     heights = np.array(table["height"])

@@ -34,12 +34,16 @@ from rotframe.app.sweep.spec import apply_row, key_of
 from rotframe.errors import RotframeError, ScenarioError
 from rotframe.particles.ensemble import MAX_TRACK_SAMPLES  # at most this many samples per recorded path
 
-__all__ = ["MAX_TRACK_SAMPLES", "ENSEMBLE_CHUNK", "ScenarioSource", "BatchTask", "BatchOutput", "run_batch",
+__all__ = ["MAX_TRACK_SAMPLES", "ENSEMBLE_CHUNK", "ENSEMBLE_SAMPLES", "ScenarioSource", "BatchTask", "BatchOutput", "run_batch",
            "failed_output", "blas_single_thread"]
 
 
 #: rows of one vectorised ensemble call: a fixed cut of the whole sweep's rows (row // ENSEMBLE_CHUNK)
 ENSEMBLE_CHUNK = 2048
+
+
+#: output samples of an ensemble call for the metrics (the recorded rows' paths are computed again, finer)
+ENSEMBLE_SAMPLES = 16
 
 
 @dataclass(frozen=True)
@@ -302,30 +306,30 @@ def _ensemble_batch(task, scn, scene, base):
             where.append(i)
         except ScenarioError as exc:
             errors[i] = _error_text(exc)
-    run = dict(base["run"], samples=min(int(base["run"].get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
+    # the metrics at ENSEMBLE_SAMPLES output samples (the same for every row: events are located on the flow or
+    # inside the steps, never from the samples); the recorded rows' paths again, at up to MAX_TRACK_SAMPLES
+    run = dict(base["run"], samples=ENSEMBLE_SAMPLES)
+    run_paths = dict(base["run"], samples=min(int(base["run"].get("samples") or MAX_TRACK_SAMPLES),
+                                              MAX_TRACK_SAMPLES))
     chunk_of = np.asarray(task.rows, np.int64)[where] // ENSEMBLE_CHUNK if where else np.zeros(0, np.int64)
     chunks = [np.nonzero(chunk_of == c)[0] for c in np.unique(chunk_of)]  # indices into where / values_list
     tracks = {}
 
     def one(members):
-        wanted = {j: None for j, m in enumerate(members) if int(task.rows[where[m]]) in task.track_rows}
         vals = [values_list[m] for m in members]
+        wanted = [j for j, m in enumerate(members) if int(task.rows[where[m]]) in task.track_rows]
         try:
-            return members, _ensemble_call(scene, scn, task, run, vals, wanted), wanted, None
+            out, errs = _ensemble_call(scene, scn, task, run, vals, None), None
         except (RotframeError, ArithmeticError):
-            pass
-        out, errs = [], []
-        for j, v in enumerate(vals):  # the chunk failed as a whole: each row alone, so the failure is its own
-            mine = {0: None} if j in wanted else None
-            try:
-                out.append(_ensemble_call(scene, scn, task, run, [v], mine)[0])
-                if mine:
-                    wanted[j] = mine[0]
-                errs.append("")
-            except Exception as exc:  # noqa: BLE001 -- a failed row is data
-                out.append(None)
-                errs.append(_error_text(exc))
-        return members, out, wanted, errs
+            out, errs = [], []
+            for v in vals:  # the chunk failed as a whole: each row alone, so the failure is its own
+                try:
+                    out.append(_ensemble_call(scene, scn, task, run, [v], None)[0])
+                    errs.append("")
+                except Exception as exc:  # noqa: BLE001 -- a failed row is data
+                    out.append(None)
+                    errs.append(_error_text(exc))
+        return members, out, _paths(scene, scn, task, run_paths, vals, wanted, out), errs
 
     t0 = time.perf_counter()
     threads = min(resolve_threads(None), len(chunks)) if chunks else 1
@@ -351,11 +355,23 @@ def _ensemble_batch(task, scn, scene, base):
             for name in _ordered_keys(th):
                 cols.put(cols.theory, name, idx[ok], [_float(t.get(name)) for t in th])
         for j, tr in wanted.items():
-            if tr is not None:
-                tracks[int(task.rows[idx[j]])] = _decimated(*tr)
+            tracks[int(task.rows[idx[j]])] = _decimated(*tr)
     seconds = np.full(n, (time.perf_counter() - t0) / max(n, 1))
     return BatchOutput(task.index, np.asarray(task.rows, np.int64), np.asarray(task.values, np.float64),
                        cols.metrics, cols.theory, errors, tracks, seconds)
+
+
+def _paths(scene, scn, task, run, vals, wanted, metrics):
+    """{index in vals: (times, positions)} of the recorded rows that ran (a second call, for their paths only)."""
+    wanted = [j for j in wanted if metrics[j] is not None]
+    if not wanted:
+        return {}
+    tracks = {k: None for k in range(len(wanted))}
+    try:
+        _ensemble_call(scene, scn, task, run, [vals[j] for j in wanted], tracks)
+    except (RotframeError, ArithmeticError):  # paths are for the picture only
+        return {}
+    return {j: tracks[k] for k, j in enumerate(wanted) if tracks.get(k) is not None}
 
 
 def _ensemble_call(scene, scn, task, run, values_list, tracks):
