@@ -10,7 +10,7 @@ Covered: the table is bitwise the same however the work is cut (batch size,
 backend, threads, resume); a worker killed mid-sweep costs nothing; a row that kills
 its workers is a failed row with the cause, never run in the client; the scheduler
 killed mid-sweep ends the command with exit 1 and the resume hint, and ``--resume``
-finishes the same table; SIGTERM during a Dask sweep gives 143 and the hint.
+finishes the same table; SIGTERM and SIGINT during a Dask sweep give 143 and 130 and the hint.
 """
 
 from __future__ import annotations
@@ -247,16 +247,17 @@ def wait_for_part(tmp_path, proc, name):
         time.sleep(0.05)
 
 
-def test_sigterm_during_a_dask_sweep_gives_143_and_the_hint(cluster, tmp_path):
+@pytest.mark.parametrize("sig,code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_during_a_dask_sweep_gives_its_code_and_the_hint(cluster, tmp_path, sig, code):
     module, toml = plugin(tmp_path, scene="slow-projectile", nap=0.3)
     env = dict(ENV, ROTFRAME_PLUGINS=str(module))
     argv = [sys.executable, "-m", "rotframe", "sweep", str(toml), "--samples", "40", "--vary",
             "speed=normal(1600,5)", "--scheduler", cluster.address, "--out", "s.parquet"]
     proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     wait_for_part(tmp_path, proc, "s.parquet")
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)  # a bound, so that a hang fails the test
-    assert proc.returncode == 143, err
+    assert proc.returncode == code, err
     assert "--resume" in err and "Traceback" not in err
     cluster.client.wait_for_workers(2, timeout=90)
 

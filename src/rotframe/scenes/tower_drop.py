@@ -11,6 +11,7 @@ equatorward (southward in the north) part is second order,
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -267,16 +268,23 @@ def _duration_groups(values_list, terms):
     return out
 
 
-@with_parameters(TowerDropParameters)
-def ensemble_theory(p):
+def ensemble_theory(values):
     """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
-    t = sqrt(2 h / g).
+    t = sqrt(2 h / g). ``values`` is the resolved mapping of :func:`simulate` (read
+    directly, and the Earth's constants cached per latitude: this runs once per row).
     """
-    Omega, _, g = earth_model_constants(p.latitude, p.g_model)
-    lat = math.radians(p.latitude)
-    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(p.height, lat, g, Omega)),
-            "north_deflection_m": float(analytic.drop_north_deflection_second_order(p.height, lat, g, Omega)),
-            "fall_time_s": math.sqrt(2 * p.height / g)}
+    h, latitude = float(values["height"]), float(values["latitude"])
+    Omega, g = _omega_and_g(latitude, str(values.get("g_model", "wgs84")))
+    lat = math.radians(latitude)
+    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(h, lat, g, Omega)),
+            "north_deflection_m": float(analytic.drop_north_deflection_second_order(h, lat, g, Omega)),
+            "fall_time_s": math.sqrt(2 * h / g)}
+
+
+@functools.lru_cache(maxsize=4096)
+def _omega_and_g(latitude, g_model):
+    Omega, _, g = earth_model_constants(latitude, g_model)
+    return Omega, g
