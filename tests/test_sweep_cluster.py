@@ -239,6 +239,17 @@ def test_a_row_that_kills_its_workers_is_a_failed_row_never_run_here(cluster, tm
     cluster.client.wait_for_workers(2, timeout=90)
 
 
+def test_a_batch_over_the_task_timeout_is_failed_rows_and_the_sweep_goes_on(cluster, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    module, toml = plugin(tmp_path, scene="sleepy-projectile", nap=2.0)
+    load_plugin(module)
+    spec = sweep.spec.python_spec(str(toml), points={"speed": np.array([1600.0, 1601.0])})
+    res = sweep.run_sweep(spec, "slow.parquet", client=cluster.client, batch_rows=2, task_timeout=0.5, plots=False,
+                          recording=False)
+    errors = res.table.column("error").to_pylist()
+    assert res.rows == 2 and res.failed == 2 and all(e.startswith("TimeoutError") for e in errors), errors
+
+
 def wait_for_part(tmp_path, proc, name):
     deadline = time.monotonic() + 120
     while not list((tmp_path / f"{name}.parts").glob("part-*.parquet")):

@@ -100,11 +100,17 @@ def main(args) -> int:
     task_timeout = getattr(args, "task_timeout", None)
     if task_timeout is not None and not task_timeout > 0:
         raise ScenarioError(f"--task-timeout {task_timeout:g}: must be > 0 seconds")
-    scheduler = args.scheduler
+    scheduler, from_env = args.scheduler, False
     if scheduler is None and scheduler_file is None and args.workers is None:
         scheduler = scheduler_from_env()
+        from_env = scheduler is not None
     if scheduler is not None:
-        check_scheduler(scheduler)
+        try:
+            check_scheduler(scheduler)
+        except ScenarioError as exc:
+            if not from_env:
+                raise
+            raise ScenarioError(str(exc).replace("--scheduler", "DASK_SCHEDULER_ADDRESS", 1)) from None
     scope = getattr(args, "scope", None) or InterruptScope()
     progress = Progress("sweep", "rows", enabled=not args.json)
     try:
