@@ -52,9 +52,9 @@ METHODS = _base.METHODS
 
 
 def simulate(values, terms, method, run, progress):
+    if os.environ.get("ROTFRAME_TEST_CLIENT") == str(os.getpid()):
+        raise RuntimeError("a row ran in the client")
     if values["speed"] == POISON:
-        if os.environ.get("ROTFRAME_TEST_CLIENT") == str(os.getpid()):
-            raise RuntimeError("the poison row ran in the client")
         os.kill(os.getpid(), signal.SIGKILL)
     time.sleep(NAP)
     return _base.simulate(values, terms, method, run, progress)
@@ -237,6 +237,26 @@ def test_a_row_that_kills_its_workers_is_a_failed_row_never_run_here(cluster, tm
     assert not any(e for i, e in enumerate(errors) if i != 0)
     assert np.isnan(res.table.column("range_m").to_numpy()[0])
     cluster.client.wait_for_workers(2, timeout=90)
+
+
+def test_a_scheduler_file_and_dask_scheduler_address_reach_the_cluster(cluster, tmp_path, monkeypatch):
+    from rotframe.app import cli
+
+    monkeypatch.chdir(tmp_path)
+    module, toml = plugin(tmp_path, scene="remote-projectile")
+    load_plugin(module)
+    monkeypatch.setenv("ROTFRAME_TEST_CLIENT", str(os.getpid()))  # a row run here fails
+    spec = sweep.spec.python_spec(str(toml), points={"speed": np.array([1600.0, 1601.0])})
+    path = tmp_path / "scheduler.json"
+    path.write_text(json.dumps({"address": cluster.address}), encoding="utf-8")
+    res = sweep.run_sweep(spec, "file.parquet", scheduler_file=str(path), batch_rows=1, plots=False,
+                          recording=False)
+    assert res.failed == 0, res.table.column("error").to_pylist()
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", cluster.address)
+    code = cli.main(["sweep", str(toml), "--samples", "4", "--vary", "speed=normal(1600,5)", "--out", "env.parquet",
+                     "--json"])  # the first rows are timed on the cluster too, never here
+    assert code == 0
+    assert not any(pq.read_table(tmp_path / "env.parquet").column("error").to_pylist())
 
 
 def test_a_batch_over_the_task_timeout_is_failed_rows_and_the_sweep_goes_on(cluster, tmp_path, monkeypatch):
