@@ -64,10 +64,11 @@ def fall_duration(h, drag, g):
 
     (An absolute margin would swamp a short fall.) Broadcasts over ``h``.
     """
-    t_vac = np.sqrt(2 * np.asarray(h, dtype=float) / g)
-    t_drag = np.asarray(h, dtype=float) * math.sqrt(drag / g) if drag > 0 else 0.0
-    t = t_vac + t_drag
-    out = 1.5 * t + np.minimum(1.0, 1.5 * t)
+    with np.errstate(all="ignore"):  # a height near the float limit gives inf here, refused as a duration later
+        t_vac = np.sqrt(2 * np.asarray(h, dtype=float) / g)
+        t_drag = np.asarray(h, dtype=float) * math.sqrt(drag / g) if drag > 0 else 0.0
+        t = t_vac + t_drag
+        out = 1.5 * t + np.minimum(1.0, 1.5 * t)
     return float(out) if np.ndim(out) == 0 else out
 
 

@@ -98,9 +98,14 @@ def run_on_dask(client, tasks, finished, *, split=False, task_timeout=None):
                 status = future.status
                 if status == "pending":
                     continue
-                if status not in ("finished", "error"):  # cancelled or lost: a lost connection, checked below
-                    continue
                 task = inflight[future][0]
+                if status not in ("finished", "error"):  # cancelled or lost: the scheduler forgot it
+                    if getattr(client, "status", "running") == "running":  # (a lost connection is checked below)
+                        _forget(future, inflight, order)
+                        again = _forgotten(task, finished)
+                        if again is not None:
+                            queue.appendleft(again)
+                    continue
                 output, exc = _outcome(client, future)
                 _forget(future, inflight, order)
                 if exc is None:
@@ -175,6 +180,24 @@ def _after_failure(task, exc, split, finished):
         why = f"{type(exc).__name__} on a Dask worker: {_why(exc)}"
     finished(failed_output(task, why))
     return []
+
+
+def _forgotten(task, finished, most=3):
+    """A batch the scheduler forgot (a scheduler restarted under a running client): again, at most ``most`` times.
+
+    Returns the task to submit again, or None after its rows were failed.
+    """
+    from dataclasses import replace
+
+    from rotframe.app.sweep.batch import failed_output
+
+    tries = getattr(task, "_forgotten", 0) + 1
+    if tries > most:
+        finished(failed_output(task, f"CancelledError: the Dask scheduler forgot this batch {most} times"))
+        return None
+    again = replace(task)
+    again._forgotten = tries
+    return again
 
 
 def _sub(task, part):
