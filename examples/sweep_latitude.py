@@ -1,6 +1,8 @@
 """A sweep from Python with a plot: Foucault's precession rate against latitude.
 
-Each point is one ``rotframe.run``; the curve behind is Omega sin(latitude).
+One ``rotframe.sweep`` call runs every latitude (one row each, a pandas DataFrame: the
+command line's sweep, with ``client=`` for a Dask cluster); the curve behind is
+Omega sin(latitude).
 
     python examples/sweep_latitude.py --points 13 --out foucault-latitude.png
 """
@@ -24,11 +26,10 @@ parser.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "foucau
 args = parser.parse_args()
 
 latitudes = np.linspace(-90, 90, args.points)
-rates, theory = [], []
-for lat in latitudes:
-    r = rotframe.run("foucault", "exact", latitude=lat, duration=args.duration, small_angle=True)
-    rates.append(r.metrics["precession_rate_deg_per_hour"])
-    theory.append(r.theory["precession_rate_deg_per_hour"])
+table = rotframe.sweep("foucault", grid={"latitude": latitudes}, method="exact", duration=args.duration,
+                       small_angle=True)
+rates = table["precession_rate_deg_per_hour"].to_numpy()
+theory = table["theory_precession_rate_deg_per_hour"].to_numpy()
 
 fine = np.linspace(-90, 90, 181)
 peak = max(abs(t) for t in theory)  # Omega in deg/h

@@ -21,6 +21,8 @@ from rotframe.app import runner
 from rotframe.app import sweep  # noqa: E402
 from rotframe.errors import IntegrationError, ScenarioError  # noqa: E402
 
+REPO_SCENARIOS = __import__("pathlib").Path(__file__).resolve().parents[1] / "scenarios"
+
 PROJECTILE_MC = ["--samples", "120", "--vary", "speed=normal(1600,5)", "--vary", "azimuth=normal(232,0.05)"]
 
 
@@ -104,8 +106,9 @@ def test_tower_drop_monte_carlo_is_one_ensemble_call(tmp_path, monkeypatch, caps
     out = sweep_json(capsys, "tower-drop", "--samples", "100000", "--vary", "height=normal(158.5,1)", "--seed", "7")
     elapsed = time.perf_counter() - t0
     assert out["path"] == "ensemble" and out["rows"] == 100000 and out["failed"] == 0 and out["batches"] == 1
-    assert sizes.count(100000) == 1  # the whole Monte Carlo in one compiled call ...
-    assert all(n <= sweep.MAX_TRACKS for n in sizes if n != 100000)  # ... plus the recorded paths
+    # the Monte Carlo in vectorised calls of the compiled core, one per fixed chunk of rows (and fall-time class),
+    # each particle once (and the recorded ones again, for their paths)
+    assert 100000 <= sum(sizes) <= 100000 + sweep.MAX_TRACKS and max(sizes) <= sweep.batch.ENSEMBLE_CHUNK
     assert elapsed < 45, elapsed
     table = pq.read_table(out["out"]).to_pydict()
     heights = np.array(table["height"])
@@ -289,3 +292,71 @@ def test_bad_sweeps_exit_2_with_one_line(tmp_path, args, fragment):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and fragment in lines[0], res.stderr
     assert "Traceback" not in res.stderr and not (tmp_path / "sweeps").exists()
+
+
+# ---------------------------------------------------------------------------
+# the Python API and the resume fingerprint
+# ---------------------------------------------------------------------------
+
+
+def test_python_sweep_is_the_command_lines_sweep(tmp_path, monkeypatch):
+    pd = pytest.importorskip("pandas")
+    import rotframe
+    import rotframe.app.sweep as module  # the package still imports as before
+
+    monkeypatch.chdir(tmp_path)
+    assert callable(rotframe.sweep) and module.run_sweep is sweep.run_sweep
+    df = rotframe.sweep("tower-drop", grid={"height": [20.0, 158.5], "latitude": [-30.0, 50.9]}, drag=0)
+    spec = sweep.parse_spec("tower-drop", sets={"drag": 0}, grid=["height=20:158.5:2", "latitude=-30:50.9:2"])
+    ref = sweep.run_sweep(spec, "ref.parquet", plots=False, recording=False).table.to_pandas()
+    assert isinstance(df, pd.DataFrame) and list(df.columns) == list(ref.columns)
+    pd.testing.assert_frame_equal(df, ref)
+    # points from a quasi-random design: one row each, in order; Monte Carlo as on the command line
+    qmc = pytest.importorskip("scipy.stats.qmc")
+    design = qmc.scale(qmc.LatinHypercube(d=2, seed=3).random(5), [10, -60], [300, 60])
+    df = rotframe.sweep("tower-drop", points=pd.DataFrame({"height": design[:, 0], "latitude": design[:, 1]}))
+    assert np.array_equal(df["height"], design[:, 0]) and np.array_equal(df["latitude"], design[:, 1])
+    for i in (0, 4):
+        single = rotframe.run("tower-drop", height=design[i, 0], latitude=design[i, 1])
+        assert df["east_deflection_m"][i] == pytest.approx(single.metrics["east_deflection_m"], rel=1e-12)
+    mc = rotframe.sweep("projectile", vary={"speed": "normal(1600,5)"}, samples=3, seed=2, out="mc.parquet")
+    assert np.array_equal(mc["speed"], np.random.default_rng(2).normal(1600, 5, 3))
+    assert pq.read_table("mc.parquet").num_rows == 3
+    assert not list(tmp_path.glob("sweeps"))  # out=None writes nothing
+
+
+@pytest.mark.parametrize("kwargs,fragment", [
+    ({"grid": {"hieght": [1, 2]}}, "did you mean 'height'"),
+    ({"grid": {"height": [1, 2]}, "points": {"latitude": [1, 2]}}, "not grid and points"),
+    ({"points": {"height": [1, 2], "latitude": [3]}}, "equal length"),
+    ({"points": {"height": [1, float("nan")]}}, "non-finite"),
+    ({"vary": {"height": "normal(100,1)"}}, "--vary needs --samples"),
+    ({"grid": {"height": [-1, 2]}}, "height"),
+])
+def test_python_sweep_refuses_bad_input_in_one_line(tmp_path, monkeypatch, kwargs, fragment):
+    import rotframe
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ScenarioError) as info:
+        rotframe.sweep("tower-drop", **kwargs)
+    assert fragment in str(info.value) and "\n" not in str(info.value)
+
+
+def test_resume_refuses_a_changed_scenario_file(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "my-gun.toml"
+    text = (REPO_SCENARIOS / "projectile.toml").read_text(encoding="utf-8")
+    path.write_text(text, encoding="utf-8")
+    spec = sweep.parse_spec(str(path), samples=6, vary=["speed=normal(1600,5)"], seed=1)
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(sweep.SweepInterrupted):
+        sweep.run_sweep(spec, "gun.parquet", batch_rows=2, on_batch=stop)
+    path.write_text(text + "\n# changed after the first batch\n", encoding="utf-8")
+    with pytest.raises(ScenarioError, match="scenario file.* changed"):
+        sweep.run_sweep(spec, "gun.parquet", resume=True, batch_rows=2)
+    path.write_text(text, encoding="utf-8")  # the same text again: the resume goes on
+    res = sweep.run_sweep(spec, "gun.parquet", resume=True, batch_rows=2, plots=False, recording=False)
+    assert res.computed == 4 and res.rows == 6

@@ -13,6 +13,7 @@ Running scenarios ([`rotframe.app.api`][rotframe.app.api])::
     r = rotframe.run("tower-drop", height="520 ft", latitude=50.9)
     r.metrics, r.theory, r.trajectory.r         # dicts and numpy arrays (SI)
     r.record("drop.rrd")                        # the same recording as the command line
+    df = rotframe.sweep("tower-drop", grid={"height": [50, 100]})   # one row per run (pandas)
 
 The house, from the core up (each layer imports only the layers above it in
 this list; ``docs/architecture.md`` has the arrows):
@@ -49,6 +50,7 @@ _LAZY = {
     "simulate_body": "rotframe.app.problems",
     "Force": "rotframe.problem.particles",
     "Torque": "rotframe.problem.body",
+    "sweep": "rotframe.app.sweep.api",
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
@@ -65,7 +67,7 @@ _MOVED = {
     "integrators": "rotframe.particles.integrators", "kernels": "rotframe.particles.kernels",
     "ensemble": "rotframe.particles.ensemble", "api": "rotframe.app.api", "runner": "rotframe.app.runner",
     "scenario": "rotframe.app.scenario", "record": "rotframe.app.record", "units": "rotframe.app.units",
-    "export": "rotframe.app.export", "cli": "rotframe.app.cli", "sweep": "rotframe.app.sweep",
+    "export": "rotframe.app.export", "cli": "rotframe.app.cli",
 }
 
 __all__ = ["__version__", *_LAZY]

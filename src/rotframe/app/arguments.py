@@ -150,7 +150,12 @@ def build_parser(commands):
     q.add_argument("--method", metavar="M", help="integrator (see 'rotframe show NAME')")
     g = q.add_mutually_exclusive_group()
     g.add_argument("--workers", type=whole_count, default=None, metavar="N", help="a LocalCluster of N processes")
-    g.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786")
+    g.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786 "
+                   "(default: $DASK_SCHEDULER_ADDRESS where set, else this process)")
+    g.add_argument("--scheduler-file", metavar="PATH", default=None,
+                   help="an existing Dask scheduler named by its file (dask scheduler --scheduler-file PATH)")
+    q.add_argument("--task-timeout", type=float, default=None, metavar="S",
+                   help="on Dask: fail the rows of a batch that runs longer than S seconds on a worker")
     q.add_argument("--out", metavar="PATH.parquet", default=None,
                    help="result table (default sweeps/<name>.parquet; plots and a recording go beside it)")
     q.add_argument("--resume", action="store_true", help="compute only the rows missing from --out")

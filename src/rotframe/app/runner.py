@@ -19,8 +19,9 @@ def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
 
     Parameters
     ----------
-    name_or_path : str
-        Scenario name in ``scenarios/`` or a path to a ``.toml`` file.
+    name_or_path : str or Scenario
+        Scenario name in ``scenarios/``, a path to a ``.toml`` file, or one already loaded
+        (a sweep loads it once for all its rows).
     sets : dict, optional
         Parameter overrides ``{key: value}`` as on the command line.
     method : str, optional
@@ -29,7 +30,7 @@ def run(name_or_path, sets=None, *, method=None, terms=None, progress=None):
         Model terms replacing the scenario's ``model`` list.
     """
     from rotframe.app import scenario as sc
-    scn = sc.load(name_or_path)
+    scn = name_or_path if isinstance(name_or_path, sc.Scenario) else sc.load(name_or_path)
     values = scn.with_values(sets or {})
     t0 = time.perf_counter()
     result = simulate(scn, values, method=method, terms=terms, progress=progress)

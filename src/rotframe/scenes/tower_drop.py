@@ -11,6 +11,7 @@ equatorward (southward in the north) part is second order,
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -23,7 +24,7 @@ from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
-                                  with_parameters)
+                                  scene_parameters, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -55,11 +56,20 @@ def build(p, terms):
     model = ParticleModel(resolve_terms(terms, p.drag), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]),
                           k_quadratic=p.drag, g0=g, radius=R_EARTH, gm=GM_EARTH)
     h = p.height
-    t_vac = math.sqrt(2 * h / g)
-    t_drag = h * math.sqrt(p.drag / g) if p.drag > 0 else 0.0
-    # room to land from the problem's own time scale (an absolute margin would swamp a short fall)
-    duration = 1.5 * (t_vac + t_drag) + min(1.0, 1.5 * (t_vac + t_drag))
-    return model, np.array([0.0, 0.0, h]), np.zeros(3), duration, g
+    return model, np.array([0.0, 0.0, h]), np.zeros(3), fall_duration(h, p.drag, g), g
+
+
+def fall_duration(h, drag, g):
+    """Simulated time (s) for a drop from ``h`` to land: room from the problem's own time scale.
+
+    (An absolute margin would swamp a short fall.) Broadcasts over ``h``.
+    """
+    with np.errstate(all="ignore"):  # a height near the float limit gives inf here, refused as a duration later
+        t_vac = np.sqrt(2 * np.asarray(h, dtype=float) / g)
+        t_drag = np.asarray(h, dtype=float) * math.sqrt(drag / g) if drag > 0 else 0.0
+        t = t_vac + t_drag
+        out = 1.5 * t + np.minimum(1.0, 1.5 * t)
+    return float(out) if np.ndim(out) == 0 else out
 
 
 @with_parameters(TowerDropParameters)
@@ -192,10 +202,11 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     """Metrics of many drops: one vectorised integration per group of points sharing the model.
 
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
-    latitude, drag and gravity, hence the model: each such group is one
-    ``integrate_particles`` call with one particle per point and the ground event
-    (`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
-    `analyse`; they agree with single runs to the method's accuracy (to round-off
+    latitude, drag and gravity, hence the model; those whose fall needs the same
+    simulated time (:func:`ensemble_duration`, from each point alone, never from the
+    others in the call) are one ``integrate_particles`` call with one particle per
+    point and the ground event (:func:`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
+    :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
     Parameters
@@ -213,12 +224,13 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     list of dict
         ``analyse(...)["metrics"]`` per point, in order.
     """
-    from rotframe.particles.ensemble import group_points, integrate_ensemble
+    from rotframe.particles.ensemble import integrate_ensemble
 
     metrics = [None] * len(values_list)
-    for members in group_points(values_list, varying=("height", "magnify")):
+    for members in _duration_groups(values_list, terms):
         heights = np.array([values_list[i]["height"] for i in members], dtype=float)
-        model, _, _, duration, _ = build(dict(values_list[members[0]], height=float(heights.max())), terms)
+        model, _, _, duration, _ = build(values_list[members[0]], terms)
+        duration = ensemble_duration(duration)
         r0 = np.zeros((len(members), 3))
         r0[:, 2] = heights
         keep = [k for k, i in enumerate(members) if tracks is not None and i in tracks]
@@ -233,16 +245,53 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     return metrics
 
 
-@with_parameters(TowerDropParameters)
-def ensemble_theory(p):
-    """The closed forms of `analyse`'s theory for one point, for sweep rows run as an ensemble.
+def ensemble_duration(duration):
+    """The simulated time of an ensemble member whose own fall needs ``duration``: the next power of two (s).
+
+    It depends on the point alone, so a point's numbers never depend on the other
+    points integrated with it (how a sweep cut its rows); the power of two keeps
+    points of similar heights in one vectorised call.
+    """
+    if not (math.isfinite(duration) and duration > 0):
+        return float(duration)
+    e = math.ceil(math.log2(duration))
+    return math.ldexp(1.0, e) if -1070 < e < 1020 else float(duration)
+
+
+def _duration_groups(values_list, terms):
+    """Indices grouped by model (every value but height and magnify) and by :func:`ensemble_duration`."""
+    from rotframe.particles.ensemble import group_points
+
+    out = []
+    for members in group_points(values_list, varying=("height", "magnify")):
+        first = scene_parameters(TowerDropParameters, values_list[members[0]])
+        _, _, g = earth_model_constants(first.latitude, first.g_model)
+        heights = np.array([values_list[i]["height"] for i in members], dtype=float)
+        durations = np.atleast_1d(fall_duration(heights, first.drag, g))
+        by = {}
+        for i, d in zip(members, durations):
+            by.setdefault(ensemble_duration(d), []).append(i)
+        out.extend(by[d] for d in sorted(by))
+    return out
+
+
+def ensemble_theory(values):
+    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
-    t = sqrt(2 h / g).
+    t = sqrt(2 h / g). ``values`` is the resolved mapping of :func:`simulate` (read
+    directly, and the Earth's constants cached per latitude: this runs once per row).
     """
-    Omega, _, g = earth_model_constants(p.latitude, p.g_model)
-    lat = math.radians(p.latitude)
-    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(p.height, lat, g, Omega)),
-            "north_deflection_m": float(analytic.drop_north_deflection_second_order(p.height, lat, g, Omega)),
-            "fall_time_s": math.sqrt(2 * p.height / g)}
+    h, latitude = float(values["height"]), float(values["latitude"])
+    Omega, g = _omega_and_g(latitude, str(values.get("g_model", "wgs84")))
+    lat = math.radians(latitude)
+    return {"east_deflection_m": float(analytic.drop_east_deflection_first_order(h, lat, g, Omega)),
+            "north_deflection_m": float(analytic.drop_north_deflection_second_order(h, lat, g, Omega)),
+            "fall_time_s": math.sqrt(2 * h / g)}
+
+
+@functools.lru_cache(maxsize=4096)
+def _omega_and_g(latitude, g_model):
+    Omega, _, g = earth_model_constants(latitude, g_model)
+    return Omega, g

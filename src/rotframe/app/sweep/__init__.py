@@ -16,22 +16,31 @@ with one PNG per metric against each swept parameter and a rerun recording of
 the ensemble next to it.
 
 Execution. A scene module with ``simulate_ensemble(values_list, terms, method,
-run, tracks=None)`` integrates a whole batch of points in one vectorised call
-of the compiled core (`rotframe.particles.ensemble.integrate_ensemble` helps it); otherwise each
-point goes through `rotframe.app.runner.run`. Points are cut into batches
-(about 0.2 s to 30 s of work each, at most about four per worker); batches run
-in this process, or as Dask tasks on a ``LocalCluster`` (``--workers N``) or an
-existing scheduler (``--scheduler ADDRESS``), retried when a worker is lost.
-Every finished batch is written at once as a Parquet part in
-``<out>.parts/``; the parts are merged into ``<out>`` at the end, so an
-interrupted sweep keeps its finished batches and ``--resume`` computes only
-the missing rows.
+run, tracks=None)`` integrates the rows in vectorised calls of the compiled core
+(:func:`rotframe.particles.ensemble.integrate_ensemble` helps it), one call per fixed
+chunk of :data:`~rotframe.app.sweep.batch.ENSEMBLE_CHUNK` rows of the whole sweep;
+otherwise each point goes through :func:`rotframe.app.runner.run`. Points are cut
+into batches (about 0.2 s to 30 s of work each, at most about four per worker;
+whole chunks on the ensemble path); batches run in this process, or as Dask tasks
+on a ``LocalCluster`` (``--workers N``) or an existing scheduler (``--scheduler
+ADDRESS``, ``--scheduler-file PATH``, ``DASK_SCHEDULER_ADDRESS``). A task carries
+the scenario's text and a plugin scene's source, so a worker needs only rotframe.
+Every row's numbers are bitwise the same however the rows are cut, wherever they
+run and after a resume. The faults of a cluster end in bounded time
+(:mod:`~rotframe.app.sweep.cluster`). Every finished batch is written at once as a
+Parquet part in ``<out>.parts/``; the parts are merged into ``<out>`` at the end,
+so an interrupted sweep keeps its finished batches and ``--resume`` computes only
+the missing rows, after checking the parts' fingerprint (the spec, the given
+points and the scenario's text).
+
+From Python: :func:`rotframe.sweep` (:mod:`~rotframe.app.sweep.api`), the same
+implementation, returning a pandas DataFrame.
 
 Dask and pyarrow are imported only when needed (``pip install
-rotframe[sweep]``). Modules: `spec` (what is swept),
-`batch` (one batch of rows), `execute`
-(batches here or on Dask), `store` (Parquet parts, merge, resume,
-lock), `plots` and `recording`; this
+rotframe[sweep]``). Modules: :mod:`~rotframe.app.sweep.spec` (what is swept),
+:mod:`~rotframe.app.sweep.batch` (one batch of rows), :mod:`~rotframe.app.sweep.execute`
+(batches here or on Dask), :mod:`~rotframe.app.sweep.cluster` (Dask and its faults),
+:mod:`~rotframe.app.sweep.store` (Parquet parts, merge, resume, lock), :mod:`~rotframe.app.sweep.plots` and :mod:`~rotframe.app.sweep.recording`; this
 module is the ``rotframe sweep`` command.
 """
 
@@ -41,15 +50,15 @@ import json
 import os
 
 from rotframe.app.sweep.batch import MAX_TRACK_SAMPLES, BatchOutput, BatchTask, run_batch
-from rotframe.app.sweep.execute import (CONNECT_TIMEOUT_S, MAX_TRACKS, SweepInterrupted, SweepResult, check_scheduler,
-                                        run_sweep)
+from rotframe.app.sweep.execute import (CONNECT_TIMEOUT_S, MAX_TRACKS, SweepInterrupted, SweepLost, SweepResult,
+                                        check_scheduler, run_sweep, scheduler_from_env)
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.spec import Axis, SweepSpec, Vary, parse_spec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, check_outputs, metric_columns, read_table
 from rotframe.errors import ScenarioError
 from rotframe.particles.ensemble import EnsembleRun, group_points, integrate_ensemble  # noqa: F401  (old home)
 
-__all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "parse_spec", "sweep_points", "points_of",
+__all__ = ["Axis", "Vary", "SweepSpec", "SweepResult", "SweepInterrupted", "SweepLost", "parse_spec", "sweep_points", "points_of",
            "run_sweep", "read_table", "run_batch", "BatchTask", "BatchOutput", "write_plots", "check_outputs",
            "check_scheduler", "format_result", "main", "MAX_TRACKS", "MAX_TRACK_SAMPLES", "CONNECT_TIMEOUT_S"]
 
@@ -87,13 +96,30 @@ def main(args) -> int:
         raise ScenarioError(f"--workers {args.workers}: at most {most} local processes on this machine "
                             f"({os.cpu_count()} CPUs); use --scheduler for a larger cluster")
     check_outputs(spec, args.out, args.resume)
-    if args.scheduler is not None:
-        check_scheduler(args.scheduler)
+    scheduler_file = getattr(args, "scheduler_file", None)
+    task_timeout = getattr(args, "task_timeout", None)
+    if task_timeout is not None and not task_timeout > 0:
+        raise ScenarioError(f"--task-timeout {task_timeout:g}: must be > 0 seconds")
+    scheduler, from_env = args.scheduler, False
+    if scheduler is None and scheduler_file is None and args.workers is None:
+        scheduler = scheduler_from_env()
+        from_env = scheduler is not None
+    if scheduler is not None:
+        try:
+            check_scheduler(scheduler)
+        except ScenarioError as exc:
+            if not from_env:
+                raise
+            raise ScenarioError(str(exc).replace("--scheduler", "DASK_SCHEDULER_ADDRESS", 1)) from None
     scope = getattr(args, "scope", None) or InterruptScope()
     progress = Progress("sweep", "rows", enabled=not args.json)
     try:
-        result = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                           on_batch=progress.update)
+        result = run_sweep(spec, args.out, workers=args.workers, scheduler=scheduler, resume=args.resume,
+                           on_batch=progress.update, scheduler_file=scheduler_file, task_timeout=task_timeout)
+    except SweepLost as exc:
+        progress.close()
+        messages.error(f"sweep: {exc}")
+        return 1
     except SweepInterrupted as exc:
         progress.close()
         scope.interrupted = True

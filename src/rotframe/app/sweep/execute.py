@@ -1,13 +1,17 @@
 """Running a sweep: batches sized from their cost, in this process or on Dask, each part written as it finishes.
 
 Points are cut into batches (about 0.2 s to 30 s of work each, at most about four
-per worker); batches run here, or as Dask tasks on a ``LocalCluster``
-(``--workers N``) or an existing scheduler (``--scheduler ADDRESS``), retried when a
-worker is lost. Dask is imported only when needed.
+per worker; on the ensemble path whole chunks of :data:`~rotframe.app.sweep.batch.ENSEMBLE_CHUNK`
+rows, so that a row's numbers never depend on the cut); batches run here, or as Dask
+tasks on a ``LocalCluster`` (``--workers N``) or an existing scheduler
+(``--scheduler ADDRESS``, ``--scheduler-file PATH`` or ``DASK_SCHEDULER_ADDRESS``),
+with the faults of a cluster handled in :mod:`~rotframe.app.sweep.cluster`. Dask is
+imported only when needed.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 import time
@@ -16,14 +20,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.app.messages import one_line as _one_line
-from rotframe.app.sweep.batch import BatchTask, run_batch
+from rotframe.app.sweep.batch import ENSEMBLE_CHUNK, BatchTask, ScenarioSource, run_batch
+from rotframe.app.sweep.cluster import SweepLost, quiet_dask_logs
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.recording import write_recording
 from rotframe.app.sweep.spec import SweepSpec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, require, write_part
 from rotframe.errors import ScenarioError
 
-__all__ = ["SweepResult", "SweepInterrupted", "run_sweep", "check_scheduler", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
+__all__ = ["SweepResult", "SweepInterrupted", "SweepLost", "run_sweep", "check_scheduler", "scheduler_from_env",
+           "quiet_dask_logs", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
 
 
 #: at most this many trajectories and samples per trajectory in the recording
@@ -87,7 +93,8 @@ class SweepInterrupted(KeyboardInterrupt):
 
 
 def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client=None, resume=False,
-              batch_rows=None, on_batch=None, plots=True, recording=True) -> SweepResult:
+              batch_rows=None, on_batch=None, plots=True, recording=True, scheduler_file=None,
+              task_timeout=None) -> SweepResult:
     """Run a sweep, writing each batch as it finishes; merge, plot and record at the end.
 
     Parameters
@@ -100,6 +107,8 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
         Run batches on a ``distributed.LocalCluster`` of this many single-threaded processes.
     scheduler : str, optional
         Address of an existing Dask scheduler.
+    scheduler_file : path-like, optional
+        A Dask scheduler file (``dask scheduler --scheduler-file``) naming the scheduler.
     client : distributed.Client, optional
         Use this client (not closed here) instead of ``workers`` / ``scheduler``.
     resume : bool
@@ -110,6 +119,8 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
         Called after each batch is written (progress; tests use it to interrupt).
     plots, recording : bool
         Write the PNGs and the rerun recording.
+    task_timeout : float, optional
+        On Dask: seconds a batch may run on a worker before its rows are failed with a TimeoutError.
 
     Returns
     -------
@@ -119,25 +130,31 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
     ------
     SweepInterrupted
         On Ctrl-C / SIGTERM; the finished batches stay in ``<out>.parts/``.
+    SweepLost
+        The Dask scheduler went away (noticed within :data:`rotframe.app.sweep.cluster.LOST_S`
+        seconds); the finished batches stay in ``<out>.parts/``.
     ScenarioError
         ``out`` not ending in ``.parquet``; ``--resume`` of a different sweep; an unreachable scheduler.
     """
     t_start = time.perf_counter()
     require("pyarrow", "rotframe sweep")
     files = SweepFiles.for_spec(spec, out)
+    if task_timeout is not None and not (float(task_timeout) > 0):
+        raise ScenarioError(f"--task-timeout {task_timeout}: must be > 0 seconds")
+    where = {"workers": workers, "scheduler": scheduler, "scheduler_file": scheduler_file, "client": client,
+             "task_timeout": task_timeout}
     with exclusive(files):
-        return _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
-                                 recording)
+        return _run_sweep_locked(spec, files, t_start, where, resume, batch_rows, on_batch, plots, recording)
 
 
-def _run_sweep_locked(spec, files, t_start, workers, scheduler, client, resume, batch_rows, on_batch, plots,
-                      recording):
-    meta = spec.describe()
+def _run_sweep_locked(spec, files, t_start, where, resume, batch_rows, on_batch, plots, recording):
+    source = ScenarioSource.of(spec.scenario)
+    meta = dict(spec.describe(), scenario_sha256=source.digest)
     done = prepare(files, meta, resume)
     pending = np.setdiff1d(np.arange(spec.n_rows), np.fromiter(done, dtype=np.int64, count=len(done)))
-    ctx = _Context.create(spec, files, meta)
+    ctx = _Context.create(spec, files, meta, source)
     t0 = time.perf_counter()
-    computed, batches = _compute(ctx, pending, len(done), workers, scheduler, client, batch_rows, on_batch)
+    computed, batches = _compute(ctx, pending, len(done), where, batch_rows, on_batch)
     timing = {"compute_s": time.perf_counter() - t0}
     t0 = time.perf_counter()
     table = merge(files, meta, spec, include_out=resume)
@@ -161,28 +178,28 @@ class _Context:
     spec: SweepSpec
     files: SweepFiles
     meta: dict
-    scenario_path: str
+    source: ScenarioSource
     path: str
     points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
-    threads: int | None = None  # threads of each vectorised batch (`batch_threads`)
+    threads: int | None = None  # threads of each vectorised batch (:func:`batch_threads`)
+    seconds: list = None  # seconds per row of the last batch written (the probe's timing)
 
     @classmethod
-    def create(cls, spec, files, meta):
+    def create(cls, spec, files, meta, source):
         from rotframe import scenes
-        from rotframe.app import scenario as sc
         from rotframe.numerics.sampling import decimate
 
-        scn = sc.load(spec.scenario)
+        scn = source.load()
         path = "ensemble" if hasattr(scenes.get(scn.scene), "simulate_ensemble") else "runs"
         track_rows = frozenset(int(i) for i in decimate(spec.n_rows, MAX_TRACKS))
         points = None if spec.axes else sweep_points(spec)  # a grid is computed row by row, lazily
-        return cls(spec, files, meta, str(scn.path.resolve()), path, points, track_rows)
+        return cls(spec, files, meta, source, path, points, track_rows)
 
     def task(self, index, rows):
         rows = np.asarray(rows, dtype=np.int64)
         values = points_of(self.spec, rows) if self.points is None else self.points[rows]
-        return BatchTask(index=index, scenario=self.scenario_path, sets=dict(self.spec.sets), keys=self.spec.keys,
+        return BatchTask(index=index, scenario=self.source, sets=dict(self.spec.sets), keys=self.spec.keys,
                          rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
                          track_rows=self.track_rows.intersection(rows.tolist()), threads=self.threads)
 
@@ -213,7 +230,7 @@ def _limits_now():
     return limits.current()
 
 
-def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_batch):
+def _compute(ctx, pending, n_done, where, batch_rows, on_batch):
     """Run the pending rows batch by batch, writing each part as it finishes; (rows, batches) computed."""
     if len(pending) == 0:
         return 0, 0
@@ -221,6 +238,7 @@ def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_ba
 
     def finished(output):
         write_part(ctx.files, output, ctx.spec.keys, ctx.meta)
+        ctx.seconds = [float(t) for t, e in zip(output.seconds, output.errors) if not e]
         state["done"] += len(output.rows)
         state["computed"] += len(output.rows)
         state["batches"] += 1
@@ -228,43 +246,68 @@ def _compute(ctx, pending, n_done, workers, scheduler, client, batch_rows, on_ba
             on_batch(state["done"], ctx.spec.n_rows)
 
     try:
-        _execute(ctx, pending, workers, scheduler, client, batch_rows, finished)
+        _execute(ctx, pending, where, batch_rows, finished)
     except KeyboardInterrupt:
         raise SweepInterrupted(state["done"], ctx.spec.n_rows, str(ctx.files.parts)) from None
+    except SweepLost as exc:
+        raise SweepLost(exc.why, state["done"], ctx.spec.n_rows, str(ctx.files.parts)) from None
     return state["computed"], state["batches"]
 
 
-def _execute(ctx, pending, workers, scheduler, client, batch_rows, finished):
+def _execute(ctx, pending, where, batch_rows, finished):
+    from rotframe.app.sweep import cluster
+
+    client, workers = where["client"], where["workers"]
+    scheduler, scheduler_file = where["scheduler"], where["scheduler_file"]
+    if client is None and not (workers or scheduler or scheduler_file):
+        scheduler = scheduler_from_env()
     own = None
-    if client is None and (workers or scheduler):
-        own = client = _connect(workers, scheduler)
+    if client is None and (workers or scheduler or scheduler_file):
+        own = client = _connect(workers, scheduler, scheduler_file)
     try:
         n_workers = max(1, sum(client.nthreads().values())) if client is not None else 1
-        local = workers if (own is not None and not scheduler) else None
+        local = workers if (own is not None and not (scheduler or scheduler_file)) else None
         ctx.threads = batch_threads(local_workers=local, here=client is None)
+        def run(tasks):
+            if client is None:  # one batch generated at a time
+                for task in tasks:
+                    finished(run_batch(task))
+            else:
+                with quiet_dask_logs():
+                    cluster.run_on_dask(client, list(tasks), finished, split=ctx.path == "runs",
+                                        task_timeout=where["task_timeout"])
+
         if ctx.path == "ensemble":
             size = batch_rows or _ensemble_batch_size(len(pending), n_workers, client is not None)
+            batches = _chunk_aligned(pending, size)
         else:
             if batch_rows is None:
-                pending, batch_rows = _probe(ctx, pending, n_workers, finished)
-            size = batch_rows
-        tasks = (ctx.task(i, pending[s:s + size]) for i, s in enumerate(range(0, len(pending), size)))
-        if client is None:  # one batch generated at a time
-            for task in tasks:
-                finished(run_batch(task))
-        else:
-            _execute_dask(client, list(tasks), finished)
+                pending, batch_rows = _probe(ctx, pending, n_workers, run)
+            batches = (pending[s:s + batch_rows] for s in range(0, len(pending), batch_rows))
+        run(ctx.task(i, rows) for i, rows in enumerate(batches, start=1))
     finally:
         if own is not None:
-            _close(own)
+            cluster.close_bounded(own)
 
 
-def _probe(ctx, pending, n_workers, finished):
-    """Run the first two rows here to time them; returns the rest and the rows per batch."""
-    output = run_batch(ctx.task(0, pending[:2]))
-    finished(output)
+def _chunk_aligned(pending, size):
+    """Batches of about ``size`` rows made of whole ensemble chunks (so that the cut never changes a number)."""
+    chunk = pending // ENSEMBLE_CHUNK
+    starts = np.concatenate([[0], np.nonzero(np.diff(chunk))[0] + 1, [len(pending)]])
+    per = max(1, int(size) // ENSEMBLE_CHUNK)
+    for i in range(0, len(starts) - 1, per):
+        yield pending[starts[i]:starts[min(i + per, len(starts) - 1)]]
+
+
+def _probe(ctx, pending, n_workers, run):
+    """Run the first two rows where the batches run (on Dask: never here) to time them.
+
+    Returns the rest and the rows per batch.
+    """
+    ctx.seconds = []
+    run([ctx.task(0, pending[:2])])
     rest = pending[2:]
-    per_row = max(min(output.seconds) if output.seconds else 0.0, 1e-4)
+    per_row = max(min(ctx.seconds) if ctx.seconds else 0.01, 1e-4)  # a probe that failed: a guess of 10 ms
     total = per_row * len(rest)
     target = min(max(total / (BATCHES_PER_WORKER * n_workers), MIN_BATCH_S), MAX_BATCH_S)
     return rest, max(1, int(math.ceil(target / per_row)))
@@ -275,6 +318,13 @@ def _ensemble_batch_size(n, n_workers, distributed):
         return ENSEMBLE_BATCH
     size = int(math.ceil(n / (BATCHES_PER_WORKER * n_workers)))
     return int(min(max(size, MIN_ENSEMBLE_BATCH), ENSEMBLE_BATCH))
+
+
+def scheduler_from_env():
+    """``DASK_SCHEDULER_ADDRESS`` where set (as Dask's own clients read it), else None."""
+    import os
+
+    return os.environ.get("DASK_SCHEDULER_ADDRESS", "").strip() or None
 
 
 def check_scheduler(address, timeout=None):
@@ -309,20 +359,61 @@ def check_scheduler(address, timeout=None):
     return f"{parts.scheme}://{host}:{port}"
 
 
-def _connect(workers, scheduler):
+def _connect(workers, scheduler, scheduler_file=None):
     import logging
+    import warnings
 
-    require("distributed", "--scheduler" if scheduler else "--workers")
+    require("distributed", "--scheduler" if (scheduler or scheduler_file) else "--workers")
     from distributed import Client, LocalCluster
 
+    if scheduler_file:
+        return _client_bounded(Client, None, scheduler_file, scheduler_file=_scheduler_file(scheduler_file))
     if scheduler:
         return _client_bounded(Client, check_scheduler(scheduler), scheduler)
-    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
-    return Client(cluster)
+    with quiet_dask_logs(), _children_ignore_sigint(), warnings.catch_warnings():
+        # no dashboard wanted; its HTTP server (health checks) takes any free port, and says nothing about 8787
+        warnings.filterwarnings("ignore", message=".*already in use", category=UserWarning)
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.CRITICAL)
+        return Client(cluster, set_as_default=False)
 
 
-def _client_bounded(Client, address, given, timeout=None):
+def _children_ignore_sigint():
+    """Worker processes started inside ignore Ctrl-C (a terminal sends it to the whole group): this
+    process handles it and closes them, without a traceback from each."""
+    import contextlib
+    import signal
+    import threading
+
+    @contextlib.contextmanager
+    def ignoring():
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+    return ignoring()
+
+
+def _scheduler_file(path):
+    from pathlib import Path
+
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+        address = data["address"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) else "not a Dask scheduler file (JSON with an 'address')"
+        raise ScenarioError(f"--scheduler-file {str(path)!r}: cannot be read ({why})") from None
+    check_scheduler(address)
+    return str(p)
+
+
+def _client_bounded(Client, address, given, timeout=None, scheduler_file=None):
     """A Dask client of ``address``, or ScenarioError within ``timeout`` s whatever answers there.
 
     Dask's own connect timeout does not bound the handshake: a listener that is not a
@@ -336,11 +427,12 @@ def _client_bounded(Client, address, given, timeout=None):
 
     def make():
         try:
-            box["client"] = Client(address, timeout=f"{timeout}s", set_as_default=False)
+            box["client"] = Client(address, timeout=f"{timeout}s", set_as_default=False,
+                                   scheduler_file=scheduler_file)
         except BaseException as exc:  # noqa: BLE001 -- reported below
             box["error"] = exc
 
-    with _quiet_dask_logs():
+    with quiet_dask_logs():
         worker = threading.Thread(target=make, daemon=True, name="rotframe-dask-connect")
         worker.start()
         worker.join(timeout + 2.0)
@@ -348,7 +440,8 @@ def _client_bounded(Client, address, given, timeout=None):
         return box["client"]
     _quiet_dask_unraisable()
     why = _one_line(box["error"])[:200] if "error" in box else f"no Dask handshake within {timeout:g} s"
-    raise ScenarioError(f"--scheduler {given!r}: not a Dask scheduler or not answering ({why})")
+    option = "--scheduler-file" if scheduler_file else "--scheduler"
+    raise ScenarioError(f"{option} {given!r}: not a Dask scheduler or not answering ({why})")
 
 
 def _quiet_dask_unraisable():
@@ -368,58 +461,3 @@ def _quiet_dask_unraisable():
 
     hook._rotframe_quiet = True
     sys.unraisablehook = hook
-
-
-def _quiet_dask_logs():
-    import contextlib
-    import logging
-
-    @contextlib.contextmanager
-    def quiet():
-        loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
-                                                  "distributed.client", "tornado")]
-        levels = [lg.level for lg in loggers]
-        for lg in loggers:
-            lg.setLevel(logging.CRITICAL)
-        try:
-            yield
-        finally:
-            for lg, level in zip(loggers, levels):
-                lg.setLevel(level)
-
-    return quiet()
-
-
-def _close(client):
-    cluster = client.cluster if hasattr(client, "cluster") else None
-    client.close()
-    if cluster is not None:
-        cluster.close()
-
-
-def _execute_dask(client, tasks, finished):
-    """Submit every batch (with ``retries``); write each as it completes.
-
-    Dask reschedules the tasks of a lost worker and retries a failed task; a batch that
-    still fails is submitted again, and finally computed here, so no row is lost.
-    """
-    from distributed import as_completed
-
-    futures = {client.submit(run_batch, t, retries=RETRIES, pure=False): (t, 0) for t in tasks}
-    queue = as_completed(list(futures))
-    try:
-        for future in queue:
-            task, attempt = futures.pop(future)
-            try:
-                output = future.result()
-            except Exception:  # noqa: BLE001 -- KilledWorker, CommClosedError, a worker's MemoryError ...
-                if attempt >= RETRIES:
-                    finished(run_batch(task))
-                    continue
-                again = client.submit(run_batch, task, retries=RETRIES, pure=False)
-                futures[again] = (task, attempt + 1)
-                queue.add(again)
-                continue
-            finished(output)
-    finally:
-        client.cancel(list(futures))

@@ -18,7 +18,7 @@ import numpy as np
 from rotframe.app.options import split_set
 from rotframe.errors import ScenarioError
 
-__all__ = ["Axis", "Vary", "SweepSpec", "SweptKey", "DISTRIBUTIONS", "parse_spec", "sweep_points", "points_of",
+__all__ = ["Axis", "Vary", "SweepSpec", "SweptKey", "DISTRIBUTIONS", "parse_spec", "python_spec", "sweep_points", "points_of",
            "key_of", "apply_row"]
 
 
@@ -63,6 +63,9 @@ class SweepSpec:
     vary : list of Vary
     seed : int
     method : str or None
+    points : (rows, keys) float array or None
+        Given points, one row each (``rotframe.sweep(points=...)``); their keys are ``point_keys``.
+    point_keys : list of str
     """
 
     scenario: str
@@ -73,11 +76,13 @@ class SweepSpec:
     vary: list = field(default_factory=list)
     seed: int = 0
     method: str | None = None
+    points: object = None
+    point_keys: list = field(default_factory=list)
 
     @property
     def keys(self) -> list:
         """Swept keys, in column order."""
-        return [a.key for a in self.axes] + [v.key for v in self.vary]
+        return [a.key for a in self.axes] + [v.key for v in self.vary] + list(self.point_keys)
 
     @property
     def log_keys(self) -> set:
@@ -87,16 +92,34 @@ class SweepSpec:
     @property
     def n_rows(self) -> int:
         """Number of points."""
+        if self.points is not None:
+            return int(len(self.points))
         if self.axes:
             return int(np.prod([len(a.values) for a in self.axes]))
         return int(self.samples or 0)
 
     def describe(self) -> dict:
-        """A JSON-able description, stored in every Parquet file of the sweep."""
-        return {"scenario": self.name, "sets": dict(self.sets),
-                "axes": [[a.key, list(a.values), a.log] for a in self.axes], "samples": self.samples,
-                "vary": [asdict(v) for v in self.vary], "seed": self.seed, "method": self.method,
-                "keys": self.keys, "rows": self.n_rows}
+        """A JSON-able description, stored in every Parquet file of the sweep (given points by their digest)."""
+        out = {"scenario": self.name, "sets": {k: _jsonable(v) for k, v in self.sets.items()},
+               "axes": [[a.key, list(a.values), a.log] for a in self.axes], "samples": self.samples,
+               "vary": [asdict(v) for v in self.vary], "seed": self.seed, "method": self.method,
+               "keys": self.keys, "rows": self.n_rows}
+        if self.points is not None:
+            import hashlib
+
+            data = np.ascontiguousarray(self.points, dtype=np.float64)
+            out["points"] = {"keys": list(self.point_keys), "sha256": hashlib.sha256(data.tobytes()).hexdigest()}
+        return out
+
+
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    return value if isinstance(value, (str, int, float, bool, type(None))) else str(value)
 
 
 def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=(), seed=0, method=None):
@@ -142,6 +165,92 @@ def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=
     return spec
 
 
+def python_spec(scenario, *, sets=None, grid=None, vary=None, points=None, samples=None, seed=None, method=None):
+    """A :class:`SweepSpec` from ``rotframe.sweep``'s arguments (Python values, not command-line text).
+
+    ``grid``: key -> sequence of values (the product is taken, last key fastest); ``vary``: key ->
+    a distribution string as on the command line (``"normal(1600,5)"``) with ``samples``; ``points``:
+    a pandas DataFrame or a dict of equal-length arrays, one row each. One of the three.
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the argument, the key and the value and what is allowed.
+    """
+    from rotframe.app import scenario as sc
+
+    given = [n for n, v in (("grid", grid), ("vary", vary), ("points", points)) if v is not None and len(v)]
+    if len(given) > 1:
+        raise ScenarioError(f"sweep: give one of grid=, vary= (with samples=) or points=, not {' and '.join(given)}")
+    if points is None or not len(points):
+        if vary or samples is not None:
+            return parse_spec(scenario, sets=sets, samples=samples, seed=0 if seed is None else seed, method=method,
+                              vary=[f"{k}={v}" for k, v in (vary or {}).items()])
+        return _grid_spec(scenario, sets, grid or {}, method)
+    if samples is not None:
+        raise ScenarioError("sweep: samples= goes with vary=, not with points= (whose length is the row count)")
+    scn = sc.load(scenario)
+    sets = dict(sets or {})
+    base = scn.with_values(sets)
+    _check_method(scn, method)
+    names, cols = _point_columns(points)
+    keys = [_parse_key(scn, "points", name) for name in names]
+    for key, col in zip(keys, cols):
+        if len(col) and not np.all(np.isfinite(col)):
+            raise ScenarioError(f"points: column {key.text!r} has a non-finite value; allowed: finite numbers")
+        if len(col):
+            _check_value(scn, base, key, "points", key.text, col)
+    from rotframe import limits
+
+    limits.check_rows(len(cols[0]), what="sweep")
+    spec = SweepSpec(scenario=str(scenario), name=scn.name, sets=sets, seed=0 if seed is None else int(seed),
+                     method=method, points=np.stack(cols, axis=1), point_keys=[k.text for k in keys])
+    _check_keys_once(spec)
+    return spec
+
+
+def _grid_spec(scenario, sets, grid, method):
+    from rotframe.app import scenario as sc
+
+    scn = sc.load(scenario)
+    base = scn.with_values(dict(sets or {}))
+    axes = []
+    for name, values in grid.items():
+        key = _parse_key(scn, "grid", str(name))
+        try:
+            arr = np.atleast_1d(np.asarray(values, dtype=np.float64))
+        except (TypeError, ValueError):
+            raise ScenarioError(f"grid: {name!r} = {str(values)[:80]!r}: not a sequence of numbers") from None
+        if arr.ndim != 1 or not len(arr) or not np.all(np.isfinite(arr)):
+            raise ScenarioError(f"grid: {name!r}: allowed: a non-empty sequence of finite numbers")
+        _check_value(scn, base, key, "grid", str(name), arr)
+        axes.append(Axis(key.text, tuple(float(x) for x in arr)))
+    spec = parse_spec(scenario, sets=sets, method=method, grid=[], samples=None, vary=[]) if not axes else None
+    if spec is not None:
+        return spec  # (parse_spec's own "nothing to sweep" error)
+    from rotframe import limits
+
+    limits.check_rows(math.prod(len(a.values) for a in axes), what="sweep")
+    _check_method(scn, method)
+    spec = SweepSpec(scenario=str(scenario), name=scn.name, sets=dict(sets or {}), axes=axes, method=method)
+    _check_keys_once(spec)
+    return spec
+
+
+def _point_columns(points):
+    """(names, float columns) of a DataFrame or a dict of equal-length arrays."""
+    try:
+        names = [str(c) for c in points.keys()]
+        cols = [np.asarray(points[c], dtype=np.float64).ravel() for c in points.keys()]
+    except (AttributeError, TypeError, ValueError) as exc:
+        raise ScenarioError(f"points: {type(points).__name__}: allowed: a pandas DataFrame or a dict of "
+                            f"equal-length arrays of numbers ({str(exc)[:80]})") from None
+    if not cols or len({len(c) for c in cols}) != 1 or not len(cols[0]):
+        raise ScenarioError("points: the columns must be non-empty and of equal length "
+                            f"(got {', '.join(f'{n}: {len(c)}' for n, c in zip(names, cols))})")
+    return names, cols
+
+
 def sweep_points(spec: SweepSpec) -> np.ndarray:
     """The swept values, one row per point: a (rows, keys) float array in `SweepSpec.keys` order.
 
@@ -149,6 +258,8 @@ def sweep_points(spec: SweepSpec) -> np.ndarray:
     rows are drawn from ``default_rng(seed)``, one distribution after the other, so the
     same spec always gives the same rows.
     """
+    if spec.points is not None:
+        return np.asarray(spec.points, dtype=np.float64)
     if spec.axes:
         grid = list(itertools.product(*[a.values for a in spec.axes]))
         return np.array(grid, dtype=np.float64).reshape(len(grid), len(spec.axes))
@@ -165,6 +276,8 @@ def points_of(spec: SweepSpec, rows) -> np.ndarray:
     whole; Monte Carlo rows are drawn in order from the seed.
     """
     rows = np.asarray(rows, dtype=np.int64)
+    if spec.points is not None:
+        return np.asarray(spec.points, dtype=np.float64)[rows]
     if spec.axes:
         shape = tuple(len(a.values) for a in spec.axes)
         idx = np.unravel_index(rows, shape) if len(rows) else [np.zeros(0, np.int64)] * len(shape)

@@ -137,25 +137,31 @@ def _tables(files, include_out):
     return paths
 
 
+#: what makes two sweeps the same: the spec, the given points' digest and the scenario's text (and plugin source)
+_SAME = ("scenario", "sets", "axes", "samples", "vary", "seed", "method", "points", "scenario_sha256")
+
+
 def _fingerprint(meta):
-    return json.dumps({k: meta.get(k) for k in ("scenario", "sets", "axes", "samples", "vary", "seed", "method")},
-                      sort_keys=True)
+    return json.dumps({k: meta.get(k) for k in _SAME}, sort_keys=True)
 
 
 def _describe_difference(found, meta):
-    diff = [k for k in ("scenario", "sets", "axes", "samples", "vary", "seed", "method")
-            if json.dumps(found.get(k), sort_keys=True) != json.dumps(meta.get(k), sort_keys=True)]
-    return "different " + ", ".join(diff) if diff else "no sweep description"
+    diff = [k for k in _SAME if json.dumps(found.get(k), sort_keys=True) != json.dumps(meta.get(k), sort_keys=True)]
+    if diff == ["scenario_sha256"]:
+        return ("the scenario file, its plugin scene or rotframe's version changed since its rows were computed"
+                if found.get("scenario_sha256") else "it has no fingerprint of the scenario's text (an older rotframe)")
+    words = {"points": "given points", "scenario_sha256": "scenario text"}
+    return "different " + ", ".join(words.get(k, k) for k in diff) if diff else "no sweep description"
 
 
 def write_part(files, output, keys, meta):
     """One batch's rows (and tracks) to ``<out>.parts/``, atomically."""
     import pyarrow.parquet as pq
 
-    if not output.rows:
+    if not len(output.rows):
         return
-    first = min(r["row"] for r in output.rows)
-    table = _rows_table(output.rows, keys, meta)
+    first = int(np.min(output.rows))
+    table = _rows_table(output, keys, meta)
     path = files.parts / f"part-{first:09d}.parquet"
     from rotframe.app.outputs import atomic_path
 
@@ -165,28 +171,21 @@ def write_part(files, output, keys, meta):
             _write_tracks(files.parts / f"tracks-{first:09d}.npz", output.tracks)
 
 
-def _rows_table(rows, keys, meta):
+def _rows_table(output, keys, meta):
+    """A batch's columns (:class:`rotframe.app.sweep.batch.BatchOutput`) as an Arrow table."""
     import pyarrow as pa
 
-    metrics = _ordered_union(r["metrics"] for r in rows)
-    theory = _ordered_union(r["theory"] for r in rows)
-    cols = {"row": pa.array([r["row"] for r in rows], pa.int64())}
+    n = len(output.rows)
+    cols = {"row": pa.array(np.asarray(output.rows, np.int64), pa.int64())}
+    values = np.asarray(output.values, np.float64).reshape(n, len(keys))
     for i, key in enumerate(keys):
-        cols[key] = pa.array([r["values"][i] for r in rows], pa.float64())
-    for m in metrics:
-        cols[m] = pa.array([r["metrics"].get(m, math.nan) for r in rows], pa.float64())
-    for m in theory:
-        cols["theory_" + m] = pa.array([r["theory"].get(m, math.nan) for r in rows], pa.float64())
-    cols["error"] = pa.array([r["error"] for r in rows], pa.string())
+        cols[key] = pa.array(values[:, i], pa.float64())
+    for m, col in output.metrics.items():
+        cols[m] = pa.array(np.asarray(col, np.float64), pa.float64())
+    for m, col in output.theory.items():
+        cols["theory_" + m] = pa.array(np.asarray(col, np.float64), pa.float64())
+    cols["error"] = pa.array(list(output.errors), pa.string())
     return pa.table(cols).replace_schema_metadata({META_KEY: json.dumps(meta)})
-
-
-def _ordered_union(dicts):
-    seen = {}
-    for d in dicts:
-        for k in d:
-            seen.setdefault(k, None)
-    return list(seen)
 
 
 def merge(files, meta, spec, include_out):

@@ -1,0 +1,89 @@
+"""``rotframe.sweep``: a sweep from Python, returning a pandas DataFrame.
+
+The same implementation as ``rotframe sweep`` (:func:`rotframe.app.sweep.execute.run_sweep`):
+the same rows, batches, parts and resume, and bitwise the same table whether it runs
+in this process or on a ``distributed.Client`` of the caller's.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+__all__ = ["sweep"]
+
+
+def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed=None, client=None, out=None,
+          **fixed):
+    """Run a scenario once per point and return one row per run.
+
+    Parameters
+    ----------
+    name_or_path : str or path
+        A scenario name (``rotframe.scenarios()``) or a ``.toml`` scenario file.
+    grid : dict, optional
+        Parameter -> sequence of values; the Cartesian product is swept (last key fastest).
+        A vector component is named ``"omega[0]"``.
+    vary : dict, optional
+        Parameter -> a distribution as on the command line, ``"normal(MEAN,SD)"`` or
+        ``"uniform(LO,HI)"``, with ``samples`` draws from ``numpy.random.default_rng(seed)``.
+    points : pandas.DataFrame or dict of arrays, optional
+        Given points, one row each (for example from ``scipy.stats.qmc``); the columns
+        are parameter names.
+    samples : int, optional
+        Monte Carlo sample count (with ``vary``).
+    seed : int, optional
+        Seed of the Monte Carlo draws (default 0).
+    client : distributed.Client, optional
+        Run the batches on this Dask cluster (not closed here); default this process.
+    out : path-like, optional
+        Also write the table to this ``.parquet`` file (its finished batches go to
+        ``<out>.parts/`` as they finish). Default: nothing is written.
+    **fixed
+        Parameter values fixed for every row (numbers in the documented unit, strings
+        such as ``"520 ft"`` or astropy quantities), the run settings ``step``,
+        ``rtol`` and ``samples``, and ``method``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``row``, the swept values (documented units), every metric, ``theory_<metric>``
+        where the scene has a closed form, and ``error`` (empty where the run was fine).
+
+    Raises
+    ------
+    rotframe.errors.ScenarioError
+        Bad input, in one line naming the argument, key and value.
+    rotframe.app.sweep.cluster.SweepLost
+        The Dask scheduler went away (the finished batches stay in ``<out>.parts/``).
+    KeyboardInterrupt
+        Ctrl-C (a :class:`~rotframe.app.sweep.execute.SweepInterrupted` saying what was kept).
+
+    Examples
+    --------
+    >>> import rotframe
+    >>> df = rotframe.sweep("tower-drop", grid={"height": [50, 100, 150]}, latitude=45)
+    >>> list(df["height"])
+    [50.0, 100.0, 150.0]
+    """
+    from rotframe.app.sweep.execute import run_sweep
+    from rotframe.app.sweep.spec import python_spec
+    from rotframe.app.sweep.store import require
+
+    require("pandas", "rotframe.sweep")
+    method = fixed.pop("method", None)
+    sets = {k: _plain(v) for k, v in fixed.items()}
+    spec = python_spec(str(name_or_path), sets=sets, grid=grid, vary=vary, points=points, samples=samples, seed=seed,
+                       method=method)
+    if out is not None:
+        return run_sweep(spec, out, client=client, plots=False, recording=False).table.to_pandas()
+    with tempfile.TemporaryDirectory(prefix="rotframe-sweep-") as tmp:
+        return run_sweep(spec, Path(tmp) / f"{spec.name}.parquet", client=client, plots=False,
+                         recording=False).table.to_pandas()
+
+
+def _plain(value):
+    """An astropy quantity as the text the scenario parser reads (``"520.0 ft"``); anything else as it is."""
+    if hasattr(value, "unit") and hasattr(value, "value") and getattr(value, "ndim", 0) == 0:
+        return f"{float(value.value)!r} {value.unit.to_string()}"
+    return value
