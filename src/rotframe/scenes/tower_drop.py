@@ -203,10 +203,10 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
 
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model; those whose fall needs the same
-    simulated time (:func:`ensemble_duration`, from each point alone, never from the
+    simulated time (`ensemble_duration`, from each point alone, never from the
     others in the call) are one ``integrate_particles`` call with one particle per
-    point and the ground event (:func:`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
-    :func:`analyse`; they agree with single runs to the method's accuracy (to round-off
+    point and the ground event (`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
+    `analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
     Parameters
@@ -259,7 +259,7 @@ def ensemble_duration(duration):
 
 
 def _duration_groups(values_list, terms):
-    """Indices grouped by model (every value but height and magnify) and by :func:`ensemble_duration`."""
+    """Indices grouped by model (every value but height and magnify) and by `ensemble_duration`."""
     from rotframe.particles.ensemble import group_points
 
     out = []
@@ -276,11 +276,11 @@ def _duration_groups(values_list, terms):
 
 
 def ensemble_theory(values):
-    """The closed forms of :func:`analyse`'s theory for one point, for sweep rows run as an ensemble.
+    """The closed forms of `analyse`'s theory for one point, for sweep rows run as an ensemble.
 
     Vacuum, uniform gravity: east (1/3) Omega g t^3 cos(lat) (first order), north
     (1/6) Omega^2 g t^4 sin(lat) cos(lat) towards the equator (second order),
-    t = sqrt(2 h / g). ``values`` is the resolved mapping of :func:`simulate` (read
+    t = sqrt(2 h / g). ``values`` is the resolved mapping of `simulate` (read
     directly, and the Earth's constants cached per latitude: this runs once per row).
     """
     h, latitude = float(values["height"]), float(values["latitude"])

@@ -17,9 +17,9 @@ the ensemble next to it.
 
 Execution. A scene module with ``simulate_ensemble(values_list, terms, method,
 run, tracks=None)`` integrates the rows in vectorised calls of the compiled core
-(:func:`rotframe.particles.ensemble.integrate_ensemble` helps it), one call per fixed
-chunk of :data:`~rotframe.app.sweep.batch.ENSEMBLE_CHUNK` rows of the whole sweep;
-otherwise each point goes through :func:`rotframe.app.runner.run`. Points are cut
+(`rotframe.particles.ensemble.integrate_ensemble` helps it), one call per fixed
+chunk of `ENSEMBLE_CHUNK` rows of the whole sweep;
+otherwise each point goes through `rotframe.app.runner.run`. Points are cut
 into batches (about 0.2 s to 30 s of work each, at most about four per worker;
 whole chunks on the ensemble path); batches run in this process, or as Dask tasks
 on a ``LocalCluster`` (``--workers N``) or an existing scheduler (``--scheduler
@@ -27,20 +27,20 @@ ADDRESS``, ``--scheduler-file PATH``, ``DASK_SCHEDULER_ADDRESS``). A task carrie
 the scenario's text and a plugin scene's source, so a worker needs only rotframe.
 Every row's numbers are bitwise the same however the rows are cut, wherever they
 run and after a resume. The faults of a cluster end in bounded time
-(:mod:`~rotframe.app.sweep.cluster`). Every finished batch is written at once as a
+(`cluster`). Every finished batch is written at once as a
 Parquet part in ``<out>.parts/``; the parts are merged into ``<out>`` at the end,
 so an interrupted sweep keeps its finished batches and ``--resume`` computes only
 the missing rows, after checking the parts' fingerprint (the spec, the given
 points and the scenario's text).
 
-From Python: :func:`rotframe.sweep` (:mod:`~rotframe.app.sweep.api`), the same
+From Python: `rotframe.sweep` (`api`), the same
 implementation, returning a pandas DataFrame.
 
 Dask and pyarrow are imported only when needed (``pip install
-rotframe[sweep]``). Modules: :mod:`~rotframe.app.sweep.spec` (what is swept),
-:mod:`~rotframe.app.sweep.batch` (one batch of rows), :mod:`~rotframe.app.sweep.execute`
-(batches here or on Dask), :mod:`~rotframe.app.sweep.cluster` (Dask and its faults),
-:mod:`~rotframe.app.sweep.store` (Parquet parts, merge, resume, lock), :mod:`~rotframe.app.sweep.plots` and :mod:`~rotframe.app.sweep.recording`; this
+rotframe[sweep]``). Modules: `spec` (what is swept),
+`batch` (one batch of rows), `execute`
+(batches here or on Dask), `cluster` (Dask and its faults),
+`store` (Parquet parts, merge, resume, lock), `plots` and `recording`; this
 module is the ``rotframe sweep`` command.
 """
 

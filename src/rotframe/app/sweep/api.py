@@ -1,6 +1,6 @@
 """``rotframe.sweep``: a sweep from Python, returning a pandas DataFrame.
 
-The same implementation as ``rotframe sweep`` (:func:`rotframe.app.sweep.execute.run_sweep`):
+The same implementation as ``rotframe sweep`` (`rotframe.app.sweep.execute.run_sweep`):
 the same rows, batches, parts and resume, and bitwise the same table whether it runs
 in this process or on a ``distributed.Client`` of the caller's.
 """
@@ -57,7 +57,7 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     rotframe.app.sweep.cluster.SweepLost
         The Dask scheduler went away (the finished batches stay in ``<out>.parts/``).
     KeyboardInterrupt
-        Ctrl-C (a :class:`~rotframe.app.sweep.execute.SweepInterrupted` saying what was kept).
+        Ctrl-C (a `SweepInterrupted` saying what was kept).
 
     Examples
     --------

@@ -1,18 +1,18 @@
 """One batch of a sweep's rows, computed in this process or on a Dask worker.
 
 A task carries everything a worker needs and nothing of the client's disk: the
-scenario's text (:class:`ScenarioSource`, parsed once per process and text), the
+scenario's text (`ScenarioSource`, parsed once per process and text), the
 source of a plugin scene's module, the swept values and the limits in force. A
 worker needs only rotframe installed.
 
 A scene module with ``simulate_ensemble(values_list, terms, method, run, tracks=None)``
 integrates the rows in vectorised calls of the compiled core. The rows of one call
-are always those of one fixed chunk of :data:`ENSEMBLE_CHUNK` consecutive rows of
+are always those of one fixed chunk of `ENSEMBLE_CHUNK` consecutive rows of
 the whole sweep (valid rows only), so a row's numbers never depend on how the sweep
 was cut into batches, on the worker count, the backend or a resume; where a chunk's
 call fails as a whole (one particle's numerical failure), each of its rows runs as
 an ensemble of one, and the failure lands in that row's ``error``. Other scenes run
-each row through :func:`rotframe.app.runner.run`. A failed row is data (its
+each row through `rotframe.app.runner.run`. A failed row is data (its
 ``error``), never the end of the sweep. BLAS is held to one thread inside the
 batch (the threads are the batch's own, or the worker's), so that no run
 oversubscribes the cores.
@@ -90,7 +90,7 @@ class ScenarioSource:
         return h.hexdigest()
 
     def load(self):
-        """The parsed :class:`rotframe.app.scenario.Scenario`, once per process and source."""
+        """The parsed `rotframe.app.scenario.Scenario`, once per process and source."""
         key = self.digest
         found = _LOADED.get(key)
         if found is None:
@@ -189,7 +189,7 @@ class BatchTask:
 
 @dataclass
 class BatchOutput:
-    """Rows computed by :func:`run_batch`, as columns.
+    """Rows computed by `run_batch`, as columns.
 
     ``metrics`` and ``theory`` map a name to a float array (NaN where a row has none),
     ``errors`` is one string per row (empty when fine), ``tracks`` maps a row to

@@ -2,7 +2,7 @@
 
 Batches are submitted a few more than the cluster has threads, and their futures are
 polled (no Dask default client is needed, and Ctrl-C or SIGTERM is seen within
-:data:`POLL_S`). What can go wrong, and what the sweep does:
+`POLL_S`). What can go wrong, and what the sweep does:
 
 - A worker dies (killed, out of memory): the scheduler runs its tasks elsewhere. A
   batch whose workers die again and again (Dask's ``distributed.scheduler.allowed-failures``,
@@ -14,10 +14,10 @@ polled (no Dask default client is needed, and Ctrl-C or SIGTERM is seen within
   rows are failed with the worker's exception.
 - A batch runs longer than ``task_timeout`` seconds (counted from when a worker thread
   was free for it): its rows are failed with a TimeoutError and the sweep goes on.
-- No batch finishes for :data:`STALL_S` seconds: a line on stderr says so (and how many
+- No batch finishes for `STALL_S` seconds: a line on stderr says so (and how many
   workers the scheduler has); the sweep keeps waiting.
-- The scheduler goes away: after :data:`LOST_S` seconds without it the sweep ends with
-  :class:`SweepLost` (exit 1, the finished batches kept for
+- The scheduler goes away: after `LOST_S` seconds without it the sweep ends with
+  `SweepLost` (exit 1, the finished batches kept for
   ``--resume``).
 """
 
@@ -209,7 +209,7 @@ def _sub(task, part):
 
 
 def _check_connection(client, lost_since):
-    """None while the scheduler is there; the time it went; SweepLost after :data:`LOST_S`."""
+    """None while the scheduler is there; the time it went; SweepLost after `LOST_S`."""
     status = getattr(client, "status", "running")
     if status == "running":
         return None

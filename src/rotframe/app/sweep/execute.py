@@ -1,11 +1,11 @@
 """Running a sweep: batches sized from their cost, in this process or on Dask, each part written as it finishes.
 
 Points are cut into batches (about 0.2 s to 30 s of work each, at most about four
-per worker; on the ensemble path whole chunks of :data:`~rotframe.app.sweep.batch.ENSEMBLE_CHUNK`
+per worker; on the ensemble path whole chunks of `ENSEMBLE_CHUNK`
 rows, so that a row's numbers never depend on the cut); batches run here, or as Dask
 tasks on a ``LocalCluster`` (``--workers N``) or an existing scheduler
 (``--scheduler ADDRESS``, ``--scheduler-file PATH`` or ``DASK_SCHEDULER_ADDRESS``),
-with the faults of a cluster handled in :mod:`~rotframe.app.sweep.cluster`. Dask is
+with the faults of a cluster handled in `cluster`. Dask is
 imported only when needed.
 """
 
@@ -131,7 +131,7 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
     SweepInterrupted
         On Ctrl-C / SIGTERM; the finished batches stay in ``<out>.parts/``.
     SweepLost
-        The Dask scheduler went away (noticed within :data:`rotframe.app.sweep.cluster.LOST_S`
+        The Dask scheduler went away (noticed within `rotframe.app.sweep.cluster.LOST_S`
         seconds); the finished batches stay in ``<out>.parts/``.
     ScenarioError
         ``out`` not ending in ``.parquet``; ``--resume`` of a different sweep; an unreachable scheduler.
@@ -182,7 +182,7 @@ class _Context:
     path: str
     points: object  # (rows, keys) array of a Monte Carlo sweep; None for a grid (computed per batch)
     track_rows: frozenset
-    threads: int | None = None  # threads of each vectorised batch (:func:`batch_threads`)
+    threads: int | None = None  # threads of each vectorised batch (`batch_threads`)
     seconds: list = None  # seconds per row of the last batch written (the probe's timing)
 
     @classmethod

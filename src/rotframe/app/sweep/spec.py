@@ -166,7 +166,7 @@ def parse_spec(scenario, *, sets=None, grid=(), log_grid=(), samples=None, vary=
 
 
 def python_spec(scenario, *, sets=None, grid=None, vary=None, points=None, samples=None, seed=None, method=None):
-    """A :class:`SweepSpec` from ``rotframe.sweep``'s arguments (Python values, not command-line text).
+    """A `SweepSpec` from ``rotframe.sweep``'s arguments (Python values, not command-line text).
 
     ``grid``: key -> sequence of values (the product is taken, last key fastest); ``vary``: key ->
     a distribution string as on the command line (``"normal(1600,5)"``) with ``samples``; ``points``:

@@ -172,7 +172,7 @@ def write_part(files, output, keys, meta):
 
 
 def _rows_table(output, keys, meta):
-    """A batch's columns (:class:`rotframe.app.sweep.batch.BatchOutput`) as an Arrow table."""
+    """A batch's columns (`rotframe.app.sweep.batch.BatchOutput`) as an Arrow table."""
     import pyarrow as pa
 
     n = len(output.rows)
