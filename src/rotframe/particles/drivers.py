@@ -16,7 +16,7 @@ import numpy as np
 
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
-from rotframe.particles.events import crossed, event_value, locate_event, locate_event_dop853, record_event, start_value
+from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import advance, make_plan, method_steps
 from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
@@ -93,6 +93,28 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                     k_step += steps_per_sample
                     if p == 0:
                         nfev0 += nfev_step * steps_per_sample
+                elif n_ev == 1 and (wt is None or m.steady):
+                    # one event at a steady rate (an ensemble to the ground): the watch loop keeps the
+                    # step and the event test in registers; the same steps, tests and location as below
+                    row = event_row(events, 0)
+                    k = 0
+                    while k < steps_per_sample:
+                        done, start, state, g_start, g_new, hit = watch_steps(
+                            method, state, steps_per_sample - k, h, m, plan, rk4, sphere, row, g_old[0])
+                        k += done
+                        k_step += done
+                        g_old[0] = g_new
+                        if hit:
+                            t = t0 + (k_step - 1) * h
+                            tau, at = locate_event(method, events, 0, start, g_start, t, h, m, wt, wv, wint,
+                                                   rk4, sphere)
+                            record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, 0, t + tau, at)
+                            if events[0, 4] != 0.0:
+                                state = at
+                                is_alive = False
+                                break
+                    if p == 0:
+                        nfev0 += nfev_step * k
                 else:
                     for _ in range(steps_per_sample):
                         t = t0 + k_step * h
