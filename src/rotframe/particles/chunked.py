@@ -142,34 +142,55 @@ class KernelSetup:
             return None, None, None, None, None, evb.max_events
         return evb.args()
 
-    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None):
+    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None,
+             sps=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` (:class:`EventBuffers`)
         the events; ``atol``, ``h_state`` (N,) and ``h0`` are DOP853's. Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
-        of particle 0). ``t0`` (default the sample time ``first``) lets a fixed-step
-        call start inside a sample interval (:meth:`one_sample_in_pieces`).
+        of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
+        :attr:`sps`) let a fixed-step call start inside a sample interval and take part
+        of it (:meth:`one_sample_in_pieces`).
+
+        More particles than one block (:data:`rotframe.particles.ensemble.BLOCK`) run in
+        fixed blocks on every core (:func:`rotframe.particles.blocks.run_blocks`),
+        bitwise as one call.
         """
+        from rotframe.particles.blocks import run_blocks
+
         start = self.times[first] if t0 is None else t0
         kernel = self.kernel()
+        ev_t, ev_r, ev_v, ev_count, ev_which, max_events = self.event_records(evb)
+        per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
         if self.info.kind == "fixed":
-            n_done, bad, nfev = kernel(
-                self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt_arg,
-                self.wv, self.wint, self.ev_tab, out_r, out_v, *self.event_records(evb), self.rk4, self.sphere)
-            return n_done, bad, nfev, self.sps * n_done
+            k = self.sps if sps is None else sps
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(self.info.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                              self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
+                              max_events, self.rk4, self.sphere) + (k * count,)
+
+            n_done, bad, nfev, steps = run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
+            return n_done, bad, nfev, k * n_done
         h0 = self.h0 if h0 is None else h0
         end = first + 1 + max(count, 1)
+        times = self.times[first + 1:end]
         if self.steady_args is not None:
             q, tab = self.steady_args
-            return kernel(r, v, start, self.times[first + 1:end], q, self.rtol, atol, h0, tab, np.empty((31, 6)),
-                          out_r, out_v, h_state)
-        A, B, C, E3, E5 = self.tableau
-        return kernel(
-            r, v, alive, start, self.times[first + 1:end], self.P, self.wt_arg, self.wv,
-            self.rtol, atol, h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
-            *self.event_records(evb), h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(r, v, start, times, q, self.rtol, atol, h0, tab, np.empty((31, 6)), out_r, out_v,
+                              h_state)
+        else:
+            A, B, C, E3, E5 = self.tableau
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, h0, A, B, C,
+                              E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
+                              h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
+        return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
 
     def warm_up(self):
         """Load or compile the driver now; the seconds it took, or 0.0 if it was ready.
@@ -208,15 +229,11 @@ class KernelSetup:
         sps = self.sps
         j = 0
         nfev = 0
-        from rotframe.particles import drivers
-
         while j < sps:
             k = min(piece, sps - j)
             last = j + k == sps
-            n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
-                                                self.wt_arg, self.wv, self.wint, self.ev_tab,
-                                                out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
-                                                *self.event_records(evb), self.rk4, self.sphere)
+            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1] if last else scratch_r,
+                                           out_v[:1] if last else scratch_v, evb, t0=t0 + j * self.h, sps=k)
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0
@@ -239,8 +256,12 @@ def _adaptive_chunk(info, per_sample, samples, n):
     return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
 
 
-def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
+def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False):
     """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
+
+    ``records=True`` leaves a complete run's events in their record arrays
+    (``traj.extras["event_records"]``, an :class:`EventBuffers`) instead of splitting
+    them into per-particle lists (about 1 us a particle, holding the GIL).
 
     ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
     (:meth:`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
@@ -334,7 +355,10 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
     traj = Trajectory(times, out_r, out_v, info.name, steps, nfev, True, setup.duration)
     traj.extras["step"] = setup.h
     traj.extras["compile_s"] = compile_s
-    evb.attach(traj, events)
+    if records:
+        traj.extras["event_records"] = evb
+    else:
+        evb.attach(traj, events)
     return traj
 
 

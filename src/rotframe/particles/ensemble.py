@@ -1,12 +1,14 @@
 """Ensembles of particles to a terminal event, on every core.
 
 A scene's ``simulate_ensemble`` integrates many particles that share one model
-(for example drops from different heights) in vectorised calls of the compiled
-core. The particles are cut into fixed blocks of :data:`BLOCK` particles, and
-the blocks run on a pool of threads (the compiled kernels release the GIL).
+(for example drops from different heights) in one call of the compiled core
+(:func:`rotframe.particles.integrators.integrate_particles`), which cuts them
+into fixed blocks of :data:`BLOCK` particles and runs the blocks on a pool of
+threads (:mod:`rotframe.particles.blocks`; the compiled kernels release the GIL).
 The cut does not depend on the number of threads, and every particle is
 integrated on its own inside a block, so the results are bitwise identical
-for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``).
+for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``). The first
+events are read from the kernels' record arrays, not from per-particle lists.
 
 ``threads=None`` means the count in force: the one set by :func:`threads_scope`
 for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
@@ -167,42 +169,16 @@ def group_points(values_list, varying) -> list:
 # ---------------------------------------------------------------------------
 
 
-class _Merged:
-    """Positions of every particle over the common sample times (what paths need)."""
-
-    def __init__(self, times, r):
-        self.times, self.r = times, r
-
-
 def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads):
-    """(t_event, state, trajectory-like) of the whole ensemble, block by block on a thread pool."""
-    n = len(r0)
-    if method == "exact" or n <= BLOCK:
+    """(t_event, state, trajectory) of the whole ensemble: one call, in fixed blocks on the thread pool.
+
+    :func:`rotframe.particles.integrators.integrate_particles` cuts the particles into
+    blocks of :data:`BLOCK` on the threads in force (:mod:`rotframe.particles.blocks`).
+    """
+    with threads_scope(resolve_threads(threads)):
         traj = _integrate(model, r0, v0, duration, event, method, run, samples)
-        t_event, state = _first_events(traj, event)
-        return t_event, state, traj
-    bounds = [(lo, min(n, lo + BLOCK)) for lo in range(0, n, BLOCK)]
-
-    def one(b):
-        lo, hi = b
-        traj = _integrate(model, r0[lo:hi], v0[lo:hi], duration, event, method, run, samples)
-        t_event, state = _first_events(traj, event)
-        return t_event, state, traj.times, traj.r
-
-    workers = min(resolve_threads(threads), len(bounds))
-    if workers == 1:
-        parts = [one(b) for b in bounds]
-    else:
-        from concurrent.futures import ThreadPoolExecutor
-
-        # compile (or load) the kernel once in this thread, so that the pool does not wait on the compiler
-        _integrate(model, r0[:1], v0[:1], duration, event, method, run, 1)
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            parts = list(pool.map(one, bounds))  # in block order; the first failure is raised
-    t_event = np.concatenate([p[0] for p in parts])
-    state = np.concatenate([p[1] for p in parts])
-    r = np.concatenate([p[3] for p in parts], axis=1)
-    return t_event, state, _Merged(parts[0][2], r)
+    t_event, state = _first_events(traj, event)
+    return t_event, state, traj
 
 
 def _integrate(model, r0, v0, duration, event, method, run, samples):
@@ -215,18 +191,25 @@ def _integrate(model, r0, v0, duration, event, method, run, samples):
     max_events = 1 if event.terminal else 64
     return integrate_particles(model, r0, v0, duration, method=method, step=run.get("step"),
                                rtol=run.get("rtol") or 1e-10, samples=int(samples), events=[event],
-                               max_events=max_events, **kw)
+                               max_events=max_events, records=True, **kw)
 
 
 def _first_events(traj, event):
     """(t, state) of each particle's first ``event`` found by the kernel; the end state where none.
 
-    Vectorised (C-level loops over the per-particle records), so that little of a
-    block's time is spent holding the GIL.
+    Read from the kernels' record arrays where the run left them there (vectorised, so
+    that little time is spent holding the GIL), else from the per-particle lists.
     """
     n = traj.r.shape[1]
     state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
     t_event = np.full(n, math.nan)
+    evb = traj.extras.get("event_records")
+    if evb is not None:
+        hit = evb.count > 0  # one event: every record is of it, the first in column 0
+        t_event[hit] = evb.t[hit, 0]
+        state[hit, :3] = evb.r[hit, 0]
+        state[hit, 3:] = evb.v[hit, 0]
+        return t_event, state
     times, states = traj.event_times[event.name], traj.event_states[event.name]
     counts = np.fromiter(map(len, times), dtype=np.int64, count=n)
     hit = counts > 0

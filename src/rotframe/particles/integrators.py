@@ -118,8 +118,14 @@ def default_method(model: ParticleModel, events: Sequence[Event] = (), otherwise
 def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,
                         method: str | None = None, step: float | None = None, rtol: float = 1e-10,
                         atol: float | None = None, samples: int = 1000, events: Sequence[Event] = (),
-                        progress: Callable[[float], object] | None = None, max_events: int = 64) -> Trajectory:
-    """Integrate an ensemble of particles in a rotating frame.
+                        progress: Callable[[float], object] | None = None, max_events: int = 64,
+                        records: bool = False) -> Trajectory:
+    """Integrate an ensemble of particles in a rotating frame, on every core.
+
+    More than :data:`rotframe.particles.ensemble.BLOCK` particles run in fixed blocks on
+    the threads in force (``--threads``, ``rotframe.run(..., threads=N)``, else every
+    core); the result is bitwise the same for any number of threads. For many calls of
+    one set-up, :class:`rotframe.particles.prepared.PreparedRun` makes it once.
 
     Parameters
     ----------
@@ -140,6 +146,13 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         Number of output samples after t = 0 (uniform in time).
     events : sequence of Event
     progress : callable(fraction) or None
+    max_events : int
+        Event records kept per particle (more are counted, not kept).
+    records : bool
+        Leave the events of a complete run of a compiled method in their record arrays,
+        ``traj.extras["event_records"]`` (:class:`rotframe.particles.trajectory.EventBuffers`),
+        instead of per-particle lists in ``event_times`` and ``event_states`` (for large
+        ensembles, :mod:`rotframe.particles.ensemble`). ``exact`` always gives the lists.
 
     Returns
     -------
@@ -177,7 +190,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
                                 "use rotation-splitting, rotation-splitting4, rk4 or dop853")
         return _integrate_exact(model, r0, v0, duration, samples, events, progress)
     setup = KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events)
-    return run_chunked(setup, model, r0, v0, progress, max_events)
+    return run_chunked(setup, model, r0, v0, progress, max_events, records)
 
 
 # ---------------------------------------------------------------------------
