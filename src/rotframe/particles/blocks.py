@@ -16,6 +16,9 @@ The count of threads is :func:`rotframe.particles.ensemble.resolve_threads`
 
 from __future__ import annotations
 
+import math
+import threading
+
 import numpy as np
 
 __all__ = ["block_bounds", "run_blocks"]
@@ -30,6 +33,26 @@ def block_bounds(n):
 
     size = int(ensemble.BLOCK)
     return [(lo, min(n, lo + size)) for lo in range(0, n, size)] or [(0, 0)]
+
+
+_LOCAL = threading.local()
+#: largest scratch array (bytes) a thread keeps between calls
+_KEEP_BYTES = 8 << 20
+
+
+def _scratch(i, shape):
+    """An uninitialised float array of ``shape``: the calling thread's ``i``-th, reused when small."""
+    if 8 * math.prod(shape) > _KEEP_BYTES:
+        return np.empty(shape)
+    kept = getattr(_LOCAL, "arrays", None)
+    if kept is None:
+        kept = _LOCAL.arrays = {}
+    a = kept.get((i, shape))
+    if a is None:
+        if len(kept) >= 8:
+            kept.clear()
+        a = kept[(i, shape)] = np.empty(shape)
+    return a
 
 
 def _pool(workers):
@@ -74,14 +97,21 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
 
     def block(b):
         lo, hi = b
-        mine = [None if a is None else np.ascontiguousarray(a[lo:hi]) for a in per_particle]
-        outs = [np.ascontiguousarray(a[:, lo:hi]) for a in per_sample]
+        # a block of a C-contiguous array is one already (its view is passed, nothing copied);
+        # only a strided one (samples of several times) is copied in and back
+        views = [None if a is None else a[lo:hi] for a in per_particle]
+        mine = [None if a is None else np.ascontiguousarray(a) for a in views]
+        out_views = [a[:, lo:hi] for a in per_sample]
+        # the drivers only write the samples: a strided block gets a scratch array of its thread's
+        # (kept between calls, so that its pages are not faulted in again), copied out after the run
+        outs = [a if a.flags.c_contiguous else _scratch(i, a.shape) for i, a in enumerate(out_views)]
         res = one(*mine, *outs, *scalars)
-        for a, m in zip(per_particle, mine):
-            if a is not None:
-                a[lo:hi] = m
-        for a, m in zip(per_sample, outs):
-            a[:, lo:hi] = m
+        for a, m in zip(views, mine):
+            if a is not None and m is not a:
+                a[...] = m
+        for a, m in zip(out_views, outs):
+            if m is not a:
+                a[...] = m
         return res
 
     workers = min(ensemble.resolve_threads(None), len(bounds))

@@ -256,9 +256,10 @@ def _adaptive_chunk(info, per_sample, samples, n):
     return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
 
 
-def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False):
+def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False, owned=False):
     """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
 
+    ``owned=True``: ``r0, v0`` are the caller's own copies, advanced in place (one copy fewer).
     ``records=True`` leaves a complete run's events in their record arrays
     (``traj.extras["event_records"]``, an :class:`EventBuffers`) instead of splitting
     them into per-particle lists (about 1 us a particle, holding the GIL).
@@ -277,14 +278,16 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     info = setup.info
     samples, times, events = setup.samples, setup.times, setup.events
     n = r0.shape[0]
-    evb = EventBuffers(n, max_events)
+    # no event: no records (a (N, 64) table of them would cost more than a short run)
+    evb = EventBuffers(n, max_events if events else 0)
     alive = np.ones(n, dtype=np.bool_)
-    r = r0.copy()
-    v = v0.copy()
     out_r = np.empty((samples + 1, n, 3))
     out_v = np.empty((samples + 1, n, 3))
     out_r[0] = r0
     out_v[0] = v0
+    r = r0 if owned else r0.copy()
+    v = v0 if owned else v0.copy()
+    r0, v0 = out_r[0], out_v[0]  # the initial state, kept (r, v advance in place)
     if info.kind == "fixed":
         cost = setup.sps * n * setup.evals_per_step
         atol = 0.0
@@ -309,7 +312,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
                 probe = first = setup.call(r, v, alive, 0, 1, out_r[1:2], out_v[1:2], evb, atol, h_state)
             else:
                 probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
-                                   EventBuffers(n, max_events), atol, h_state.copy())
+                                   EventBuffers(n, evb.max_events), atol, h_state.copy())
             chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
         while done < samples:
             m = min(chunk, samples - done)

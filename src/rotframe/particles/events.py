@@ -65,11 +65,13 @@ def row_value(row, state, radius):
     return math.sqrt(x * x + y * y + dz * dz) - radius - value
 
 
-@jit_internal
+@_inline
 def watch_steps(method, state, n, h, m, plan, rk4, sphere, row, g_old):
     """Up to ``n`` steps with one plan, watching one event (:func:`event_row`); stops after its first crossing.
 
-    The fixed-step drivers' loop for one event at a steady rate: each step is
+    The fixed-step drivers' loop for one event at a steady rate, inlined into the
+    driver (a call per sample interval would pass the packed model and the plan, some
+    40 scalars, every few steps): each step is
     :func:`rotframe.particles.kernels.one_step` (inlined, so the step's scalars stay
     in registers), then the event function and :func:`crossed`. Returns
     ``(k, start, state, g_start, g_new, hit)``: the steps taken, the state before

@@ -190,7 +190,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
                                 "use rotation-splitting, rotation-splitting4, rk4 or dop853")
         return _integrate_exact(model, r0, v0, duration, samples, events, progress)
     setup = KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events)
-    return run_chunked(setup, model, r0, v0, progress, max_events, records)
+    return run_chunked(setup, model, r0, v0, progress, max_events, records, owned=True)
 
 
 # ---------------------------------------------------------------------------
