@@ -16,7 +16,7 @@ import pytest
 
 from rotframe.app import cli
 from rotframe.errors import ScenarioError
-from rotframe.particles import ensemble
+from rotframe.particles import ensemble, threads
 
 pq = pytest.importorskip("pyarrow.parquet")
 
@@ -33,7 +33,7 @@ def spy(monkeypatch):
         return n
 
     monkeypatch.setattr(ensemble, "resolve_threads", resolving)
-    monkeypatch.setattr(ensemble, "BLOCK", 64)
+    monkeypatch.setattr(threads, "BLOCK", 64)
     return seen
 
 

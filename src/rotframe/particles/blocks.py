@@ -4,13 +4,13 @@ The drivers (:mod:`rotframe.particles.drivers`) integrate each particle on its
 own: a particle's result depends on its own initial state and the call's
 arguments (times, step, tolerances, event table), never on the others. So a
 call over N particles can be cut into fixed blocks of
-:data:`rotframe.particles.ensemble.BLOCK` particles, each block run by the same
+:data:`rotframe.particles.threads.BLOCK` particles, each block run by the same
 driver on a thread of a pool (the drivers release the GIL), and the result is
 bitwise that of one call, for any number of threads. The cut depends on N
 only. Each block has contiguous arrays of its own (copies in and out), so the
 driver sees the array types of a single call and compiles nothing more.
 
-The count of threads is :func:`rotframe.particles.ensemble.resolve_threads`
+The count of threads is :func:`rotframe.particles.threads.resolve_threads`
 (the ``--threads`` option, ``rotframe.run(..., threads=N)``, else every core).
 """
 
@@ -29,9 +29,9 @@ _POOLS: dict = {}
 
 def block_bounds(n):
     """``[(lo, hi), ...]``: the fixed blocks of ``n`` particles (one block when ``n <= BLOCK``)."""
-    from rotframe.particles import ensemble
+    from rotframe.particles import threads
 
-    size = int(ensemble.BLOCK)
+    size = int(threads.BLOCK)
     return [(lo, min(n, lo + size)) for lo in range(0, n, size)] or [(0, 0)]
 
 
@@ -89,7 +89,7 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
         The fewest samples done over the blocks, the first bad particle (an index into
         the whole call) or -1, and the cost of particle 0 (block 0's).
     """
-    from rotframe.particles import ensemble
+    from rotframe.particles import threads
 
     bounds = block_bounds(n)
     if len(bounds) == 1:
@@ -114,7 +114,7 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
                 a[...] = m
         return res
 
-    workers = min(ensemble.resolve_threads(None), len(bounds))
+    workers = min(threads.resolve_threads(None), len(bounds))
     if workers == 1:
         results = [block(b) for b in bounds]
     else:

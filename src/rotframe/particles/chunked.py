@@ -154,7 +154,7 @@ class KernelSetup:
         :attr:`sps`) let a fixed-step call start inside a sample interval and take part
         of it (:meth:`one_sample_in_pieces`).
 
-        More particles than one block (:data:`rotframe.particles.ensemble.BLOCK`) run in
+        More particles than one block (:data:`rotframe.particles.threads.BLOCK`) run in
         fixed blocks on every core (:func:`rotframe.particles.blocks.run_blocks`),
         bitwise as one call.
         """

@@ -10,76 +10,30 @@ integrated on its own inside a block, so the results are bitwise identical
 for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``). The first
 events are read from the kernels' record arrays, not from per-particle lists.
 
-``threads=None`` means the count in force: the one set by :func:`threads_scope`
-for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
-threads=N)``), else every core (``os.cpu_count()``). The count is held in a
-:class:`contextvars.ContextVar`, like :mod:`rotframe.limits`, so nothing
-outlives the command that set it.
+``threads=None`` means the count in force, ``device=None`` the device in force
+(:mod:`rotframe.particles.threads`: the CLI's ``--threads N`` and ``--device``,
+``rotframe.run(..., threads=N, device=...)``, else every core of the CPU).
 """
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import math
-import os
 from dataclasses import dataclass
 
 import numpy as np
 
+# where ensembles run (threads, device) is rotframe.particles.threads; its names are kept here too
+from rotframe.particles.threads import (BLOCK, DEVICES, check_device, check_threads, device_in_force,  # noqa: F401
+                                        device_scope, resolve_threads, threads_in_force, threads_scope)
+
 __all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope", "threads_in_force", "check_threads",
-           "resolve_threads",
+           "resolve_threads", "DEVICES", "check_device", "device_scope", "device_in_force",
            "BLOCK", "MAX_TRACK_SAMPLES", "PATH_BUDGET"]
 
 #: at most this many samples per kept path
 MAX_TRACK_SAMPLES = 500
 #: particle-samples held at once by :func:`integrate_ensemble` (13 floats each)
 PATH_BUDGET = 2_000_000
-#: particles per block; fixed, so that the cut never depends on the number of threads
-BLOCK = 4096
-
-#: threads in force (None: every core); set per command by :func:`threads_scope`
-_THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
-
-
-def check_threads(threads, what="threads") -> int | None:
-    """``threads`` as a whole number >= 1 (None stays None); ScenarioError in one line otherwise."""
-    if threads is None:
-        return None
-    from rotframe.errors import ScenarioError
-
-    try:
-        ok = not isinstance(threads, bool) and float(threads) == int(threads)
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok or int(threads) < 1:
-        raise ScenarioError(f"{what}: {threads!r}; must be a whole number >= 1 (default: every core, "
-                            f"{os.cpu_count() or 1} here)")
-    return int(threads)
-
-
-@contextlib.contextmanager
-def threads_scope(threads):
-    """Make ``threads`` (None: every core) the count in force inside the block."""
-    token = _THREADS.set(check_threads(threads))
-    try:
-        yield _THREADS.get()
-    finally:
-        _THREADS.reset(token)
-
-
-def threads_in_force() -> int | None:
-    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
-    return _THREADS.get()
-
-
-def resolve_threads(threads=None) -> int:
-    """The number of threads for ``threads`` (None: the count in force, else every core)."""
-    if threads is None:
-        threads = _THREADS.get()
-    if threads is None:
-        threads = os.cpu_count() or 1
-    return check_threads(threads)
 
 
 @dataclass
@@ -103,7 +57,8 @@ class EnsembleRun:
     method: str
 
 
-def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), threads=None) -> EnsembleRun:
+def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), threads=None,
+                       device=None) -> EnsembleRun:
     """Integrate an ensemble to a terminal event in vectorised calls of the compiled core, on every core.
 
     The integrator locates the event for every particle (the kernels inside the
@@ -127,6 +82,11 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
     threads : int, optional
         Threads for the compiled methods (None: :func:`resolve_threads`). The
         result does not depend on it. ``exact`` runs in one vectorised call.
+    device : str, optional
+        ``"cpu"`` or ``"gpu"`` (None: :func:`device_in_force`). On the GPU
+        (:mod:`rotframe.particles.gpu`, the fixed-step methods) the event times and
+        states agree with the CPU's to round-off (the same steps from the same source);
+        the kept paths are integrated on the CPU.
     """
     r0 = np.asarray(r0, dtype=np.float64)
     v0 = np.asarray(v0, dtype=np.float64)
@@ -140,6 +100,8 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
         atol = float(run.get("rtol") or 1e-10) * scale
     run = dict(run, atol=atol)
+    if (check_device(device) or device_in_force()) == "gpu":
+        return _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples)
     if n * (path_samples + 1) <= PATH_BUDGET:
         t_event, state, traj = _integrate_blocks(model, r0, v0, duration, event, method, run,
                                                  max(path_samples, 16), threads)
@@ -150,6 +112,23 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, path_samples) if keep else None
         sub_index = list(range(len(keep)))
     paths = {k: _path_until(sub, j, t_event[k], state[k]) for k, j in zip(keep, sub_index)}
+    return EnsembleRun(t_event, state, paths, method)
+
+
+def _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples):
+    """:func:`integrate_ensemble` on the GPU: the same step as the CPU's (its sample count), paths on the CPU."""
+    from rotframe.particles.gpu import integrate_ensemble_gpu
+
+    n = len(r0)
+    # the samples the CPU ensemble asks for (the fixed step divides their interval)
+    small = n * (path_samples + 1) <= PATH_BUDGET
+    samples = max(path_samples, 16) if small else 1
+    t_event, state = integrate_ensemble_gpu(model, r0, v0, duration, event, method=method,
+                                            run=dict(run, samples=samples))
+    paths = {}
+    if keep:  # on the CPU's sample grid for them
+        sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, samples if small else path_samples)
+        paths = {k: _path_until(sub, j, t_event[k], state[k]) for j, k in enumerate(keep)}
     return EnsembleRun(t_event, state, paths, method)
 
 
