@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.particles import threads
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
 __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
@@ -117,13 +118,26 @@ class KernelSetup:
 
     def kernel(self):
         """The compiled driver of this method."""
+        kernel = self.__dict__.get("_kernel")
+        if kernel is not None:
+            return kernel
         if self.steady_args is not None:
             from rotframe.particles.dop853_steady import run_dop853_steady
 
-            return run_dop853_steady
-        from rotframe.particles import drivers
+            kernel = run_dop853_steady
+        else:
+            from rotframe.particles import drivers
 
-        return drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+            kernel = drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+        self._kernel = kernel
+        return kernel
+
+    def guarded(self, model):
+        """Whether runs of ``model`` need the energy guard (:func:`_energy_guard`); made once."""
+        g = self.__dict__.get("_guarded")
+        if g is None:
+            g = self._guarded = _guard_applies(model)
+        return g
 
     def abs_tol(self, r0, v0):
         """DOP853's absolute tolerance: ``atol``, else ``rtol`` times max(1, |r0|, |v0|) (componentwise max)."""
@@ -163,6 +177,13 @@ class KernelSetup:
         start = self.times[first] if t0 is None else t0
         kernel = self.kernel()
         ev_t, ev_r, ev_v, ev_count, ev_which, max_events = self.event_records(evb)
+        if self.info.kind == "fixed" and r.shape[0] <= threads.BLOCK:
+            # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
+            k = self.sps if sps is None else sps
+            n_done, bad, nfev = kernel(self.info.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                                       self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count,
+                                       ev_which, max_events, self.rk4, self.sphere)
+            return n_done, bad, nfev, k * n_done
         per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
         if self.info.kind == "fixed":
             k = self.sps if sps is None else sps
@@ -278,6 +299,10 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     info = setup.info
     samples, times, events = setup.samples, setup.times, setup.events
     n = r0.shape[0]
+    if progress is None and info.kind == "fixed" and n <= threads.BLOCK and owned:
+        traj = _run_once(setup, model, r0, v0, max_events, records)
+        if traj is not None:
+            return traj
     # no event: no records (a (N, 64) table of them would cost more than a short run)
     evb = EventBuffers(n, max_events if events else 0)
     alive = np.ones(n, dtype=np.bool_)
@@ -365,6 +390,45 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     return traj
 
 
+#: the shared records of a run without events (never written: the drivers get None for them)
+_NO_RECORDS = EventBuffers(0, 0)
+
+
+def _run_once(setup, model, r, v, max_events, records):
+    """A short fixed-step run in one call of the driver, with the least Python around it; None if it does not apply.
+
+    The run of :func:`run_chunked` when it is one chunk (at most about 4e6 step-evaluations),
+    one block and the model needs no energy guard: the same call of the driver with the same
+    arguments, so the same numbers. A failure (a non-finite state) returns None after
+    restoring nothing: the caller runs the general path from the initial state, which
+    raises with the partial trajectory.
+    """
+    samples, n = setup.samples, r.shape[0]
+    if setup.sps * n * setup.evals_per_step * samples > 4e6 or setup.guarded(model):
+        return None
+    out_r = np.empty((samples + 1, n, 3))
+    out_v = np.empty((samples + 1, n, 3))
+    out_r[0] = r
+    out_v[0] = v
+    evb = EventBuffers(n, max_events) if setup.events else _NO_RECORDS
+    alive = np.empty(n, dtype=np.bool_)
+    alive.fill(True)
+    compile_s = setup.warm_up()
+    n_done, bad, nfev, steps = setup.call(r, v, alive, 0, samples, out_r[1:], out_v[1:], evb)
+    if n_done < samples or bad >= 0:
+        r[...] = out_r[0]  # the general path starts again from the initial state, and raises
+        v[...] = out_v[0]
+        return None
+    traj = Trajectory(setup.times, out_r, out_v, setup.info.name, steps, nfev, True, setup.duration)
+    traj.extras["step"] = setup.h
+    traj.extras["compile_s"] = compile_s
+    if records:
+        traj.extras["event_records"] = evb
+    else:
+        evb.attach(traj, setup.events)
+    return traj
+
+
 def _inertial_speed(model, t, r, v):
     """|v + w(t) x r| for positions and velocities (..., N, 3) at times t (...,)."""
     w = np.interp(t, model.omega.times, model.omega.values)
@@ -382,11 +446,16 @@ def _energy_guard(model, r0, v0):
     is the mark of an unstable step (docs/physics/stability.md). Models with a
     real force that can add energy (gravity, springs, a pendulum) return None.
     """
-    terms = set(model.terms)
-    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
-    if not fictitious <= terms or not terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}:
+    if not _guard_applies(model):
         return None
     return _inertial_speed(model, 0.0, r0, v0)
+
+
+def _guard_applies(model):
+    """Whether the model's true motion keeps the inertial speeds from growing (see :func:`_energy_guard`)."""
+    terms = set(model.terms)
+    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
+    return fictitious <= terms and terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}
 
 
 def _energy_growth(model, guard, times, out_r, out_v, lo, hi):
