@@ -93,6 +93,10 @@ class KernelSetup:
         self.rk4 = True if info.kind == "fixed" and info.code == 2 else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.steady_args = None  # (q, tab) of the specialised DOP853 driver, where the model allows it
+        self.fixed = info.kind == "fixed"
+        # the arguments of every fixed-step driver call that do not change (unpacked into it)
+        self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
+        self._family = (self.rk4, self.sphere)
         self.samples = samples
         self.duration = duration
         self.dt_sample = dt = duration / samples
@@ -172,18 +176,18 @@ class KernelSetup:
         fixed blocks on every core (:func:`rotframe.particles.blocks.run_blocks`),
         bitwise as one call.
         """
-        from rotframe.particles.blocks import run_blocks
-
-        start = self.times[first] if t0 is None else t0
-        kernel = self.kernel()
-        ev_t, ev_r, ev_v, ev_count, ev_which, max_events = self.event_records(evb)
-        if self.info.kind == "fixed" and r.shape[0] <= threads.BLOCK:
+        start = float(self.times[first]) if t0 is None else t0
+        kernel = self.__dict__.get("_kernel") or self.kernel()
+        records = self.event_records(evb)
+        if self.fixed and r.shape[0] <= threads.BLOCK:
             # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
             k = self.sps if sps is None else sps
-            n_done, bad, nfev = kernel(self.info.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
-                                       self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count,
-                                       ev_which, max_events, self.rk4, self.sphere)
+            n_done, bad, nfev = kernel(self.info.code, r, v, alive, start, self.h, k, count, *self._model_args,
+                                       out_r, out_v, *records, *self._family)
             return n_done, bad, nfev, k * n_done
+        from rotframe.particles.blocks import run_blocks
+
+        ev_t, ev_r, ev_v, ev_count, ev_which, max_events = records
         per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
         if self.info.kind == "fixed":
             k = self.sps if sps is None else sps
@@ -412,7 +416,7 @@ def _run_once(setup, model, r, v, max_events, records):
     out_v[0] = v
     evb = EventBuffers(n, max_events) if setup.events else _NO_RECORDS
     alive = np.empty(n, dtype=np.bool_)
-    alive.fill(True)
+    alive[:] = True
     compile_s = setup.warm_up()
     n_done, bad, nfev, steps = setup.call(r, v, alive, 0, samples, out_r[1:], out_v[1:], evb)
     if n_done < samples or bad >= 0:

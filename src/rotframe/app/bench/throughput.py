@@ -59,8 +59,67 @@ def ensemble_rows(quick):
                 rows += _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, quick, ceiling)
     finally:
         numba.set_num_threads(saved)
+    rows += call_overhead_rows()
     for r in rows:
         r["cpu_count"] = os.cpu_count()
+    return rows
+
+
+#: issue 26's goal: ``integrate_particles`` costs at most this much (s) a call beyond its steps
+OVERHEAD_GOAL_S = 10e-6
+
+
+def call_overhead_rows(repeats=2000):
+    """What a call of ``integrate_particles`` costs beyond its steps, beside ``PreparedRun`` and the driver alone.
+
+    One particle, ten steps of the splitting (gravity + Coriolis), one sample: the
+    compiled driver's own call with the same arguments (``KernelSetup.call``'s
+    driver, timed alone) is the steps; ``overhead_s`` is the rest of a call. The best
+    of five rounds of ``repeats`` calls each (the mean of a round), so that a busy
+    machine's pauses do not count.
+    """
+    from rotframe.particles.chunked import KernelSetup
+    from rotframe.particles.integrators import METHODS, integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.particles.prepared import PreparedRun
+
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0.0, 4.6e-5, 5.7e-5]),
+                          g=np.array([0.0, 0.0, -9.81]))
+    r0, v0 = np.array([0.0, 0.0, 100.0]), np.array([1.0, 0.0, 0.0])
+    setup = KernelSetup(model, METHODS["rotation-splitting"], 1.0, 1, step=0.1)
+    kernel = setup.kernel()
+    r, v = r0[None].copy(), v0[None].copy()
+    alive = np.ones(1, dtype=np.bool_)
+    out_r, out_v = np.empty((1, 1, 3)), np.empty((1, 1, 3))
+
+    def driver():
+        kernel(setup.info.code, r, v, alive, 0.0, setup.h, setup.sps, 1, setup.P, setup.wt_arg, setup.wv,
+               setup.wint, None, out_r, out_v, None, None, None, None, None, 0, setup.rk4, setup.sphere)
+
+    prepared = PreparedRun(model, "rotation-splitting", 1.0, step=0.1, samples=1, n=1)
+    calls = {"compiled driver alone (the steps)": driver,
+             "integrate_particles": lambda: integrate_particles(model, r0, v0, 1.0, method="rotation-splitting",
+                                                                step=0.1, samples=1),
+             "PreparedRun": lambda: prepared(r0, v0)}
+    per_call = {}
+    for name, fn in calls.items():
+        fn()
+        best = math.inf
+        for _ in range(5):
+            t0 = time.perf_counter()
+            for _ in range(repeats):
+                fn()
+            best = min(best, (time.perf_counter() - t0) / repeats)
+        per_call[name] = best
+    steps = per_call["compiled driver alone (the steps)"]
+    rows = []
+    for name, wall in per_call.items():
+        row = {"scenario": "call-overhead", "method": name, "setting": "1 particle x 10 splitting steps, 1 sample",
+               "wall_s": wall, "error": math.nan, "error_kind": "time a call (best of 5 rounds)", "nfev": 10,
+               "overhead_s": wall - steps}
+        if name == "integrate_particles":
+            row.update(goal_s=OVERHEAD_GOAL_S, goal_met=bool(wall - steps <= OVERHEAD_GOAL_S))
+        rows.append(row)
     return rows
 
 
