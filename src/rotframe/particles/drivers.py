@@ -19,7 +19,7 @@ from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
-from rotframe.particles.kernels import advance, make_plan, method_steps, one_step
+from rotframe.particles.kernels import advance, make_plan, method_steps, one_step, rk4_step
 from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
@@ -81,6 +81,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     if events is not None:
         g_old = np.empty(n_ev)
         row = event_row(events, 0) if n_ev > 0 else (0.0, 0, 0.0, 0.0)  # the watch loop's event, read once
+    is_rk4 = False if rk4 is None else rk4
     nfev0 = 0
     n_done = n_samples
     bad = -1
@@ -96,7 +97,10 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
             if is_alive:
                 if events is None:
                     # no event to watch: the whole sample interval in one call
-                    if wt is None or m.steady:
+                    if is_rk4 and (wt is None or m.steady):
+                        for _ in range(steps_per_sample):  # a loop of its own: RK4's body alone
+                            state = rk4_step(state, h, m, plan)
+                    elif wt is None or m.steady:
                         for _ in range(steps_per_sample):  # one_step inlined: the scalars stay in registers
                             state = one_step(method, state, h, m, plan, rk4, sphere)
                     else:

@@ -96,18 +96,70 @@ def _particle(r, v, g, w, c, s, h, steps, p, rk4, ground):
     v[p, 0], v[p, 1], v[p, 2] = vx, vy, vz
 
 
-@njit(cache=True, error_model="numpy")
+# one compiled loop per method and event flag, so that the flags are constants in each (as rotframe's
+# drivers prune what a run does not use): the ceiling carries no branch that the work does not need
+_VARIANTS = {}
+
+
+def _variants():
+    if _VARIANTS:
+        return _VARIANTS
+
+    @njit(cache=True, error_model="numpy")
+    def serial_split(r, v, g, w, c, s, h, steps):
+        for p in range(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, False, False)
+
+    @njit(cache=True, error_model="numpy")
+    def serial_split_ground(r, v, g, w, c, s, h, steps):
+        for p in range(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, False, True)
+
+    @njit(cache=True, error_model="numpy")
+    def serial_rk4(r, v, g, w, c, s, h, steps):
+        for p in range(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, True, False)
+
+    @njit(cache=True, error_model="numpy")
+    def serial_rk4_ground(r, v, g, w, c, s, h, steps):
+        for p in range(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, True, True)
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    def parallel_split(r, v, g, w, c, s, h, steps):
+        for p in prange(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, False, False)
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    def parallel_split_ground(r, v, g, w, c, s, h, steps):
+        for p in prange(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, False, True)
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    def parallel_rk4(r, v, g, w, c, s, h, steps):
+        for p in prange(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, True, False)
+
+    @njit(cache=True, error_model="numpy", parallel=True)
+    def parallel_rk4_ground(r, v, g, w, c, s, h, steps):
+        for p in prange(r.shape[0]):
+            _particle(r, v, g, w, c, s, h, steps, p, True, True)
+
+    _VARIANTS.update({(False, False, False): serial_split, (False, False, True): serial_split_ground,
+                      (False, True, False): serial_rk4, (False, True, True): serial_rk4_ground,
+                      (True, False, False): parallel_split, (True, False, True): parallel_split_ground,
+                      (True, True, False): parallel_rk4, (True, True, True): parallel_rk4_ground})
+    return _VARIANTS
+
+
 def serial(r, v, g, w, c, s, h, steps, rk4, ground):
-    """All particles on one core."""
-    for p in range(r.shape[0]):
-        _particle(r, v, g, w, c, s, h, steps, p, rk4, ground)
+    """All particles on one core (RK4 or the splitting; watching the ground or not)."""
+    _variants()[(False, bool(rk4), bool(ground))](r, v, g, w, c, s, h, steps)
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
 def parallel(r, v, g, w, c, s, h, steps, rk4, ground):
     """Particles spread over numba's threads with ``prange``."""
-    for p in prange(r.shape[0]):
-        _particle(r, v, g, w, c, s, h, steps, p, rk4, ground)
+    _variants()[(True, bool(rk4), bool(ground))](r, v, g, w, c, s, h, steps)
 
 
 def rotation_cos_sin(w, h):

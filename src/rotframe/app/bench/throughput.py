@@ -36,8 +36,9 @@ def ensemble_rows(quick):
     (checked: no event found), so both take the same steps of the same particles; the
     final states of ours and of the hand-written loop must agree to round-off
     (``same_work``, ``same_work_max_rel``) and DOP853 must take the same number of
-    steps (``same_steps``). Times are the minimum over repeats (the fairest on a
-    shared machine). The first four rows are the splitting with the ground event.
+    steps (``same_steps``). Times are the minimum over rounds that run the four in
+    turn (the fairest on a shared machine). The first four rows are the splitting
+    with the ground event.
     """
     import numba
 
@@ -215,12 +216,12 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
     rows = []
     label = f"{method}{' + ground event' if event else ''}"
     door = ("integrate_ensemble" if event and not dop else "integrate_particles") + " (N, 3)"
-    for name, threads, fn in [(f"rotframe {door} {label}, 1 thread", 1, lambda: ours(1)),
-                              (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
-                              (f"hand-written {label}, 1 core", 1, serial),
-                              (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads,
-                               parallel)]:
-        wall = _best(fn, budget=budget, max_repeats=3 if quick else 5)
+    cases = [(f"rotframe {door} {label}, 1 thread", 1, lambda: ours(1)),
+             (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
+             (f"hand-written {label}, 1 core", 1, serial),
+             (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads, parallel)]
+    walls = _best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 7)
+    for (name, threads, fn), wall in zip(cases, walls):
         total = n * per_particle
         rows.append({"scenario": "ensemble", "method": name, "setting": what, "wall_s": wall, "error": math.nan,
                      "error_kind": "throughput (best of repeats)", "nfev": int(total), "particle_steps_per_s": total / wall,
@@ -280,14 +281,23 @@ def same_work(ours, hand, n, steps, h):
         note.removeprefix("NOT the same work: "))
 
 
-def _best(fn, budget, max_repeats):
-    """The shortest wall time of ``fn()`` over repeats that fit in ``budget`` seconds (at least two)."""
-    times = []
-    while len(times) < 2 or (len(times) < max_repeats and sum(times) < budget):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+def _best_interleaved(fns, budget, max_rounds):
+    """The shortest wall time of each of ``fns`` over rounds that run each once in turn (at least two rounds).
+
+    Interleaved, so that a shared machine's busy spells fall on all of them alike.
+    """
+    best = [math.inf] * len(fns)
+    spent = 0.0
+    rounds = 0
+    while rounds < 2 or (rounds < max_rounds and spent < budget * len(fns)):
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            fn()
+            wall = time.perf_counter() - t0
+            best[i] = min(best[i], wall)
+            spent += wall
+        rounds += 1
+    return best
 
 
 def sweep_rows(quick):
