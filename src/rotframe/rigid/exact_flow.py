@@ -26,7 +26,7 @@ import numpy as np
 from rotframe.numerics.rotation import quat_mul
 from rotframe.rigid.elliptic import carlson_rf, ellipk_agm, incomplete_pi, jacobi_reduced
 
-__all__ = ["flow_into"]
+__all__ = ["flow_into", "flow_ready"]
 
 _jit = jit_kernel
 
@@ -167,6 +167,27 @@ def _flow(moments, L0, q0, t, out_L, out_q):
         for j in range(3):  # ordered -> body: P^T L
             out_L[k, j] = P[0, j] * l0 + P[1, j] * l1 + P[2, j] * l2
     return True
+
+
+def flow_ready() -> bool:
+    """Whether the compiled flow runs without compiling: loaded in this process, or in numba's disk cache.
+
+    Compiling it costs a first run seconds (about 8 s on a 2-core machine, the elliptic
+    routines with it), more than the scenes' whole first run; so
+    :func:`rotframe.rigid.free_body.free_body_exact` takes this path only where it is ready
+    (a call of :func:`flow_into` compiles and caches it, as ``rotframe bench`` does).
+    """
+    if _flow.overloads:
+        return True
+    if not _ON_DISK:  # read numba's index once a process (empty when missing or stale)
+        try:
+            _ON_DISK.append(bool(_flow._cache._cache_file._load_index()))
+        except Exception:  # noqa: BLE001 -- no cache, or another numba: treat as not ready
+            _ON_DISK.append(False)
+    return _ON_DISK[0]
+
+
+_ON_DISK: list = []  # whether numba's disk cache holds the flow, read once
 
 
 def flow_into(inertia, L0_body, q0, times):

@@ -66,16 +66,18 @@ def free_body_exact(
 
     The asymmetric body with valid input runs the compiled closed form
     (:func:`rotframe.rigid.exact_flow.flow_into`: a few microseconds for a few time
-    points); every other case (two equal moments, the separatrix, rotation about the
+    points) once it is compiled (:func:`rotframe.rigid.exact_flow.flow_ready`: loaded, or
+    in numba's disk cache; a first run does not compile it); every other case (two equal moments, the separatrix, rotation about the
     middle axis, ``L = 0``, a zero moment) and the refusal of invalid input are
     :func:`free_body_closed_form`'s, whose docstring states the formulas, parameters and
     results. The two agree to round-off (``tests/test_rigid_exact.py``).
     """
-    from rotframe.rigid.exact_flow import flow_into
+    from rotframe.rigid import exact_flow
 
-    fast = flow_into(inertia, L0_body, q0, times)
-    if fast is not None:
-        return fast
+    if exact_flow.flow_ready():  # compiled already: a first run does not pay its compile
+        fast = exact_flow.flow_into(inertia, L0_body, q0, times)
+        if fast is not None:
+            return fast
     return free_body_closed_form(inertia, L0_body, q0, times)
 
 
