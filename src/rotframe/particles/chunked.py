@@ -202,7 +202,15 @@ class KernelSetup:
         h0 = self.h0 if h0 is None else h0
         end = first + 1 + max(count, 1)
         times = self.times[first + 1:end]
-        if self.steady_args is not None:
+        steady = self.steady_args is not None
+        if steady and r.shape[0] > threads.BLOCK:
+            # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py):
+            # its force is inlined into the stages, the specialised one keeps calls (a smaller first compile)
+            from rotframe.particles import drivers
+
+            kernel = drivers.run_dop853
+            steady = False
+        if steady:
             q, tab = self.steady_args
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
