@@ -118,8 +118,10 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
     # compile the kernels first, so that the signal arrives while the run integrates
     assert rotframe("run", "turntable", "--set", "duration=0.1", "--method", "splitting", "--no-record",
                     cwd=tmp_path).returncode == 0
-    proc = subprocess.Popen([sys.executable, "-m", "rotframe", "run", "turntable", "--set", "duration=4000",
-                             "--set", "step=1e-5", "--method", "splitting"], cwd=tmp_path,
+    # step 1e-6: the spin-up makes the step unstable past t = 240 s, which must be far (some 2.4e8
+    # steps) when the signal comes (at 1e-5 the compiled kernels reached it within the 4 s)
+    proc = subprocess.Popen([sys.executable, "-m", "rotframe", "run", "turntable", "--set", "duration=400",
+                             "--set", "step=1e-6", "--method", "splitting"], cwd=tmp_path,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(4.0)
     proc.send_signal(signal.SIGTERM)
