@@ -114,7 +114,8 @@ def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
 
 
 def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path):
-    # one sample interval of 5e8 steps: the kernel is called in pieces, so SIGINT is seen within the loop
+    # one sample interval of 5.7e9 steps (tens of seconds: the compiled splitting watching the ground event
+    # did the former 5.7e8 within the 5 s wait): the kernel is called in pieces, so SIGINT is seen within the loop
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
     warm = subprocess.run([sys.executable, "-m", "rotframe", "run", "tower-drop", "--method", "splitting",
                            "--set", "step=1e-3", "--no-record"], cwd=tmp_path, env=env, capture_output=True)

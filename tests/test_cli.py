@@ -121,7 +121,7 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
 
     # the sign: the second compiled call (the first after loading the kernel), so the run is integrating
     proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.call", 2, "run", "turntable",
-                       "--set", "duration=4000", "--set", "step=1e-5", "--method", "splitting")
+                       "--set", "duration=400", "--set", "step=1e-6", "--method", "splitting")
     wait_for(sign, proc)
     proc.send_signal(signal.SIGTERM)
     out, err = proc.communicate(timeout=120)

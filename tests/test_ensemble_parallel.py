@@ -10,7 +10,7 @@ equal bitwise; a small block size keeps the test cheap.
 import numpy as np
 import pytest
 
-from rotframe.particles import ensemble
+from rotframe.particles import ensemble, threads
 from rotframe.particles.integrators import Event, integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
@@ -37,7 +37,7 @@ def _same(a, b):
 @pytest.mark.parametrize("method,run", [("splitting", {"step": 1e-2, "samples": 1}),
                                         ("dop853", {"rtol": 1e-8, "samples": 1})])
 def test_threads_do_not_change_the_result(monkeypatch, method, run):
-    monkeypatch.setattr(ensemble, "BLOCK", 64)
+    monkeypatch.setattr(threads, "BLOCK", 64)
     monkeypatch.setattr(ensemble, "PATH_BUDGET", 100)  # the large-ensemble branch: one sample per particle
     r0, v0 = _start(300)
     model = _model()
@@ -52,7 +52,7 @@ def test_threads_do_not_change_the_result(monkeypatch, method, run):
 
 
 def test_blocked_equals_one_unblocked_call(monkeypatch):
-    monkeypatch.setattr(ensemble, "BLOCK", 50)
+    monkeypatch.setattr(threads, "BLOCK", 50)
     monkeypatch.setattr(ensemble, "PATH_BUDGET", 100)
     r0, v0 = _start(170, seed=5)
     model = _model()
@@ -65,7 +65,7 @@ def test_blocked_equals_one_unblocked_call(monkeypatch):
 
 
 def test_small_ensemble_with_paths_is_thread_independent(monkeypatch):
-    monkeypatch.setattr(ensemble, "BLOCK", 40)
+    monkeypatch.setattr(threads, "BLOCK", 40)
     r0, v0 = _start(100, seed=7)
     model = _model()
     a = ensemble.integrate_ensemble(model, r0, v0, 10.0, GROUND, method="rk4", run={"step": 1e-2, "samples": 50},
@@ -114,3 +114,24 @@ def test_threads_scope_is_not_seen_by_other_threads():
         t.start()
         t.join()
     assert seen["n"] == ensemble.resolve_threads(None)
+
+
+def test_large_steady_dop853_run_takes_the_general_driver_bitwise(monkeypatch):
+    """More particles than a block run DOP853 on the general driver; it matches the specialised one bitwise."""
+    from rotframe.particles import drivers
+
+    r0, v0 = _start(12, seed=9)
+    model = _model()
+    one = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
+    monkeypatch.setattr(threads, "BLOCK", 5)
+    calls = []
+    real = drivers.run_dop853
+
+    def spy(*args):
+        calls.append(args[0].shape[0])
+        return real(*args)
+
+    monkeypatch.setattr(drivers, "run_dop853", spy)
+    many = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
+    assert calls  # the general driver ran
+    assert np.array_equal(one.r, many.r) and np.array_equal(one.v, many.v)

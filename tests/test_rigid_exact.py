@@ -1,7 +1,8 @@
 """The compiled exact free-body flow (rotframe.rigid.exact_flow) against independent references.
 
 Carlson's integrals and K against scipy.special (other implementations of the
-same functions); the flow against rigid.free_body_exact (the same closed form,
+same functions); the flow, which the public ``rigid.free_body_exact`` runs where it
+applies, against ``free_body.free_body_closed_form`` (the same closed form,
 checked against mpmath in test_rigid, evaluated with scipy's special functions)
 and against the compiled DOP853 at a tight tolerance (a different method).
 """
@@ -13,7 +14,10 @@ from scipy import special
 from rotframe.rigid import dynamics as rigid
 from rotframe.rigid.adaptive import rigid_dop853
 from rotframe.rigid.elliptic import carlson_rf, carlson_rj, ellipk_agm
-from rotframe.rigid.exact_flow import free_body_flow
+from rotframe.rigid.exact_flow import flow_into, flow_ready
+from rotframe.rigid.free_body import free_body_closed_form
+
+free_body_flow = rigid.free_body_exact  # the public door: the compiled flow where it applies
 
 
 def _body(rng):
@@ -48,8 +52,10 @@ def test_flow_matches_free_body_exact_on_random_bodies():
         L0 = rng.normal(size=3) * rng.uniform(0.1, 10.0)
         q0 = rng.normal(size=4)
         t = np.concatenate([[0.0], rng.uniform(-50.0, 200.0, 4)])
+        fast = flow_into(inertia, L0, q0, t)  # compiles the flow (or loads it): then the door takes it
         La, qa = free_body_flow(inertia, L0, q0, t)
-        Lb, qb = rigid.free_body_exact(inertia, L0, q0, t)
+        assert fast is not None and np.array_equal(La, fast[0]) and np.array_equal(qa, fast[1])  # compiled
+        Lb, qb = free_body_closed_form(inertia, L0, q0, t)
         assert np.max(np.abs(La - Lb)) / np.linalg.norm(L0) < 1e-12
         assert np.max(np.abs(qa - qb)) < 1e-12
         assert np.allclose(qa[0], q0 / np.linalg.norm(q0), atol=1e-15, rtol=0)  # q(0) = q0, same sign
@@ -73,14 +79,45 @@ def test_flow_matches_an_integrator():
                                          ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0])])
 def test_special_cases_are_passed_on(inertia, L0):
     t = np.array([0.0, 1.0, 7.5])
+    assert flow_into(inertia, L0, [0, 0, 0, 1.0], t) is None
     La, qa = free_body_flow(inertia, L0, [0, 0, 0, 1.0], t)
-    Lb, qb = rigid.free_body_exact(inertia, L0, [0, 0, 0, 1.0], t)
+    Lb, qb = free_body_closed_form(inertia, L0, [0, 0, 0, 1.0], t)
     assert np.array_equal(La, Lb) and np.array_equal(qa, qb)
+
+
+def test_scalar_time_takes_the_compiled_flow():
+    assert flow_into([1.0, 2.0, 3.0], [0.1, 1.0, 0.1], [0, 0, 0, 1.0], 2.5) is not None
+    assert flow_ready()
+    L, q = free_body_flow([1.0, 2.0, 3.0], [0.1, 1.0, 0.1], [0, 0, 0, 1.0], 2.5)
+    Lb, qb = free_body_closed_form([1.0, 2.0, 3.0], [0.1, 1.0, 0.1], [0, 0, 0, 1.0], 2.5)
+    assert L.shape == Lb.shape == (1, 3) and q.shape == qb.shape == (1, 4)
+    assert np.max(np.abs(L - Lb)) < 1e-13 and np.max(np.abs(q - qb)) < 1e-13
 
 
 def test_invalid_input_raises_like_free_body_exact():
     with pytest.raises(Exception) as fast:
         free_body_flow([1.0, 1.0, 5.0], [1.0, 0.0, 0.0], [0, 0, 0, 1.0], [0.0, 1.0])  # no such body
     with pytest.raises(Exception) as slow:
-        rigid.free_body_exact([1.0, 1.0, 5.0], [1.0, 0.0, 0.0], [0, 0, 0, 1.0], [0.0, 1.0])
+        free_body_closed_form([1.0, 1.0, 5.0], [1.0, 0.0, 0.0], [0, 0, 0, 1.0], [0.0, 1.0])
     assert type(fast.value) is type(slow.value) and str(fast.value) == str(slow.value)
+
+
+def test_a_first_run_does_not_compile_the_flow(tmp_path):
+    """With an empty compile cache, free_body_exact answers by the closed form and compiles nothing."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import numpy as np\n"
+            "from rotframe.rigid import exact_flow\n"
+            "from rotframe.rigid.dynamics import free_body_exact\n"
+            "from rotframe.rigid.free_body import free_body_closed_form\n"
+            "args = ([1.0, 2.0, 3.0], [0.1, 1.0, 0.1], [0, 0, 0, 1.0], np.array([0.0, 100.0]))\n"
+            "L, q = free_body_exact(*args)\n"
+            "Lc, qc = free_body_closed_form(*args)\n"
+            "assert np.array_equal(L, Lc) and np.array_equal(q, qc)\n"
+            "assert not exact_flow.flow_ready() and not exact_flow._flow.overloads\n"
+            "print('ok')\n")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr[-2000:]

@@ -16,7 +16,7 @@ import pytest
 
 from rotframe.app import cli
 from rotframe.errors import ScenarioError
-from rotframe.particles import ensemble
+from rotframe.particles import ensemble, threads
 
 pq = pytest.importorskip("pyarrow.parquet")
 
@@ -33,7 +33,7 @@ def spy(monkeypatch):
         return n
 
     monkeypatch.setattr(ensemble, "resolve_threads", resolving)
-    monkeypatch.setattr(ensemble, "BLOCK", 64)
+    monkeypatch.setattr(threads, "BLOCK", 64)
     return seen
 
 
@@ -126,14 +126,13 @@ def test_benchsame_work_check_accepts_the_ceiling_and_rejects_other_physics():
     from rotframe.app.bench import ceiling
     from rotframe.app.bench.throughput import same_work
 
-    n, steps, h = 300, 50, 1e-3
+    n, steps, h = 300, 48, 1e-3  # 16 samples of 3 steps (an ensemble this small samples 16 times)
     ours, r0, v0, w, g = _drops(n, steps, h)
-    axis = w / np.linalg.norm(w)
     angle = -2 * np.linalg.norm(w) * h
 
     def hand(c, s, k=steps):
         r, v = r0.copy(), v0.copy()
-        ceiling.serial(r, v, g, axis, c, s, h, k)
+        ceiling.serial(r, v, g, w, c, s, h, k, False, True)  # the splitting, watching the ground
         return r, v
 
     same, rel, note = same_work(ours, hand(math.cos(angle), math.sin(angle)), n, steps, h)
@@ -148,7 +147,11 @@ def test_bench_ensemble_honours_threads_and_reports_the_ceiling(capsys):
     captured = capsys.readouterr()
     assert code == 0, captured.err
     rows = [r for r in json.loads(captured.out) if r["scenario"] == "ensemble"]
-    assert [r["threads"] for r in rows] == [1, 1, 1, 1]
+    assert len(rows) == 24 and {r["threads"] for r in rows} == {1}  # 3 methods x (event, none) x 4 rows
+    assert {(r["integrator"], r["event"]) for r in rows} == {(m, e) for m in ("rotation-splitting", "rk4", "dop853")
+                                                             for e in (True, False)}
+    for r in rows:
+        assert r["same_work"] is True and r["same_steps"] is True, r["method"]
     allcore = rows[1]
     assert allcore["bitwise_identical_to_1_thread"] is True
     assert allcore["same_work"] is True and allcore["same_work_max_rel"] <= 1e-12

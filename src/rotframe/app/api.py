@@ -108,8 +108,8 @@ def load(name_or_path: str | Path):
 
 
 def run(name_or_path: str | Path, method: str | None = None, *, progress: ProgressLike = None,
-        threads: int | None = None, **params: Any) -> "Result":
-    """Run a scenario; returns a [`Result`][rotframe.app.api.Result].
+        threads: int | None = None, device: str | None = None, **params: Any) -> "Result":
+    """Run a scenario; returns a :class:`Result`.
 
     Parameters
     ----------
@@ -126,6 +126,10 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
         Threads for ensembles of particles during this run only (default:
         every core); the results do not depend on it. Not a whole number
         >= 1: ScenarioError.
+    device : str, optional
+        ``"cpu"`` (default) or ``"gpu"``: where ensembles of particles run during
+        this run (a CUDA GPU, float64, the fixed-step methods;
+        :mod:`rotframe.particles.gpu`). ``"gpu"`` without one: ScenarioError.
     **params
         Parameter values (numbers in the documented unit, astropy quantities or
         strings such as ``"520 ft"``), and the run settings ``step`` (s),
@@ -161,11 +165,12 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     from rotframe import scenes
     from rotframe.app import runner
     from rotframe.errors import IntegrationError
-    from rotframe.particles.ensemble import check_threads, threads_scope
+    from rotframe.particles.ensemble import check_device, check_threads, device_scope, threads_scope
     from rotframe.particles.integrators import RunInterrupted
 
     t_start = time.perf_counter()
     check_threads(threads)
+    check_device(device)
     scn = load(name_or_path)
     values = resolve_values(scn, params)
     scene = scenes.get(scn.scene)
@@ -176,7 +181,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     callback = _progress_callback(progress)
     t0 = time.perf_counter()
     try:
-        with threads_scope(threads):
+        with threads_scope(threads), device_scope(device):
             scene_result = runner.simulate(scn, values, method=method, progress=callback)
     except (IntegrationError, RunInterrupted) as exc:
         if exc.partial is not None:

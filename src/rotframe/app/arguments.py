@@ -10,7 +10,7 @@ import argparse
 import math
 import os
 
-__all__ = ["UsageError", "Parser", "build_parser", "add_limits", "add_threads", "threads_count", "positive_count",
+__all__ = ["UsageError", "Parser", "build_parser", "add_limits", "add_threads", "add_device", "threads_count", "positive_count",
            "seed_value", "whole_count"]
 
 
@@ -38,6 +38,12 @@ def add_threads(q, what):
     q.add_argument("--threads", type=threads_count, default=None, metavar="N",
                    help=f"threads for {what} (default: every core, {os.cpu_count() or 1} here); the results do not "
                         "depend on it")
+
+
+def add_device(q, what):
+    q.add_argument("--device", choices=("cpu", "gpu"), default=None,
+                   help=f"where {what} run: cpu (default; every core) or gpu (a CUDA GPU, float64; the "
+                        "fixed-step methods); gpu without a CUDA GPU is refused")
 
 
 def threads_count(text):
@@ -124,6 +130,7 @@ def build_parser(commands):
     q.add_argument("--png", metavar="FILE", default=None, help="also write a picture of the run (PNG, matplotlib)")
     add_limits(q)
     add_threads(q, "ensembles of particles (a scene's run of a few particles uses one)")
+    add_device(q, "ensembles of particles")
     q.set_defaults(func=commands["run"])
 
     q = sub.add_parser("bench", help="speed against error for every method")
@@ -162,6 +169,7 @@ def build_parser(commands):
     q.add_argument("--json", action="store_true", help="print the result as JSON on stdout and nothing else")
     add_limits(q, rows=True)
     add_threads(q, "vectorised ensemble batches (per batch; a LocalCluster of W workers shares the cores)")
+    add_device(q, "vectorised ensemble batches (in this process)")
     q.set_defaults(func=commands["sweep"])
 
     q = sub.add_parser("view", help="open a recording in the rerun viewer",

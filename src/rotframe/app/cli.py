@@ -251,8 +251,15 @@ def _threads(args):
     return threads_scope(getattr(args, "threads", None))
 
 
+def _device(args):
+    """The command's ``--device`` for its ensembles, checked (gpu without one: exit 2, one line)."""
+    from rotframe.particles.ensemble import device_scope
+
+    return device_scope(getattr(args, "device", None))
+
+
 def cmd_run(args) -> int:
-    with _limits(args), _threads(args):
+    with _limits(args), _threads(args), _device(args):
         return _run(args)
 
 
@@ -365,7 +372,7 @@ def cmd_bench(args) -> int:
 def cmd_sweep(args) -> int:
     from rotframe.app.sweep import main as sweep_main
 
-    with _limits(args), _threads(args):
+    with _limits(args), _threads(args), _device(args):
         return sweep_main(args)
 
 

@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.particles import threads
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
 __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
@@ -92,6 +93,10 @@ class KernelSetup:
         self.rk4 = True if info.kind == "fixed" and info.code == 2 else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.steady_args = None  # (q, tab) of the specialised DOP853 driver, where the model allows it
+        self.fixed = info.kind == "fixed"
+        # the arguments of every fixed-step driver call that do not change (unpacked into it)
+        self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
+        self._family = (self.rk4, self.sphere)
         self.samples = samples
         self.duration = duration
         self.dt_sample = dt = duration / samples
@@ -117,13 +122,26 @@ class KernelSetup:
 
     def kernel(self):
         """The compiled driver of this method."""
+        kernel = self.__dict__.get("_kernel")
+        if kernel is not None:
+            return kernel
         if self.steady_args is not None:
             from rotframe.particles.dop853_steady import run_dop853_steady
 
-            return run_dop853_steady
-        from rotframe.particles import drivers
+            kernel = run_dop853_steady
+        else:
+            from rotframe.particles import drivers
 
-        return drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+            kernel = drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+        self._kernel = kernel
+        return kernel
+
+    def guarded(self, model):
+        """Whether runs of ``model`` need the energy guard (:func:`_energy_guard`); made once."""
+        g = self.__dict__.get("_guarded")
+        if g is None:
+            g = self._guarded = _guard_applies(model)
+        return g
 
     def abs_tol(self, r0, v0):
         """DOP853's absolute tolerance: ``atol``, else ``rtol`` times max(1, |r0|, |v0|) (componentwise max)."""
@@ -142,34 +160,70 @@ class KernelSetup:
             return None, None, None, None, None, evb.max_events
         return evb.args()
 
-    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None):
+    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None,
+             sps=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
         the events; ``atol``, ``h_state`` (N,) and ``h0`` are DOP853's. Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
-        of particle 0). ``t0`` (default the sample time ``first``) lets a fixed-step
-        call start inside a sample interval (`one_sample_in_pieces`).
+        of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
+        :attr:`sps`) let a fixed-step call start inside a sample interval and take part
+        of it (:meth:`one_sample_in_pieces`).
+
+        More particles than one block (:data:`rotframe.particles.threads.BLOCK`) run in
+        fixed blocks on every core (:func:`rotframe.particles.blocks.run_blocks`),
+        bitwise as one call.
         """
-        start = self.times[first] if t0 is None else t0
-        kernel = self.kernel()
+        start = float(self.times[first]) if t0 is None else t0
+        kernel = self.__dict__.get("_kernel") or self.kernel()
+        records = self.event_records(evb)
+        if self.fixed and r.shape[0] <= threads.BLOCK:
+            # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
+            k = self.sps if sps is None else sps
+            n_done, bad, nfev = kernel(self.info.code, r, v, alive, start, self.h, k, count, *self._model_args,
+                                       out_r, out_v, *records, *self._family)
+            return n_done, bad, nfev, k * n_done
+        from rotframe.particles.blocks import run_blocks
+
+        ev_t, ev_r, ev_v, ev_count, ev_which, max_events = records
+        per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
         if self.info.kind == "fixed":
-            n_done, bad, nfev = kernel(
-                self.info.code, r, v, alive, start, self.h, self.sps, count, self.P, self.wt_arg,
-                self.wv, self.wint, self.ev_tab, out_r, out_v, *self.event_records(evb), self.rk4, self.sphere)
-            return n_done, bad, nfev, self.sps * n_done
+            k = self.sps if sps is None else sps
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(self.info.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                              self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
+                              max_events, self.rk4, self.sphere) + (k * count,)
+
+            n_done, bad, nfev, steps = run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
+            return n_done, bad, nfev, k * n_done
         h0 = self.h0 if h0 is None else h0
         end = first + 1 + max(count, 1)
-        if self.steady_args is not None:
+        times = self.times[first + 1:end]
+        steady = self.steady_args is not None
+        if steady and r.shape[0] > threads.BLOCK:
+            # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py):
+            # its force is inlined into the stages, the specialised one keeps calls (a smaller first compile)
+            from rotframe.particles import drivers
+
+            kernel = drivers.run_dop853
+            steady = False
+        if steady:
             q, tab = self.steady_args
-            return kernel(r, v, start, self.times[first + 1:end], q, self.rtol, atol, h0, tab, np.empty((31, 6)),
-                          out_r, out_v, h_state)
-        A, B, C, E3, E5 = self.tableau
-        return kernel(
-            r, v, alive, start, self.times[first + 1:end], self.P, self.wt_arg, self.wv,
-            self.rtol, atol, h0, A, B, C, E3, E5, self.ev_tab, out_r, out_v,
-            *self.event_records(evb), h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(r, v, start, times, q, self.rtol, atol, h0, tab, np.empty((31, 6)), out_r, out_v,
+                              h_state)
+        else:
+            A, B, C, E3, E5 = self.tableau
+
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, h0, A, B, C,
+                              E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
+                              h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
+        return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
 
     def warm_up(self):
         """Load or compile the driver now; the seconds it took, or 0.0 if it was ready.
@@ -208,15 +262,11 @@ class KernelSetup:
         sps = self.sps
         j = 0
         nfev = 0
-        from rotframe.particles import drivers
-
         while j < sps:
             k = min(piece, sps - j)
             last = j + k == sps
-            n_done, bad, nf = drivers.run_fixed(self.info.code, r, v, alive, t0 + j * self.h, self.h, k, 1, self.P,
-                                                self.wt_arg, self.wv, self.wint, self.ev_tab,
-                                                out_r[:1] if last else scratch_r, out_v[:1] if last else scratch_v,
-                                                *self.event_records(evb), self.rk4, self.sphere)
+            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1] if last else scratch_r,
+                                           out_v[:1] if last else scratch_v, evb, t0=t0 + j * self.h, sps=k)
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0
@@ -239,8 +289,13 @@ def _adaptive_chunk(info, per_sample, samples, n):
     return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
 
 
-def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
-    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a [`Trajectory`][rotframe.particles.trajectory.Trajectory].
+def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False, owned=False):
+    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
+
+    ``owned=True``: ``r0, v0`` are the caller's own copies, advanced in place (one copy fewer).
+    ``records=True`` leaves a complete run's events in their record arrays
+    (``traj.extras["event_records"]``, an :class:`EventBuffers`) instead of splitting
+    them into per-particle lists (about 1 us a particle, holding the GIL).
 
     ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
     (`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
@@ -256,14 +311,20 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
     info = setup.info
     samples, times, events = setup.samples, setup.times, setup.events
     n = r0.shape[0]
-    evb = EventBuffers(n, max_events)
+    if progress is None and info.kind == "fixed" and n <= threads.BLOCK and owned:
+        traj = _run_once(setup, model, r0, v0, max_events, records)
+        if traj is not None:
+            return traj
+    # no event: no records (a (N, 64) table of them would cost more than a short run)
+    evb = EventBuffers(n, max_events if events else 0)
     alive = np.ones(n, dtype=np.bool_)
-    r = r0.copy()
-    v = v0.copy()
     out_r = np.empty((samples + 1, n, 3))
     out_v = np.empty((samples + 1, n, 3))
     out_r[0] = r0
     out_v[0] = v0
+    r = r0 if owned else r0.copy()
+    v = v0 if owned else v0.copy()
+    r0, v0 = out_r[0], out_v[0]  # the initial state, kept (r, v advance in place)
     if info.kind == "fixed":
         cost = setup.sps * n * setup.evals_per_step
         atol = 0.0
@@ -288,7 +349,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
                 probe = first = setup.call(r, v, alive, 0, 1, out_r[1:2], out_v[1:2], evb, atol, h_state)
             else:
                 probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
-                                   EventBuffers(n, max_events), atol, h_state.copy())
+                                   EventBuffers(n, evb.max_events), atol, h_state.copy())
             chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
         while done < samples:
             m = min(chunk, samples - done)
@@ -334,7 +395,49 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64):
     traj = Trajectory(times, out_r, out_v, info.name, steps, nfev, True, setup.duration)
     traj.extras["step"] = setup.h
     traj.extras["compile_s"] = compile_s
-    evb.attach(traj, events)
+    if records:
+        traj.extras["event_records"] = evb
+    else:
+        evb.attach(traj, events)
+    return traj
+
+
+#: the shared records of a run without events (never written: the drivers get None for them)
+_NO_RECORDS = EventBuffers(0, 0)
+
+
+def _run_once(setup, model, r, v, max_events, records):
+    """A short fixed-step run in one call of the driver, with the least Python around it; None if it does not apply.
+
+    The run of :func:`run_chunked` when it is one chunk (at most about 4e6 step-evaluations),
+    one block and the model needs no energy guard: the same call of the driver with the same
+    arguments, so the same numbers. A failure (a non-finite state) returns None after
+    restoring nothing: the caller runs the general path from the initial state, which
+    raises with the partial trajectory.
+    """
+    samples, n = setup.samples, r.shape[0]
+    if setup.sps * n * setup.evals_per_step * samples > 4e6 or setup.guarded(model):
+        return None
+    out_r = np.empty((samples + 1, n, 3))
+    out_v = np.empty((samples + 1, n, 3))
+    out_r[0] = r
+    out_v[0] = v
+    evb = EventBuffers(n, max_events) if setup.events else _NO_RECORDS
+    alive = np.empty(n, dtype=np.bool_)
+    alive[:] = True
+    compile_s = setup.warm_up()
+    n_done, bad, nfev, steps = setup.call(r, v, alive, 0, samples, out_r[1:], out_v[1:], evb)
+    if n_done < samples or bad >= 0:
+        r[...] = out_r[0]  # the general path starts again from the initial state, and raises
+        v[...] = out_v[0]
+        return None
+    traj = Trajectory(setup.times, out_r, out_v, setup.info.name, steps, nfev, True, setup.duration)
+    traj.extras["step"] = setup.h
+    traj.extras["compile_s"] = compile_s
+    if records:
+        traj.extras["event_records"] = evb
+    else:
+        evb.attach(traj, setup.events)
     return traj
 
 
@@ -355,11 +458,16 @@ def _energy_guard(model, r0, v0):
     is the mark of an unstable step (docs/physics/stability.md). Models with a
     real force that can add energy (gravity, springs, a pendulum) return None.
     """
-    terms = set(model.terms)
-    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
-    if not fictitious <= terms or not terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}:
+    if not _guard_applies(model):
         return None
     return _inertial_speed(model, 0.0, r0, v0)
+
+
+def _guard_applies(model):
+    """Whether the model's true motion keeps the inertial speeds from growing (see :func:`_energy_guard`)."""
+    terms = set(model.terms)
+    fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
+    return fictitious <= terms and terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}
 
 
 def _energy_growth(model, guard, times, out_r, out_v, lo, hi):

@@ -14,15 +14,22 @@ from __future__ import annotations
 import math
 import numpy as np
 
+from rotframe.numerics.compiled import inlined
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
-from rotframe.particles.events import crossed, event_value, locate_event, locate_event_dop853, record_event, start_value
+from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
-from rotframe.particles.kernels import advance, make_plan, method_steps
+from rotframe.particles.kernels import advance, make_plan, method_steps, one_step, rk4_step
 from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
 __all__ = ["run_fixed", "run_dop853"]
+
+# inlined into run_fixed: a call per sample interval that passes arrays (the schedule, the output)
+# costs their reference counts, some 20 ns a particle and sample, as much as a few steps
+_store = inlined(store)
+_advance = inlined(advance)
+_is_finite = inlined(is_finite)
 
 
 @jit_kernel
@@ -73,6 +80,8 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     n_ev = 0 if events is None else events.shape[0]
     if events is not None:
         g_old = np.empty(n_ev)
+        row = event_row(events, 0) if n_ev > 0 else (0.0, 0, 0.0, 0.0)  # the watch loop's event, read once
+    is_rk4 = False if rk4 is None else rk4
     nfev0 = 0
     n_done = n_samples
     bad = -1
@@ -88,11 +97,39 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
             if is_alive:
                 if events is None:
                     # no event to watch: the whole sample interval in one call
-                    state = advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4,
-                                    sphere)
+                    if is_rk4 and (wt is None or m.steady):
+                        for _ in range(steps_per_sample):  # a loop of its own: RK4's body alone
+                            state = rk4_step(state, h, m, plan)
+                    elif wt is None or m.steady:
+                        for _ in range(steps_per_sample):  # one_step inlined: the scalars stay in registers
+                            state = one_step(method, state, h, m, plan, rk4, sphere)
+                    else:
+                        state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan,
+                                         rk4, sphere)
                     k_step += steps_per_sample
                     if p == 0:
                         nfev0 += nfev_step * steps_per_sample
+                elif n_ev == 1 and (wt is None or m.steady):
+                    # one event at a steady rate (an ensemble to the ground): the watch loop keeps the
+                    # step and the event test in registers; the same steps, tests and location as below
+                    k = 0
+                    while k < steps_per_sample:
+                        done, start, state, g_start, g_new, hit = watch_steps(
+                            method, state, steps_per_sample - k, h, m, plan, rk4, sphere, row, g_old[0])
+                        k += done
+                        k_step += done
+                        g_old[0] = g_new
+                        if hit:
+                            t = t0 + (k_step - 1) * h
+                            tau, at = locate_event(method, events, 0, start, g_start, t, h, m, wt, wv, wint,
+                                                   rk4, sphere)
+                            record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, 0, t + tau, at)
+                            if events[0, 4] != 0.0:
+                                state = at
+                                is_alive = False
+                                break
+                    if p == 0:
+                        nfev0 += nfev_step * k
                 else:
                     for _ in range(steps_per_sample):
                         t = t0 + k_step * h
@@ -116,13 +153,13 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                         if stop:
                             is_alive = False
                             break
-                if not is_finite(state):
+                if not _is_finite(state):
                     if s < n_done:
                         n_done = s
                     if bad < 0:
                         bad = p
                     break
-            store(out_r, out_v, s, p, state)
+            _store(out_r, out_v, s, p, state)  # inlined: a call passing two arrays costs their reference counts
         store_particle(r, v, p, state)
         alive[p] = is_alive
     return n_done, bad, nfev0

@@ -1,83 +1,39 @@
 """Ensembles of particles to a terminal event, on every core.
 
 A scene's ``simulate_ensemble`` integrates many particles that share one model
-(for example drops from different heights) in vectorised calls of the compiled
-core. The particles are cut into fixed blocks of `BLOCK` particles, and
-the blocks run on a pool of threads (the compiled kernels release the GIL).
+(for example drops from different heights) in one call of the compiled core
+(:func:`rotframe.particles.integrators.integrate_particles`), which cuts them
+into fixed blocks of :data:`BLOCK` particles and runs the blocks on a pool of
+threads (:mod:`rotframe.particles.blocks`; the compiled kernels release the GIL).
 The cut does not depend on the number of threads, and every particle is
 integrated on its own inside a block, so the results are bitwise identical
-for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``).
+for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``). The first
+events are read from the kernels' record arrays, not from per-particle lists.
 
-``threads=None`` means the count in force: the one set by `threads_scope`
-for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
-threads=N)``), else every core (``os.cpu_count()``). The count is held in a
-`contextvars.ContextVar`, like `rotframe.limits`, so nothing
-outlives the command that set it.
+``threads=None`` means the count in force, ``device=None`` the device in force
+(:mod:`rotframe.particles.threads`: the CLI's ``--threads N`` and ``--device``,
+``rotframe.run(..., threads=N, device=...)``, else every core of the CPU).
 """
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import math
-import os
 from dataclasses import dataclass
 
 import numpy as np
 
+# where ensembles run (threads, device) is rotframe.particles.threads; its names are kept here too
+from rotframe.particles.threads import (BLOCK, DEVICES, check_device, check_threads, device_in_force,  # noqa: F401
+                                        device_scope, resolve_threads, threads_in_force, threads_scope)
+
 __all__ = ["EnsembleRun", "integrate_ensemble", "group_points", "threads_scope", "threads_in_force", "check_threads",
-           "resolve_threads",
+           "resolve_threads", "DEVICES", "check_device", "device_scope", "device_in_force",
            "BLOCK", "MAX_TRACK_SAMPLES", "PATH_BUDGET"]
 
 #: at most this many samples per kept path
 MAX_TRACK_SAMPLES = 500
 #: particle-samples held at once by `integrate_ensemble` (13 floats each)
 PATH_BUDGET = 2_000_000
-#: particles per block; fixed, so that the cut never depends on the number of threads
-BLOCK = 4096
-
-#: threads in force (None: every core); set per command by `threads_scope`
-_THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
-
-
-def check_threads(threads, what="threads") -> int | None:
-    """``threads`` as a whole number >= 1 (None stays None); ScenarioError in one line otherwise."""
-    if threads is None:
-        return None
-    from rotframe.errors import ScenarioError
-
-    try:
-        ok = not isinstance(threads, bool) and float(threads) == int(threads)
-    except (TypeError, ValueError, OverflowError):
-        ok = False
-    if not ok or int(threads) < 1:
-        raise ScenarioError(f"{what}: {threads!r}; must be a whole number >= 1 (default: every core, "
-                            f"{os.cpu_count() or 1} here)")
-    return int(threads)
-
-
-@contextlib.contextmanager
-def threads_scope(threads):
-    """Make ``threads`` (None: every core) the count in force inside the block."""
-    token = _THREADS.set(check_threads(threads))
-    try:
-        yield _THREADS.get()
-    finally:
-        _THREADS.reset(token)
-
-
-def threads_in_force() -> int | None:
-    """The count set by the innermost `threads_scope`; None where none was set (every core)."""
-    return _THREADS.get()
-
-
-def resolve_threads(threads=None) -> int:
-    """The number of threads for ``threads`` (None: the count in force, else every core)."""
-    if threads is None:
-        threads = _THREADS.get()
-    if threads is None:
-        threads = os.cpu_count() or 1
-    return check_threads(threads)
 
 
 @dataclass
@@ -101,7 +57,8 @@ class EnsembleRun:
     method: str
 
 
-def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), threads=None) -> EnsembleRun:
+def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), threads=None,
+                       device=None) -> EnsembleRun:
     """Integrate an ensemble to a terminal event in vectorised calls of the compiled core, on every core.
 
     The integrator locates the event for every particle (the kernels inside the
@@ -125,6 +82,11 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
     threads : int, optional
         Threads for the compiled methods (None: `resolve_threads`). The
         result does not depend on it. ``exact`` runs in one vectorised call.
+    device : str, optional
+        ``"cpu"`` or ``"gpu"`` (None: :func:`device_in_force`). On the GPU
+        (:mod:`rotframe.particles.gpu`, the fixed-step methods) the event times and
+        states agree with the CPU's to round-off (the same steps from the same source);
+        the kept paths are integrated on the CPU.
     """
     r0 = np.asarray(r0, dtype=np.float64)
     v0 = np.asarray(v0, dtype=np.float64)
@@ -138,6 +100,8 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
         atol = float(run.get("rtol") or 1e-10) * scale
     run = dict(run, atol=atol)
+    if (check_device(device) or device_in_force()) == "gpu":
+        return _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples)
     if n * (path_samples + 1) <= PATH_BUDGET:
         t_event, state, traj = _integrate_blocks(model, r0, v0, duration, event, method, run,
                                                  max(path_samples, 16), threads)
@@ -148,6 +112,23 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, path_samples) if keep else None
         sub_index = list(range(len(keep)))
     paths = {k: _path_until(sub, j, t_event[k], state[k]) for k, j in zip(keep, sub_index)}
+    return EnsembleRun(t_event, state, paths, method)
+
+
+def _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples):
+    """:func:`integrate_ensemble` on the GPU: the same step as the CPU's (its sample count), paths on the CPU."""
+    from rotframe.particles.gpu import integrate_ensemble_gpu
+
+    n = len(r0)
+    # the samples the CPU ensemble asks for (the fixed step divides their interval)
+    small = n * (path_samples + 1) <= PATH_BUDGET
+    samples = max(path_samples, 16) if small else 1
+    t_event, state = integrate_ensemble_gpu(model, r0, v0, duration, event, method=method,
+                                            run=dict(run, samples=samples))
+    paths = {}
+    if keep:  # on the CPU's sample grid for them
+        sub = _integrate(model, r0[keep], v0[keep], duration, event, method, run, samples if small else path_samples)
+        paths = {k: _path_until(sub, j, t_event[k], state[k]) for j, k in enumerate(keep)}
     return EnsembleRun(t_event, state, paths, method)
 
 
@@ -167,42 +148,16 @@ def group_points(values_list, varying) -> list:
 # ---------------------------------------------------------------------------
 
 
-class _Merged:
-    """Positions of every particle over the common sample times (what paths need)."""
-
-    def __init__(self, times, r):
-        self.times, self.r = times, r
-
-
 def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads):
-    """(t_event, state, trajectory-like) of the whole ensemble, block by block on a thread pool."""
-    n = len(r0)
-    if method == "exact" or n <= BLOCK:
+    """(t_event, state, trajectory) of the whole ensemble: one call, in fixed blocks on the thread pool.
+
+    :func:`rotframe.particles.integrators.integrate_particles` cuts the particles into
+    blocks of :data:`BLOCK` on the threads in force (:mod:`rotframe.particles.blocks`).
+    """
+    with threads_scope(resolve_threads(threads)):
         traj = _integrate(model, r0, v0, duration, event, method, run, samples)
-        t_event, state = _first_events(traj, event)
-        return t_event, state, traj
-    bounds = [(lo, min(n, lo + BLOCK)) for lo in range(0, n, BLOCK)]
-
-    def one(b):
-        lo, hi = b
-        traj = _integrate(model, r0[lo:hi], v0[lo:hi], duration, event, method, run, samples)
-        t_event, state = _first_events(traj, event)
-        return t_event, state, traj.times, traj.r
-
-    workers = min(resolve_threads(threads), len(bounds))
-    if workers == 1:
-        parts = [one(b) for b in bounds]
-    else:
-        from concurrent.futures import ThreadPoolExecutor
-
-        # compile (or load) the kernel once in this thread, so that the pool does not wait on the compiler
-        _integrate(model, r0[:1], v0[:1], duration, event, method, run, 1)
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            parts = list(pool.map(one, bounds))  # in block order; the first failure is raised
-    t_event = np.concatenate([p[0] for p in parts])
-    state = np.concatenate([p[1] for p in parts])
-    r = np.concatenate([p[3] for p in parts], axis=1)
-    return t_event, state, _Merged(parts[0][2], r)
+    t_event, state = _first_events(traj, event)
+    return t_event, state, traj
 
 
 def _integrate(model, r0, v0, duration, event, method, run, samples):
@@ -215,18 +170,25 @@ def _integrate(model, r0, v0, duration, event, method, run, samples):
     max_events = 1 if event.terminal else 64
     return integrate_particles(model, r0, v0, duration, method=method, step=run.get("step"),
                                rtol=run.get("rtol") or 1e-10, samples=int(samples), events=[event],
-                               max_events=max_events, **kw)
+                               max_events=max_events, records=True, **kw)
 
 
 def _first_events(traj, event):
     """(t, state) of each particle's first ``event`` found by the kernel; the end state where none.
 
-    Vectorised (C-level loops over the per-particle records), so that little of a
-    block's time is spent holding the GIL.
+    Read from the kernels' record arrays where the run left them there (vectorised, so
+    that little time is spent holding the GIL), else from the per-particle lists.
     """
     n = traj.r.shape[1]
     state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
     t_event = np.full(n, math.nan)
+    evb = traj.extras.get("event_records")
+    if evb is not None:
+        hit = evb.count > 0  # one event: every record is of it, the first in column 0
+        t_event[hit] = evb.t[hit, 0]
+        state[hit, :3] = evb.r[hit, 0]
+        state[hit, 3:] = evb.v[hit, 0]
+        return t_event, state
     times, states = traj.event_times[event.name], traj.event_states[event.name]
     counts = np.fromiter(map(len, times), dtype=np.int64, count=n)
     hit = counts > 0

@@ -15,12 +15,16 @@ from __future__ import annotations
 
 import math
 
+from numba import njit
+
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
-from rotframe.particles.kernels import make_plan, method_steps
+from rotframe.particles.kernels import make_plan, method_steps, one_step, rk4_step
 from rotframe.particles.packed import as_state, jit_internal
 
-__all__ = ["event_value", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
+_inline = njit(inline="always", error_model="numpy", nogil=True)
+
+__all__ = ["event_value", "event_row", "row_value", "watch_steps", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
            "locate_event", "locate_event_dop853", "record_event"]
 
 
@@ -36,6 +40,63 @@ def event_value(events, e, state, radius):
     x, y, z = state[0], state[1], state[2]
     dz = z + radius
     return math.sqrt(x * x + y * y + dz * dz) - radius - events[e, 2]
+
+
+@jit_internal
+def event_row(events, e):
+    """Row ``e`` of the event table as scalars ``(kind, component, value, direction)``, read once per call."""
+    return events[e, 0], int(events[e, 1]), events[e, 2], events[e, 3]
+
+
+@_inline
+def row_value(row, state, radius):
+    """:func:`event_value` of an :func:`event_row` (the same operations; inlined into the watch loop).
+
+    The component is picked by comparisons, not by indexing the state tuple with a
+    run-time index (which numba lowers through memory, at every step).
+    """
+    kind, c, value, _ = row
+    x, y, z, vx, vy, vz = state
+    if kind == 0.0:
+        return (x if c == 0 else y if c == 1 else z) - value
+    if kind == 1.0:
+        return (vx if c == 0 else vy if c == 1 else vz) - value
+    dz = z + radius
+    return math.sqrt(x * x + y * y + dz * dz) - radius - value
+
+
+@_inline
+def watch_steps(method, state, n, h, m, plan, rk4, sphere, row, g_old):
+    """Up to ``n`` steps with one plan, watching one event (:func:`event_row`); stops after its first crossing.
+
+    The fixed-step drivers' loop for one event at a steady rate, inlined into the
+    driver (a call per sample interval would pass the packed model and the plan, some
+    40 scalars, every few steps): each step is
+    :func:`rotframe.particles.kernels.one_step` (inlined, so the step's scalars stay
+    in registers), then the event function and :func:`crossed`. Returns
+    ``(k, start, state, g_start, g_new, hit)``: the steps taken, the state before
+    and after the last of them, the event function before and after it, and
+    whether it crossed (then the crossing is in the last step).
+    """
+    direction = row[3]
+    if rk4 is not None and rk4:
+        # RK4 in a loop of its own (one loop holding both methods' bodies ran RK4 at half speed)
+        for k in range(n):
+            start = state
+            state = rk4_step(state, h, m, plan)
+            g_new = row_value(row, state, m.radius)
+            if _crossed(direction, g_old, g_new):
+                return k + 1, start, state, g_old, g_new, True
+            g_old = g_new
+        return n, state, state, g_old, g_old, False
+    for k in range(n):
+        start = state
+        state = one_step(method, state, h, m, plan, rk4, sphere)
+        g_new = row_value(row, state, m.radius)
+        if _crossed(direction, g_old, g_new):
+            return k + 1, start, state, g_old, g_new, True
+        g_old = g_new
+    return n, state, state, g_old, g_old, False
 
 
 @jit_internal
@@ -87,6 +148,8 @@ def crossed(direction, g0, g1):
         return g0 > 0.0 and g1 <= 0.0
     return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
 
+
+_crossed = _inline(crossed.py_func)  # the same rule, inlined into the watch loop
 
 #: Most halvings of a bracket: enough to reach round-off of tau from any step length
 #: (even a crossing at tau ~ 1e-161 s, which a fixed 60 halvings of h would miss by 1e140).

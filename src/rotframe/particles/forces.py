@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 
+from numba import njit
+
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
@@ -66,11 +68,16 @@ def position_acceleration(x, y, z, m, w, wd):
     return ax, ay, az
 
 
+#: :func:`position_acceleration` inlined into :func:`state_acceleration` (a call would pass the
+#: packed model, some 30 scalars, at every force evaluation)
+_position_acceleration = njit(inline="always", error_model="numpy", nogil=True)(position_acceleration.py_func)
+
+
 @jit_internal
 def state_acceleration(state, m, w, wd):
     """Total acceleration in the rotating frame at ``state``; see `acceleration`."""
     x, y, z, vx, vy, vz = state
-    ax, ay, az = position_acceleration(x, y, z, m, w, wd)
+    ax, ay, az = _position_acceleration(x, y, z, m, w, wd)
     if m.coriolis:
         w2 = 2.0 * w
         ux = m.axis[0] * w2

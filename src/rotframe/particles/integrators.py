@@ -119,8 +119,14 @@ def default_method(model: ParticleModel, events: Sequence[Event] = (), otherwise
 def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, duration: float, *,
                         method: str | None = None, step: float | None = None, rtol: float = 1e-10,
                         atol: float | None = None, samples: int = 1000, events: Sequence[Event] = (),
-                        progress: Callable[[float], object] | None = None, max_events: int = 64) -> Trajectory:
-    """Integrate an ensemble of particles in a rotating frame.
+                        progress: Callable[[float], object] | None = None, max_events: int = 64,
+                        records: bool = False) -> Trajectory:
+    """Integrate an ensemble of particles in a rotating frame, on every core.
+
+    More than :data:`rotframe.particles.threads.BLOCK` particles run in fixed blocks on
+    the threads in force (``--threads``, ``rotframe.run(..., threads=N)``, else every
+    core); the result is bitwise the same for any number of threads. For many calls of
+    one set-up, :class:`rotframe.particles.prepared.PreparedRun` makes it once.
 
     Parameters
     ----------
@@ -141,6 +147,13 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         Number of output samples after t = 0 (uniform in time).
     events : sequence of Event
     progress : callable(fraction) or None
+    max_events : int
+        Event records kept per particle (more are counted, not kept).
+    records : bool
+        Leave the events of a complete run of a compiled method in their record arrays,
+        ``traj.extras["event_records"]`` (:class:`rotframe.particles.trajectory.EventBuffers`),
+        instead of per-particle lists in ``event_times`` and ``event_states`` (for large
+        ensembles, :mod:`rotframe.particles.ensemble`). ``exact`` always gives the lists.
 
     Returns
     -------
@@ -158,30 +171,75 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     """
     method = canonical_method(method or default_method(model, events))
     info = METHODS[method]
-    r0 = np.atleast_2d(np.asarray(r0, dtype=np.float64)).copy()
-    v0 = np.atleast_2d(np.asarray(v0, dtype=np.float64)).copy()
-    if r0.shape != v0.shape or r0.shape[-1] != 3:
+    r0 = np.array(r0, dtype=np.float64, ndmin=2)  # our own copies (the drivers advance them in place)
+    v0 = np.array(v0, dtype=np.float64, ndmin=2)
+    if r0.shape != v0.shape or r0.shape[-1] != 3 or r0.ndim != 2:
         raise ScenarioError(f"initial state: r0 and v0 must be (N, 3), got {r0.shape} and {v0.shape}")
     duration = float(duration)
     if not (math.isfinite(duration) and duration > 0):
         raise ScenarioError(f"duration: {duration:g} s; must be finite and > 0 (a parameter too large or too small?)")
-    if not (np.isfinite(r0).all() and np.isfinite(v0).all()):
+    if not _finite(r0, v0):
         raise ScenarioError("initial state: the parameters give a non-finite position or velocity "
                             "(a parameter too large?)")
     samples = max(1, int(samples))
+    if info.kind != "exact":
+        setup = _setup(model, info, duration, samples, step, rtol, atol, events, r0.shape[0])
+        return run_chunked(setup, model, r0, v0, progress, max_events, records, owned=True)
     _check_work(info, duration, step, samples, r0.shape[0], model)
-    if info.kind == "exact":
-        if not model.has_exact_flow:
-            why = "; ".join(model.nonlinear_reasons())
-            raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}) "
-                                "or a force-free one (only coriolis, centrifugal and euler); "
-                                "use rotation-splitting, rotation-splitting4, rk4 or dop853")
-        return _integrate_exact(model, r0, v0, duration, samples, events, progress)
-    setup = KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events)
-    return run_chunked(setup, model, r0, v0, progress, max_events)
+    if not model.has_exact_flow:
+        why = "; ".join(model.nonlinear_reasons())
+        raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}) "
+                            "or a force-free one (only coriolis, centrifugal and euler); "
+                            "use rotation-splitting, rotation-splitting4, rk4 or dop853")
+    return _integrate_exact(model, r0, v0, duration, samples, events, progress)
 
 
 # ---------------------------------------------------------------------------
+
+#: the set-ups of recent runs: (model and run settings) -> [KernelSetup, limits checked, particles checked]
+_SETUPS: dict = {}
+_SETUPS_KEPT = 16
+
+
+def _setup(model, info, duration, samples, step, rtol, atol, events, n):
+    """The :class:`KernelSetup` of a run, made once for the same model and settings (its work checked).
+
+    A repeated call (the same model values, method, duration, samples, step, tolerances and
+    events) reuses the set-up and its work check, so that a short run costs little beyond its
+    steps. The key holds the model's packed values and schedule, so a model changed in place
+    is a new key.
+    """
+    from rotframe import limits
+
+    P = model.pack()
+    w = model.omega
+    try:
+        key = (model.terms, P.tobytes(), w.axis.tobytes(), w.times.tobytes(), w.values.tobytes(), info.name,
+               duration, samples, step, rtol, atol, tuple(events))
+        hash(key)
+    except TypeError:  # an unhashable setting: no reuse
+        key = None
+    entry = _SETUPS.get(key) if key is not None else None
+    lim = limits.current()
+    if entry is None:
+        _check_work(info, duration, step, samples, n, model)
+        entry = [KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events), lim, n]
+        if key is not None:
+            if len(_SETUPS) >= _SETUPS_KEPT:
+                _SETUPS.pop(next(iter(_SETUPS)))
+            _SETUPS[key] = entry
+    elif entry[1] is not lim or entry[2] != n:
+        _check_work(info, duration, step, samples, n, model)
+        entry[1], entry[2] = lim, n
+    return entry[0]
+
+
+
+def _finite(r0, v0):
+    """Whether every value of ``r0`` and ``v0`` is finite (a few particles: in Python, faster than numpy's calls)."""
+    if r0.size <= 24:
+        return all(map(math.isfinite, r0.ravel().tolist() + v0.ravel().tolist()))
+    return bool(np.isfinite(r0).all() and np.isfinite(v0).all())
 
 
 def _check_work(info, duration, step, samples, n, model):

@@ -18,14 +18,23 @@ from __future__ import annotations
 
 import math
 
+from numba import njit
+
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
 from rotframe.particles.packed import NFEV, jit_internal, jit_kernel, unpack
+
+#: a step's body, inlined by numba into each loop that calls it (a call per step would pass the
+#: packed model and the plan, some 40 scalars, every step: three times the cost of the step)
+_inline = njit(inline="always", error_model="numpy", nogil=True)
+#: the force, inlined into the RK4 step (four evaluations a step: four calls passing the packed model)
+_acceleration = _inline(state_acceleration.py_func)
+_position_acceleration = _inline(position_acceleration.py_func)
 from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 
-__all__ = ["make_plan", "method_steps", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
+__all__ = ["make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
 
 # numba compiles a separate version of a function for every constant it is called with
@@ -125,53 +134,70 @@ def _sub_steps(method, h):
 def _free_steps(state, n, method, h, m, plan):
     """Exact-rotation splitting of a free particle; see `step_splitting`.
 
+    ``n`` steps of :func:`free_step`, which numba inlines here: with nothing but
+    scalars in the loop, this is the throughput path of the ensemble driver.
+    """
+    for _ in range(n):
+        state = free_step(state, method, h, m, plan)
+    return state
+
+
+@_inline
+def free_step(state, method, h, m, plan):
+    """One step of the exact-rotation splitting of a free particle (inlined into its callers).
+
     Per sub-step: drift r += v h/2; kick v += a_pos(r) h/2 and exact drag;
     rotate v about w_hat by -2 turn (cos and sin from the plan); drag and kick
-    again; drift h/2. With nothing but scalars in the loop, this is the
-    throughput path of the ensemble driver.
+    again; drift h/2.
     """
     x, y, z, vx, vy, vz = state
     ux, uy, uz = m.axis
     n_sub, lengths = _sub_steps(method, h)
-    for _ in range(n):
-        for i in range(n_sub):
-            hh = 0.5 * lengths[i]
-            w, wd, turn, c, s = plan[i]
-            x += hh * vx
-            y += hh * vy
-            z += hh * vz
-            if m.uniform:
-                ax, ay, az = m.g
-            else:
-                ax, ay, az = position_acceleration(x, y, z, m, w, wd)
-            vx += hh * ax
-            vy += hh * ay
-            vz += hh * az
-            k1 = 0.0
-            k2 = 0.0
-            if m.drag:
-                k1, k2 = drag_coefficients(z, m)
-                vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
-            if m.coriolis:
-                vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
-            if m.drag:
-                vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
-            vx += hh * ax
-            vy += hh * ay
-            vz += hh * az
-            x += hh * vx
-            y += hh * vy
-            z += hh * vz
+    for i in range(n_sub):
+        hh = 0.5 * lengths[i]
+        w, wd, turn, c, s = plan[i]
+        x += hh * vx
+        y += hh * vy
+        z += hh * vz
+        if m.uniform:
+            ax, ay, az = m.g
+        else:
+            ax, ay, az = _position_acceleration(x, y, z, m, w, wd)
+        vx += hh * ax
+        vy += hh * ay
+        vz += hh * az
+        k1 = 0.0
+        k2 = 0.0
+        if m.drag:
+            k1, k2 = drag_coefficients(z, m)
+            vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+        if m.coriolis:
+            vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
+        if m.drag:
+            vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+        vx += hh * ax
+        vy += hh * ay
+        vz += hh * az
+        x += hh * vx
+        y += hh * vy
+        z += hh * vz
     return x, y, z, vx, vy, vz
 
 
 @jit_internal
 def _sphere_steps(state, n, method, h, m, plan):
-    """Splitting on the sphere |r - pivot| = L; see `step_sphere`."""
-    n_sub, lengths = _sub_steps(method, h)
+    """Splitting on the sphere |r - pivot| = L; see :func:`step_sphere`."""
     for _ in range(n):
-        for i in range(n_sub):
-            state = _sphere_step(state, lengths[i], m, plan[i])
+        state = sphere_step(state, method, h, m, plan)
+    return state
+
+
+@_inline
+def sphere_step(state, method, h, m, plan):
+    """One step of the splitting on the sphere (its sub-steps; inlined into its callers)."""
+    n_sub, lengths = _sub_steps(method, h)
+    for i in range(n_sub):
+        state = _sphere_step(state, lengths[i], m, plan[i])
     return state
 
 
@@ -242,42 +268,49 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
 
 @jit_internal
 def _rk4_steps(state, n, h, m, plan):
-    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see `step_rk4`."""
+    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see :func:`step_rk4`."""
+    for _ in range(n):
+        state = rk4_step(state, h, m, plan)
+    return state
+
+
+@_inline
+def rk4_step(state, h, m, plan):
+    """One classical Runge-Kutta step (inlined into its callers); see :func:`step_rk4`."""
     x, y, z, vx, vy, vz = state
     hh = 0.5 * h
     h6 = h / 6.0
     w1, wd1 = plan[0][0], plan[0][1]
     w2, wd2 = plan[1][0], plan[1][1]
     w4, wd4 = plan[2][0], plan[2][1]
-    for _ in range(n):
-        a1x, a1y, a1z = state_acceleration((x, y, z, vx, vy, vz), m, w1, wd1)
-        x2 = x + hh * vx
-        y2 = y + hh * vy
-        z2 = z + hh * vz
-        v2x = vx + hh * a1x
-        v2y = vy + hh * a1y
-        v2z = vz + hh * a1z
-        a2x, a2y, a2z = state_acceleration((x2, y2, z2, v2x, v2y, v2z), m, w2, wd2)
-        x3 = x + hh * v2x
-        y3 = y + hh * v2y
-        z3 = z + hh * v2z
-        v3x = vx + hh * a2x
-        v3y = vy + hh * a2y
-        v3z = vz + hh * a2z
-        a3x, a3y, a3z = state_acceleration((x3, y3, z3, v3x, v3y, v3z), m, w2, wd2)
-        x4 = x + h * v3x
-        y4 = y + h * v3y
-        z4 = z + h * v3z
-        v4x = vx + h * a3x
-        v4y = vy + h * a3y
-        v4z = vz + h * a3z
-        a4x, a4y, a4z = state_acceleration((x4, y4, z4, v4x, v4y, v4z), m, w4, wd4)
-        x, y, z, vx, vy, vz = (x + h6 * (vx + 2.0 * v2x + 2.0 * v3x + v4x),
-                               y + h6 * (vy + 2.0 * v2y + 2.0 * v3y + v4y),
-                               z + h6 * (vz + 2.0 * v2z + 2.0 * v3z + v4z),
-                               vx + h6 * (a1x + 2.0 * a2x + 2.0 * a3x + a4x),
-                               vy + h6 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y),
-                               vz + h6 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z))
+    a1x, a1y, a1z = _acceleration((x, y, z, vx, vy, vz), m, w1, wd1)
+    x2 = x + hh * vx
+    y2 = y + hh * vy
+    z2 = z + hh * vz
+    v2x = vx + hh * a1x
+    v2y = vy + hh * a1y
+    v2z = vz + hh * a1z
+    a2x, a2y, a2z = _acceleration((x2, y2, z2, v2x, v2y, v2z), m, w2, wd2)
+    x3 = x + hh * v2x
+    y3 = y + hh * v2y
+    z3 = z + hh * v2z
+    v3x = vx + hh * a2x
+    v3y = vy + hh * a2y
+    v3z = vz + hh * a2z
+    a3x, a3y, a3z = _acceleration((x3, y3, z3, v3x, v3y, v3z), m, w2, wd2)
+    x4 = x + h * v3x
+    y4 = y + h * v3y
+    z4 = z + h * v3z
+    v4x = vx + h * a3x
+    v4y = vy + h * a3y
+    v4z = vz + h * a3z
+    a4x, a4y, a4z = _acceleration((x4, y4, z4, v4x, v4y, v4z), m, w4, wd4)
+    x, y, z, vx, vy, vz = (x + h6 * (vx + 2.0 * v2x + 2.0 * v3x + v4x),
+                           y + h6 * (vy + 2.0 * v2y + 2.0 * v3y + v4y),
+                           z + h6 * (vz + 2.0 * v2z + 2.0 * v3z + v4z),
+                           vx + h6 * (a1x + 2.0 * a2x + 2.0 * a3x + a4x),
+                           vy + h6 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y),
+                           vz + h6 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z))
     return x, y, z, vx, vy, vz
 
 
@@ -299,6 +332,18 @@ def method_steps(method, state, n, h, m, plan, rk4, sphere):
         if sphere:
             return _sphere_steps(state, n, method, h, m, plan)
     return _free_steps(state, n, method, h, m, plan)
+
+
+@_inline
+def one_step(method, state, h, m, plan, rk4, sphere):
+    """One step of :func:`method_steps` (inlined into its callers: the event watch's loop)."""
+    if rk4 is not None:
+        if rk4:
+            return rk4_step(state, h, m, plan)
+    if sphere is not None:
+        if sphere:
+            return sphere_step(state, method, h, m, plan)
+    return free_step(state, method, h, m, plan)
 
 
 @jit_internal

@@ -113,6 +113,8 @@ class EventBuffers:
         particle order, each in record order), so that large ensembles do not
         spend their time here holding the GIL.
         """
+        if not events:
+            return
         kept = np.minimum(self.count, self.max_events)
         valid = np.arange(self.max_events)[None, :] < kept[:, None]
         for e_idx, ev in enumerate(events):

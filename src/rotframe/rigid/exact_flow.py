@@ -1,16 +1,18 @@
-"""The exact free asymmetric rigid body in one compiled call (a fast path of ``rigid.free_body_exact``).
+"""The exact free asymmetric rigid body in one compiled call (the fast path of ``rigid.free_body_exact``).
 
-[`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] evaluates the closed-form motion (Jacobi
+:func:`rotframe.rigid.free_body.free_body_closed_form` evaluates the closed-form motion (Jacobi
 elliptic functions for the momentum, Carlson's integrals for the angle about
 ``L``; docs/physics.md, rigid bodies) with numpy and scipy on arrays: right for
 many time points, but a few hundred microseconds of setup and small-array calls
-for one. [`free_body_flow`][rotframe.rigid.exact_flow.free_body_flow] computes the same formulas, setup included, in
+for one. :func:`flow_into` computes the same formulas, setup included, in
 one numba function: the ordered frame, ``K(m)`` by the arithmetic-geometric
 mean (A&S 17.6), ``R_F``, ``R_J``, ``R_C`` by Carlson's duplication algorithm
 (Carlson 1995, Numer. Algorithms 10, 13) and ``sn, cn, dn`` by descending Landen
 transformations, all from [`rotframe.rigid.elliptic`][rotframe.rigid.elliptic], and the attitude as the product
 ``q = S0 Rz(psi) Ry(-theta) Rz(-phi) P``. Symmetric bodies, the separatrix,
-rotation about the middle axis and ``L = 0`` go to ``free_body_exact``.
+rotation about the middle axis and ``L = 0`` are left to ``free_body_closed_form``;
+:func:`rotframe.rigid.free_body.free_body_exact` (the public door) tries this
+path first and falls back to it.
 """
 
 from __future__ import annotations
@@ -23,9 +25,8 @@ import numpy as np
 
 from rotframe.numerics.rotation import quat_mul
 from rotframe.rigid.elliptic import carlson_rf, ellipk_agm, incomplete_pi, jacobi_reduced
-from rotframe.rigid.free_body import free_body_exact
 
-__all__ = ["free_body_flow"]
+__all__ = ["flow_into", "flow_ready"]
 
 _jit = jit_kernel
 
@@ -168,26 +169,49 @@ def _flow(moments, L0, q0, t, out_L, out_q):
     return True
 
 
-def free_body_flow(inertia, L0_body, q0, times):
-    """The exact torque-free motion at ``times``, as [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] returns it.
+def flow_ready() -> bool:
+    """Whether the compiled flow runs without compiling: loaded in this process, or in numba's disk cache.
 
-    The same closed form, evaluated in one compiled call for the asymmetric
-    body (a few microseconds for a few time points); other cases (two equal
-    moments, the separatrix, rotation about the middle axis, ``L = 0``) and
-    invalid input are passed to [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact].
+    Compiling it costs a first run seconds (about 8 s on a 2-core machine, the elliptic
+    routines with it), more than the scenes' whole first run; so
+    :func:`rotframe.rigid.free_body.free_body_exact` takes this path only where it is ready
+    (a call of :func:`flow_into` compiles and caches it, as ``rotframe bench`` does).
+    """
+    if _flow.overloads:
+        return True
+    if not _ON_DISK:  # read numba's index once a process (empty when missing or stale)
+        try:
+            _ON_DISK.append(bool(_flow._cache._cache_file._load_index()))
+        except Exception:  # noqa: BLE001 -- no cache, or another numba: treat as not ready
+            _ON_DISK.append(False)
+    return _ON_DISK[0]
+
+
+_ON_DISK: list = []  # whether numba's disk cache holds the flow, read once
+
+
+def flow_into(inertia, L0_body, q0, times):
+    """The exact torque-free motion at ``times`` by the compiled closed form, or None where it does not apply.
+
+    The fast path of :func:`rotframe.rigid.free_body.free_body_exact` (which calls it
+    first): the asymmetric body, valid input, ``times`` 1-D. None for two equal moments,
+    the separatrix, rotation about the middle axis, ``L = 0``, a zero moment and invalid
+    input, which ``free_body_exact`` evaluates (or refuses) itself.
 
     Returns
     -------
-    L_body : (n, 3) ndarray, kg m^2/s
-    q : (n, 4) ndarray, scalar-last, body -> space
+    (L_body (n, 3), q (n, 4)) or None
     """
-    t = np.asarray(times, dtype=np.float64)
-    moments = np.asarray(inertia, dtype=np.float64)
-    L0 = np.asarray(L0_body, dtype=np.float64)
-    q = np.asarray(q0, dtype=np.float64)
+    try:
+        t = np.atleast_1d(np.asarray(times, dtype=np.float64))
+        moments = np.asarray(inertia, dtype=np.float64)
+        L0 = np.asarray(L0_body, dtype=np.float64)
+        q = np.asarray(q0, dtype=np.float64)
+    except (TypeError, ValueError):  # text, complex: free_body_exact's checks say what is wrong
+        return None
     if t.ndim == 1 and moments.shape == (3,) and L0.shape == (3,) and q.shape == (4,):
         out_L = np.empty((t.size, 3))
         out_q = np.empty((t.size, 4))
         if _flow(moments, L0, q, t, out_L, out_q):
             return out_L, out_q
-    return free_body_exact(inertia, L0_body, q0, times)
+    return None

@@ -15,10 +15,11 @@ Conventions (the whole rigid layer uses them)
   body angular velocity is ``omega_body = L_body / I``. Euler's equations read
   ``dL/dt = L x omega + N_body`` and the attitude ``dq/dt = q * (omega, 0) / 2``.
 
-[`free_body_exact`][rotframe.rigid.free_body.free_body_exact] keeps ``L`` to about ``1e-14 |L|`` over many flips, also
-beside the separatrix, and the attitude to about ``1e-12`` rad.
-[`rotframe.rigid.exact_flow.free_body_flow`][rotframe.rigid.exact_flow.free_body_flow] is the same closed form in one
-compiled call.
+:func:`free_body_exact` keeps ``L`` to about ``1e-14 |L|`` over many flips, also
+beside the separatrix, and the attitude to about ``1e-12`` rad. It runs the
+closed form compiled (:func:`rotframe.rigid.exact_flow.flow_into`, a few
+microseconds a call) where it applies, else :func:`free_body_closed_form`, the
+same formulas with numpy and scipy on arrays.
 
 References
 ----------
@@ -52,7 +53,7 @@ from rotframe.rigid.checks import (
 from rotframe.rigid.elliptic import incomplete_pi_arrays, jacobi_reduced_arrays
 from rotframe.validation import check_vector3, guard_public
 
-__all__ = ["free_body_exact", "elliptic_period"]
+__all__ = ["free_body_exact", "free_body_closed_form", "elliptic_period"]
 
 
 def free_body_exact(
@@ -61,7 +62,32 @@ def free_body_exact(
     q0: ArrayLike,
     times: ArrayLike,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Exact motion of the torque-free rigid body.
+    """Exact motion of the torque-free rigid body (the closed form, compiled where it can be).
+
+    The asymmetric body with valid input runs the compiled closed form
+    (:func:`rotframe.rigid.exact_flow.flow_into`: a few microseconds for a few time
+    points) once it is compiled (:func:`rotframe.rigid.exact_flow.flow_ready`: loaded, or
+    in numba's disk cache; a first run does not compile it); every other case (two equal moments, the separatrix, rotation about the
+    middle axis, ``L = 0``, a zero moment) and the refusal of invalid input are
+    :func:`free_body_closed_form`'s, whose docstring states the formulas, parameters and
+    results. The two agree to round-off (``tests/test_rigid_exact.py``).
+    """
+    from rotframe.rigid import exact_flow
+
+    if exact_flow.flow_ready():  # compiled already: a first run does not pay its compile
+        fast = exact_flow.flow_into(inertia, L0_body, q0, times)
+        if fast is not None:
+            return fast
+    return free_body_closed_form(inertia, L0_body, q0, times)
+
+
+def free_body_closed_form(
+    inertia: ArrayLike,
+    L0_body: ArrayLike,
+    q0: ArrayLike,
+    times: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Exact motion of the torque-free rigid body, evaluated with numpy and scipy on arrays.
 
     Angular momentum (Landau & Lifshitz par. 37, in the notation of
     docs/physics/rigid-bodies.md): in a frame of principal axes ordered so that ``L`` circulates

@@ -17,126 +17,287 @@ __all__ = ["ensemble_rows", "same_work", "sweep_rows", "startup_rows", "record_r
 
 
 def ensemble_rows(quick):
-    """Particle-steps per second of the tower-drop ensemble path on one core and on all, beside hand-written loops.
+    """Particle-steps per second of rotframe's many-particle paths beside hand-written ``prange`` loops.
 
-    rotframe: `rotframe.particles.ensemble.integrate_ensemble` (gravity + Coriolis,
-    exact-rotation splitting, the ground event watched every step) with
-    ``threads=1`` and with every core (or ``--threads N``). Ceiling: the same
-    splitting written out by hand (`rotframe.app.bench.ceiling`, no event),
-    serial and with ``prange`` on as many numba threads. ``parallel_efficiency``
-    is the N-core rate over ``N x`` the single-core rate; ``goal_ratio`` that rate
-    over ``0.7 x N x`` the single-core rate (1 or more meets the goal);
-    ``scaling_vs_ceiling`` our efficiency over the ceiling's (what the machine
-    allows: on a busy or shared machine neither scales).
+    Cases: the exact-rotation splitting, RK4 and DOP853 on gravity + Coriolis, each
+    without an event (:func:`rotframe.particles.integrators.integrate_particles` with
+    (N, 3) states, the public many-particle call) and with the ground event
+    (:func:`rotframe.particles.ensemble.integrate_ensemble`, the scenes' and sweeps'
+    ensemble path). Each case has four rows: rotframe with ``threads=1`` and with every
+    core (or ``--threads N``), the hand-written loop of the same steps
+    (:mod:`rotframe.app.bench.ceiling`) on one core and with ``prange`` on as many
+    numba threads (the ceiling). ``of_ceiling``: rotframe's rate over the hand-written
+    loop's at the same thread count (the goal is 0.7 or more). The all-core row of
+    each case also has ``parallel_efficiency`` (N-core rate over ``N x`` one core),
+    ``goal_ratio`` (that over 0.7), ``scaling_vs_ceiling`` (over the ceiling's own
+    efficiency: a shared machine scales neither) and ``bitwise_identical_to_1_thread``.
 
-    Same work: every particle starts 1000 m up and none lands within the run
-    (checked: no event), so both take the same steps of the same particles; the
-    final states of ours and of the serial hand-written loop are compared, and
-    must agree to round-off (``same_work``, ``same_work_max_rel``).
-    Times are the minimum over repeats (the fairest on a shared machine).
+    Same work: every particle starts high enough that none lands within the run
+    (checked: no event found), so both take the same steps of the same particles; the
+    final states of ours and of the hand-written loop must agree to round-off
+    (``same_work``, ``same_work_max_rel``) and DOP853 must take the same number of
+    steps (``same_steps``). Times are the minimum over rounds that run the four in
+    turn (the fairest on a shared machine). The first four rows are the splitting
+    with the ground event.
     """
     import numba
 
     from rotframe.app.bench import ceiling
-    from rotframe.particles.ensemble import integrate_ensemble, resolve_threads
-    from rotframe.particles.integrators import Event
-    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.particles.ensemble import resolve_threads
 
-    n, steps = (20000, 50) if quick else (100000, 200)
+    # steps: a multiple of 16, the samples of an ensemble run without kept paths
+    # (rotframe.particles.ensemble), so that its step is the ceiling's
+    n, steps = (20000, 48) if quick else (100000, 192)
     cores = resolve_threads(None)  # --threads N, else every core
     prange_threads = min(cores, numba.config.NUMBA_NUM_THREADS)
-    w = np.array([0.0, 4.6e-5, 5.7e-5])
-    g = np.array([0.0, 0.0, -9.81])
-    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=g)
-    rng = np.random.default_rng(1)
-    r0 = rng.normal(size=(n, 3)) + [0, 0, 1000]
-    v0 = rng.normal(size=(n, 3))
-    h = 1e-3
-    ground = Event("ground", "r", 2, 0.0, -1, True)
-
-    def ours(threads):
-        return integrate_ensemble(model, r0, v0, steps * h, ground, method="rotation-splitting",
-                                  run={"step": h, "samples": 1}, threads=threads)
-
-    c, s = math.cos(-2 * np.linalg.norm(w) * h), math.sin(-2 * np.linalg.norm(w) * h)
-    axis = w / np.linalg.norm(w)
-    ceiling.serial(r0[:2].copy(), v0[:2].copy(), g, axis, c, s, h, 2)
-    ceiling.parallel(r0[:2].copy(), v0[:2].copy(), g, axis, c, s, h, 2)
-
-    def hand(fn):
-        def go():
-            r, v = r0.copy(), v0.copy()
-            fn(r, v, g, axis, c, s, h, steps)
-            return r, v
-        return go
-
-    ours(1)
-    a = ours(1)
-    b = ours(None)
-    identical = bool(np.array_equal(a.state, b.state) and np.array_equal(a.t_event, b.t_event, equal_nan=True))
-    same, same_rel, same_note = same_work(a, hand(ceiling.serial)(), n, steps, h)
     rows = []
     budget = 1.0 if quick else 3.0
     saved = numba.get_num_threads()
     try:
         numba.set_num_threads(prange_threads)
-        for name, threads, fn in [("rotframe ensemble, 1 thread", 1, lambda: ours(1)),
-                                  (f"rotframe ensemble, {cores} threads", cores, lambda: ours(None)),
-                                  ("hand-written loop, 1 core", 1, hand(ceiling.serial)),
-                                  (f"hand-written prange loop, {prange_threads} threads (ceiling)", prange_threads,
-                                   hand(ceiling.parallel))]:
-            wall = _best(fn, budget=budget, max_repeats=3 if quick else 5)
-            rows.append({"scenario": "ensemble", "method": name, "setting": f"{n} particles x {steps} steps",
-                         "wall_s": wall, "error": math.nan, "error_kind": "throughput (best of repeats)",
-                         "nfev": n * steps, "particle_steps_per_s": n * steps / wall, "threads": threads})
+        for method, rk4 in (("rotation-splitting", False), ("rk4", True), ("dop853", None)):
+            for event in (True, False):
+                rows += _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, quick, ceiling)
     finally:
         numba.set_num_threads(saved)
+    rows += call_overhead_rows()
+    for r in rows:
+        r["cpu_count"] = os.cpu_count()
+    return rows
+
+
+#: issue 26's goal: ``integrate_particles`` costs at most this much (s) a call beyond its steps
+OVERHEAD_GOAL_S = 10e-6
+
+
+def call_overhead_rows(repeats=2000):
+    """What a call of ``integrate_particles`` costs beyond its steps, beside ``PreparedRun`` and the driver alone.
+
+    One particle, ten steps of the splitting (gravity + Coriolis), one sample: the
+    compiled driver's own call with the same arguments (``KernelSetup.call``'s
+    driver, timed alone) is the steps; ``overhead_s`` is the rest of a call. The best
+    of five rounds of ``repeats`` calls each (the mean of a round), so that a busy
+    machine's pauses do not count.
+    """
+    from rotframe.particles.chunked import KernelSetup
+    from rotframe.particles.integrators import METHODS, integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.particles.prepared import PreparedRun
+
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant([0.0, 4.6e-5, 5.7e-5]),
+                          g=np.array([0.0, 0.0, -9.81]))
+    r0, v0 = np.array([0.0, 0.0, 100.0]), np.array([1.0, 0.0, 0.0])
+    setup = KernelSetup(model, METHODS["rotation-splitting"], 1.0, 1, step=0.1)
+    kernel = setup.kernel()
+    r, v = r0[None].copy(), v0[None].copy()
+    alive = np.ones(1, dtype=np.bool_)
+    out_r, out_v = np.empty((1, 1, 3)), np.empty((1, 1, 3))
+
+    def driver():
+        kernel(setup.info.code, r, v, alive, 0.0, setup.h, setup.sps, 1, setup.P, setup.wt_arg, setup.wv,
+               setup.wint, None, out_r, out_v, None, None, None, None, None, 0, setup.rk4, setup.sphere)
+
+    prepared = PreparedRun(model, "rotation-splitting", 1.0, step=0.1, samples=1, n=1)
+    calls = {"compiled driver alone (the steps)": driver,
+             "integrate_particles": lambda: integrate_particles(model, r0, v0, 1.0, method="rotation-splitting",
+                                                                step=0.1, samples=1),
+             "PreparedRun": lambda: prepared(r0, v0)}
+    per_call = {}
+    for name, fn in calls.items():
+        fn()
+        best = math.inf
+        for _ in range(5):
+            t0 = time.perf_counter()
+            for _ in range(repeats):
+                fn()
+            best = min(best, (time.perf_counter() - t0) / repeats)
+        per_call[name] = best
+    steps = per_call["compiled driver alone (the steps)"]
+    rows = []
+    for name, wall in per_call.items():
+        row = {"scenario": "call-overhead", "method": name, "setting": "1 particle x 10 splitting steps, 1 sample",
+               "wall_s": wall, "error": math.nan, "error_kind": "time a call (best of 5 rounds)", "nfev": 10,
+               "overhead_s": wall - steps}
+        if name == "integrate_particles":
+            row.update(goal_s=OVERHEAD_GOAL_S, goal_met=bool(wall - steps <= OVERHEAD_GOAL_S))
+        rows.append(row)
+    return rows
+
+
+def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, quick, ceiling):
+    """The four rows of one method, with or without the ground event (see :func:`ensemble_rows`)."""
+    from rotframe.numerics.dop853 import coefficients
+    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.particles.integrators import Event, integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    dop = rk4 is None
+    g = np.array([0.0, 0.0, -9.81])
+    rng = np.random.default_rng(1)
+    if dop:
+        # DOP853 chooses its steps: a fast frame (|w| = 0.5 rad/s) over 20 s, so that each particle
+        # takes some hundreds of steps; a tenth of the particles
+        n = n // 10
+        w = np.array([0.0, 0.3, 0.4])
+        duration, h, rtol = 20.0, 0.0, 1e-10
+        r0 = rng.normal(size=(n, 3)) + [0, 0, 1e4]
+    else:
+        w = np.array([0.0, 4.6e-5, 5.7e-5])
+        h = 1e-3
+        duration, rtol = steps * h, 1e-10
+        r0 = rng.normal(size=(n, 3)) + [0, 0, 1000]
+    v0 = rng.normal(size=(n, 3))
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=g)
+    ground = Event("ground", "r", 2, 0.0, -1, True)
+    atol = rtol * max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))  # the ensemble's own rule
+    run = {"step": h or None, "samples": 1, "rtol": rtol}
+
+    def ours(threads):
+        if event and not dop:
+            res = integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run, threads=threads)
+            return res.state, int(np.sum(np.isfinite(res.t_event))), None
+        from rotframe.particles.ensemble import threads_in_force, threads_scope
+
+        with threads_scope(threads if threads is not None else threads_in_force()):
+            # DOP853 with the event: the ensemble's own call with one sample (an ensemble this small asks
+            # for 16, and DOP853's first step is a tenth of the sample interval: other steps than the ceiling's)
+            traj = integrate_particles(model, r0, v0, duration, method=method, step=h or None, rtol=rtol,
+                                       atol=atol, samples=1, events=[ground] if event else (), max_events=1,
+                                       records=True)
+        evb = traj.extras.get("event_records")
+        landed = 0 if evb is None else int(np.sum(evb.count > 0))
+        return np.concatenate([traj.r[-1], traj.v[-1]], axis=1), landed, traj.steps
+
+    if dop:
+        tab = _dop853_table(coefficients())
+        hand_steps = np.zeros(n, dtype=np.int64)
+
+        def hand(fn):
+            def go(k=n):
+                r, v = r0[:k].copy(), v0[:k].copy()
+                fn(r, v, g, w, tab, rtol, atol, duration / 10.0, duration, event, hand_steps[:k])
+                return r, v
+            return go
+        serial, parallel = hand(ceiling.dop853_serial), hand(ceiling.dop853_parallel)
+        per_particle = None
+    else:
+        c, s = ceiling.rotation_cos_sin(w, h)
+
+        def hand(fn):
+            def go(k=n):
+                r, v = r0[:k].copy(), v0[:k].copy()
+                fn(r, v, g, w, c, s, h, steps, rk4, event)
+                return r, v
+            return go
+        serial, parallel = hand(ceiling.serial), hand(ceiling.parallel)
+        per_particle = steps
+    serial(2)
+    parallel(2)
+    a = ours(1)
+    b = ours(None)
+    identical = bool(np.array_equal(a[0], b[0]))
+    ref = np.concatenate(serial(), axis=1)
+    if dop:
+        per_particle = float(np.mean(hand_steps))
+    tol = 1e-9 if dop else 1e-12
+    same, rel, note = same_state(a[0], a[1], ref, tol)
+    if dop:
+        same_steps = bool(a[2] == int(hand_steps[0]))
+    else:
+        from rotframe.particles.chunked import steps_per_sample
+
+        # the ensemble samples its runs 16 times (the fixed step divides the sample interval)
+        k = 16 if event else 1
+        same_steps = bool(k * steps_per_sample(duration / k, h) == steps)
+    what = (f"{method}, gravity + Coriolis, {'with the ground event watched every step' if event else 'no event'}; "
+            f"{n} particles x {per_particle:.4g} steps{' (mean; DOP853 chooses them)' if dop else ''}")
+    if dop and a[2] is not None:
+        note += f"; particle 0 took {a[2]} steps in ours and {int(hand_steps[0])} in the hand-written loop"
+    rows = []
+    label = f"{method}{' + ground event' if event else ''}"
+    door = ("integrate_ensemble" if event and not dop else "integrate_particles") + " (N, 3)"
+    cases = [(f"rotframe {door} {label}, 1 thread", 1, lambda: ours(1)),
+             (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
+             (f"hand-written {label}, 1 core", 1, serial),
+             (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads, parallel)]
+    walls = _best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 7)
+    for (name, threads, fn), wall in zip(cases, walls):
+        total = n * per_particle
+        rows.append({"scenario": "ensemble", "method": name, "setting": what, "wall_s": wall, "error": math.nan,
+                     "error_kind": "throughput (best of repeats)", "nfev": int(total), "particle_steps_per_s": total / wall,
+                     "threads": threads, "integrator": method, "event": event})
     single, multi = rows[0]["particle_steps_per_s"], rows[1]["particle_steps_per_s"]
     rows[1]["parallel_efficiency"] = multi / (cores * single)
     rows[1]["goal_ratio"] = multi / (0.7 * cores * single)
     rows[1]["bitwise_identical_to_1_thread"] = identical
     rows[3]["parallel_efficiency"] = rows[3]["particle_steps_per_s"] / (prange_threads * rows[2]["particle_steps_per_s"])
-    # the ceiling's own scaling is what this machine allows (a shared or busy machine scales less)
     rows[1]["scaling_vs_ceiling"] = rows[1]["parallel_efficiency"] / rows[3]["parallel_efficiency"]
     rows[1]["of_ceiling"] = multi / rows[3]["particle_steps_per_s"]
     rows[0]["of_ceiling"] = single / rows[2]["particle_steps_per_s"]
     for r in rows:
-        r.update(same_work=same, same_work_max_rel=same_rel, same_work_note=same_note, cpu_count=os.cpu_count())
+        r.update(same_work=same and same_steps, same_work_max_rel=rel, same_work_note=note, same_steps=same_steps)
     return rows
 
 
-def same_work(ours, hand, n, steps, h):
-    """(same, max relative difference, note): do ours and the hand-written loop take the same steps of the same physics?
+def _dop853_table(coeffs):
+    """The DOP853 tableau as one (16, 13) array (rows 0-11 A, 12 B, 13 C, 14 E3, 15 E5), for the ceiling."""
+    A, B, C, E3, E5 = coeffs
+    tab = np.zeros((16, 13))
+    tab[:12, :12] = A
+    tab[12, :12] = B
+    tab[13, :12] = C
+    tab[14] = E3
+    tab[15] = E5
+    return tab
 
-    Both must have integrated every particle for all ``steps`` (ours found no ground
-    event) and reach the same final (r, v). Tolerance 1e-12 of the state's scale: the
-    two differ only in the order of floating-point operations, so their difference is
-    round-off, about ``steps x`` 1e-16 (2e-14 at 200 steps), while a missing Coriolis
-    term or another splitting order differs by about 1e-7 of it or more here.
+
+def same_state(ours, landed, ref, tol=1e-12):
+    """(same, max relative difference, note): do ours and the hand-written loop end in the same states?
+
+    Both must have integrated every particle to the end (ours found no ground event) and
+    reach the same final (r, v) (N, 6) to ``tol`` of the state's scale. The two differ only
+    in the order of floating-point operations, so their difference is round-off, about
+    ``steps x`` 1e-16 (2e-14 at 200 steps), while a missing Coriolis term or another
+    splitting order differs by about 1e-7 of it or more.
     """
-    r, v = hand
-    landed = int(np.sum(np.isfinite(ours.t_event)))
-    ref = np.concatenate([r, v], axis=1)
     # round-off follows the size of the whole vector (a rotation mixes its components): scale by the largest |r|, |v|
-    scale = np.repeat([max(np.linalg.norm(r, axis=1).max(), 1.0), max(np.linalg.norm(v, axis=1).max(), 1.0)], 3)
-    rel = float(np.max(np.abs(ours.state - ref) / scale))
-    same = bool(landed == 0 and rel <= 1e-12)
-    note = (f"same {n} particles, {steps} steps of {h:g} s, gravity + Coriolis by Strang exact-rotation splitting in "
-            f"both; final states agree to {rel:.1e} of their scale (round-off; allowed 1e-12); ours also watches the "
-            f"ground event every step ({landed} landed)")
+    scale = np.repeat([max(np.linalg.norm(ref[:, :3], axis=1).max(), 1.0),
+                       max(np.linalg.norm(ref[:, 3:], axis=1).max(), 1.0)], 3)
+    rel = float(np.max(np.abs(ours - ref) / scale))
+    same = bool(landed == 0 and rel <= tol)
+    note = (f"final states agree to {rel:.1e} of their scale (round-off; allowed {tol:g}); "
+            f"{landed} particles landed (must be 0)")
     if not same:
         note = "NOT the same work: " + note
     return same, rel, note
 
 
-def _best(fn, budget, max_repeats):
-    """The shortest wall time of ``fn()`` over repeats that fit in ``budget`` seconds (at least two)."""
-    times = []
-    while len(times) < 2 or (len(times) < max_repeats and sum(times) < budget):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
+def same_work(ours, hand, n, steps, h):
+    """:func:`same_state` of an ensemble run ``ours`` and the hand-written loop's ``(r, v)``: (same, rel, note)."""
+    r, v = hand
+    landed = int(np.sum(np.isfinite(ours.t_event)))
+    same, rel, note = same_state(ours.state, landed, np.concatenate([r, v], axis=1))
+    return same, rel, f"{'same' if same else 'NOT the same work:'} {n} particles, {steps} steps of {h:g} s: " + (
+        note.removeprefix("NOT the same work: "))
+
+
+def _best_interleaved(fns, budget, max_rounds):
+    """The shortest wall time of each of ``fns`` over rounds that run each once in turn (at least two rounds).
+
+    Interleaved, so that a shared machine's busy spells fall on all of them alike.
+    """
+    best = [math.inf] * len(fns)
+    spent = 0.0
+    rounds = 0
+    while rounds < 2 or (rounds < max_rounds and spent < budget * len(fns)):
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            fn()
+            wall = time.perf_counter() - t0
+            best[i] = min(best[i], wall)
+            spent += wall
+        rounds += 1
+    return best
 
 
 def sweep_rows(quick):

@@ -1,0 +1,128 @@
+"""One call of a compiled particle driver over many particles, on every core.
+
+The drivers (:mod:`rotframe.particles.drivers`) integrate each particle on its
+own: a particle's result depends on its own initial state and the call's
+arguments (times, step, tolerances, event table), never on the others. So a
+call over N particles can be cut into fixed blocks of
+:data:`rotframe.particles.threads.BLOCK` particles, each block run by the same
+driver on a thread of a pool (the drivers release the GIL), and the result is
+bitwise that of one call, for any number of threads. The cut depends on N
+only. Each block has contiguous arrays of its own (copies in and out), so the
+driver sees the array types of a single call and compiles nothing more.
+
+The count of threads is :func:`rotframe.particles.threads.resolve_threads`
+(the ``--threads`` option, ``rotframe.run(..., threads=N)``, else every core).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+
+__all__ = ["block_bounds", "run_blocks"]
+
+#: thread pools by size, made on first use and kept (a pool per call would cost ~100 us)
+_POOLS: dict = {}
+
+
+def block_bounds(n):
+    """``[(lo, hi), ...]``: the fixed blocks of ``n`` particles (one block when ``n <= BLOCK``)."""
+    from rotframe.particles import threads
+
+    size = int(threads.BLOCK)
+    return [(lo, min(n, lo + size)) for lo in range(0, n, size)] or [(0, 0)]
+
+
+_LOCAL = threading.local()
+#: largest scratch array (bytes) a thread keeps between calls
+_KEEP_BYTES = 8 << 20
+
+
+def _scratch(i, shape):
+    """An uninitialised float array of ``shape``: the calling thread's ``i``-th, reused when small."""
+    if 8 * math.prod(shape) > _KEEP_BYTES:
+        return np.empty(shape)
+    kept = getattr(_LOCAL, "arrays", None)
+    if kept is None:
+        kept = _LOCAL.arrays = {}
+    a = kept.get((i, shape))
+    if a is None:
+        if len(kept) >= 8:
+            kept.clear()
+        a = kept[(i, shape)] = np.empty(shape)
+    return a
+
+
+def _pool(workers):
+    pool = _POOLS.get(workers)
+    if pool is None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        pool = _POOLS[workers] = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rotframe-block")
+    return pool
+
+
+def run_blocks(one, n, per_particle, per_sample, scalars=()):
+    """Run ``one(*block_arrays)`` on every block of ``n`` particles, on the thread pool; merged results.
+
+    Parameters
+    ----------
+    one : callable
+        ``one(*arrays)`` runs the driver on one block and returns ``(n_done, bad, nfev, steps)``.
+    n : int
+        Particles.
+    per_particle : sequence of arrays or None
+        Arrays whose first axis is the particle (``r``, ``v``, ``alive``, event records,
+        ``h_state``); each block gets a contiguous copy, written back after the run.
+        None stays None.
+    per_sample : sequence of arrays
+        Arrays (K, N, ...) whose second axis is the particle (the output samples);
+        each block gets contiguous copies, written back.
+    scalars : sequence
+        Passed after the arrays unchanged.
+
+    Returns
+    -------
+    (n_done, bad, nfev, steps)
+        The fewest samples done over the blocks, the first bad particle (an index into
+        the whole call) or -1, and the cost of particle 0 (block 0's).
+    """
+    from rotframe.particles import threads
+
+    bounds = block_bounds(n)
+    if len(bounds) == 1:
+        return one(*per_particle, *per_sample, *scalars)
+
+    def block(b):
+        lo, hi = b
+        # a block of a C-contiguous array is one already (its view is passed, nothing copied);
+        # only a strided one (samples of several times) is copied in and back
+        views = [None if a is None else a[lo:hi] for a in per_particle]
+        mine = [None if a is None else np.ascontiguousarray(a) for a in views]
+        out_views = [a[:, lo:hi] for a in per_sample]
+        # the drivers only write the samples: a strided block gets a scratch array of its thread's
+        # (kept between calls, so that its pages are not faulted in again), copied out after the run
+        outs = [a if a.flags.c_contiguous else _scratch(i, a.shape) for i, a in enumerate(out_views)]
+        res = one(*mine, *outs, *scalars)
+        for a, m in zip(views, mine):
+            if a is not None and m is not a:
+                a[...] = m
+        for a, m in zip(out_views, outs):
+            if m is not a:
+                a[...] = m
+        return res
+
+    workers = min(threads.resolve_threads(None), len(bounds))
+    if workers == 1:
+        results = [block(b) for b in bounds]
+    else:
+        results = list(_pool(workers).map(block, bounds))  # block order; the first failure is raised
+    n_done = min(r[0] for r in results)
+    bad = -1
+    for (lo, _), r in zip(bounds, results):
+        if r[1] >= 0:
+            bad = lo + int(r[1])
+            break
+    return n_done, bad, results[0][2], results[0][3]

@@ -1,0 +1,130 @@
+"""Where ensembles run: on how many threads, and on which device.
+
+``threads=None`` means the count in force: the one set by :func:`threads_scope`
+for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
+threads=N)``), else every core (``os.cpu_count()``). The device in force is set
+the same way by :func:`device_scope` (``--device``, ``rotframe.run(...,
+device=...)``): ``"cpu"`` unless a command asks for ``"gpu"``. Both are held in
+:class:`contextvars.ContextVar` s, like :mod:`rotframe.limits`, so nothing
+outlives the command that set them.
+
+:data:`BLOCK` is the fixed cut of a many-particle call into blocks
+(:mod:`rotframe.particles.blocks`): it never depends on the number of threads,
+so the results do not either. :mod:`rotframe.particles.ensemble` re-exports
+these names.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+
+__all__ = ["BLOCK", "check_threads", "threads_scope", "threads_in_force", "resolve_threads", "DEVICES",
+           "gpu_available", "require_gpu", "check_device", "device_scope", "device_in_force"]
+
+#: particles per block; fixed, so that the cut never depends on the number of threads
+BLOCK = 4096
+
+#: threads in force (None: every core); set per command by :func:`threads_scope`
+_THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
+
+#: where ensembles run: the CPU's cores, or a CUDA GPU (:mod:`rotframe.particles.gpu`)
+DEVICES = ("cpu", "gpu")
+#: device in force (None: cpu); set per command by :func:`device_scope`
+_DEVICE: contextvars.ContextVar[str | None] = contextvars.ContextVar("rotframe_device", default=None)
+
+
+def gpu_available() -> bool:
+    """Whether numba can run CUDA kernels here: a CUDA GPU, or numba's simulator (``NUMBA_ENABLE_CUDASIM=1``)."""
+    from numba import config
+
+    if config.ENABLE_CUDASIM:
+        return True
+    try:
+        from numba import cuda
+
+        return bool(cuda.is_available())
+    except Exception:  # noqa: BLE001 -- no driver, no toolkit: no GPU
+        return False
+
+
+def require_gpu(what="device"):
+    """Raise ScenarioError (one line) unless :func:`gpu_available`."""
+    if not gpu_available():
+        from rotframe.errors import ScenarioError
+
+        raise ScenarioError(f"{what}: 'gpu', but no CUDA GPU is available here (numba.cuda.is_available() is "
+                            "False); use 'cpu'")
+
+
+def check_device(device, what="device") -> str | None:
+    """``device`` as one of :data:`DEVICES` (None stays None); ScenarioError in one line otherwise.
+
+    ``"gpu"`` also needs a CUDA GPU (or numba's simulator): without one, ScenarioError
+    saying so (the command line exits 2).
+    """
+    if device is None:
+        return None
+    from rotframe.errors import ScenarioError
+
+    if device not in DEVICES:
+        raise ScenarioError(f"{what}: {device!r}; allowed: {', '.join(DEVICES)}")
+    if device == "gpu":
+        require_gpu(what)
+    return device
+
+
+@contextlib.contextmanager
+def device_scope(device):
+    """Make ``device`` (None: cpu) the device of the ensembles run inside the block (checked first)."""
+    token = _DEVICE.set(check_device(device))
+    try:
+        yield _DEVICE.get()
+    finally:
+        _DEVICE.reset(token)
+
+
+def device_in_force() -> str:
+    """The device set by the innermost :func:`device_scope`: ``"cpu"`` where none was set."""
+    return _DEVICE.get() or "cpu"
+
+
+def check_threads(threads, what="threads") -> int | None:
+    """``threads`` as a whole number >= 1 (None stays None); ScenarioError in one line otherwise."""
+    if threads is None:
+        return None
+    from rotframe.errors import ScenarioError
+
+    try:
+        ok = not isinstance(threads, bool) and float(threads) == int(threads)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or int(threads) < 1:
+        raise ScenarioError(f"{what}: {threads!r}; must be a whole number >= 1 (default: every core, "
+                            f"{os.cpu_count() or 1} here)")
+    return int(threads)
+
+
+@contextlib.contextmanager
+def threads_scope(threads):
+    """Make ``threads`` (None: every core) the count in force inside the block."""
+    token = _THREADS.set(check_threads(threads))
+    try:
+        yield _THREADS.get()
+    finally:
+        _THREADS.reset(token)
+
+
+def threads_in_force() -> int | None:
+    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
+    return _THREADS.get()
+
+
+def resolve_threads(threads=None) -> int:
+    """The number of threads for ``threads`` (None: the count in force, else every core)."""
+    if threads is None:
+        threads = _THREADS.get()
+    if threads is None:
+        threads = os.cpu_count() or 1
+    return check_threads(threads)

@@ -1,0 +1,127 @@
+"""The GPU ensemble (rotframe.particles.gpu) on numba's CUDA simulator, against the CPU ensemble.
+
+The simulator (``NUMBA_ENABLE_CUDASIM=1``, set before numba is first imported) runs the
+CUDA kernel in Python on a machine without a GPU, so these checks run in a new process
+with the variable set. The GPU kernel is compiled from the same Python source as the CPU
+kernels (the forces, steps and event rules), so it must agree with the CPU ensemble to
+round-off: event times and states, terminal and non-terminal events, every fixed-step
+method, a varying rotation rate. The simulator is slow: a handful of particles.
+
+Without a GPU (and without the simulator) ``device="gpu"`` is refused in one line, exit 2.
+"""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from rotframe.app import cli
+from rotframe.errors import ScenarioError
+from rotframe.particles import gpu
+from rotframe.particles.ensemble import check_device
+
+SCRIPT = textwrap.dedent("""
+    import json, math
+    import numpy as np
+    from numba import config
+    assert config.ENABLE_CUDASIM
+    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.particles.integrators import Event
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    g = np.array([0.0, 0.0, -9.81])
+    steady = OmegaSchedule.constant(np.array([0.0, 4.6e-5, 5.7e-5]) * 300)
+    varying = OmegaSchedule(np.array([0.0, 0.6, 0.8]), np.array([0.0, 1.0, 3.0]), np.array([0.02, 0.05, 0.01]))
+    cases = [
+        ("rotation-splitting", ParticleModel(("gravity", "coriolis"), omega=steady, g=g),
+         Event("ground", "r", 2, 0.0, -1, True)),
+        ("rk4", ParticleModel(("gravity", "coriolis", "centrifugal", "quadratic-drag"), omega=steady, g=g,
+                              k_quadratic=2e-3), Event("ground", "r", 2, 0.0, -1, True)),
+        ("rotation-splitting4", ParticleModel(("gravity", "coriolis"), omega=steady, g=g),
+         Event("apex", "v", 2, 0.0, -1, False)),
+        ("rotation-splitting", ParticleModel(("coriolis", "centrifugal", "euler", "gravity"), omega=varying, g=g),
+         Event("ground", "r", 2, 0.0, -1, True)),
+        ("rotation-splitting", ParticleModel(("altitude-gravity", "coriolis", "linear-drag"), omega=steady,
+                                             g0=9.81, radius=6.371e6, k_linear=0.05),
+         Event("ground", "altitude", 0, 0.0, -1, True)),
+    ]
+    rng = np.random.default_rng(11)
+    out = []
+    for method, model, event in cases:
+        n = 5
+        r0 = np.zeros((n, 3))
+        r0[:, 2] = rng.uniform(5.0, 40.0, n)
+        v0 = rng.normal(scale=3.0, size=(n, 3))
+        v0[:, 2] = np.abs(v0[:, 2]) + 2.0  # rising first: the apex and the ground both come
+        run = {"step": 2e-2, "samples": 4}
+        cpu = integrate_ensemble(model, r0, v0, 4.0, event, method=method, run=run, keep=[1], device="cpu")
+        gpu = integrate_ensemble(model, r0, v0, 4.0, event, method=method, run=run, keep=[1], device="gpu")
+        hit = np.isfinite(cpu.t_event)
+        out.append({"method": method, "event": event.name, "hits": int(hit.sum()),
+                    "same_hits": bool(np.array_equal(hit, np.isfinite(gpu.t_event))),
+                    "dt": float(np.max(np.abs(cpu.t_event[hit] - gpu.t_event[hit]), initial=0.0)),
+                    "ds": float(np.max(np.abs(cpu.state - gpu.state) / np.maximum(1.0, np.abs(cpu.state)))),
+                    "path": bool(np.allclose(cpu.paths[1][1], gpu.paths[1][1], rtol=0, atol=1e-9))})
+    print(json.dumps(out))
+""")
+
+
+def _simulated(code, *args):
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    return subprocess.run([sys.executable, *code, *args], env=env, capture_output=True, text=True, timeout=900)
+
+
+def test_gpu_kernel_on_the_simulator_agrees_with_the_cpu_ensemble():
+    res = _simulated(["-c", SCRIPT])
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = json.loads(res.stdout.strip().splitlines()[-1])
+    assert len(rows) == 5
+    for row in rows:
+        assert row["hits"] > 0 and row["same_hits"], row  # the events fire, for the same particles
+        # round-off: the same steps from the same source (a real GPU may fuse multiply-adds)
+        assert row["dt"] <= 1e-12 and row["ds"] <= 1e-12 and row["path"], row
+
+
+def test_sweep_device_gpu_on_the_simulator_gives_the_cpu_rows(tmp_path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    rows = {}
+    for device in ("cpu", "gpu"):
+        out = tmp_path / f"{device}.parquet"
+        res = _simulated(["-m", "rotframe", "sweep", "tower-drop", "--grid", "height=20:60:3", "--method",
+                          "rotation-splitting", "--set", "step=0.01", "--device", device, "--out", str(out), "--json"])
+        assert res.returncode == 0, res.stderr[-3000:]
+        assert json.loads(res.stdout)["path"] == "ensemble"
+        rows[device] = pq.read_table(out).to_pydict()
+    for key in ("east_deflection_m", "fall_time_s"):
+        a, b = rows["cpu"][key], rows["gpu"][key]
+        assert len(a) == 3 and all(abs(x - y) <= 1e-12 * max(1.0, abs(x)) for x, y in zip(a, b)), key
+
+
+@pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
+def test_device_gpu_without_a_gpu_exits_2_in_one_line(capsys):
+    code = cli.main(["run", "tower-drop", "--device", "gpu", "--no-record"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "no CUDA GPU" in err and "'gpu'" in err
+    with pytest.raises(ScenarioError, match="no CUDA GPU"):
+        check_device("gpu")
+
+
+def test_device_names_are_checked(capsys):
+    with pytest.raises(ScenarioError, match="device: 'tpu'; allowed: cpu, gpu"):
+        check_device("tpu")
+    assert cli.main(["run", "tower-drop", "--device", "tpu", "--no-record"]) == 2
+    assert "invalid choice" in capsys.readouterr().err
+
+
+def test_gpu_physics_is_the_cpu_source():
+    """The device functions are compiled from the CPU kernels' own Python functions (one source)."""
+    from rotframe.particles import forces, kernels
+
+    for kernel in (forces.state_acceleration, kernels.free_step, kernels.one_step):
+        assert gpu.device_function(kernel).py_func.__code__ is kernel.py_func.__code__
+    # the calls inside are rebound to the GPU versions of the same functions
+    assert gpu.device_function(kernels.one_step).py_func.__globals__["free_step"] is gpu.device_function(
+        kernels.free_step)
