@@ -556,11 +556,14 @@ def test_second_process_compiles_nothing(tmp_path):
 # 9. many particles: each as if alone, bitwise; independent of the thread count
 # ---------------------------------------------------------------------------------------------
 
-def test_many_particles_bitwise_and_thread_independent():
+def test_many_particles_bitwise_and_thread_independent(monkeypatch):
     """N particles of very different scales: each particle's numbers are those of its run alone, bitwise
-    (its own tolerance scale, its own steps), and do not depend on the thread count (over 512 particles,
-    blocks of them run on threads)."""
+    (its own tolerance scale, its own steps), and do not depend on the thread count (blocks of 256
+    particles here, so that several run on threads)."""
+    from rotframe.particles import threads as particle_threads
     from rotframe.particles.ensemble import threads_scope
+
+    monkeypatch.setattr(particle_threads, "BLOCK", 256)
 
     rng = np.random.default_rng(7)
     N = 600

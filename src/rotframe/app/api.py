@@ -109,7 +109,7 @@ def load(name_or_path: str | Path):
 
 def run(name_or_path: str | Path, method: str | None = None, *, progress: ProgressLike = None,
         threads: int | None = None, device: str | None = None, **params: Any) -> "Result":
-    """Run a scenario; returns a :class:`Result`.
+    """Run a scenario; returns a [`Result`][rotframe.app.api.Result].
 
     Parameters
     ----------
@@ -129,7 +129,7 @@ def run(name_or_path: str | Path, method: str | None = None, *, progress: Progre
     device : str, optional
         ``"cpu"`` (default) or ``"gpu"``: where ensembles of particles run during
         this run (a CUDA GPU, float64, the fixed-step methods;
-        :mod:`rotframe.particles.gpu`). ``"gpu"`` without one: ScenarioError.
+        [`rotframe.particles.gpu`][rotframe.particles.gpu]). ``"gpu"`` without one: ScenarioError.
     **params
         Parameter values (numbers in the documented unit, astropy quantities or
         strings such as ``"520 ft"``), and the run settings ``step`` (s),

@@ -1,16 +1,16 @@
 """One call of a compiled particle driver over many particles, on every core.
 
-The drivers (:mod:`rotframe.particles.drivers`) integrate each particle on its
+The drivers (`rotframe.particles.drivers`) integrate each particle on its
 own: a particle's result depends on its own initial state and the call's
 arguments (times, step, tolerances, event table), never on the others. So a
 call over N particles can be cut into fixed blocks of
-:data:`rotframe.particles.threads.BLOCK` particles, each block run by the same
+`rotframe.particles.threads.BLOCK` particles, each block run by the same
 driver on a thread of a pool (the drivers release the GIL), and the result is
 bitwise that of one call, for any number of threads. The cut depends on N
 only. Each block has contiguous arrays of its own (copies in and out), so the
 driver sees the array types of a single call and compiles nothing more.
 
-The count of threads is :func:`rotframe.particles.threads.resolve_threads`
+The count of threads is [`rotframe.particles.threads.resolve_threads`][rotframe.particles.threads.resolve_threads]
 (the ``--threads`` option, ``rotframe.run(..., threads=N)``, else every core).
 """
 

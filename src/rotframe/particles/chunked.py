@@ -137,7 +137,7 @@ class KernelSetup:
         return kernel
 
     def guarded(self, model):
-        """Whether runs of ``model`` need the energy guard (:func:`_energy_guard`); made once."""
+        """Whether runs of ``model`` need the energy guard (`_energy_guard`); made once."""
         g = self.__dict__.get("_guarded")
         if g is None:
             g = self._guarded = _guard_applies(model)
@@ -169,11 +169,11 @@ class KernelSetup:
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
         of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
-        :attr:`sps`) let a fixed-step call start inside a sample interval and take part
-        of it (:meth:`one_sample_in_pieces`).
+        `sps`) let a fixed-step call start inside a sample interval and take part
+        of it (`one_sample_in_pieces`).
 
-        More particles than one block (:data:`rotframe.particles.threads.BLOCK`) run in
-        fixed blocks on every core (:func:`rotframe.particles.blocks.run_blocks`),
+        More particles than one block (`rotframe.particles.threads.BLOCK`) run in
+        fixed blocks on every core (`rotframe.particles.blocks.run_blocks`),
         bitwise as one call.
         """
         start = float(self.times[first]) if t0 is None else t0
@@ -290,11 +290,11 @@ def _adaptive_chunk(info, per_sample, samples, n):
 
 
 def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False, owned=False):
-    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a :class:`Trajectory`.
+    """Integrate ``r0, v0`` (N, 3) with ``setup`` in interruptible chunks; a [`Trajectory`][rotframe.particles.trajectory.Trajectory].
 
     ``owned=True``: ``r0, v0`` are the caller's own copies, advanced in place (one copy fewer).
     ``records=True`` leaves a complete run's events in their record arrays
-    (``traj.extras["event_records"]``, an :class:`EventBuffers`) instead of splitting
+    (``traj.extras["event_records"]``, an [`EventBuffers`][rotframe.particles.trajectory.EventBuffers]) instead of splitting
     them into per-particle lists (about 1 us a particle, holding the GIL).
 
     ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
@@ -409,7 +409,7 @@ _NO_RECORDS = EventBuffers(0, 0)
 def _run_once(setup, model, r, v, max_events, records):
     """A short fixed-step run in one call of the driver, with the least Python around it; None if it does not apply.
 
-    The run of :func:`run_chunked` when it is one chunk (at most about 4e6 step-evaluations),
+    The run of `run_chunked` when it is one chunk (at most about 4e6 step-evaluations),
     one block and the model needs no energy guard: the same call of the driver with the same
     arguments, so the same numbers. A failure (a non-finite state) returns None after
     restoring nothing: the caller runs the general path from the initial state, which
@@ -464,7 +464,7 @@ def _energy_guard(model, r0, v0):
 
 
 def _guard_applies(model):
-    """Whether the model's true motion keeps the inertial speeds from growing (see :func:`_energy_guard`)."""
+    """Whether the model's true motion keeps the inertial speeds from growing (see `_energy_guard`)."""
     terms = set(model.terms)
     fictitious = {"coriolis", "centrifugal"} | (set() if model.omega.is_constant else {"euler"})
     return fictitious <= terms and terms <= fictitious | {"euler", "linear-drag", "quadratic-drag"}

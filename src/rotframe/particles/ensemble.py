@@ -2,16 +2,16 @@
 
 A scene's ``simulate_ensemble`` integrates many particles that share one model
 (for example drops from different heights) in one call of the compiled core
-(:func:`rotframe.particles.integrators.integrate_particles`), which cuts them
-into fixed blocks of :data:`BLOCK` particles and runs the blocks on a pool of
-threads (:mod:`rotframe.particles.blocks`; the compiled kernels release the GIL).
+([`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles]), which cuts them
+into fixed blocks of `BLOCK` particles and runs the blocks on a pool of
+threads (`rotframe.particles.blocks`; the compiled kernels release the GIL).
 The cut does not depend on the number of threads, and every particle is
 integrated on its own inside a block, so the results are bitwise identical
 for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``). The first
 events are read from the kernels' record arrays, not from per-particle lists.
 
 ``threads=None`` means the count in force, ``device=None`` the device in force
-(:mod:`rotframe.particles.threads`: the CLI's ``--threads N`` and ``--device``,
+([`rotframe.particles.threads`][rotframe.particles.threads]: the CLI's ``--threads N`` and ``--device``,
 ``rotframe.run(..., threads=N, device=...)``, else every core of the CPU).
 """
 
@@ -83,8 +83,8 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
         Threads for the compiled methods (None: `resolve_threads`). The
         result does not depend on it. ``exact`` runs in one vectorised call.
     device : str, optional
-        ``"cpu"`` or ``"gpu"`` (None: :func:`device_in_force`). On the GPU
-        (:mod:`rotframe.particles.gpu`, the fixed-step methods) the event times and
+        ``"cpu"`` or ``"gpu"`` (None: [`device_in_force`][rotframe.particles.threads.device_in_force]). On the GPU
+        ([`rotframe.particles.gpu`][rotframe.particles.gpu], the fixed-step methods) the event times and
         states agree with the CPU's to round-off (the same steps from the same source);
         the kept paths are integrated on the CPU.
     """
@@ -116,7 +116,7 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
 
 
 def _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples):
-    """:func:`integrate_ensemble` on the GPU: the same step as the CPU's (its sample count), paths on the CPU."""
+    """[`integrate_ensemble`][rotframe.particles.ensemble.integrate_ensemble] on the GPU: the same step as the CPU's (its sample count), paths on the CPU."""
     from rotframe.particles.gpu import integrate_ensemble_gpu
 
     n = len(r0)
@@ -151,8 +151,8 @@ def group_points(values_list, varying) -> list:
 def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads):
     """(t_event, state, trajectory) of the whole ensemble: one call, in fixed blocks on the thread pool.
 
-    :func:`rotframe.particles.integrators.integrate_particles` cuts the particles into
-    blocks of :data:`BLOCK` on the threads in force (:mod:`rotframe.particles.blocks`).
+    [`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles] cuts the particles into
+    blocks of `BLOCK` on the threads in force (`rotframe.particles.blocks`).
     """
     with threads_scope(resolve_threads(threads)):
         traj = _integrate(model, r0, v0, duration, event, method, run, samples)

@@ -50,7 +50,7 @@ def event_row(events, e):
 
 @_inline
 def row_value(row, state, radius):
-    """:func:`event_value` of an :func:`event_row` (the same operations; inlined into the watch loop).
+    """`event_value` of an `event_row` (the same operations; inlined into the watch loop).
 
     The component is picked by comparisons, not by indexing the state tuple with a
     run-time index (which numba lowers through memory, at every step).
@@ -67,13 +67,13 @@ def row_value(row, state, radius):
 
 @_inline
 def watch_steps(method, state, n, h, m, plan, rk4, sphere, row, g_old):
-    """Up to ``n`` steps with one plan, watching one event (:func:`event_row`); stops after its first crossing.
+    """Up to ``n`` steps with one plan, watching one event (`event_row`); stops after its first crossing.
 
     The fixed-step drivers' loop for one event at a steady rate, inlined into the
     driver (a call per sample interval would pass the packed model and the plan, some
     40 scalars, every few steps): each step is
-    :func:`rotframe.particles.kernels.one_step` (inlined, so the step's scalars stay
-    in registers), then the event function and :func:`crossed`. Returns
+    `rotframe.particles.kernels.one_step` (inlined, so the step's scalars stay
+    in registers), then the event function and `crossed`. Returns
     ``(k, start, state, g_start, g_new, hit)``: the steps taken, the state before
     and after the last of them, the event function before and after it, and
     whether it crossed (then the crossing is in the last step).

@@ -68,7 +68,7 @@ def position_acceleration(x, y, z, m, w, wd):
     return ax, ay, az
 
 
-#: :func:`position_acceleration` inlined into :func:`state_acceleration` (a call would pass the
+#: `position_acceleration` inlined into `state_acceleration` (a call would pass the
 #: packed model, some 30 scalars, at every force evaluation)
 _position_acceleration = njit(inline="always", error_model="numpy", nogil=True)(position_acceleration.py_func)
 

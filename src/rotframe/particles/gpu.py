@@ -1,19 +1,19 @@
 """Ensembles on a CUDA GPU, from the same physics source as the CPU kernels.
 
-The forces (:mod:`rotframe.particles.forces`), the one-step maps
-(:mod:`rotframe.particles.kernels`), the schedule readers and the event rules
-(:mod:`rotframe.particles.events`) are plain Python functions that numba
-compiles for the CPU (``njit``). :func:`device_function` compiles the same
+The forces (`rotframe.particles.forces`), the one-step maps
+(`rotframe.particles.kernels`), the schedule readers and the event rules
+(`rotframe.particles.events`) are plain Python functions that numba
+compiles for the CPU (``njit``). [`device_function`][rotframe.particles.gpu.device_function] compiles the same
 Python source for the GPU (``numba.cuda.jit(device=True)``): it takes a CPU
 kernel's ``py_func`` and rebinds every compiled function that it calls to that
 function's own GPU version, recursively. So there is one source of the physics,
 compiled for two targets, and a fix to a force is a fix on both.
 
-:func:`integrate_ensemble_gpu` runs one GPU thread per particle through the
+[`integrate_ensemble_gpu`][rotframe.particles.gpu.integrate_ensemble_gpu] runs one GPU thread per particle through the
 fixed-step methods (``rotation-splitting``, ``rotation-splitting4``, ``rk4``),
 watching one event as the CPU driver does (the same crossing rule and
 bisection on the method's own step), in float64. It returns what
-:func:`rotframe.particles.ensemble.integrate_ensemble` needs: the first event's
+[`rotframe.particles.ensemble.integrate_ensemble`][rotframe.particles.ensemble.integrate_ensemble] needs: the first event's
 time and state of every particle, else its state at the end. Without a GPU
 (``numba.cuda.is_available()`` False) it refuses in one line, unless numba's
 CUDA simulator is on (``NUMBA_ENABLE_CUDASIM=1``, set before numba is first
@@ -41,14 +41,14 @@ _KERNEL = []  # the compiled kernel, made on first use
 
 
 def available() -> bool:
-    """Whether numba can run CUDA kernels here (:func:`rotframe.particles.threads.gpu_available`)."""
+    """Whether numba can run CUDA kernels here ([`rotframe.particles.threads.gpu_available`][rotframe.particles.threads.gpu_available])."""
     from rotframe.particles.threads import gpu_available
 
     return gpu_available()
 
 
 def require(what="device"):
-    """Raise ScenarioError (one line) unless :func:`available`."""
+    """Raise ScenarioError (one line) unless [`available`][rotframe.particles.gpu.available]."""
     from rotframe.particles.threads import require_gpu
 
     require_gpu(what)
@@ -94,9 +94,9 @@ def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, event
                             hit_any):
     """One GPU thread per particle: ``n_steps`` steps of ``method`` from ``t0``, watching one event.
 
-    The loop of :func:`rotframe.particles.drivers.run_fixed` for one sample interval and
-    one event: the same steps (:func:`one_step` at a steady rate, a plan per step else),
-    the same crossing test, and the same location (:func:`locate_event`, bisection on a
+    The loop of `rotframe.particles.drivers.run_fixed` for one sample interval and
+    one event: the same steps (`one_step` at a steady rate, a plan per step else),
+    the same crossing test, and the same location (`locate_event`, bisection on a
     re-step). ``events`` (1, 5) is the event table, ``watch`` 0 (none) or 1; a terminal event stops
     the particle. ``out`` (N, 6) receives the end state; ``ev_t`` (N,) and ``ev_state``
     (N, 6) the first event (``hit_any`` (N,) 1 where there was one).
@@ -138,7 +138,7 @@ def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, event
 
 
 def _kernel():
-    """The compiled GPU kernel (made on first use, from :func:`_ensemble_kernel_source`)."""
+    """The compiled GPU kernel (made on first use, from `_ensemble_kernel_source`)."""
     if _KERNEL:
         return _KERNEL[0]
     from numba import cuda
@@ -167,7 +167,7 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     Raises
     ------
     ScenarioError
-        No GPU (:func:`require`), or a method the GPU does not run (:data:`GPU_METHODS`).
+        No GPU ([`require`][rotframe.particles.gpu.require]), or a method the GPU does not run (`GPU_METHODS`).
     """
     from rotframe.errors import ScenarioError
     from rotframe.particles.chunked import steps_per_sample

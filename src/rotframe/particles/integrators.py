@@ -123,10 +123,10 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
                         records: bool = False) -> Trajectory:
     """Integrate an ensemble of particles in a rotating frame, on every core.
 
-    More than :data:`rotframe.particles.threads.BLOCK` particles run in fixed blocks on
+    More than `rotframe.particles.threads.BLOCK` particles run in fixed blocks on
     the threads in force (``--threads``, ``rotframe.run(..., threads=N)``, else every
     core); the result is bitwise the same for any number of threads. For many calls of
-    one set-up, :class:`rotframe.particles.prepared.PreparedRun` makes it once.
+    one set-up, [`rotframe.particles.prepared.PreparedRun`][rotframe.particles.prepared.PreparedRun] makes it once.
 
     Parameters
     ----------
@@ -151,9 +151,9 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         Event records kept per particle (more are counted, not kept).
     records : bool
         Leave the events of a complete run of a compiled method in their record arrays,
-        ``traj.extras["event_records"]`` (:class:`rotframe.particles.trajectory.EventBuffers`),
+        ``traj.extras["event_records"]`` ([`rotframe.particles.trajectory.EventBuffers`][rotframe.particles.trajectory.EventBuffers]),
         instead of per-particle lists in ``event_times`` and ``event_states`` (for large
-        ensembles, :mod:`rotframe.particles.ensemble`). ``exact`` always gives the lists.
+        ensembles, [`rotframe.particles.ensemble`][rotframe.particles.ensemble]). ``exact`` always gives the lists.
 
     Returns
     -------
@@ -202,7 +202,7 @@ _SETUPS_KEPT = 16
 
 
 def _setup(model, info, duration, samples, step, rtol, atol, events, n):
-    """The :class:`KernelSetup` of a run, made once for the same model and settings (its work checked).
+    """The `KernelSetup` of a run, made once for the same model and settings (its work checked).
 
     A repeated call (the same model values, method, duration, samples, step, tolerances and
     events) reuses the set-up and its work check, so that a short run costs little beyond its

@@ -134,7 +134,7 @@ def _sub_steps(method, h):
 def _free_steps(state, n, method, h, m, plan):
     """Exact-rotation splitting of a free particle; see `step_splitting`.
 
-    ``n`` steps of :func:`free_step`, which numba inlines here: with nothing but
+    ``n`` steps of `free_step`, which numba inlines here: with nothing but
     scalars in the loop, this is the throughput path of the ensemble driver.
     """
     for _ in range(n):
@@ -186,7 +186,7 @@ def free_step(state, method, h, m, plan):
 
 @jit_internal
 def _sphere_steps(state, n, method, h, m, plan):
-    """Splitting on the sphere |r - pivot| = L; see :func:`step_sphere`."""
+    """Splitting on the sphere |r - pivot| = L; see `step_sphere`."""
     for _ in range(n):
         state = sphere_step(state, method, h, m, plan)
     return state
@@ -268,7 +268,7 @@ def _great_circle(x, y, z, vx, vy, vz, tau, m):
 
 @jit_internal
 def _rk4_steps(state, n, h, m, plan):
-    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see :func:`step_rk4`."""
+    """Classical Runge-Kutta, the rates at t, t + h/2 and t + h from the plan; see `step_rk4`."""
     for _ in range(n):
         state = rk4_step(state, h, m, plan)
     return state
@@ -276,7 +276,7 @@ def _rk4_steps(state, n, h, m, plan):
 
 @_inline
 def rk4_step(state, h, m, plan):
-    """One classical Runge-Kutta step (inlined into its callers); see :func:`step_rk4`."""
+    """One classical Runge-Kutta step (inlined into its callers); see `step_rk4`."""
     x, y, z, vx, vy, vz = state
     hh = 0.5 * h
     h6 = h / 6.0
@@ -336,7 +336,7 @@ def method_steps(method, state, n, h, m, plan, rk4, sphere):
 
 @_inline
 def one_step(method, state, h, m, plan, rk4, sphere):
-    """One step of :func:`method_steps` (inlined into its callers: the event watch's loop)."""
+    """One step of `method_steps` (inlined into its callers: the event watch's loop)."""
     if rk4 is not None:
         if rk4:
             return rk4_step(state, h, m, plan)

@@ -1,16 +1,16 @@
 """Where ensembles run: on how many threads, and on which device.
 
-``threads=None`` means the count in force: the one set by :func:`threads_scope`
+``threads=None`` means the count in force: the one set by [`threads_scope`][rotframe.particles.threads.threads_scope]
 for the duration of a command (the CLI's ``--threads N``, ``rotframe.run(...,
 threads=N)``), else every core (``os.cpu_count()``). The device in force is set
-the same way by :func:`device_scope` (``--device``, ``rotframe.run(...,
+the same way by [`device_scope`][rotframe.particles.threads.device_scope] (``--device``, ``rotframe.run(...,
 device=...)``): ``"cpu"`` unless a command asks for ``"gpu"``. Both are held in
-:class:`contextvars.ContextVar` s, like :mod:`rotframe.limits`, so nothing
+`contextvars.ContextVar` s, like `rotframe.limits`, so nothing
 outlives the command that set them.
 
-:data:`BLOCK` is the fixed cut of a many-particle call into blocks
-(:mod:`rotframe.particles.blocks`): it never depends on the number of threads,
-so the results do not either. :mod:`rotframe.particles.ensemble` re-exports
+`BLOCK` is the fixed cut of a many-particle call into blocks
+(`rotframe.particles.blocks`): it never depends on the number of threads,
+so the results do not either. [`rotframe.particles.ensemble`][rotframe.particles.ensemble] re-exports
 these names.
 """
 
@@ -26,12 +26,12 @@ __all__ = ["BLOCK", "check_threads", "threads_scope", "threads_in_force", "resol
 #: particles per block; fixed, so that the cut never depends on the number of threads
 BLOCK = 4096
 
-#: threads in force (None: every core); set per command by :func:`threads_scope`
+#: threads in force (None: every core); set per command by [`threads_scope`][rotframe.particles.threads.threads_scope]
 _THREADS: contextvars.ContextVar[int | None] = contextvars.ContextVar("rotframe_threads", default=None)
 
-#: where ensembles run: the CPU's cores, or a CUDA GPU (:mod:`rotframe.particles.gpu`)
+#: where ensembles run: the CPU's cores, or a CUDA GPU ([`rotframe.particles.gpu`][rotframe.particles.gpu])
 DEVICES = ("cpu", "gpu")
-#: device in force (None: cpu); set per command by :func:`device_scope`
+#: device in force (None: cpu); set per command by [`device_scope`][rotframe.particles.threads.device_scope]
 _DEVICE: contextvars.ContextVar[str | None] = contextvars.ContextVar("rotframe_device", default=None)
 
 
@@ -50,7 +50,7 @@ def gpu_available() -> bool:
 
 
 def require_gpu(what="device"):
-    """Raise ScenarioError (one line) unless :func:`gpu_available`."""
+    """Raise ScenarioError (one line) unless [`gpu_available`][rotframe.particles.threads.gpu_available]."""
     if not gpu_available():
         from rotframe.errors import ScenarioError
 
@@ -59,7 +59,7 @@ def require_gpu(what="device"):
 
 
 def check_device(device, what="device") -> str | None:
-    """``device`` as one of :data:`DEVICES` (None stays None); ScenarioError in one line otherwise.
+    """``device`` as one of `DEVICES` (None stays None); ScenarioError in one line otherwise.
 
     ``"gpu"`` also needs a CUDA GPU (or numba's simulator): without one, ScenarioError
     saying so (the command line exits 2).
@@ -86,7 +86,7 @@ def device_scope(device):
 
 
 def device_in_force() -> str:
-    """The device set by the innermost :func:`device_scope`: ``"cpu"`` where none was set."""
+    """The device set by the innermost [`device_scope`][rotframe.particles.threads.device_scope]: ``"cpu"`` where none was set."""
     return _DEVICE.get() or "cpu"
 
 
@@ -117,7 +117,7 @@ def threads_scope(threads):
 
 
 def threads_in_force() -> int | None:
-    """The count set by the innermost :func:`threads_scope`; None where none was set (every core)."""
+    """The count set by the innermost [`threads_scope`][rotframe.particles.threads.threads_scope]; None where none was set (every core)."""
     return _THREADS.get()
 
 

@@ -433,76 +433,28 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
 
 
-#: particles per block handed to a thread (fixed: the numbers never depend on it, each particle runs alone)
-BLOCK = 512
-
-
 def run_blocks(advance, N, args):
-    """``advance(lo, hi, *args)`` over fixed blocks of the N particles, on the ensemble's threads.
+    """``advance(lo, hi, *args)`` over the fixed blocks of the N particles, on the ensemble's threads.
 
-    The compiled driver releases the GIL, so blocks run in parallel on
-    ``rotframe.particles.ensemble.resolve_threads`` threads (every core, or ``--threads``).
+    The blocks are the particle core's (`rotframe.particles.blocks.block_bounds`: fixed, the
+    cut depends on N alone) and each particle is integrated alone, so the numbers never depend
+    on the thread count. The compiled driver releases the GIL, so blocks run in parallel on
+    `rotframe.particles.threads.resolve_threads` threads (every core, or ``--threads``).
     """
-    if N <= BLOCK:
-        advance(0, N, *args)
-        return
-    from concurrent.futures import ThreadPoolExecutor
+    from rotframe.particles.blocks import block_bounds
+    from rotframe.particles.threads import resolve_threads
 
-    from rotframe.particles.ensemble import resolve_threads
-
-    blocks = [(lo, min(N, lo + BLOCK)) for lo in range(0, N, BLOCK)]
+    blocks = block_bounds(N)
     threads = max(1, min(int(resolve_threads(None)), len(blocks)))
     if threads == 1:
         for lo, hi in blocks:
             advance(lo, hi, *args)
         return
+    from concurrent.futures import ThreadPoolExecutor
+
     with ThreadPoolExecutor(threads) as pool:
         for future in [pool.submit(advance, lo, hi, *args) for lo, hi in blocks]:
             future.result()
-
-
-#: the per-particle arrays a driver call changes besides the samples and event records (copied before each
-#: call, so that a call in which a user function raised can be replayed one step at a time)
-_REPLAYED = ("TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
-
-
-def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events):
-    """A user function raised inside a compiled call: find the step, name the function, give time and state.
-
-    The call is replayed from the state saved before it, one step per call, particle by particle
-    (the drivers are deterministic), up to the step where the exception comes again; the force that
-    raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
-    ``.partial`` keep the samples up to that step).
-    """
-    y[...] = saved["Y"]
-    for key in _REPLAYED:
-        state[key][...] = saved[key]
-    what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
-    where = ""
-    for i in np.flatnonzero(state["ST"] == 0):
-        for _ in range(int(args["budget"]) + 1):
-            t, yi = float(state["TC"][i]), y[i].copy()
-            try:
-                module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
-            except Exception:  # the user's function raised again: this step
-                dt = hfix if method == "rk4" else float(state["H"][i])
-                blame = _blame(forces, params, t, yi, dt)
-                where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
-                         f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
-                state["TC"][i] = t
-                break
-            if state["ST"][i] != 0:
-                break
-        if where:
-            break
-    if not where:
-        t = float(np.min(state["TC"]))
-        where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
-    good = int(np.min(state["IDX"]))
-    err = uf.UserFunctionError(f"simulate: {where}; samples up to there are kept")
-    err.t_reached = float(times[max(good, 1) - 1])
-    err.partial = _trajectory(times, OUT, state, events, method, good)
-    raise err from None
 
 
 def _compile_failure(exc, roles, params, r, v, frame):

@@ -1,17 +1,17 @@
 """The exact free asymmetric rigid body in one compiled call (the fast path of ``rigid.free_body_exact``).
 
-:func:`rotframe.rigid.free_body.free_body_closed_form` evaluates the closed-form motion (Jacobi
+[`rotframe.rigid.free_body.free_body_closed_form`][rotframe.rigid.free_body.free_body_closed_form] evaluates the closed-form motion (Jacobi
 elliptic functions for the momentum, Carlson's integrals for the angle about
 ``L``; docs/physics.md, rigid bodies) with numpy and scipy on arrays: right for
 many time points, but a few hundred microseconds of setup and small-array calls
-for one. :func:`flow_into` computes the same formulas, setup included, in
+for one. [`flow_into`][rotframe.rigid.exact_flow.flow_into] computes the same formulas, setup included, in
 one numba function: the ordered frame, ``K(m)`` by the arithmetic-geometric
 mean (A&S 17.6), ``R_F``, ``R_J``, ``R_C`` by Carlson's duplication algorithm
 (Carlson 1995, Numer. Algorithms 10, 13) and ``sn, cn, dn`` by descending Landen
 transformations, all from [`rotframe.rigid.elliptic`][rotframe.rigid.elliptic], and the attitude as the product
 ``q = S0 Rz(psi) Ry(-theta) Rz(-phi) P``. Symmetric bodies, the separatrix,
 rotation about the middle axis and ``L = 0`` are left to ``free_body_closed_form``;
-:func:`rotframe.rigid.free_body.free_body_exact` (the public door) tries this
+[`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] (the public door) tries this
 path first and falls back to it.
 """
 
@@ -174,8 +174,8 @@ def flow_ready() -> bool:
 
     Compiling it costs a first run seconds (about 8 s on a 2-core machine, the elliptic
     routines with it), more than the scenes' whole first run; so
-    :func:`rotframe.rigid.free_body.free_body_exact` takes this path only where it is ready
-    (a call of :func:`flow_into` compiles and caches it, as ``rotframe bench`` does).
+    [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] takes this path only where it is ready
+    (a call of [`flow_into`][rotframe.rigid.exact_flow.flow_into] compiles and caches it, as ``rotframe bench`` does).
     """
     if _flow.overloads:
         return True
@@ -193,7 +193,7 @@ _ON_DISK: list = []  # whether numba's disk cache holds the flow, read once
 def flow_into(inertia, L0_body, q0, times):
     """The exact torque-free motion at ``times`` by the compiled closed form, or None where it does not apply.
 
-    The fast path of :func:`rotframe.rigid.free_body.free_body_exact` (which calls it
+    The fast path of [`rotframe.rigid.free_body.free_body_exact`][rotframe.rigid.free_body.free_body_exact] (which calls it
     first): the asymmetric body, valid input, ``times`` 1-D. None for two equal moments,
     the separatrix, rotation about the middle axis, ``L = 0``, a zero moment and invalid
     input, which ``free_body_exact`` evaluates (or refuses) itself.

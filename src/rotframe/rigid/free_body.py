@@ -15,10 +15,10 @@ Conventions (the whole rigid layer uses them)
   body angular velocity is ``omega_body = L_body / I``. Euler's equations read
   ``dL/dt = L x omega + N_body`` and the attitude ``dq/dt = q * (omega, 0) / 2``.
 
-:func:`free_body_exact` keeps ``L`` to about ``1e-14 |L|`` over many flips, also
+[`free_body_exact`][rotframe.rigid.free_body.free_body_exact] keeps ``L`` to about ``1e-14 |L|`` over many flips, also
 beside the separatrix, and the attitude to about ``1e-12`` rad. It runs the
-closed form compiled (:func:`rotframe.rigid.exact_flow.flow_into`, a few
-microseconds a call) where it applies, else :func:`free_body_closed_form`, the
+closed form compiled ([`rotframe.rigid.exact_flow.flow_into`][rotframe.rigid.exact_flow.flow_into], a few
+microseconds a call) where it applies, else [`free_body_closed_form`][rotframe.rigid.free_body.free_body_closed_form], the
 same formulas with numpy and scipy on arrays.
 
 References
@@ -65,11 +65,11 @@ def free_body_exact(
     """Exact motion of the torque-free rigid body (the closed form, compiled where it can be).
 
     The asymmetric body with valid input runs the compiled closed form
-    (:func:`rotframe.rigid.exact_flow.flow_into`: a few microseconds for a few time
-    points) once it is compiled (:func:`rotframe.rigid.exact_flow.flow_ready`: loaded, or
+    ([`rotframe.rigid.exact_flow.flow_into`][rotframe.rigid.exact_flow.flow_into]: a few microseconds for a few time
+    points) once it is compiled ([`rotframe.rigid.exact_flow.flow_ready`][rotframe.rigid.exact_flow.flow_ready]: loaded, or
     in numba's disk cache; a first run does not compile it); every other case (two equal moments, the separatrix, rotation about the
     middle axis, ``L = 0``, a zero moment) and the refusal of invalid input are
-    :func:`free_body_closed_form`'s, whose docstring states the formulas, parameters and
+    [`free_body_closed_form`][rotframe.rigid.free_body.free_body_closed_form]'s, whose docstring states the formulas, parameters and
     results. The two agree to round-off (``tests/test_rigid_exact.py``).
     """
     from rotframe.rigid import exact_flow

@@ -7,7 +7,7 @@ hand: once on one core (``serial``), once with ``prange`` over particles on all
 - the exact-rotation splitting (Strang: half drift, half kick, exact rotation
   of the velocity by ``-2 |w| h`` about ``w``, half kick, half drift);
 - classical RK4 on ``a = g - 2 w x v``;
-- adaptive DOP853 (:func:`dop853_serial`, :func:`dop853_parallel`) with Hairer's
+- adaptive DOP853 (`dop853_serial`, `dop853_parallel`) with Hairer's
   error control and step-size rule as rotframe's (so the same steps), from
   ``t = 0`` to ``T``, the stages in arrays of the particle's own.
 
@@ -248,6 +248,6 @@ def dop853_serial(r, v, g, w, tab, rtol, atol, h0, T, ground, steps):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def dop853_parallel(r, v, g, w, tab, rtol, atol, h0, T, ground, steps):
-    """:func:`dop853_serial` with ``prange`` over particles."""
+    """`dop853_serial` with ``prange`` over particles."""
     for p in prange(r.shape[0]):
         steps[p] = _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground)

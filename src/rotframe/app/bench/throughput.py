@@ -20,12 +20,12 @@ def ensemble_rows(quick):
     """Particle-steps per second of rotframe's many-particle paths beside hand-written ``prange`` loops.
 
     Cases: the exact-rotation splitting, RK4 and DOP853 on gravity + Coriolis, each
-    without an event (:func:`rotframe.particles.integrators.integrate_particles` with
+    without an event ([`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles] with
     (N, 3) states, the public many-particle call) and with the ground event
-    (:func:`rotframe.particles.ensemble.integrate_ensemble`, the scenes' and sweeps'
+    ([`rotframe.particles.ensemble.integrate_ensemble`][rotframe.particles.ensemble.integrate_ensemble], the scenes' and sweeps'
     ensemble path). Each case has four rows: rotframe with ``threads=1`` and with every
     core (or ``--threads N``), the hand-written loop of the same steps
-    (:mod:`rotframe.app.bench.ceiling`) on one core and with ``prange`` on as many
+    (`rotframe.app.bench.ceiling`) on one core and with ``prange`` on as many
     numba threads (the ceiling). ``of_ceiling``: rotframe's rate over the hand-written
     loop's at the same thread count (the goal is 0.7 or more). The all-core row of
     each case also has ``parallel_efficiency`` (N-core rate over ``N x`` one core),
@@ -125,7 +125,7 @@ def call_overhead_rows(repeats=2000):
 
 
 def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, quick, ceiling):
-    """The four rows of one method, with or without the ground event (see :func:`ensemble_rows`)."""
+    """The four rows of one method, with or without the ground event (see `ensemble_rows`)."""
     from rotframe.numerics.dop853 import coefficients
     from rotframe.particles.ensemble import integrate_ensemble
     from rotframe.particles.integrators import Event, integrate_particles
@@ -273,7 +273,7 @@ def same_state(ours, landed, ref, tol=1e-12):
 
 
 def same_work(ours, hand, n, steps, h):
-    """:func:`same_state` of an ensemble run ``ours`` and the hand-written loop's ``(r, v)``: (same, rel, note)."""
+    """`same_state` of an ensemble run ``ours`` and the hand-written loop's ``(r, v)``: (same, rel, note)."""
     r, v = hand
     landed = int(np.sum(np.isfinite(ours.t_event)))
     same, rel, note = same_state(ours.state, landed, np.concatenate([r, v], axis=1))
