@@ -52,7 +52,9 @@ def test_sweep_threads_option_reaches_the_ensemble_and_changes_no_number(tmp_pat
     assert spy and set(spy) == {1}
     spy.clear()
     two = _sweep(tmp_path, capsys, 2)
-    assert spy and set(spy) == {2}
+    # the option reaches the sweep's ensemble work: 2 threads at the batch (its chunks may then run one
+    # thread each, side by side), never more than asked
+    assert spy and max(spy) == 2
     assert ensemble.threads_in_force() is None  # the option did not outlive the command
     for key in ("east_deflection_m", "north_deflection_m", "fall_time_s"):
         a, b = np.array(one[key], dtype=float), np.array(two[key], dtype=float)

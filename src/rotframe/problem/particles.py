@@ -457,6 +457,50 @@ def run_blocks(advance, N, args):
             future.result()
 
 
+#: the per-particle arrays a driver call changes besides the samples and event records (copied before each
+#: call, so that a call in which a user function raised can be replayed one step at a time)
+_REPLAYED = ("TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
+
+
+def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events):
+    """A user function raised inside a compiled call: find the step, name the function, give time and state.
+
+    The call is replayed from the state saved before it, one step per call, particle by particle
+    (the drivers are deterministic), up to the step where the exception comes again; the force that
+    raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
+    ``.partial`` keep the samples up to that step).
+    """
+    y[...] = saved["Y"]
+    for key in _REPLAYED:
+        state[key][...] = saved[key]
+    what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
+    where = ""
+    for i in np.flatnonzero(state["ST"] == 0):
+        for _ in range(int(args["budget"]) + 1):
+            t, yi = float(state["TC"][i]), y[i].copy()
+            try:
+                module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
+            except Exception:  # the user's function raised again: this step
+                dt = hfix if method == "rk4" else float(state["H"][i])
+                blame = _blame(forces, params, t, yi, dt)
+                where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
+                         f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
+                state["TC"][i] = t
+                break
+            if state["ST"][i] != 0:
+                break
+        if where:
+            break
+    if not where:
+        t = float(np.min(state["TC"]))
+        where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
+    good = int(np.min(state["IDX"]))
+    err = uf.UserFunctionError(f"simulate: {where}; samples up to there are kept")
+    err.t_reached = float(times[max(good, 1) - 1])
+    err.partial = _trajectory(times, OUT, state, events, method, good)
+    raise err from None
+
+
 def _compile_failure(exc, roles, params, r, v, frame):
     def sample_args(role):
         if role.startswith("forces") and role.endswith("potential"):

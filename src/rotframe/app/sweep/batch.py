@@ -332,13 +332,24 @@ def _ensemble_batch(task, scn, scene, base):
         return members, out, _paths(scene, scn, task, run_paths, vals, wanted, out), errs
 
     t0 = time.perf_counter()
-    threads = min(resolve_threads(None), len(chunks)) if chunks else 1
+    cores = resolve_threads(None)
+    threads = min(cores, len(chunks)) if chunks else 1
     if threads > 1:
+        import contextvars
         from concurrent.futures import ThreadPoolExecutor
 
+        from rotframe.particles.ensemble import threads_scope
+
+        def in_scope(members):  # the chunks share the cores: each takes its part of them
+            with threads_scope(max(1, cores // threads)):
+                return one(members)
+
         results = [one(chunks[0])]  # compiles (or loads) the kernels once, so that the pool does not wait on them
+        # each chunk runs in a copy of this thread's context: the device and limits in force reach the pool's
+        # threads (a ContextVar is per thread; a new thread would see the defaults: all cores, the CPU)
+        contexts = [contextvars.copy_context() for _ in chunks[1:]]
         with ThreadPoolExecutor(max_workers=threads) as pool:
-            results += list(pool.map(one, chunks[1:]))
+            results += list(pool.map(lambda job: job[0].run(in_scope, job[1]), zip(contexts, chunks[1:])))
     else:
         results = [one(c) for c in chunks]
     theory = getattr(scene, "ensemble_theory", None)  # the theory columns single runs have
