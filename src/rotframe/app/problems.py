@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
 
 __all__ = ["simulate", "simulate_body", "ProblemScenario"]
 
@@ -37,16 +36,6 @@ class ProblemScenario:
     parameters: dict = field(default_factory=dict)
     run: dict = field(default_factory=dict)
     model: list = field(default_factory=list)
-
-
-@dataclass
-class _SceneResult:
-    trajectory: Any
-    terms: list
-    method: str
-    steps: int
-    nfev: int = 0
-    extras: dict = field(default_factory=dict)
 
 
 def _summary(name, params, terms, method, steps, diagnostics, warnings, notes, timing, complete, t_reached):
@@ -98,6 +87,7 @@ def _describe(f):
 
 
 def _result(scn, scene, scene_result, summary):
+    """The same `Result` as `rotframe.run`'s, recording through the problem's own ``scene``."""
     from rotframe.app.api import Result
 
     return Result(scn, {"run": {}}, scene_result, summary, scene=scene)
@@ -207,7 +197,9 @@ def _particle_result(run, forces, origin_acceleration, duration, simulate_s):
     scn = ProblemScenario("simulate", "simulate", "Your own problem (rotframe.simulate)",
                           f"{traj.r.shape[1]} particle(s) in a frame given as {run.frame.kind}; forces: "
                           + (", ".join(terms[:len(forces)]) or "none"))
-    scene_result = _SceneResult(traj, terms, traj.method, traj.steps, traj.nfev,
+    from rotframe.scenes.base import SceneResult
+
+    scene_result = SceneResult(traj, terms, traj.method, traj.steps, traj.nfev,
                                 extras={"diagnostics": run.diagnostics, "frame": run.frame})
     result = _result(scn, ParticleProblemScene(), scene_result, summary)
     result.trajectory.frame = "the frame given by omega (its own axes)"
@@ -261,7 +253,9 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
                        run.diagnostics, run.warnings, run.notes, timing, run.complete, run.t_reached)
     scn = ProblemScenario("simulate_body", "simulate_body", "Your own rigid body (rotframe.simulate_body)",
                           "Euler's equations" + (" with a torque" if torque is not None else ", torque-free"))
-    scene_result = _SceneResult(run, terms, run.method, run.steps, run.nfev,
+    from rotframe.scenes.base import SceneResult
+
+    scene_result = SceneResult(run, terms, run.method, run.steps, run.nfev,
                                 extras={"diagnostics": run.diagnostics, "inertia": np.diag(run.inertia).copy()
                                         if np.all(run.inertia == np.diag(np.diag(run.inertia))) else run.inertia})
     result = _result(scn, BodyProblemScene(), scene_result, summary)

@@ -34,14 +34,7 @@ def rhs(t, y, dy, P, F, G):
     dy[0] = L2 * w3 - L3 * w2 + tx
     dy[1] = L3 * w1 - L1 * w3 + ty
     dy[2] = L1 * w2 - L2 * w1 + tz
-    qx = y[3]
-    qy = y[4]
-    qz = y[5]
-    qw = y[6]
-    dy[3] = 0.5 * (qw * w1 + qy * w3 - qz * w2)
-    dy[4] = 0.5 * (qw * w2 + qz * w1 - qx * w3)
-    dy[5] = 0.5 * (qw * w3 + qx * w2 - qy * w1)
-    dy[6] = -0.5 * (qx * w1 + qy * w2 + qz * w3)
+    attitude_rate(y, dy, 3, w1, w2, w3)
 
 
 @jit

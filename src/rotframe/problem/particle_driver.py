@@ -67,14 +67,7 @@ def rhs(t, y, dy, P, F, G):
     dy[4] = ay - oy
     dy[5] = az - oz
     if D == 10:
-        qx = y[6]
-        qy = y[7]
-        qz = y[8]
-        qw = y[9]
-        dy[6] = 0.5 * (qw * wx + qy * wz - qz * wy)
-        dy[7] = 0.5 * (qw * wy + qz * wx - qx * wz)
-        dy[8] = 0.5 * (qw * wz + qx * wy - qy * wx)
-        dy[9] = -0.5 * (qx * wx + qy * wy + qz * wz)
+        attitude_rate(y, dy, 6, wx, wy, wz)
 
 
 @jit

@@ -31,6 +31,19 @@ SAFE = 0.9
 
 
 @jit
+def attitude_rate(y, dy, k, wx, wy, wz):
+    """q' = q (w, 0) / 2 for the scalar-last quaternion y[k:k + 4] (w in the rotating axes), into dy."""
+    qx = y[k]
+    qy = y[k + 1]
+    qz = y[k + 2]
+    qw = y[k + 3]
+    dy[k] = 0.5 * (qw * wx + qy * wz - qz * wy)
+    dy[k + 1] = 0.5 * (qw * wy + qz * wx - qx * wz)
+    dy[k + 2] = 0.5 * (qw * wz + qx * wy - qy * wx)
+    dy[k + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+
+
+@jit
 def dop853_step(t, y, h, t_end, K, yt, yn, P, F, G):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
     for s in range(1, 12):
