@@ -538,16 +538,9 @@ def _python_scalars(obj):
 
 
 def _progress_callback(progress: ProgressLike):
-    from rotframe.app.progress import auto_bar
+    from rotframe.app.progress import progress_callback
 
-    if progress is True:
-        # asked for: tqdm.auto's bar (a widget in Jupyter) if installed, else a line on any stream
-        return auto_bar("run")
-    if progress is False or progress is None:
-        return None
-    if not callable(progress):
-        raise ScenarioError(f"progress={progress!r}: expected a callable(fraction), True or None")
-    return progress
+    return progress_callback(progress, "run")
 
 
 # ---------------------------------------------------------------------------

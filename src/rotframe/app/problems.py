@@ -65,18 +65,9 @@ def _si(value, unit, key):
 
 
 def _progress(progress, label):
-    """``progress=True``: a bar that suits where it is drawn; a callable passes through; None/False: none."""
-    from rotframe.errors import ScenarioError
+    from rotframe.app.progress import progress_callback
 
-    if progress is True:
-        from rotframe.app.progress import auto_bar
-
-        return auto_bar(label)
-    if progress is None or progress is False:
-        return None
-    if not callable(progress):
-        raise ScenarioError(f"progress={progress!r}: expected a callable(fraction), True or None")
-    return progress
+    return progress_callback(progress, label)
 
 
 def _describe(f):

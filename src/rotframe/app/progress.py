@@ -17,7 +17,7 @@ from __future__ import annotations
 import sys
 import time
 
-__all__ = ["Progress", "auto_bar"]
+__all__ = ["Progress", "auto_bar", "progress_callback"]
 
 
 class Progress:
@@ -144,3 +144,17 @@ def _duration(seconds: float) -> str:
     if seconds < 5400:
         return f"{seconds / 60:.1f} min"
     return f"{seconds / 3600:.1f} h"
+
+
+def progress_callback(progress, label: str = "run"):
+    """What ``progress=`` means in the Python API: True, a bar that suits where it is drawn (`auto_bar`);
+    a callable, itself (fed the fraction done); None or False, none. Anything else: ScenarioError."""
+    from rotframe.errors import ScenarioError
+
+    if progress is True:
+        return auto_bar(label)
+    if progress is False or progress is None:
+        return None
+    if not callable(progress):
+        raise ScenarioError(f"progress={progress!r}: expected a callable(fraction), True or None")
+    return progress
