@@ -318,3 +318,23 @@ def test_the_scheduler_killed_mid_sweep_ends_with_the_hint_and_resume_finishes(t
                           capture_output=True, text=True, timeout=240)
     assert full.returncode == 0, full.stderr
     assert same(pq.read_table(tmp_path / "s.parquet"), pq.read_table(tmp_path / "full.parquet"))
+
+
+def test_dask_s_late_cancel_callback_prints_nothing_after_an_interrupt(caplog):
+    """A signal inside ``client.sync`` makes distributed schedule a ``cancel`` callback that
+    can fail (a NameError in distributed 2026.8) after the sweep has reported; tornado logs
+    it on ``tornado.application``, whose level distributed's config sets to ERROR itself."""
+    import logging
+
+    from rotframe.app.sweep import cluster as dask_path
+
+    late = logging.getLogger("tornado.application")
+    before = late.level
+    try:
+        with dask_path.quiet_dask_logs():
+            late.error("Exception in callback (inside the sweep)")
+        dask_path.silence_late_callbacks()
+        late.error("Exception in callback (after the report)")
+    finally:
+        late.setLevel(before)
+    assert not [r for r in caplog.records if r.name == "tornado.application"]

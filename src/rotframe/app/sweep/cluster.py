@@ -30,7 +30,7 @@ from collections import deque
 
 from rotframe.errors import RotframeError
 
-__all__ = ["SweepLost", "run_on_dask", "close_bounded", "quiet_dask_logs", "POLL_S", "LOST_S", "STALL_S"]
+__all__ = ["SweepLost", "run_on_dask", "close_bounded", "quiet_dask_logs", "silence_late_callbacks", "POLL_S", "LOST_S", "STALL_S"]
 
 #: seconds between looks at the futures
 POLL_S = 0.02
@@ -124,6 +124,19 @@ def run_on_dask(client, tasks, finished, *, split=False, task_timeout=None):
     finally:
         if inflight:
             _bounded(lambda: client.cancel(list(inflight), force=True), 5.0)
+
+
+def silence_late_callbacks():
+    """Keep tornado's callback log quiet for good after an interrupt.
+
+    A Ctrl-C or SIGTERM that lands inside a Dask call (``client.sync``) makes distributed
+    schedule a ``cancel`` callback on its event loop; that callback can run after this
+    sweep has reported the interrupt, and distributed 2026.8 logs it as a ``NameError``
+    traceback on ``tornado.application``. The sweep has said what happened and how to resume.
+    """
+    import logging
+
+    logging.getLogger("tornado.application").setLevel(logging.CRITICAL)
 
 
 def _threads(client):
@@ -288,7 +301,8 @@ def quiet_dask_logs():
     @contextlib.contextmanager
     def quiet():
         loggers = [logging.getLogger(n) for n in ("distributed", "distributed.comm", "distributed.core",
-                                                  "distributed.client", "distributed.node", "tornado")]
+                                                  "distributed.client", "distributed.node", "tornado",
+                                                  "tornado.application")]
         levels = [lg.level for lg in loggers]
         for lg in loggers:
             lg.setLevel(logging.CRITICAL)

@@ -285,6 +285,10 @@ def _execute(ctx, pending, where, batch_rows, finished):
                 pending, batch_rows = _probe(ctx, pending, n_workers, run)
             batches = (pending[s:s + batch_rows] for s in range(0, len(pending), batch_rows))
         run(ctx.task(i, rows) for i, rows in enumerate(batches, start=1))
+    except KeyboardInterrupt:
+        if client is not None:
+            cluster.silence_late_callbacks()
+        raise
     finally:
         if own is not None:
             cluster.close_bounded(own)
