@@ -174,3 +174,31 @@ def test_a_run_s_imports_are_read_from_its_own_importtime_report():
     seconds = import_seconds(res.stderr)
     top = [ln for ln in res.stderr.splitlines() if ln.endswith("| json") or ln.endswith("| fractions")]
     assert len(top) == 2 and seconds >= sum(int(ln.split("|")[1]) for ln in top) / 1e6 > 0
+
+
+def test_the_work_bound_is_the_fewest_evaluations_at_the_level_times_our_cost():
+    """Power-law ladders, where interpolating log work in log error is exact: an 8th-order method
+    (error c n^-8, ours, 50 ns an evaluation) and a 4th-order peer (error d n^-4, 2 ns: cheap enough to be under the goal), whose
+    constants put the level 1e-3 at n = 63,000 and 1,300,000 evaluations, between their rungs."""
+    from rotframe.app.bench.summary import GOAL, at_level, work_bound
+
+    def ladder(method, family, c, p, cost, ns):
+        return [dict(_row(method, cost * n, c * n ** -p, family), nfev=n) for n in ns]
+
+    level, n_ours, n_peer = 1e-3, 63_000.0, 1_300_000.0
+    ours = ladder("dop853", "rotframe", level * n_ours ** 8, 8, 50e-9, [50_000, 70_000, 100_000])
+    peer = ladder("diffrax-Tsit5", "peer", level * n_peer ** 4, 4, 2e-9, [500_000, 1_000_000, 2_000_000])
+    got = at_level(ours, level)
+    assert got[0] == pytest.approx(n_ours, rel=1e-12) and got[1] == pytest.approx(50e-9 * n_ours, rel=1e-12)
+    assert at_level(peer, level)[0] == pytest.approx(n_peer, rel=1e-12)
+    assert at_level(ours, 1e-12) is None  # no row reaches it
+    best = min((r for r in ours if r["error"] <= level), key=lambda r: r["wall_s"])
+    b = work_bound(ours + peer, level, best)
+    assert b["fewest_nfev"] == pytest.approx(n_ours, rel=1e-12) and b["fewest_nfev_method"] == "dop853"
+    assert b["peer_wall_at_level"] == pytest.approx(2e-9 * n_peer, rel=1e-12)
+    assert b["bound_ratio"] == pytest.approx(2e-9 * n_peer / (n_ours * 50e-9), rel=1e-12)
+    assert b["needed_s_per_eval"] == pytest.approx(2e-9 * n_peer / (GOAL * n_ours), rel=1e-12)
+    # in the summary, a level under the goal carries the bound and says it
+    summ = {r["level"]: r for r in level_summary(ours + peer)}
+    row = summ[level]
+    assert row["bound_ratio"] == pytest.approx(b["bound_ratio"]) and "the bound is x" in row["note"]

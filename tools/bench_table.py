@@ -31,6 +31,9 @@ def table(rows) -> str:
         note = r.get("note") or ""
         if r.get("shortfall"):
             note = f"short of x10 by {r['shortfall']:.2g}x: {r.get('reason', '')}".strip()
+            if r.get("bound_ratio"):
+                note += (f"; at most x{r['bound_ratio']:.2g} at our {r['s_per_eval'] * 1e9:.2g} ns an evaluation "
+                         f"with the fewest any method needs ({r['fewest_nfev']:.3g}, {r['fewest_nfev_method']})")
         lines.append(f"| {r['scenario']} ({r.get('horizon', '')}) | {r['level']:.0e} | {ours} | {peer} | {ratio} | {note} |")
     startup = [r for r in rows if r.get("scenario") == "startup" and "beyond_imports_s" in r]
     if startup:

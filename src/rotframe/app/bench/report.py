@@ -34,7 +34,8 @@ def environment():
 
 
 def plot(rows, folder):
-    """One work-precision diagram (log error against log wall time) per problem; returns the paths."""
+    """One work-precision diagram per problem: log error against log wall time, and against log
+    evaluations (the work a method needs, whatever one costs); returns the paths."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -42,22 +43,26 @@ def plot(rows, folder):
     paths = []
     keys = problem_keys(rows)
     for scenario, horizon in keys:
-        fig = Figure(figsize=(7, 5))
+        fig = Figure(figsize=(12, 5))
         FigureCanvasAgg(fig)
-        ax = fig.add_subplot()
+        by_time, by_work = fig.subplots(1, 2, sharey=True)
         sel = [r for r in rows if r["scenario"] == scenario and r.get("horizon") == horizon and r.get("kind") != "summary"]
         for method in dict.fromkeys(r["method"] for r in sel):
-            pts = sorted((r["wall_s"], r["error"]) for r in sel if r["method"] == method
-                         and r["error"] is not None and np.isfinite(r["error"]) and r["error"] > 0)
-            if pts:
-                x, y = zip(*pts)
-                style = "--" if is_peer(sel[[r["method"] for r in sel].index(method)]) else "-"
-                ax.loglog(x, y, style, marker="o", ms=3, label=method)
-        ax.set_xlabel("wall time per run (s)")
-        ax.set_ylabel("final error")
-        ax.set_title(f"{scenario}: {horizon}\n{sel[0]['error_kind']}", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+            mine = [r for r in sel if r["method"] == method and r["error"] is not None and np.isfinite(r["error"])
+                    and r["error"] > 0]
+            style = "--" if mine and is_peer(mine[0]) else "-"
+            for ax, x_of in ((by_time, lambda r: r["wall_s"]), (by_work, lambda r: r.get("nfev") or 0)):
+                pts = sorted((x_of(r), r["error"]) for r in mine if x_of(r) > 0)
+                if pts:
+                    x, y = zip(*pts)
+                    ax.loglog(x, y, style, marker="o", ms=3, label=method)
+        by_time.set_xlabel("wall time per run (s)")
+        by_work.set_xlabel("force evaluations per run (nfev)")
+        by_time.set_ylabel("final error")
+        fig.suptitle(f"{scenario}: {horizon}\n{sel[0]['error_kind']}", fontsize=9)
+        for ax in (by_time, by_work):
+            ax.grid(True, which="both", alpha=0.3)
+        by_time.legend(fontsize=7)
         path = os.path.join(folder, f"bench-{scenario}-{len(paths)}.png")
         outputs.write_atomic(path, lambda f, fig=fig: fig.savefig(f, dpi=110, bbox_inches="tight", format="png"),
                      what="bench plot")

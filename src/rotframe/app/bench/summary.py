@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LEVELS", "GOAL", "is_peer", "problem_keys", "level_summary", "shortfall_reason", "speedups"]
+__all__ = ["LEVELS", "GOAL", "is_peer", "problem_keys", "level_summary", "shortfall_reason", "at_level",
+           "work_bound", "speedups"]
 
 
 #: error levels of the summary
@@ -79,6 +80,10 @@ def level_summary(rows, levels=LEVELS):
                 row["shortfall"] = GOAL / row["ratio"]
                 row["reason"] = shortfall_reason(best_m, best_t)
                 notes.append(f"below the {GOAL:g}x goal by a factor {row['shortfall']:.1f}: {row['reason']}")
+                bound = work_bound(sel, level, best_m)
+                if bound is not None:
+                    row.update(bound)
+                    notes.append(_bound_note(bound))
             if notes:
                 row["note"] = "; ".join(notes)
             out.append(row)
@@ -103,6 +108,77 @@ def shortfall_reason(mine, peer):
     compiled = " (also compiled: the whole solve is one jax.jit call)" if peer["method"].startswith("diffrax") else ""
     return (f"the peer's evaluation costs only {unit:.2g}x ours{compiled} and it does {work:.2g}x our work "
             f"({n_p} vs {n_m} nfev)")
+
+
+def at_level(ladder, level):
+    """The work and time one method needs for a final error of exactly ``level``, from its ladder.
+
+    ``ladder``: the rows of one method (``nfev`` > 0, finite positive errors). Between the
+    two neighbouring rows whose errors bracket ``level``, log ``nfev`` and log ``wall_s``
+    are interpolated linearly in log error (a power law, as the error of a method of
+    fixed order is on the work). Where even the cheapest row is below ``level``, that row
+    is returned (an upper bound). Returns ``(nfev, wall_s)``, or None where no row
+    reaches ``level``.
+    """
+    pts = sorted((r["nfev"], r["wall_s"], r["error"]) for r in ladder
+                 if (r.get("nfev") or 0) > 0 and r["wall_s"] and r["error"] is not None and r["error"] > 0)
+    best = None
+    for k, (n, w, e) in enumerate(pts):
+        if e > level:
+            continue
+        cand = (float(n), float(w))
+        for n0, w0, e0 in pts[:k][::-1]:  # the nearest cheaper row above the level
+            if e0 > level:
+                f = np.log(e0 / level) / np.log(e0 / e)
+                cand = (float(np.exp(np.log(n0) + f * np.log(n / n0))), float(np.exp(np.log(w0) + f * np.log(w / w0))))
+                break
+        if best is None or cand[0] < best[0]:
+            best = cand
+    return best
+
+
+def work_bound(sel, level, mine):
+    """How fast rotframe could be at ``level`` at all, at its own cost of one evaluation.
+
+    A work-precision argument: the fewest evaluations that any method of the bench
+    (rotframe's or a peer's) needs for an error of ``level`` (`at_level`, along each
+    method's ladder), times the cost of one of rotframe's evaluations (``mine``: its
+    fastest run at this level), against the fastest peer's time at that error. If even
+    that bound is under `GOAL`, no method in the bench reaches the goal without a
+    cheaper evaluation; ``needed_s_per_eval`` says how cheap one would have to be.
+    Returns None where ``mine`` has no work count (a closed form).
+    """
+    if not (mine.get("nfev") or 0) > 0 or not mine["wall_s"]:
+        return None
+    by_method = {}
+    for r in sel:
+        by_method.setdefault(r["method"], []).append(r)
+    fewest, peer_time = None, None
+    for method, ladder in by_method.items():
+        got = at_level(ladder, level)
+        if got is None:
+            continue
+        if fewest is None or got[0] < fewest[0]:
+            fewest = (got[0], method)
+        if is_peer(ladder[0]) and (peer_time is None or got[1] < peer_time[0]):
+            peer_time = (got[1], method)
+    if fewest is None or peer_time is None:
+        return None
+    per_eval = mine["wall_s"] / mine["nfev"]
+    return {"fewest_nfev": fewest[0], "fewest_nfev_method": fewest[1], "s_per_eval": per_eval,
+            "peer_wall_at_level": peer_time[0], "peer_at_level": peer_time[1],
+            "bound_ratio": peer_time[0] / (fewest[0] * per_eval),
+            "needed_s_per_eval": peer_time[0] / (GOAL * fewest[0])}
+
+
+def _bound_note(b):
+    verdict = ("so no method of the bench reaches the goal at our cost of an evaluation"
+               if b["bound_ratio"] < GOAL else "so a method with fewer evaluations could reach it")
+    return (f"at this error the fewest evaluations of any method are about {b['fewest_nfev']:.3g} "
+            f"({b['fewest_nfev_method']}) and the fastest peer takes about {b['peer_wall_at_level'] * 1e3:.3g} ms "
+            f"({b['peer_at_level']}; both along the ladders, at the level); at {b['s_per_eval'] * 1e9:.3g} ns "
+            f"an evaluation the bound is x{b['bound_ratio']:.2g}, {verdict} "
+            f"(x{GOAL:g} needs {b['needed_s_per_eval'] * 1e9:.3g} ns)")
 
 
 def _compile_of(rows, r):
