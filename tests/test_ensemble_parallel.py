@@ -135,3 +135,20 @@ def test_large_steady_dop853_run_takes_the_general_driver_bitwise(monkeypatch):
     many = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
     assert calls  # the general driver ran
     assert np.array_equal(one.r, many.r) and np.array_equal(one.v, many.v)
+
+
+@pytest.mark.parametrize("n", [1, 4095, 4096, 4097, 10_000, 100_000, 123_457])
+@pytest.mark.parametrize("workers", [1, 2, 3, 16])
+def test_the_blocks_cover_every_particle_once_and_share_the_work_evenly(n, workers):
+    from rotframe.particles.blocks import block_bounds
+
+    bounds = block_bounds(n, workers)
+    assert bounds[0][0] == 0 and bounds[-1][1] == n
+    assert all(hi == lo2 for (_, hi), (lo2, _) in zip(bounds, bounds[1:]))  # contiguous, in order
+    sizes = [hi - lo for lo, hi in bounds]
+    assert max(sizes) <= threads.BLOCK
+    if workers > 1 and n > threads.BLOCK:
+        assert len(bounds) % workers == 0 and max(sizes) - min(sizes) <= 1
+        # each thread's share (blocks dealt in turn) is within one block of the even share
+        shares = [sum(sizes[k::workers]) for k in range(workers)]
+        assert max(shares) - min(shares) <= len(bounds) // workers

@@ -173,7 +173,7 @@ class KernelSetup:
         of it (`one_sample_in_pieces`).
 
         More particles than one block (`rotframe.particles.threads.BLOCK`) run in
-        fixed blocks on every core (`rotframe.particles.blocks.run_blocks`),
+        blocks on every core (`rotframe.particles.blocks.run_blocks`),
         bitwise as one call.
         """
         start = float(self.times[first]) if t0 is None else t0

@@ -3,11 +3,10 @@
 A scene's ``simulate_ensemble`` integrates many particles that share one model
 (for example drops from different heights) in one call of the compiled core
 ([`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles]), which cuts them
-into fixed blocks of `BLOCK` particles and runs the blocks on a pool of
-threads (`rotframe.particles.blocks`; the compiled kernels release the GIL).
-The cut does not depend on the number of threads, and every particle is
-integrated on its own inside a block, so the results are bitwise identical
-for any ``threads`` (tested in ``tests/test_ensemble_parallel.py``). The first
+into blocks of at most `BLOCK` particles, the same share for each thread, and
+runs the blocks on a pool of threads (`rotframe.particles.blocks`; the compiled
+kernels release the GIL). Every particle is integrated on its own inside a
+block, so the results are bitwise identical for any ``threads`` and any cut (tested in ``tests/test_ensemble_parallel.py``). The first
 events are read from the kernels' record arrays, not from per-particle lists.
 
 ``threads=None`` means the count in force, ``device=None`` the device in force
@@ -149,7 +148,7 @@ def group_points(values_list, varying) -> list:
 
 
 def _integrate_blocks(model, r0, v0, duration, event, method, run, samples, threads):
-    """(t_event, state, trajectory) of the whole ensemble: one call, in fixed blocks on the thread pool.
+    """(t_event, state, trajectory) of the whole ensemble: one call, in blocks on the thread pool.
 
     [`rotframe.particles.integrators.integrate_particles`][rotframe.particles.integrators.integrate_particles] cuts the particles into
     blocks of `BLOCK` on the threads in force (`rotframe.particles.blocks`).

@@ -123,7 +123,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
                         records: bool = False) -> Trajectory:
     """Integrate an ensemble of particles in a rotating frame, on every core.
 
-    More than `rotframe.particles.threads.BLOCK` particles run in fixed blocks on
+    More than `rotframe.particles.threads.BLOCK` particles run in blocks on
     the threads in force (``--threads``, ``rotframe.run(..., threads=N)``, else every
     core); the result is bitwise the same for any number of threads. For many calls of
     one set-up, [`rotframe.particles.prepared.PreparedRun`][rotframe.particles.prepared.PreparedRun] makes it once.

@@ -8,9 +8,10 @@ device=...)``): ``"cpu"`` unless a command asks for ``"gpu"``. Both are held in
 `contextvars.ContextVar` s, like `rotframe.limits`, so nothing
 outlives the command that set them.
 
-`BLOCK` is the fixed cut of a many-particle call into blocks
-(`rotframe.particles.blocks`): it never depends on the number of threads,
-so the results do not either. [`rotframe.particles.ensemble`][rotframe.particles.ensemble] re-exports
+`BLOCK` is the size of the blocks a many-particle call is cut into
+(`rotframe.particles.blocks`; on several threads, the blocks are evened out so
+that each thread gets the same share). Each particle is integrated alone, so the
+results depend neither on the number of threads nor on the cut. [`rotframe.particles.ensemble`][rotframe.particles.ensemble] re-exports
 these names.
 """
 
@@ -23,7 +24,7 @@ import os
 __all__ = ["BLOCK", "check_threads", "threads_scope", "threads_in_force", "resolve_threads", "DEVICES",
            "gpu_available", "require_gpu", "check_device", "device_scope", "device_in_force"]
 
-#: particles per block; fixed, so that the cut never depends on the number of threads
+#: particles per block (at most; on several threads the blocks are evened out, `rotframe.particles.blocks.block_bounds`)
 BLOCK = 4096
 
 #: threads in force (None: every core); set per command by [`threads_scope`][rotframe.particles.threads.threads_scope]

@@ -434,18 +434,19 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
 
 
 def run_blocks(advance, N, args):
-    """``advance(lo, hi, *args)`` over the fixed blocks of the N particles, on the ensemble's threads.
+    """``advance(lo, hi, *args)`` over the blocks of the N particles, on the ensemble's threads.
 
-    The blocks are the particle core's (`rotframe.particles.blocks.block_bounds`: fixed, the
-    cut depends on N alone) and each particle is integrated alone, so the numbers never depend
-    on the thread count. The compiled driver releases the GIL, so blocks run in parallel on
+    The blocks are the particle core's (`rotframe.particles.blocks.block_bounds`: the same
+    share for every thread) and each particle is integrated alone, so the numbers never depend
+    on the thread count or the cut. The compiled driver releases the GIL, so blocks run in parallel on
     `rotframe.particles.threads.resolve_threads` threads (every core, or ``--threads``).
     """
     from rotframe.particles.blocks import block_bounds
     from rotframe.particles.threads import resolve_threads
 
-    blocks = block_bounds(N)
-    threads = max(1, min(int(resolve_threads(None)), len(blocks)))
+    workers = int(resolve_threads(None))
+    blocks = block_bounds(N, workers)
+    threads = max(1, min(workers, len(blocks)))
     if threads == 1:
         for lo, hi in blocks:
             advance(lo, hi, *args)
