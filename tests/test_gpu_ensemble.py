@@ -16,6 +16,7 @@ import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 
 from rotframe.app import cli
@@ -125,3 +126,27 @@ def test_gpu_physics_is_the_cpu_source():
     # the calls inside are rebound to the GPU versions of the same functions
     assert gpu.device_function(kernels.one_step).py_func.__globals__["free_step"] is gpu.device_function(
         kernels.free_step)
+
+
+def test_a_sweep_batch_carries_the_device_to_a_dask_worker(monkeypatch):
+    """A Dask worker runs the batch in its own context, where no ``--device`` was set: the batch
+    task carries the command's device, and `run_batch` applies it there (a thread with a fresh
+    context stands for the worker)."""
+    import contextvars
+    import threading
+
+    from rotframe.app.sweep import batch, execute
+    from rotframe.particles import threads
+
+    monkeypatch.setattr(threads, "gpu_available", lambda: True)  # the check on the worker passes
+    monkeypatch.setattr(batch, "_run_batch", lambda task: threads.device_in_force())
+    with threads.device_scope("gpu"):
+        device = execute._device_now()
+    assert device == "gpu" and execute._device_now() is None  # the CPU is None (the default)
+    task = batch.BatchTask(index=1, scenario=None, sets={}, keys=[], rows=np.arange(1), values=np.zeros((1, 0)),
+                           method=None, path="ensemble", track_rows=frozenset(), device=device)
+    seen = []
+    worker = threading.Thread(target=lambda: seen.append(contextvars.Context().run(batch.run_batch, task)))
+    worker.start()
+    worker.join(30)
+    assert seen == ["gpu"]

@@ -14,7 +14,7 @@ __all__ = ["sweep"]
 
 
 def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed=None, client=None, out=None,
-          **fixed):
+          threads=None, device=None, **fixed):
     """Run a scenario once per point and return one row per run.
 
     Parameters
@@ -39,6 +39,12 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     out : path-like, optional
         Also write the table to this ``.parquet`` file (its finished batches go to
         ``<out>.parts/`` as they finish). Default: nothing is written.
+    threads : int, optional
+        Threads of each vectorised ensemble batch (as ``--threads``; default every core,
+        shared out over a local cluster's workers). The table does not depend on it.
+    device : {"cpu", "gpu"}, optional
+        Where the ensemble batches run (as ``--device``; carried to Dask workers too).
+        ``"gpu"`` without a CUDA GPU raises ScenarioError.
     **fixed
         Parameter values fixed for every row (numbers in the documented unit, strings
         such as ``"520 ft"`` or astropy quantities), the run settings ``step``,
@@ -66,11 +72,18 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     >>> list(df["height"])
     [50.0, 100.0, 150.0]
     """
-    from rotframe.app.sweep.execute import run_sweep
-    from rotframe.app.sweep.spec import python_spec
     from rotframe.app.sweep.store import require
+    from rotframe.particles.ensemble import device_scope, threads_scope
 
     require("pandas", "rotframe.sweep")
+    with threads_scope(threads), device_scope(device):
+        return _sweep(name_or_path, grid, vary, points, samples, seed, client, out, fixed)
+
+
+def _sweep(name_or_path, grid, vary, points, samples, seed, client, out, fixed):
+    from rotframe.app.sweep.execute import run_sweep
+    from rotframe.app.sweep.spec import python_spec
+
     method = fixed.pop("method", None)
     sets = {k: _plain(v) for k, v in fixed.items()}
     spec = python_spec(str(name_or_path), sets=sets, grid=grid, vary=vary, points=points, samples=samples, seed=seed,

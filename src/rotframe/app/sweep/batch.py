@@ -185,6 +185,7 @@ class BatchTask:
     track_rows: frozenset
     limits: object = None  # the command's rotframe.limits.Limits, applied on the worker too
     threads: int | None = None  # threads of the batch (None: every core here, or the Dask worker's own)
+    device: str | None = None  # the command's --device ("gpu" checked on the worker too; None: the CPU)
 
 
 @dataclass
@@ -219,10 +220,12 @@ def failed_output(task: BatchTask, message: str) -> BatchOutput:
 def run_batch(task: BatchTask) -> BatchOutput:
     """Compute the rows of one batch (in this process or on a Dask worker)."""
     from rotframe import limits
-    from rotframe.particles.ensemble import threads_scope
+    from rotframe.particles.ensemble import device_scope, threads_scope
 
     threads = task.threads if task.threads is not None else _worker_threads()
-    with limits.applied(task.limits or limits.current()), threads_scope(threads), blas_single_thread():
+    # a Dask worker's context has no --device of the command's: the task carries it ("gpu" is checked there)
+    with limits.applied(task.limits or limits.current()), threads_scope(threads), device_scope(task.device), \
+            blas_single_thread():
         return _run_batch(task)
 
 

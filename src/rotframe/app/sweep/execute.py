@@ -201,7 +201,16 @@ class _Context:
         values = points_of(self.spec, rows) if self.points is None else self.points[rows]
         return BatchTask(index=index, scenario=self.source, sets=dict(self.spec.sets), keys=self.spec.keys,
                          rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
-                         track_rows=self.track_rows.intersection(rows.tolist()), threads=self.threads)
+                         track_rows=self.track_rows.intersection(rows.tolist()), threads=self.threads,
+                         device=_device_now())
+
+
+def _device_now():
+    """The device in force (``--device``, ``device=``) for a batch task: None for the CPU."""
+    from rotframe.particles.ensemble import device_in_force
+
+    device = device_in_force()
+    return None if device == "cpu" else device
 
 
 def batch_threads(local_workers=None, here=False):
