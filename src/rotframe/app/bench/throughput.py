@@ -51,7 +51,7 @@ def ensemble_rows(quick):
     cores = resolve_threads(None)  # --threads N, else every core
     prange_threads = min(cores, numba.config.NUMBA_NUM_THREADS)
     rows = []
-    budget = 1.0 if quick else 3.0
+    budget = 1.0 if quick else 5.0  # seconds a row, at most: 15 rounds keep the best stable on a shared machine
     saved = numba.get_num_threads()
     try:
         numba.set_num_threads(prange_threads)
@@ -220,7 +220,7 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
              (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
              (f"hand-written {label}, 1 core", 1, serial),
              (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads, parallel)]
-    walls = _best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 7)
+    walls = _best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 15)
     for (name, threads, fn), wall in zip(cases, walls):
         total = n * per_particle
         rows.append({"scenario": "ensemble", "method": name, "setting": what, "wall_s": wall, "error": math.nan,
