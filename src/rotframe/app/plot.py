@@ -129,7 +129,8 @@ def _generic(result, ax1, ax2) -> None:
         t_scale, t_unit = _time_unit(times)
         for k, axis in enumerate("xyz"):
             ax2.plot(times / t_scale, r[:, 0, k] / scale, label=axis)
-        ax2.set_xlim(0.0, float(times[-1]) / t_scale)
+        if times[-1] > 0:  # a run interrupted before its first step has one sample at t = 0
+            ax2.set_xlim(0.0, float(times[-1]) / t_scale)
         ax2.set_xlabel(f"t [{t_unit}]" + (" (to the landing)" if landed else ""))
         ax2.set_ylabel(f"position [{unit}]")
         ax2.legend()

@@ -36,6 +36,7 @@ def environment():
 def plot(rows, folder):
     """One work-precision diagram per problem: log error against log wall time, and against log
     evaluations (the work a method needs, whatever one costs); returns the paths."""
+    import matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -47,15 +48,17 @@ def plot(rows, folder):
         FigureCanvasAgg(fig)
         by_time, by_work = fig.subplots(1, 2, sharey=True)
         sel = [r for r in rows if r["scenario"] == scenario and r.get("horizon") == horizon and r.get("kind") != "summary"]
-        for method in dict.fromkeys(r["method"] for r in sel):
+        colours = matplotlib.colormaps["tab20"].colors  # one colour a method (the default cycle has ten)
+        for k, method in enumerate(dict.fromkeys(r["method"] for r in sel)):
             mine = [r for r in sel if r["method"] == method and r["error"] is not None and np.isfinite(r["error"])
                     and r["error"] > 0]
-            style = "--" if mine and is_peer(mine[0]) else "-"
+            peer = bool(mine) and is_peer(mine[0])
             for ax, x_of in ((by_time, lambda r: r["wall_s"]), (by_work, lambda r: r.get("nfev") or 0)):
                 pts = sorted((x_of(r), r["error"]) for r in mine if x_of(r) > 0)
                 if pts:
                     x, y = zip(*pts)
-                    ax.loglog(x, y, style, marker="o", ms=3, label=method)
+                    ax.loglog(x, y, "--" if peer else "-", marker="s" if peer else "o", ms=3, label=method,
+                              color=colours[(2 * k) % 20 + (k // 10) % 2])
         by_time.set_xlabel("wall time per run (s)")
         by_work.set_xlabel("force evaluations per run (nfev)")
         by_time.set_ylabel("final error")
