@@ -261,15 +261,15 @@ class KernelSetup:
         most = max(1, int(4e6 // (n * self.evals_per_step)))
         sps = self.sps
         pieces = -(-sps // most)
-        scratch_r, scratch_v = np.empty((1, n, 3)), np.empty((1, n, 3))
         t0 = self.times[first]
         j = 0
         nfev = 0
         for p in range(pieces):
             k = (p + 1) * sps // pieces - j
-            last = j + k == sps
-            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1] if last else scratch_r,
-                                           out_v[:1] if last else scratch_v, evb, t0=t0 + j * self.h, sps=k)
+            # each piece writes its end state into the sample's slot; the last piece's is the sample
+            # (a slot of megabytes allocated for each piece cost page faults on every thread)
+            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1], out_v[:1], evb, t0=t0 + j * self.h,
+                                           sps=k)
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0
