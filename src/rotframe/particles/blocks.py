@@ -7,8 +7,9 @@ call over N particles can be cut into blocks of at most
 `rotframe.particles.threads.BLOCK` particles, each block run by the same
 driver on a thread of a pool (the drivers release the GIL), and the result is
 bitwise that of one call, for any number of threads and any cut. The cut
-(`block_bounds`) gives each thread the same number of particles. Each block has contiguous arrays of its own (copies in and out), so the
-driver sees the array types of a single call and compiles nothing more.
+(`block_bounds`) gives each thread the same number of particles. Each block
+has contiguous arrays of its own (copies in and out), so the driver sees the
+array types of a single call and compiles nothing more.
 
 The count of threads is [`rotframe.particles.threads.resolve_threads`][rotframe.particles.threads.resolve_threads]
 (the ``--threads`` option, ``rotframe.run(..., threads=N)``, else every core).

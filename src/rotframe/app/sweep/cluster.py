@@ -30,7 +30,8 @@ from collections import deque
 
 from rotframe.errors import RotframeError
 
-__all__ = ["SweepLost", "run_on_dask", "close_bounded", "quiet_dask_logs", "silence_late_callbacks", "POLL_S", "LOST_S", "STALL_S"]
+__all__ = ["SweepLost", "run_on_dask", "close_bounded", "quiet_dask_logs", "silence_late_callbacks", "POLL_S",
+           "LOST_S", "STALL_S"]
 
 #: seconds between looks at the futures
 POLL_S = 0.02
