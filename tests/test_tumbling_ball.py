@@ -42,7 +42,7 @@ def test_ball_follows_the_inertial_line_in_body_axes():
     line = r0 + t[:, None] * (v0 + np.cross(w0, r0))  # space axes = body axes at t = 0
     exact = rot.inv().apply(line)
     err = np.max(np.linalg.norm(res.trajectory.r[:, 0] - exact, axis=1))
-    assert err < 1e-7 * np.max(np.linalg.norm(line, axis=1))
+    assert err < 1e-9 * np.max(np.linalg.norm(line, axis=1))  # measured 3e-12 of the scale
     assert res.metrics["position_error_m"] < 1e-9
     assert res.metrics["flips"] >= 2
     assert not res.warnings

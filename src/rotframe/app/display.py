@@ -32,20 +32,9 @@ def scenario_repr(scn) -> str:
             f"{'method ' + method if method else 'the scene' + chr(39) + 's default method'}>")
 
 
-def _bounds(p) -> str:
-    parts = []
-    if p.min is not None:
-        parts.append((">" if p.exclusive_min else ">=") + f" {p.min:g}")
-    if p.max is not None:
-        parts.append(("<" if p.exclusive_max else "<=") + f" {p.max:g}")
-    if p.choices:
-        parts.append("one of " + ", ".join(map(str, p.choices)))
-    return ", ".join(parts)
-
-
 def scenario_rows(scn) -> tuple[str, list[str], list[list[str]]]:
     """Title, header and rows of a scenario's parameter table."""
-    rows = [[name, _fmt(p.default), p.unit, _bounds(p), p.doc] for name, p in scn.parameters.items()]
+    rows = [[name, _fmt(p.default), p.unit, p.bounds_text(), p.doc] for name, p in scn.parameters.items()]
     title = f"{scn.name}: {scn.title}" if getattr(scn, "title", "") else scn.name
     return title, ["parameter", "default", "unit", "allowed", "meaning"], rows
 

@@ -133,7 +133,8 @@ class Parameter:
     choices: tuple = ()
     type: str = "float"  # float, int, bool, str, vector
 
-    def describe(self) -> str:
+    def bounds_text(self) -> str:
+        """What the value may be: ``">= 0, < 90"``, ``"one of a, b"``, or ``""`` where anything goes."""
         bounds = []
         if self.min is not None:
             bounds.append((">" if self.exclusive_min else ">=") + f" {self.min:g}")
@@ -141,8 +142,12 @@ class Parameter:
             bounds.append(("<" if self.exclusive_max else "<=") + f" {self.max:g}")
         if self.choices:
             bounds.append("one of " + ", ".join(map(str, self.choices)))
+        return ", ".join(bounds)
+
+    def describe(self) -> str:
         unit = f" {self.unit}" if self.unit else ""
-        return f"{_fmt(self.default)}{unit}" + (f" ({', '.join(bounds)})" if bounds else "")
+        bounds = self.bounds_text()
+        return f"{_fmt(self.default)}{unit}" + (f" ({bounds})" if bounds else "")
 
     @property
     def bounds(self) -> tuple:

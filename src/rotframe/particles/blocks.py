@@ -22,7 +22,7 @@ import threading
 
 import numpy as np
 
-__all__ = ["block_bounds", "run_blocks"]
+__all__ = ["block_bounds", "run_blocks", "thread_pool"]
 
 #: thread pools by size, made on first use and kept (a pool per call would cost ~100 us)
 _POOLS: dict = {}
@@ -67,7 +67,8 @@ def _scratch(i, shape):
     return a
 
 
-def _pool(workers):
+def thread_pool(workers):
+    """The kept pool of ``workers`` threads (made on first use)."""
     pool = _POOLS.get(workers)
     if pool is None:
         from concurrent.futures import ThreadPoolExecutor
@@ -103,10 +104,10 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
     """
     from rotframe.particles import threads
 
+    if n <= threads.BLOCK:  # one block: the driver itself (before counting threads: a short run's overhead)
+        return one(*per_particle, *per_sample, *scalars)
     workers = threads.resolve_threads(None)
     bounds = block_bounds(n, workers)
-    if len(bounds) == 1:
-        return one(*per_particle, *per_sample, *scalars)
 
     def block(b):
         lo, hi = b
@@ -131,7 +132,7 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
     if workers == 1:
         results = [block(b) for b in bounds]
     else:
-        results = list(_pool(workers).map(block, bounds))  # block order; the first failure is raised
+        results = list(thread_pool(workers).map(block, bounds))  # block order; the first failure is raised
     n_done = min(r[0] for r in results)
     bad = -1
     for (lo, _), r in zip(bounds, results):

@@ -384,7 +384,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
             try:
-                run_blocks(module.advance, N, before + (budget,) + after)
+                advance_blocks(module.advance, N, before + (budget,) + after)
             except Exception as exc:
                 import numba
 
@@ -433,7 +433,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
 
 
-def run_blocks(advance, N, args):
+def advance_blocks(advance, N, args):
     """``advance(lo, hi, *args)`` over the blocks of the N particles, on the ensemble's threads.
 
     The blocks are the particle core's (`rotframe.particles.blocks.block_bounds`: the same
@@ -451,11 +451,14 @@ def run_blocks(advance, N, args):
         for lo, hi in blocks:
             advance(lo, hi, *args)
         return
-    from concurrent.futures import ThreadPoolExecutor
+    from concurrent.futures import wait
 
-    with ThreadPoolExecutor(threads) as pool:
-        for future in [pool.submit(advance, lo, hi, *args) for lo, hi in blocks]:
-            future.result()
+    from rotframe.particles.blocks import thread_pool
+
+    futures = [thread_pool(threads).submit(advance, lo, hi, *args) for lo, hi in blocks]
+    wait(futures)  # every block done before a failure is raised (the replay restores the arrays)
+    for future in futures:
+        future.result()
 
 
 #: the per-particle arrays a driver call changes besides the samples and event records (copied before each

@@ -110,7 +110,6 @@ def zero_velocity_curve(mu, C, extent=1.6, n=401):
         F = jacobi_constant(np.stack([X, Y, np.zeros_like(X)], -1), np.zeros(X.shape + (3,)), mu) - C
     F = np.where(np.isfinite(F), F, 1e6)
     segs = []
-    corners = [(0, 0), (0, 1), (1, 1), (1, 0)]  # (row, col) offsets around a cell
     f = [F[:-1, :-1], F[:-1, 1:], F[1:, 1:], F[1:, :-1]]
     px = [X[:-1, :-1], X[:-1, 1:], X[1:, 1:], X[1:, :-1]]
     py = [Y[:-1, :-1], Y[:-1, 1:], Y[1:, 1:], Y[1:, :-1]]
@@ -120,7 +119,6 @@ def zero_velocity_curve(mu, C, extent=1.6, n=401):
         cross = (f[a] > 0) != (f[b] > 0)
         s = np.where(cross, f[a] / np.where(f[a] - f[b] == 0, 1, f[a] - f[b]), np.nan)
         points.append((cross, px[a] + s * (px[b] - px[a]), py[a] + s * (py[b] - py[a])))
-    del corners
     count = sum(p[0].astype(int) for p in points)
     for i, j in zip(*np.nonzero(count >= 2)):
         pts = [(p[1][i, j], p[2][i, j]) for p in points if p[0][i, j]]

@@ -51,7 +51,7 @@ import os
 
 from rotframe.app.sweep.batch import MAX_TRACK_SAMPLES, BatchOutput, BatchTask, run_batch
 from rotframe.app.sweep.execute import (CONNECT_TIMEOUT_S, MAX_TRACKS, SweepInterrupted, SweepLost, SweepResult,
-                                        check_scheduler, run_sweep, scheduler_from_env)
+                                        check_scheduler, check_task_timeout, run_sweep, scheduler_from_env)
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.spec import Axis, SweepSpec, Vary, parse_spec, points_of, sweep_points
 from rotframe.app.sweep.store import SweepFiles, check_outputs, metric_columns, read_table
@@ -98,8 +98,7 @@ def main(args) -> int:
     check_outputs(spec, args.out, args.resume)
     scheduler_file = getattr(args, "scheduler_file", None)
     task_timeout = getattr(args, "task_timeout", None)
-    if task_timeout is not None and not task_timeout > 0:
-        raise ScenarioError(f"--task-timeout {task_timeout:g}: must be > 0 seconds")
+    check_task_timeout(task_timeout)
     scheduler, from_env = args.scheduler, False
     if scheduler is None and scheduler_file is None and args.workers is None:
         scheduler = scheduler_from_env()

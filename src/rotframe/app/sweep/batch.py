@@ -21,6 +21,7 @@ oversubscribes the cores.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import math
 import os
@@ -80,9 +81,9 @@ class ScenarioSource:
             raise ScenarioError(f"scenario {str(scenario)!r}: cannot be read ({exc})") from None
         return cls(scn.path.name, text, _plugin_source(scn.scene), __version__)
 
-    @property
+    @functools.cached_property
     def digest(self) -> str:
-        """sha256 of everything a worker runs from (the resume fingerprint uses it)."""
+        """sha256 of everything a worker runs from (the resume fingerprint uses it); made once."""
         h = hashlib.sha256()
         for part in (self.filename, self.text, repr(self.plugin), self.version):
             h.update(part.encode("utf-8", "surrogatepass"))
@@ -341,18 +342,13 @@ def _ensemble_batch(task, scn, scene, base):
         import contextvars
         from concurrent.futures import ThreadPoolExecutor
 
-        from rotframe.particles.ensemble import threads_scope
-
-        def in_scope(members):  # the chunks share the cores: each takes its part of them
-            with threads_scope(max(1, cores // threads)):
-                return one(members)
-
         results = [one(chunks[0])]  # compiles (or loads) the kernels once, so that the pool does not wait on them
         # each chunk runs in a copy of this thread's context: the device and limits in force reach the pool's
         # threads (a ContextVar is per thread; a new thread would see the defaults: all cores, the CPU)
         contexts = [contextvars.copy_context() for _ in chunks[1:]]
         with ThreadPoolExecutor(max_workers=threads) as pool:
-            results += list(pool.map(lambda job: job[0].run(in_scope, job[1]), zip(contexts, chunks[1:])))
+            # (each chunk runs on one thread: `_ensemble_call`; the chunks are the parallelism)
+            results += list(pool.map(lambda job: job[0].run(one, job[1]), zip(contexts, chunks[1:])))
     else:
         results = [one(c) for c in chunks]
     theory = getattr(scene, "ensemble_theory", None)  # the theory columns single runs have

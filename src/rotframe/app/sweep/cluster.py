@@ -268,8 +268,7 @@ def _why(exc):
 
 def _bounded(fn, seconds):
     """Call ``fn`` in a daemon thread, waiting at most ``seconds`` (a Dask call to a scheduler that is gone)."""
-    box = []
-    worker = threading.Thread(target=lambda: box.append(_call(fn)), daemon=True, name="rotframe-dask-cleanup")
+    worker = threading.Thread(target=lambda: _call(fn), daemon=True, name="rotframe-dask-cleanup")
     worker.start()
     worker.join(seconds)
 

@@ -29,7 +29,7 @@ from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, requ
 from rotframe.errors import ScenarioError
 
 __all__ = ["SweepResult", "SweepInterrupted", "SweepLost", "run_sweep", "check_scheduler", "scheduler_from_env",
-           "quiet_dask_logs", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
+           "check_task_timeout", "quiet_dask_logs", "batch_threads", "MAX_TRACKS", "CONNECT_TIMEOUT_S"]
 
 
 #: at most this many trajectories and samples per trajectory in the recording
@@ -139,8 +139,7 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
     t_start = time.perf_counter()
     require("pyarrow", "rotframe sweep")
     files = SweepFiles.for_spec(spec, out)
-    if task_timeout is not None and not (float(task_timeout) > 0):
-        raise ScenarioError(f"--task-timeout {task_timeout}: must be > 0 seconds")
+    check_task_timeout(task_timeout)
     where = {"workers": workers, "scheduler": scheduler, "scheduler_file": scheduler_file, "client": client,
              "task_timeout": task_timeout}
     with exclusive(files):
@@ -203,6 +202,12 @@ class _Context:
                          rows=rows, values=values, method=self.spec.method, path=self.path, limits=_limits_now(),
                          track_rows=self.track_rows.intersection(rows.tolist()), threads=self.threads,
                          device=_device_now())
+
+
+def check_task_timeout(task_timeout):
+    """ScenarioError in one line unless ``task_timeout`` is None or a number of seconds > 0."""
+    if task_timeout is not None and not (float(task_timeout) > 0):
+        raise ScenarioError(f"--task-timeout {float(task_timeout):g}: must be > 0 seconds")
 
 
 def _device_now():
