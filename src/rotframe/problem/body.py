@@ -103,7 +103,7 @@ def _inertia(inertia):
 def _header(nparams):
     args = "".join(f", P[{j}]" for j in range(nparams))
     return (f"\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n"
-            + (f"    a = torque_fn(t, y[0:3], y[3:7]{args})\n    return a[0], a[1], a[2]\n" if nparams >= 0 else ""))
+            + f"    a = torque_fn(t, y[0:3], y[3:7]{args})\n    return a[0], a[1], a[2]\n")
 
 
 _FREE_HEADER = "\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n    return 0.0, 0.0, 0.0\n"

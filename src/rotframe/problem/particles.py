@@ -526,7 +526,7 @@ def _trajectory(times, OUT, state, events, method, n_kept):
     nfev = int(np.max(state["NFEV"])) if state["NFEV"].size else 0
     complete = n_kept == times.size
     traj = Trajectory(times[:n_kept].copy(), r, v, method, steps, nfev, complete,
-                      float(times[n_kept - 1]) if complete else float(times[n_kept - 1]))
+                      float(times[n_kept - 1]))
     names = _event_names(events)
     N = OUT.shape[1]
     for k, name in enumerate(names):
