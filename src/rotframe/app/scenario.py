@@ -135,18 +135,13 @@ class Parameter:
 
     def bounds_text(self) -> str:
         """What the value may be: ``">= 0, < 90"``, ``"one of a, b"``, or ``""`` where anything goes."""
-        bounds = []
-        if self.min is not None:
-            bounds.append((">" if self.exclusive_min else ">=") + f" {self.min:g}")
-        if self.max is not None:
-            bounds.append(("<" if self.exclusive_max else "<=") + f" {self.max:g}")
-        if self.choices:
-            bounds.append("one of " + ", ".join(map(str, self.choices)))
-        return ", ".join(bounds)
+        lo = [] if self.min is None else [(">" if self.exclusive_min else ">=") + f" {self.min:g}"]
+        hi = [] if self.max is None else [("<" if self.exclusive_max else "<=") + f" {self.max:g}"]
+        of = ["one of " + ", ".join(map(str, self.choices))] if self.choices else []
+        return ", ".join(lo + hi + of)
 
     def describe(self) -> str:
-        unit = f" {self.unit}" if self.unit else ""
-        bounds = self.bounds_text()
+        bounds, unit = self.bounds_text(), (f" {self.unit}" if self.unit else "")
         return f"{_fmt(self.default)}{unit}" + (f" ({bounds})" if bounds else "")
 
     @property
