@@ -90,16 +90,17 @@ def _global_names(code):
     return out
 
 
-def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, events, watch, out, ev_t, ev_state,
-                            hit_any):
-    """One GPU thread per particle: ``n_steps`` steps of ``method`` from ``t0``, watching one event.
+def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, events, watch, out, ev_t):
+    """One GPU thread per particle: ``n_steps`` steps of ``method`` from ``t0``, up to its first event.
 
     The loop of `rotframe.particles.drivers.run_fixed` for one sample interval and
     one event: the same steps (`one_step` at a steady rate, a plan per step else),
     the same crossing test, and the same location (`locate_event`, bisection on a
-    re-step). ``events`` (1, 5) is the event table, ``watch`` 0 (none) or 1; a terminal event stops
-    the particle. ``out`` (N, 6) receives the end state; ``ev_t`` (N,) and ``ev_state``
-    (N, 6) the first event (``hit_any`` (N,) 1 where there was one).
+    re-step). ``events`` (1, 5) is the event table, ``watch`` 0 (none) or 1. The
+    ensemble reports each particle's first event only, so the thread stops there,
+    terminal event or not. ``out`` (N, 6) receives the first event's state, else the
+    end state; ``ev_t`` (N,) the first event's time, else NaN. Both are written for
+    every particle, so they need no upload.
     """
     p = cuda.grid(1)  # noqa: F821 -- bound to numba.cuda in the compiled copy
     if p >= r.shape[0]:
@@ -109,7 +110,7 @@ def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, event
     sphere = m.length > 0.0
     plan = make_plan(method, t0, h, m, wt, wv, wint)  # noqa: F821
     state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
-    hit_any[p] = 0
+    ev_t[p] = math.nan
     g_old = 0.0
     if watch != 0:
         w0, wd0 = rates(t0, m.steady, m.w, wt, wv)  # noqa: F821
@@ -122,16 +123,10 @@ def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, event
         if watch != 0:
             g_new = event_value(events, 0, state, m.radius)  # noqa: F821
             if crossed(events[0, 3], g_old, g_new):  # noqa: F821
-                tau, at = locate_event(method, events, 0, start, g_old, t, h, m, wt, wv, wint, rk4,  # noqa: F821
-                                       sphere)
-                if hit_any[p] == 0:
-                    hit_any[p] = 1
-                    ev_t[p] = t + tau
-                    for i in range(6):
-                        ev_state[p, i] = at[i]
-                if events[0, 4] != 0.0:
-                    state = at
-                    break
+                tau, state = locate_event(method, events, 0, start, g_old, t, h, m, wt, wv, wint, rk4,  # noqa: F821
+                                          sphere)
+                ev_t[p] = t + tau
+                break
             g_old = g_new
     for i in range(6):
         out[p, i] = state[i]
@@ -187,25 +182,16 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     r0 = np.ascontiguousarray(r0, dtype=np.float64)
     v0 = np.ascontiguousarray(v0, dtype=np.float64)
     n = r0.shape[0]
-    table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
-    out = np.empty((n, 6))
-    ev_t = np.full(n, math.nan)
-    ev_state = np.zeros((n, 6))
-    hit = np.zeros(n, dtype=np.int64)
     if n == 0:
-        return ev_t, out
+        return np.full(0, math.nan), np.empty((0, 6))
+    table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
     P = model.pack()
     wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
-    args = [cuda.to_device(a) for a in (r0, v0)]
+    d_out, d_t = cuda.device_array((n, 6)), cuda.device_array(n)  # written by every thread: no upload
     kernel = _kernel()
     blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
-    d_out, d_t, d_state, d_hit = (cuda.to_device(a) for a in (out, ev_t, ev_state, hit))
-    kernel[blocks, _THREADS_PER_BLOCK](info.code, args[0], args[1], 0.0, h, sps * samples, cuda.to_device(P),
-                                       cuda.to_device(wt), cuda.to_device(wv), cuda.to_device(wint),
-                                       cuda.to_device(table), 0 if event is None else 1, d_out, d_t, d_state, d_hit)
-    out, ev_t, ev_state, hit = d_out.copy_to_host(), d_t.copy_to_host(), d_state.copy_to_host(), d_hit.copy_to_host()
-    state = out.copy()
-    got = hit != 0
-    state[got] = ev_state[got]
-    t_event = np.where(got, ev_t, math.nan)
-    return t_event, state
+    kernel[blocks, _THREADS_PER_BLOCK](info.code, cuda.to_device(r0), cuda.to_device(v0), 0.0, h, sps * samples,
+                                       cuda.to_device(P), cuda.to_device(wt), cuda.to_device(wv),
+                                       cuda.to_device(wint), cuda.to_device(table), 0 if event is None else 1,
+                                       d_out, d_t)
+    return d_t.copy_to_host(), d_out.copy_to_host()

@@ -21,7 +21,8 @@ Modules: `problems` (the problems and ladders),
 `measure` (timing rotframe and the scipy baselines),
 `peers` (the peers' right-hand sides), `summary`
 (error levels, speed-ups), `throughput` (ensemble, sweep, start-up,
-recording) and `report` (table, plots, JSON).
+recording), `gpu` (the GPU ensemble beside hand-written kernels and JAX) and
+`report` (table, plots, JSON).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from rotframe.app.bench.measure import PEER_RTOLS, SCIPY_METHODS, Plan, planned_
 from rotframe.app.bench.problems import EXTRAS, PREPARED, Problem, attitude_error, problems  # noqa: F401
 from rotframe.app.bench.report import environment, json_rows, plot, table
 from rotframe.app.bench.summary import LEVELS, is_peer, level_summary, problem_keys, speedups  # noqa: F401
+from rotframe.app.bench.gpu import gpu_rows
 from rotframe.app.bench.throughput import ensemble_rows, record_rows, startup_rows, sweep_rows
 from rotframe.app.bench.user_force import user_force_rows
 
@@ -67,10 +69,16 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
     for p in probs:
         rows.extend(run_problem(p, on_row, plan))
         notes.extend(f"{p.scenario}: {n}" for n in p.notes)
+    if "gpu" in extras and "gpu" not in names:
+        from rotframe.particles.threads import gpu_available
+
+        if not gpu_available():  # named, it is refused in one line (exit 2); in the whole bench, a note
+            extras.remove("gpu")
+            notes.append("gpu: not measured: no CUDA GPU here (numba.cuda.is_available() is False)")
     for name in extras:
         fn = {"ensemble": lambda: ensemble_rows(quick), "sweep": lambda: sweep_rows(quick),
               "startup": startup_rows, "record": lambda: record_rows(10**5 if quick else 10**6),
-              "user-force": lambda: user_force_rows(quick)}[name]
+              "user-force": lambda: user_force_rows(quick), "gpu": lambda: gpu_rows(quick)}[name]
         rows.extend(fn())
         plan.step(name)
     rows.extend(level_summary(rows))

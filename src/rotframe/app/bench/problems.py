@@ -67,7 +67,7 @@ def problems(names=None, quick=False):
 
 
 #: benchmarks that are not problems
-EXTRAS = ("ensemble", "sweep", "startup", "record", "user-force")
+EXTRAS = ("ensemble", "sweep", "startup", "record", "user-force", "gpu")
 
 
 #: rtol ladder of the rigid bodies' dop853: 1e-4 to 1e-13 in half decades (3e-k between), so that the

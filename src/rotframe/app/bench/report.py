@@ -91,7 +91,12 @@ def table(rows, speed) -> str:
                           f"({r['goal_ratio']:.2f} of the 0.7 goal; the ceiling's scaling x {r['scaling_vs_ceiling']:.2f}), "
                           f"{r['of_ceiling']:.2f} of the ceiling, "
                           f"bitwise identical to 1 thread: {r['bitwise_identical_to_1_thread']}")
-            if "same_work" in r and r["method"].startswith("hand-written prange"):
+            if "of_ceiling" in r and "ceiling_goal" in r:
+                jax = r.get("vs_jax_vmap")
+                extra += (f", {r['of_ceiling']:.2f} of the hand-written kernel (goal {r['ceiling_goal']:g}), "
+                          + (f"x{jax:.3g} JAX vmap (goal x{r['jax_goal']:g})" if jax else "no JAX ratio")
+                          + (f"; {r['notes']}" if r.get("notes") else ""))
+            if "same_work" in r and (r["method"].startswith("hand-written prange") or r["scenario"] == "gpu-ensemble"):
                 extra += f"; {r['same_work_note']}"
         if "rows_per_s" in r:
             extra = f"  {r['rows_per_s']:.3g} rows/s"

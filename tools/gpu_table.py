@@ -1,0 +1,45 @@
+"""The GPU ensemble table (Markdown) from ``rotframe bench gpu --json``.
+
+    rotframe bench gpu --json > docs/bench/gpu.json
+    python tools/gpu_table.py docs/bench/gpu.json
+
+One row per method and event: rotframe's GPU door, the hand-written kernels and JAX, in
+particle-steps per second, with rotframe's ratio to the faster hand-written kernel and to JAX.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+
+def table(rows) -> str:
+    body = [r for r in rows if r.get("scenario") == "gpu-ensemble"]
+    if not body:
+        return "no gpu-ensemble rows\n"
+    lines = [f"GPU: {body[0]['gpu']}{' (numba CUDA simulator: no timing of meaning)' if body[0]['simulator'] else ''}",
+             "", "| case | rotframe | hand-written numba CUDA | hand-written CUDA C | JAX jit(vmap) | "
+             "of the ceiling (goal 0.5) | x JAX (goal 10) | same work |", "|---|---|---|---|---|---|---|---|"]
+    cases = {}
+    for r in body:
+        cases.setdefault((r["integrator"], r["event"]), []).append(r)
+    for (method, event), rs in cases.items():
+        def rate(prefix):
+            hit = [r for r in rs if r["method"].startswith(prefix)]
+            return f"{hit[0]['particle_steps_per_s']:.3g}" if hit else "-"
+        mine = rs[0]
+        jax = mine.get("vs_jax_vmap")
+        lines.append(f"| {method}{' + ground event' if event else ''} | {rate('rotframe')} | "
+                     f"{rate('hand-written numba')} | {rate('hand-written CUDA C')} | {rate('JAX')} | "
+                     f"{mine['of_ceiling']:.2f} | {'-' if jax is None else f'x{jax:.3g}'} | "
+                     f"{all(r['same_work'] for r in rs)} |")
+    lines.append("")
+    lines.append(f"Particle-steps per second; {body[0]['setting'].split(', ', 2)[-1]}.")
+    notes = sorted({r["notes"] for r in body if r.get("notes")})
+    lines.extend(f"Note: {n}." for n in notes)
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    with open(sys.argv[1]) as f:
+        print(table(json.load(f)), end="")
