@@ -29,6 +29,14 @@ __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GR
 GROWTH_LIMIT = 1e-3
 
 
+#: step-evaluations of one call of a fixed-step driver, at most (a run's calls and a long sample
+#: interval's pieces are cut to it). A constant, so that the cut never depends on the thread count
+#: (a piece's start time enters a varying rate's plan). About 0.15 s on one core, under 0.1 s on two:
+#: how often Python regains control (signals, progress). Each call costs a dispatch to every thread:
+#: at 4e6, on 16 threads, the dispatches took half of a 100,000-particle RK4 run (issue 26).
+CALL_EVALS = 1.6e7
+
+
 def sample_times(duration, samples):
     """``samples`` equal intervals from 0, the last sample at ``duration`` exactly: (samples + 1,) times."""
     times = np.arange(samples + 1) * (duration / samples)
@@ -252,13 +260,13 @@ class KernelSetup:
         return elapsed if overloads is not None and len(kernel.overloads) > before else 0.0
 
     def one_sample_in_pieces(self, r, v, alive, first, out_r, out_v, evb, n):
-        """One sample interval of ``sps`` fixed steps as several calls of about 4e6 step-evaluations.
+        """One sample interval of ``sps`` fixed steps as several calls of at most `CALL_EVALS` step-evaluations.
 
         The calls are of equal length (within one step): 12 steps of 100,000 RK4 particles are
         two calls of 6, not 10 and 2 (a short call is all dispatch and waiting on the threads).
         Returns ``(n_done, bad, nfev, steps)`` as `call` for that one sample.
         """
-        most = max(1, int(4e6 // (n * self.evals_per_step)))
+        most = max(1, int(CALL_EVALS // (n * self.evals_per_step)))
         sps = self.sps
         pieces = -(-sps // most)
         t0 = self.times[first]
@@ -337,7 +345,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
         h_state = np.zeros(n)
         cost = n * 200
     guard = _energy_guard(model, r0, v0)
-    chunk = max(1, int(4e6 // max(cost, 1)))
+    chunk = max(1, int(CALL_EVALS // max(cost, 1)))
     done = 0
     nfev = 0
     steps = 0
@@ -364,9 +372,9 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             sl = slice(done + 1, done + 1 + m)
             if first is not None:
                 (n_done, bad, nf, st), first = first, None
-            elif info.kind == "fixed" and cost > 4e6:
+            elif info.kind == "fixed" and cost > CALL_EVALS:
                 # one sample interval is more than a chunk of work: advance it in pieces, so that
-                # Python regains control (signals, progress) about every 0.1 s
+                # Python regains control (signals, progress) between them
                 n_done, bad, nf, st = setup.one_sample_in_pieces(r, v, alive, done, out_r[sl], out_v[sl], evb, n)
             else:
                 n_done, bad, nf, st = setup.call(r, v, alive, done, m, out_r[sl], out_v[sl], evb, atol, h_state)
@@ -417,14 +425,14 @@ _NO_RECORDS = EventBuffers(0, 0)
 def _run_once(setup, model, r, v, max_events, records):
     """A short fixed-step run in one call of the driver, with the least Python around it; None if it does not apply.
 
-    The run of `run_chunked` when it is one chunk (at most about 4e6 step-evaluations),
+    The run of `run_chunked` when it is one chunk (at most `CALL_EVALS` step-evaluations),
     one block and the model needs no energy guard: the same call of the driver with the same
     arguments, so the same numbers. A failure (a non-finite state) returns None after
     restoring nothing: the caller runs the general path from the initial state, which
     raises with the partial trajectory.
     """
     samples, n = setup.samples, r.shape[0]
-    if setup.sps * n * setup.evals_per_step * samples > 4e6 or setup.guarded(model):
+    if setup.sps * n * setup.evals_per_step * samples > CALL_EVALS or setup.guarded(model):
         return None
     out_r = np.empty((samples + 1, n, 3))
     out_v = np.empty((samples + 1, n, 3))
