@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Issue 26's checks on a lent GPU machine, in one call (see docs/guide/bench.md):
-#   the machine, the GPU bench (rotframe bench gpu) and the CPU ensemble bench on every core.
+#   the machine, the GPU kernel's register limits (tools/gpu_variants.py), the GPU bench (rotframe bench gpu)
+#   and the CPU ensemble bench on every core.
 # Run from the repository root; results land in $OUT (default /tmp/rotframe-device).
 set -u
 OUT=${OUT:-/tmp/rotframe-device}
 mkdir -p "$OUT"
-export PYTHONPATH=$PWD/src PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false ROTFRAME_DEBUG=1
+export PYTHONPATH=$PWD/tools/device_shim:$PWD/src PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false ROTFRAME_DEBUG=1
 PY=${PY:-python3}
 nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.sm,clocks.max.sm --format=csv 2>&1 | tee "$OUT/machine.txt"
 nproc | tee -a "$OUT/machine.txt"
@@ -26,20 +27,12 @@ except Exception as e:
     print("cupy:", type(e).__name__, e)
 PY
 t0=$(date +%s)
+timeout ${VARIANTS_TIMEOUT:-120} $PY tools/gpu_variants.py 2>&1 | tee "$OUT/variants.txt" | grep -v Warning
+echo "gpu variants: in $(( $(date +%s) - t0 )) s"
+t0=$(date +%s)
 timeout ${GPU_TIMEOUT:-300} $PY -m rotframe bench gpu ${GPU_ARGS:-} --json > "$OUT/gpu.json" 2> "$OUT/gpu.err"
 echo "bench gpu: rc=$? in $(( $(date +%s) - t0 )) s"; tail -c 3000 "$OUT/gpu.err"
 $PY tools/gpu_table.py "$OUT/gpu.json" | tee "$OUT/gpu.md"
-$PY - <<'PY' 2>&1 | tee -a "$OUT/gpu.md"
-# registers and local memory of rotframe's GPU kernel and the hand-written one (spills show as local memory)
-from rotframe.particles import gpu
-from rotframe.app.bench import gpu as bench_gpu
-for name, k in (("rotframe", gpu._kernel()), ("hand-written rk4+ground", bench_gpu._numba_ceiling(True, True))):
-    try:
-        for sig, d in k.overloads.items():
-            print(name, "regs/thread", d.get_regs_per_thread(), "local bytes/thread", d.get_local_mem_per_thread())
-    except Exception as e:
-        print(name, "no resource report:", type(e).__name__, e)
-PY
 if [ "${CPU:-1}" = 1 ]; then
   t0=$(date +%s)
   timeout ${CPU_TIMEOUT:-240} $PY -m rotframe bench ensemble --json > "$OUT/ensemble.json" 2> "$OUT/ensemble.err"

@@ -37,7 +37,9 @@ GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
 _THREADS_PER_BLOCK = 128
 
 _DEVICE = {}  # CPU dispatcher -> its GPU device function
-_KERNEL = []  # the compiled kernel, made on first use
+_KERNELS = {}  # (method, rk4, sphere, watch, steady, structure, registers) -> the compiled kernel, made on first use
+#: registers a thread at most (None: the compiler's choice); `tools/gpu_variants.py` times the choices
+_MAX_REGISTERS = None
 
 
 def available() -> bool:
@@ -77,8 +79,25 @@ def device_function(kernel):
     clone = types.FunctionType(fn.__code__, names, fn.__name__, fn.__defaults__, fn.__closure__)
     clone.__qualname__ = fn.__qualname__
     clone.__module__ = fn.__module__
-    done = _DEVICE[kernel] = cuda.jit(device=True)(clone)
+    done = _DEVICE[kernel] = cuda.jit(device=True, **_inline_options())(clone)
     return done
+
+
+def _inline_options():
+    """Every device function inlined into its caller (``forceinline``, where numba's CUDA target has it).
+
+    Not inlined, each call passes the packed model (some 30 scalars) through the call
+    ABI: 68 calls and 180 registers a thread in the kernel, against 47 in a
+    hand-written one (``ptxas -v``, sm_90), so that a third as many threads fit on a
+    multiprocessor. numba's simulator runs Python and takes no such option.
+    """
+    import inspect
+
+    from numba import config, cuda
+
+    if not config.ENABLE_CUDASIM and "forceinline" in inspect.signature(cuda.jit).parameters:
+        return {"forceinline": True}
+    return {}
 
 
 def _global_names(code):
@@ -90,65 +109,109 @@ def _global_names(code):
     return out
 
 
-def _ensemble_kernel_source(method, r, v, t0, h, n_steps, P, wt, wv, wint, events, watch, out, ev_t):
-    """One GPU thread per particle: ``n_steps`` steps of ``method`` from ``t0``, up to its first event.
+def _ensemble_kernel_source(r, v, t0, h, n_steps, P, wt, wv, wint, events, out, ev_t):
+    """One GPU thread per particle: ``n_steps`` steps of ``METHOD`` from ``t0``, up to its first event.
 
     The loop of `rotframe.particles.drivers.run_fixed` for one sample interval and
     one event: the same steps (`one_step` at a steady rate, a plan per step else),
     the same crossing test, and the same location (`locate_event`, bisection on a
-    re-step). ``events`` (1, 5) is the event table, ``watch`` 0 (none) or 1. The
-    ensemble reports each particle's first event only, so the thread stops there,
-    terminal event or not. ``out`` (N, 6) receives the first event's state, else the
-    end state; ``ev_t`` (N,) the first event's time, else NaN. Both are written for
-    every particle, so they need no upload.
+    re-step). ``events`` (1, 5) is the event table. ``METHOD``, ``RK4`` and ``SPHERE``
+    (True, or None where false, as the CPU drivers pass them), ``WATCH`` (an event or
+    not), ``STEADY`` (a constant rate) and the model's structure (``structured``,
+    `_structure_source`) are constants of each compiled copy (`_kernel`), so that a
+    copy holds only the branches and the values its run needs. The ensemble
+    reports each particle's first event only, so the thread stops there, terminal
+    event or not. ``out`` (N, 6) receives the first event's state, else the end
+    state; ``ev_t`` (N,) the first event's time, else NaN. Both are written for every
+    particle, so they need no upload.
     """
-    p = cuda.grid(1)  # noqa: F821 -- bound to numba.cuda in the compiled copy
+    p = cuda.grid(1)  # noqa: F821 -- the names in capitals and the functions are bound per compiled copy
     if p >= r.shape[0]:
         return
-    m = unpack(P, wt, wv)  # noqa: F821
-    rk4 = method == 2
-    sphere = m.length > 0.0
-    plan = make_plan(method, t0, h, m, wt, wv, wint)  # noqa: F821
+    m = structured(unpack(P, wt, wv))  # noqa: F821
+    plan = make_plan(METHOD, t0, h, m, wt, wv, wint)  # noqa: F821
     state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
     ev_t[p] = math.nan
     g_old = 0.0
-    if watch != 0:
-        w0, wd0 = rates(t0, m.steady, m.w, wt, wv)  # noqa: F821
+    if WATCH:  # noqa: F821
+        w0, wd0 = rates(t0, STEADY, m.w, wt, wv)  # noqa: F821
         g_old = start_value(events, 0, state, m, w0, wd0)  # noqa: F821
+    t = t0
+    start = state
+    hit = False
     for k in range(n_steps):
         t = t0 + k * h
         start = state
-        step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)  # noqa: F821
-        state = one_step(method, state, h, m, step_plan, rk4, sphere)  # noqa: F821
-        if watch != 0:
+        step_plan = plan if STEADY else make_plan(METHOD, t, h, m, wt, wv, wint)  # noqa: F821
+        state = one_step(METHOD, state, h, m, step_plan, RK4, SPHERE)  # noqa: F821
+        if WATCH:  # noqa: F821
             g_new = event_value(events, 0, state, m.radius)  # noqa: F821
             if crossed(events[0, 3], g_old, g_new):  # noqa: F821
-                tau, state = locate_event(method, events, 0, start, g_old, t, h, m, wt, wv, wint, rk4,  # noqa: F821
-                                          sphere)
-                ev_t[p] = t + tau
+                hit = True
                 break
             g_old = g_new
-    for i in range(6):
-        out[p, i] = state[i]
+    if hit:
+        # located after the loop, so that the bisection's registers are not held through every step
+        tau, state = locate_event(METHOD, events, 0, start, g_old, t, h, m, wt, wv, wint, RK4, SPHERE)  # noqa: F821
+        ev_t[p] = t + tau
+    out[p, 0], out[p, 1], out[p, 2], out[p, 3], out[p, 4], out[p, 5] = state
 
 
-def _kernel():
-    """The compiled GPU kernel (made on first use, from `_ensemble_kernel_source`)."""
-    if _KERNEL:
-        return _KERNEL[0]
-    from numba import cuda
+def _structure_source(P, wt, wv):
+    """Python source of ``structured(m)``: the packed model with its structure as constants.
+
+    ``m`` is `rotframe.particles.packed.unpack`'s model of this run, read on the GPU.
+    Every field that is a switch (a boolean, the gravity mode) or zero in this run is
+    written as its value, the others are read from ``m``: with every device function
+    inlined, the compiler drops the terms the model does not have and keeps no
+    register for them (``ptxas -v``, sm_90, gravity + Coriolis: 52 registers a thread
+    for RK4, 90 with the ground event, where a model read at run time took 140 and
+    168; a hand-written kernel takes 47). The values are the run's own, so the
+    numbers are those of the general kernel and of the CPU.
+    """
+    from rotframe.particles import packed
+
+    host = packed.unpack.py_func(P, wt, wv)
+    parts = []
+    for name, value in zip(packed.PackedModel._fields, host):
+        if isinstance(value, (bool, np.bool_)):
+            parts.append(repr(bool(value)))
+        elif name == "gmode" or (not isinstance(value, tuple) and float(value) == 0.0):
+            parts.append(repr(float(value)))
+        elif isinstance(value, tuple) and all(float(x) == 0.0 for x in value):
+            parts.append("(0.0, 0.0, 0.0)")
+        else:
+            parts.append(f"m.{name}")
+    return f"def structured(m):\n    return PackedModel({', '.join(parts)})\n"
+
+
+def _kernel(method, rk4, sphere, watch, steady, structure):
+    """The compiled GPU kernel for one run's constants (made on first use, from `_ensemble_kernel_source`).
+
+    ``structure`` is `_structure_source`'s text for the run's model.
+    """
+    key = (method, rk4, sphere, watch, steady, structure, _MAX_REGISTERS)
+    done = _KERNELS.get(key)
+    if done is not None:
+        return done
+    from numba import config, cuda
 
     from rotframe.particles import events, kernels, packed, schedule
 
+    made = {"PackedModel": packed.PackedModel}
+    exec(compile(structure, "<rotframe.particles.gpu structured>", "exec"), made)  # noqa: S102 -- our own text
     names = dict(_ensemble_kernel_source.__globals__)
-    names.update(cuda=cuda, unpack=device_function(packed.unpack), make_plan=device_function(kernels.make_plan),
+    names.update(cuda=cuda, METHOD=method, RK4=rk4, SPHERE=sphere, WATCH=watch, STEADY=steady,
+                 structured=cuda.jit(device=True, **_inline_options())(made["structured"]),
+                 unpack=device_function(packed.unpack), make_plan=device_function(kernels.make_plan),
                  rates=device_function(schedule.rates), one_step=device_function(kernels.one_step),
                  crossed=device_function(events.crossed), event_value=device_function(events.event_value),
                  start_value=device_function(events.start_value), locate_event=device_function(events.locate_event))
     fn = _ensemble_kernel_source
     clone = types.FunctionType(fn.__code__, names, "rotframe_ensemble_kernel", fn.__defaults__, fn.__closure__)
-    _KERNEL.append(cuda.jit(clone))
-    return _KERNEL[0]
+    limit = {} if config.ENABLE_CUDASIM or not _MAX_REGISTERS else {"max_registers": _MAX_REGISTERS}
+    done = _KERNELS[key] = cuda.jit(clone, **limit)
+    return done
 
 
 def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
@@ -166,6 +229,7 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     """
     from rotframe.errors import ScenarioError
     from rotframe.particles.chunked import steps_per_sample
+    from rotframe.particles import packed
     from rotframe.particles.integrators import METHODS, canonical_method
 
     require()
@@ -188,10 +252,12 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     P = model.pack()
     wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
     d_out, d_t = cuda.device_array((n, 6)), cuda.device_array(n)  # written by every thread: no upload
-    kernel = _kernel()
+    steady = bool(np.all(wv == wv[0]))
+    sphere = True if P[packed.I_PLEN] > 0.0 else None
+    kernel = _kernel(info.code, True if info.code == 2 else None, sphere, event is not None, steady,
+                     _structure_source(P, wt, wv))
     blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
-    kernel[blocks, _THREADS_PER_BLOCK](info.code, cuda.to_device(r0), cuda.to_device(v0), 0.0, h, sps * samples,
+    kernel[blocks, _THREADS_PER_BLOCK](cuda.to_device(r0), cuda.to_device(v0), 0.0, h, sps * samples,
                                        cuda.to_device(P), cuda.to_device(wt), cuda.to_device(wv),
-                                       cuda.to_device(wint), cuda.to_device(table), 0 if event is None else 1,
-                                       d_out, d_t)
+                                       cuda.to_device(wint), cuda.to_device(table), d_out, d_t)
     return d_t.copy_to_host(), d_out.copy_to_host()
