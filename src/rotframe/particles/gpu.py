@@ -28,7 +28,7 @@ import types
 
 import numpy as np
 
-__all__ = ["available", "require", "device_function", "integrate_ensemble_gpu", "GPU_METHODS"]
+__all__ = ["available", "require", "device_function", "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
 
 #: the particle methods the GPU runs (the fixed-step ones)
 GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
@@ -227,37 +227,57 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     ScenarioError
         No GPU ([`require`][rotframe.particles.gpu.require]), or a method the GPU does not run (`GPU_METHODS`).
     """
-    from rotframe.errors import ScenarioError
-    from rotframe.particles.chunked import steps_per_sample
-    from rotframe.particles import packed
-    from rotframe.particles.integrators import METHODS, canonical_method
-
-    require()
-    method = canonical_method(method)
-    if method not in GPU_METHODS:
-        raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
     from numba import cuda
 
-    info = METHODS[method]
-    samples = max(1, int(run.get("samples") or 1))
-    dt = duration / samples
-    sps = steps_per_sample(dt, run.get("step"))
-    h = dt / sps
+    launch = GpuLaunch(model, duration, event, method=method, run=run)
     r0 = np.ascontiguousarray(r0, dtype=np.float64)
     v0 = np.ascontiguousarray(v0, dtype=np.float64)
     n = r0.shape[0]
     if n == 0:
         return np.full(0, math.nan), np.empty((0, 6))
-    table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
-    P = model.pack()
-    wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
     d_out, d_t = cuda.device_array((n, 6)), cuda.device_array(n)  # written by every thread: no upload
-    steady = bool(np.all(wv == wv[0]))
-    sphere = True if P[packed.I_PLEN] > 0.0 else None
-    kernel = _kernel(info.code, True if info.code == 2 else None, sphere, event is not None, steady,
-                     _structure_source(P, wt, wv))
-    blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
-    kernel[blocks, _THREADS_PER_BLOCK](cuda.to_device(r0), cuda.to_device(v0), 0.0, h, sps * samples,
-                                       cuda.to_device(P), cuda.to_device(wt), cuda.to_device(wv),
-                                       cuda.to_device(wint), cuda.to_device(table), d_out, d_t)
+    launch(cuda.to_device(r0), cuda.to_device(v0), d_out, d_t)
     return d_t.copy_to_host(), d_out.copy_to_host()
+
+
+class GpuLaunch:
+    """One ensemble run's compiled kernel and its uploaded settings, launched on device arrays.
+
+    [`integrate_ensemble_gpu`][rotframe.particles.gpu.integrate_ensemble_gpu] makes one per call; the bench
+    (``rotframe bench gpu``) times its launches on arrays already on the GPU.
+    ``launch(r, v, out, ev_t)``: ``r, v`` (N, 3) device arrays of the initial state,
+    ``out`` (N, 6) and ``ev_t`` (N,) device arrays that receive the first event's state
+    and time, else the end state and NaN (`_ensemble_kernel_source`).
+    """
+
+    def __init__(self, model, duration, event, *, method, run):
+        from numba import cuda
+
+        from rotframe.errors import ScenarioError
+        from rotframe.particles import packed
+        from rotframe.particles.chunked import steps_per_sample
+        from rotframe.particles.integrators import METHODS, canonical_method
+
+        require()
+        method = canonical_method(method)
+        if method not in GPU_METHODS:
+            raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
+        info = METHODS[method]
+        samples = max(1, int(run.get("samples") or 1))
+        dt = duration / samples
+        sps = steps_per_sample(dt, run.get("step"))
+        self.h = dt / sps
+        self.steps = sps * samples
+        P = model.pack()
+        wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
+        table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
+        steady = bool(np.all(wv == wv[0]))
+        sphere = True if P[packed.I_PLEN] > 0.0 else None
+        self.kernel = _kernel(info.code, True if info.code == 2 else None, sphere, event is not None, steady,
+                              _structure_source(P, wt, wv))
+        self.settings = [cuda.to_device(a) for a in (P, wt, wv, wint, table)]
+
+    def __call__(self, r, v, out, ev_t):
+        blocks = (r.shape[0] + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
+        if blocks:
+            self.kernel[blocks, _THREADS_PER_BLOCK](r, v, 0.0, self.h, self.steps, *self.settings, out, ev_t)

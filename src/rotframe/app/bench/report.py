@@ -93,7 +93,9 @@ def table(rows, speed) -> str:
                           f"bitwise identical to 1 thread: {r['bitwise_identical_to_1_thread']}")
             if "of_ceiling" in r and "ceiling_goal" in r:
                 jax = r.get("vs_jax_vmap")
-                extra += (f", {r['of_ceiling']:.2f} of the hand-written kernel (goal {r['ceiling_goal']:g}), "
+                alone = r.get("kernel_of_ceiling")
+                extra += (f", {r['of_ceiling']:.2f} of the hand-written kernel (goal {r['ceiling_goal']:g}"
+                          + (f"; the kernels alone {alone:.2f}" if alone else "") + "), "
                           + (f"x{jax:.3g} JAX vmap (goal x{r['jax_goal']:g})" if jax else "no JAX ratio")
                           + (f"; {r['notes']}" if r.get("notes") else ""))
             if "same_work" in r and (r["method"].startswith("hand-written prange") or r["scenario"] == "gpu-ensemble"):
