@@ -150,3 +150,67 @@ def test_a_sweep_batch_carries_the_device_to_a_dask_worker(monkeypatch):
     worker.start()
     worker.join(30)
     assert seen == ["gpu"]
+
+
+def _models():
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    steady = OmegaSchedule.constant(np.array([0.0, 4.6e-5, 5.7e-5]))
+    varying = OmegaSchedule(np.array([0.0, 0.6, 0.8]), np.array([0.0, 1.0, 3.0]), np.array([0.02, 0.05, 0.01]))
+    g = np.array([0.0, 0.0, -9.81])
+    return [ParticleModel(("gravity", "coriolis"), omega=steady, g=g),
+            ParticleModel(("coriolis", "centrifugal", "euler", "gravity"), omega=varying, g=g),
+            ParticleModel(("altitude-gravity", "coriolis", "linear-drag"), omega=steady, g0=9.81, radius=6.371e6,
+                          k_linear=0.05),
+            ParticleModel(("gravity", "coriolis", "centrifugal", "quadratic-drag"), omega=steady, g=g,
+                          k_quadratic=2e-3)]
+
+
+@pytest.mark.parametrize("k", range(4))
+def test_the_gpu_model_structure_is_the_run_s_own_model(k):
+    """`_structure_source` writes switches and zeros as constants and reads the rest: applied to the
+    run's own model, it must give that model back, field by field (a constant that differed from the
+    run's value would change the GPU's numbers)."""
+    from rotframe.particles import packed
+
+    model = _models()[k]
+    P, wt, wv = model.pack(), model.omega.times, model.omega.values
+    source = gpu._structure_source(P, wt, wv)
+    made = {"PackedModel": packed.PackedModel}
+    exec(source, made)
+    host = packed.unpack.py_func(P, wt, wv)
+    assert made["structured"](host) == host
+    # every field that is neither a switch nor zero is read, not frozen (so another run's values pass through)
+    other = host._replace(**{f: 1.25 for f, v in zip(host._fields, host)
+                             if isinstance(v, float) and v != 0.0 and f != "gmode"})
+    for field, value in zip(host._fields, made["structured"](other)):
+        original = getattr(host, field)
+        if isinstance(original, float) and original != 0.0 and field != "gmode":
+            assert value == 1.25, field
+
+
+def test_bench_gpu_on_the_simulator_does_the_same_work_as_the_hand_written_kernel():
+    """``rotframe bench gpu`` on numba's simulator: every case runs rotframe's GPU door, the
+    hand-written numba kernel (and JAX where installed), they end in the same states, and the
+    ratios are there (the simulator times nothing of meaning)."""
+    res = _simulated(["-m", "rotframe", "bench", "gpu", "--json"])
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = [r for r in json.loads(res.stdout) if r.get("scenario") == "gpu-ensemble"]
+    assert {(r["integrator"], r["event"]) for r in rows} == {(m, e) for m in ("rotation-splitting", "rk4")
+                                                             for e in (True, False)}
+    doors = [r for r in rows if r["method"].startswith("rotframe integrate_ensemble")]
+    assert len(doors) == 4 and all(r["simulator"] for r in rows)
+    for r in doors:
+        assert r["of_ceiling"] > 0 and r["kernel_of_ceiling"] > 0 and r["ceiling_goal"] == 0.5
+    timed_from_host = [r for r in rows if "same_work" in r]
+    assert all(r["same_work"] for r in timed_from_host), [r["same_work_note"] for r in timed_from_host]
+    assert any(r["method"].startswith("hand-written numba") for r in timed_from_host)
+    assert {r["method"].split(":")[0] for r in rows if r.get("kernel_alone")} == {
+        "rotframe kernel alone (GpuLaunch)", "hand-written numba CUDA kernel alone"}
+
+
+@pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
+def test_bench_gpu_without_a_gpu_exits_2_in_one_line(capsys):
+    assert cli.main(["bench", "gpu"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "bench: 'gpu' needs a CUDA GPU" in err
