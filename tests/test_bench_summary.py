@@ -1,8 +1,9 @@
 """The bench's summary per problem and error level, and its peers' right-hand sides (no timing asserted).
 
 The summary is checked on hand-made rows (what it must pick is known); the peers'
-right-hand sides against rotframe.rigid.dynamics.rigid_rhs and the particle equations
-written out here with np.cross (a third, plain writing of the same formulas).
+right-hand sides, and rotframe's own heavy-top right-hand side, against the heavy top's and the
+particle's equations written out here with np.cross and scipy's Rotation (a third, plain writing
+of the same formulas).
 """
 
 import math
@@ -50,9 +51,26 @@ def test_peer_rigid_rhs_match_rotframe():
     f, g = peers.python_rhs(spec), peers.numba_rhs(spec)
     for _ in range(5):
         y = rng.normal(size=7)
-        ref = rigid.rigid_rhs(0.0, y, inertia, mgl=0.04)
+        ref = _heavy_top_equations(y, inertia, 0.04)
+        assert np.allclose(rigid.rigid_rhs(0.0, y, inertia, mgl=0.04), ref, rtol=1e-13,
+                           atol=1e-13 * np.abs(ref).max())
         assert np.allclose(f(0.0, y), ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
         assert np.allclose(g(0.0, y), ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
+
+
+def _heavy_top_equations(y, inertia, mgl):
+    """Euler's equations with the gravity torque and the quaternion kinematics, written out here:
+    dL/dt = L x w + mgl z_b x e3 (z_b the space vertical in body axes, from scipy's Rotation),
+    dq/dt = q (x) (w, 0) / 2 in scalar-last form (vector qs w + qv x w, scalar -qv . w)."""
+    from scipy.spatial.transform import Rotation
+
+    L, q = y[:3], y[3:]
+    w = L / inertia
+    e3 = np.array([0.0, 0.0, 1.0])
+    z_b = Rotation.from_quat(q).inv().apply(e3)  # body -> space is R(q); its inverse takes space z to body axes
+    dL = np.cross(L, w) + mgl * np.cross(z_b, e3)
+    qv, qs = q[:3], q[3]
+    return np.concatenate([dL, 0.5 * (qs * w + np.cross(qv, w)), [-0.5 * qv @ w]])
 
 
 @pytest.mark.parametrize("spec", [

@@ -70,6 +70,36 @@ def test_lorentz_force_gyrates_at_the_cyclotron_radius():
     assert np.max(np.abs(radius - speed / (qm * B))) < 1e-9
 
 
+def _charged_particle(qm, B, E, r0, v0, t):
+    """Closed form of a' = qm (E + v x B), uniform fields: free fall along B at qm E_par, gyration at
+    qm |B| about the E x B drift across it (written out here, independent of rotframe)."""
+    B, E, r0, v0 = (np.asarray(a, dtype=float) for a in (B, E, r0, v0))
+    b = B / np.linalg.norm(B)
+    omega = qm * np.linalg.norm(B)
+    e_par = (E @ b) * b
+    drift = np.cross(E, B) / (B @ B)
+    v_par = (v0 @ b) * b
+    u0 = v0 - v_par - drift  # the gyrating part: du/dt = qm u x B = -omega b x u
+    c, s = np.cos(omega * t), np.sin(omega * t)
+    u = u0 * c - np.cross(b, u0) * s
+    v = v_par + qm * e_par * t + drift + u
+    r = r0 + (v_par + drift) * t + 0.5 * qm * e_par * t * t + (u0 * s + np.cross(b, u0) * (c - 1.0)) / omega
+    return r, v
+
+
+def test_lorentz_force_in_oblique_fields_drifts_at_e_cross_b():
+    """B oblique to every axis and E with parts along and across it: the closed form catches a
+    flipped sign, a swapped component or a dropped E (the B along z test alone would not)."""
+    qm, B, E = 1.5, [0.3, -0.4, 0.5], [0.2, 0.1, -0.3]
+    r0, v0, T = [1.0, -2.0, 0.5], [0.7, 0.4, -0.2], 12.0
+    run = simulate_particles(omega=[0.0, 0.0, 0.0], r0=r0, v0=v0, duration=T, forces=[forces.lorentz(qm, B, E)],
+                             rtol=1e-12, samples=40)
+    r, v = _charged_particle(qm, B, E, r0, v0, T)
+    assert np.linalg.norm(np.cross(E, B)) > 0.1  # a real drift
+    assert np.max(np.abs(run.trajectory.r[-1, 0] - r)) < 1e-9 * max(1.0, np.max(np.abs(r)))
+    assert np.max(np.abs(run.trajectory.v[-1, 0] - v)) < 1e-9 * max(1.0, np.max(np.abs(v)))
+
+
 def test_bad_constants_are_refused_in_one_line():
     with pytest.raises(ScenarioError, match="altitude_gravity: radius"):
         forces.altitude_gravity(9.81, 0.0)
