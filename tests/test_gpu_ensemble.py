@@ -214,3 +214,23 @@ def test_bench_gpu_without_a_gpu_exits_2_in_one_line(capsys):
     assert cli.main(["bench", "gpu"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "bench: 'gpu' needs a CUDA GPU" in err
+
+
+def test_a_run_that_asked_for_the_gpu_and_had_no_ensemble_says_so():
+    """``rotframe run foucault --device gpu``: one pendulum, no ensemble, so the CPU ran it; the
+    summary's warnings say that the device was not used (it was silent before)."""
+    res = _simulated(["-m", "rotframe", "run", "foucault", "--device", "gpu", "--no-record", "--json"])
+    assert res.returncode == 0, res.stderr[-3000:]
+    warnings = json.loads(res.stdout)["warnings"]
+    assert any(w.startswith("device = gpu is not used: this run of foucault has no ensemble") for w in warnings)
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["tower-drop", "--grid", "height=20:60:3", "--method", "dop853"], "method: 'dop853' on device 'gpu'"),
+    (["foucault", "--grid", "latitude=10:60:3"], "device: 'gpu' for a sweep of foucault"),
+])
+def test_a_gpu_sweep_no_row_could_run_on_the_gpu_is_refused_up_front(tmp_path, args, expected):
+    out = tmp_path / "s.parquet"
+    res = _simulated(["-m", "rotframe", "sweep", *args, "--device", "gpu", "--out", str(out)])
+    assert res.returncode == 2 and expected in res.stderr and len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert not out.exists()

@@ -52,7 +52,13 @@ def simulate(scn, values, *, method=None, terms=None, progress=None):
         raise ScenarioError(f"--method {method!r}: allowed for {scn.name}: {', '.join(allowed)}")
     params = {k: v for k, v in values.items() if k != "run"}
     terms = list(scn.model if terms is None else terms)
-    return scene.simulate(params, terms, method, run_settings, progress)
+    from rotframe.particles import gpu, threads
+
+    before = gpu.launches()
+    result = scene.simulate(params, terms, method, run_settings, progress)
+    if threads.device_in_force() == "gpu" and gpu.launches() == before:
+        result.extras["gpu_unused"] = True  # said in the summary's warnings (`summarize`)
+    return result
 
 
 def summarize(scn, values, result, timing, given=()):
@@ -86,7 +92,7 @@ def summarize(scn, values, result, timing, given=()):
         "diagnostics": _plain(analysis.get("diagnostics", {})),
         "warnings": list(analysis.get("warnings", [])) + theory_warnings(
             analysis["metrics"], theory, analysis.get("tolerance", {}), analysis.get("theory_notes", {}))
-        + unused_settings(given, values["run"], result.method),
+        + unused_settings(given, values["run"], result.method) + _gpu_unused(scn, result),
         "timing": dict(timing),
         "recording": None,
     }
@@ -119,6 +125,14 @@ def unused_settings(given, run, method):
            "adaptive": f"{method} is adaptive and chooses its own steps (set rtol instead)",
            "fixed": f"{method} takes fixed steps and has no tolerance (set step instead)"}[kind]
     return [f"{key} = {run.get(key)} is not used: {why}" for key in _UNREAD[kind] if key in given]
+
+
+def _gpu_unused(scn, result):
+    """A warning when the GPU was asked for (``--device gpu``) and this run had no ensemble for it."""
+    if not result.extras.get("gpu_unused"):
+        return []
+    return [f"device = gpu is not used: this run of {scn.name} has no ensemble (the GPU runs the ensembles of the "
+            f"fixed-step methods); it ran on the CPU"]
 
 
 def _plain(values: dict) -> dict:

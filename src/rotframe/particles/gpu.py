@@ -28,7 +28,7 @@ import types
 
 import numpy as np
 
-__all__ = ["available", "require", "device_function", "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
+__all__ = ["available", "require", "launches", "device_function", "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
 
 #: the particle methods the GPU runs (the fixed-step ones)
 GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
@@ -37,6 +37,7 @@ GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
 _THREADS_PER_BLOCK = 128
 
 _DEVICE = {}  # CPU dispatcher -> its GPU device function
+_LAUNCHES = [0]  # kernel launches in this process (`launches`)
 _KERNELS = {}  # (method, rk4, sphere, watch, steady, structure, registers) -> the compiled kernel, made on first use
 #: registers a thread at most (None: the compiler's choice); `tools/gpu_variants.py` times the choices
 _MAX_REGISTERS = None
@@ -47,6 +48,11 @@ def available() -> bool:
     from rotframe.particles.threads import gpu_available
 
     return gpu_available()
+
+
+def launches() -> int:
+    """How many ensembles this process has run on the GPU (a run that asked for the GPU and ran none is told)."""
+    return _LAUNCHES[0]
 
 
 def require(what="device"):
@@ -279,5 +285,6 @@ class GpuLaunch:
 
     def __call__(self, r, v, out, ev_t):
         blocks = (r.shape[0] + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
+        _LAUNCHES[0] += 1
         if blocks:
             self.kernel[blocks, _THREADS_PER_BLOCK](r, v, 0.0, self.h, self.steps, *self.settings, out, ev_t)

@@ -191,6 +191,7 @@ class _Context:
 
         scn = source.load()
         path = "ensemble" if hasattr(scenes.get(scn.scene), "simulate_ensemble") else "runs"
+        _check_gpu_sweep(scn, spec, path)
         track_rows = frozenset(int(i) for i in decimate(spec.n_rows, MAX_TRACKS))
         points = None if spec.axes else sweep_points(spec)  # a grid is computed row by row, lazily
         return cls(spec, files, meta, source, path, points, track_rows)
@@ -208,6 +209,25 @@ def check_task_timeout(task_timeout):
     """ScenarioError in one line unless ``task_timeout`` is None or a number of seconds > 0."""
     if task_timeout is not None and not (float(task_timeout) > 0):
         raise ScenarioError(f"--task-timeout {float(task_timeout):g}: must be > 0 seconds")
+
+
+def _check_gpu_sweep(scn, spec, path):
+    """ScenarioError in one line when the GPU is asked for (``--device gpu``) and no row could use it.
+
+    The GPU runs the ensembles of the fixed-step methods: a scene swept run by run, or an ensemble
+    of another method, would run every row on the CPU (or fail each row) after the user asked for it.
+    """
+    if _device_now() != "gpu":
+        return
+    from rotframe.particles.gpu import GPU_METHODS
+    from rotframe.particles.integrators import canonical_method
+
+    if path != "ensemble":
+        raise ScenarioError(f"device: 'gpu' for a sweep of {scn.name}, which runs one run a row (the GPU runs "
+                            "the ensembles of scenes such as tower-drop); use --device cpu")
+    method = spec.method or scn.with_values(dict(spec.sets))["run"].get("method")
+    if method is not None and canonical_method(method) not in GPU_METHODS:
+        raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
 
 
 def _device_now():
