@@ -8,6 +8,8 @@ torques are module-level functions so that the generated drivers are compiled on
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -216,6 +218,23 @@ def torque_nan_later(t, L, q, tau):
     if t > 1.0:
         return np.nan, 0.0, 0.0
     return tau[0], tau[1], tau[2]
+
+
+def torque_sqrt_later(t, L, q, tau):
+    s = math.sqrt(1.0 - t)  # compiled (error_model numpy): NaN after t = 1; as plain Python: ValueError
+    return tau[0] * s, tau[1] * s, tau[2] * s
+
+
+def test_torque_that_gives_nan_compiled_and_raises_in_python_is_named_in_one_line():
+    """The blame probe runs the torque as plain Python, where math.sqrt(-x) raises instead of giving
+    NaN: the failure must still be one IntegrationError line naming the torque, not a traceback."""
+    from rotframe.errors import IntegrationError
+
+    with pytest.raises(IntegrationError) as info:
+        rotframe.simulate_body(inertia=INERTIA, L0=L0, q0=Q0, duration=3.0, torque=torque_sqrt_later,
+                               params=(np.array([0.0, 0.0, 0.1]),), samples=30)
+    msg = str(info.value)
+    assert "\n" not in msg and "torque_sqrt_later" in msg and "ValueError" in msg
 
 
 def test_torque_that_fails_later_is_named():

@@ -238,7 +238,12 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         if torque is not None:  # a torque that turns non-finite at a time: probe it inside the failed step
             dt = hfix if method != "dop853" else 10.0 * float(H[0])
             for tp in (t_bad, t_bad + 1e-3 * dt, t_bad + 0.5 * dt, t_bad + dt):
-                a = np.asarray(uf.plain_function(torque)(tp, y[0, :3].copy(), y[0, 3:].copy(), *params), float)
+                try:  # as plain Python the torque may raise where compiled it gave NaN (math.sqrt(-1))
+                    a = np.asarray(uf.plain_function(torque)(tp, y[0, :3].copy(), y[0, 3:].copy(), *params), float)
+                except Exception as exc:  # the user's function, reported in the message
+                    blame = (f"; torque ({uf.display_name(torque)}) raised {type(exc).__name__}: {exc} "
+                             f"at t = {tp:.9g} s")
+                    break
                 if a.shape == (3,) and not np.all(np.isfinite(a)):
                     blame = f"; torque ({uf.display_name(torque)}) returned {a.tolist()} at t = {tp:.9g} s"
                     break

@@ -17,8 +17,12 @@ of repeated calls after one that compiles:
 - JAX: ``jit(vmap(particle))`` with ``lax.fori_loop`` over the same steps in
   float64 (a landed particle masked by ``where``), on JAX's default device.
 
+Then rotframe's kernel and the hand-written numba one alone, launched on arrays
+already on the GPU (no transfers; rotframe's through
+[`rotframe.particles.gpu.GpuLaunch`][rotframe.particles.gpu.GpuLaunch]).
+
 ``of_ceiling`` is rotframe's rate over the faster hand-written kernel's (the
-goal is 0.5 or more), ``vs_jax_vmap`` over JAX's where JAX ran on the same GPU
+goal is 0.5 or more), ``kernel_of_ceiling`` the same for the kernels alone, ``vs_jax_vmap`` over JAX's where JAX ran on the same GPU
 (the goal is 10 or more; null with a note where JAX ran elsewhere or is not
 installed). ``same_work``: every final state agrees with the numba kernel's to
 round-off and no particle landed. On numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``)
@@ -29,10 +33,11 @@ meaning (``simulator`` true).
 from __future__ import annotations
 
 import math
-import time
 import types
 
 import numpy as np
+
+from rotframe.app.bench.throughput import best_interleaved
 
 __all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL"]
 
@@ -62,7 +67,7 @@ def gpu_rows(quick):
     rows = []
     for method, rk4 in (("rotation-splitting", False), ("rk4", True)):
         for event in (True, False):
-            rows += _case(method, rk4, event, n, steps, quick or simulator, name)
+            rows += _case(method, rk4, event, n, steps, quick or simulator)
     for r in rows:
         r.update(gpu=name, simulator=simulator)
     return rows
@@ -78,7 +83,7 @@ def _gpu_name():
     return name.decode() if isinstance(name, bytes) else str(name)
 
 
-def _case(method, rk4, event, n, steps, quick, gpu_name):
+def _case(method, rk4, event, n, steps, quick):
     """The rows of one method, with or without the ground event."""
     from rotframe.app.bench import ceiling
     from rotframe.app.bench.throughput import same_state
@@ -132,7 +137,7 @@ def _case(method, rk4, event, n, steps, quick, gpu_name):
             notes.append(f"{case[0]}: failed here ({type(exc).__name__}: {exc})"[:300])
     ref = results[1][0]
     budget, rounds = (0.5, 3) if quick else (3.0, 10)
-    walls = _best_of([fn for _, fn, _ in cases], budget, rounds)
+    walls = best_interleaved([fn for _, fn, _ in cases], budget, rounds)
     total = n * steps
     label = f"{method}{' + ground event' if event else ''}"
     what = f"{label}, gravity + Coriolis, {n} particles x {steps} steps of {h:g} s, fp64"
@@ -201,24 +206,8 @@ def _kernels_alone(model, duration, event, method, run, hand, r0, v0, hand_args,
 
     ours()
     theirs()
-    walls = _best_of([theirs, ours], budget, rounds)
+    walls = best_interleaved([theirs, ours], budget, rounds)
     return [("hand-written numba CUDA kernel alone", walls[0]), ("rotframe kernel alone (GpuLaunch)", walls[1])]
-
-
-def _best_of(fns, budget, max_rounds):
-    """The shortest wall time of each of ``fns`` over interleaved rounds (at least two)."""
-    best = [math.inf] * len(fns)
-    spent = 0.0
-    rounds = 0
-    while rounds < 2 or (rounds < max_rounds and spent < budget * len(fns)):
-        for i, fn in enumerate(fns):
-            t0 = time.perf_counter()
-            fn()
-            wall = time.perf_counter() - t0
-            best[i] = min(best[i], wall)
-            spent += wall
-        rounds += 1
-    return best
 
 
 def _numba_ceiling_source(r, v, g, w, c, s, h, steps):

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 
-__all__ = ["ensemble_rows", "same_work", "sweep_rows", "startup_rows", "record_rows"]
+__all__ = ["ensemble_rows", "same_work", "same_state", "best_interleaved", "sweep_rows", "startup_rows", "record_rows"]
 
 
 def ensemble_rows(quick):
@@ -220,7 +220,7 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
              (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
              (f"hand-written {label}, 1 core", 1, serial),
              (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads, parallel)]
-    walls = _best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 15)
+    walls = best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 15)
     for (name, threads, fn), wall in zip(cases, walls):
         total = n * per_particle
         rows.append({"scenario": "ensemble", "method": name, "setting": what, "wall_s": wall, "error": math.nan,
@@ -281,7 +281,7 @@ def same_work(ours, hand, n, steps, h):
         note.removeprefix("NOT the same work: "))
 
 
-def _best_interleaved(fns, budget, max_rounds):
+def best_interleaved(fns, budget, max_rounds):
     """The shortest wall time of each of ``fns`` over rounds that run each once in turn (at least two rounds).
 
     Interleaved, so that a shared machine's busy spells fall on all of them alike.
