@@ -102,3 +102,12 @@ def test_a_prepared_run_is_timed_alone_and_gives_the_same_result():
     # a method that is not prepared times run itself
     call, finish = timed_call(p, "dop853", 1e-8)
     np.testing.assert_array_equal(finish(call())[0], p.run("dop853", 1e-8)[0])
+
+
+def test_bench_help_names_every_benchmark_that_is_not_a_problem():
+    from rotframe.app.bench import EXTRAS
+
+    out = subprocess.run([sys.executable, "-m", "rotframe", "bench", "--help"], capture_output=True, text=True,
+                         timeout=120).stdout
+    words = " ".join(out.split())  # argparse wraps the help text (user- force)
+    assert all(name in words.replace("- ", "-") for name in EXTRAS), words

@@ -134,7 +134,9 @@ def build_parser(commands):
     q.set_defaults(func=commands["run"])
 
     q = sub.add_parser("bench", help="speed against error for every method")
-    q.add_argument("names", nargs="*", metavar="NAME", help="problems to run (default: all)")
+    q.add_argument("names", nargs="*", metavar="NAME",
+                   help="scenario problems, or ensemble, sweep, startup, record, user-force, gpu (default: all; "
+                        "gpu only where a CUDA GPU is)")
     q.add_argument("--json", action="store_true", help="print a JSON list of rows on stdout and nothing else")
     q.add_argument("--quick", action="store_true", help="a short ladder, for a smoke test")
     q.add_argument("--plots", metavar="DIR", default=None, help="write work-precision PNGs to DIR")
