@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.problem.body import simulate_rigid_body
+from rotframe.rigid.observables import body_to_space
 from rotframe.problem.particles import simulate_particles
 from rotframe.scenes.base import SceneResult, run_setting, with_parameters
 
@@ -50,18 +51,8 @@ class TumblingBallParameters:
 PARAMETERS = TumblingBallParameters
 
 
-def _rotate(q, v):
-    """R(q) v for scalar-last unit quaternions q (n, 4), vectors v (n, 3): body -> space."""
-    u, s = q[:, :3], q[:, 3:4]
-    c = np.cross(u, v)
-    return v + 2 * s * c + 2 * np.cross(u, c)
-
-
-def _rotate_back(q, v):
-    """R(q)^T v: space -> body."""
-    u, s = q[:, :3], q[:, 3:4]
-    c = np.cross(u, v)
-    return v - 2 * s * c + 2 * np.cross(u, c)
+#: the conjugate of a scalar-last quaternion, as a factor
+_CONJUGATE = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 @with_parameters(TumblingBallParameters)
@@ -89,10 +80,10 @@ def oracle(body, times, r0, v0, w0):
     """The ball's exact path in body axes: the inertial straight line turned by the body's attitude."""
     q_at = _attitude_at(body, times)
     R0 = np.repeat(body.q[:1], 1, axis=0)
-    start = _rotate(R0, r0[None, :])[0]
-    vel = _rotate(R0, (v0 + np.cross(w0, r0))[None, :])[0]
+    start = body_to_space(R0, r0[None, :])[0]
+    vel = body_to_space(R0, (v0 + np.cross(w0, r0))[None, :])[0]
     line = start[None, :] + times[:, None] * vel[None, :]
-    return _rotate_back(q_at, line), line
+    return body_to_space(q_at * _CONJUGATE, line), line  # R(q)^T = R(q*): space -> body
 
 
 def _attitude_at(body, times):
