@@ -37,6 +37,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotframe.errors import ScenarioError
+from rotframe.problem.callables import check_call, plain_function
+from rotframe.validation import check_vector3
 
 __all__ = ["FrameSpec", "frame_spec", "origin_spec", "KINDS"]
 
@@ -152,15 +154,6 @@ def _quintic_basis_derivative(s):
             30 * s2 - 60 * s3 + 30 * s4, -12 * s2 + 28 * s3 - 15 * s4, 0.5 * (3 * s2 - 8 * s3 + 5 * s4))
 
 
-def _vector3(value, what):
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (3,):
-        raise ScenarioError(f"{what}: expected a 3-vector, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ScenarioError(f"{what}: {arr.tolist()} is not finite")
-    return np.ascontiguousarray(arr)
-
-
 def _table(value, what):
     times, vectors = value
     times = np.asarray(times, dtype=float)
@@ -230,18 +223,10 @@ def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
         if omega_dot is not None and not callable(omega_dot):
             raise ScenarioError(f"{what}_dot: must be a callable t -> (3,) beside a callable {what}")
         for f, name in ((value, what), (omega_dot, f"{what}_dot")):
-            if f is None:
-                continue
-            try:
-                out = np.asarray(getattr(f, "py_func", f)(0.0), dtype=float)
-            except Exception as exc:  # the user's function: any error is theirs, reported in one line
-                raise ScenarioError(f"{name}: {_name(f)} raised {type(exc).__name__}: {exc} at t = 0") from None
-            if out.shape != (3,):
-                raise ScenarioError(f"{name}: {_name(f)} returned shape {out.shape} at t = 0; expected (3,)")
-            if not np.all(np.isfinite(out)):
-                raise ScenarioError(f"{name}: {_name(f)} returned {out.tolist()} at t = 0 (not finite)")
+            if f is not None:
+                check_call(name, f, (0.0,), (3,), when="at t = 0")
         funcs = (value,) if omega_dot is None else (value, omega_dot)
-        step = derivative_step(getattr(value, "py_func", value)) if omega_dot is None else 0.0
+        step = derivative_step(plain_function(value)) if omega_dot is None else 0.0
         return FrameSpec("function", (np.array([step, 0.0, 0.0]),), funcs)
     if omega_dot is not None:
         raise ScenarioError(f"{what}_dot is only for a callable {what}")
@@ -249,7 +234,7 @@ def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
         return _body(value, what)
     if isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1 and np.ndim(value[1]) == 2:
         return _table(value, what)
-    return FrameSpec("constant", (_vector3(value, what),), is_constant=True)
+    return FrameSpec("constant", (np.ascontiguousarray(check_vector3(value, what, ScenarioError)),), is_constant=True)
 
 
 def origin_spec(value, what="origin_acceleration") -> FrameSpec:
@@ -262,7 +247,3 @@ def origin_spec(value, what="origin_acceleration") -> FrameSpec:
     if spec.kind == "constant" and not np.any(spec.data[0]):
         return FrameSpec("zero", (np.zeros(3),), is_constant=True)
     return spec
-
-
-def _name(f):
-    return getattr(f, "__qualname__", None) or getattr(f, "__name__", None) or repr(f)
