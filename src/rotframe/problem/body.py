@@ -24,7 +24,7 @@ from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import build_module
-from rotframe.problem.particles import DEFAULT_RTOL, DEFAULT_SAMPLES, STATUS, canonical_method
+from rotframe.problem.particles import STATUS, canonical_method
 
 __all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES", "Torque"]
 
@@ -115,7 +115,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     import time
 
     from rotframe import limits
-    from rotframe.problem.particles import check_params, number
+    from rotframe.problem.particles import check_params, run_grid
 
     attitude_only = bool(getattr(torque, "attitude_only", False))
     if isinstance(torque, Torque):
@@ -148,32 +148,13 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if abs(nq - 1.0) > 1e-6:
         raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
     q = q / nq
-    duration = number(duration, "duration", "s")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
+    fixed = method not in ("exact", "dop853")
+    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
     if torque is not None and not callable(torque):
         raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
     params = check_params(params)
-    samples = DEFAULT_SAMPLES if samples is None else samples
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
-    samples = int(samples)
-    times = np.linspace(0.0, duration, samples + 1)
-    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
-    if not (1e-15 <= rtol < 1):
-        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
     if method == "exact":
         return _exact(I, L, q, times)
-    hfix = 0.0
-    if method != "dop853":
-        step = duration / samples / 20 if step is None else number(step, "step", "s")
-        if not (math.isfinite(step) and step > 0) or step < 1e-300:
-            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
-        per = max(1, math.ceil((duration / samples) / step - 1e-9))
-        hfix = (duration / samples) / per
-        limits.check_run(steps=per * samples, samples=samples + 1, what=f"method {method}")
-    else:
-        limits.check_run(steps=samples, samples=samples + 1, what="method dop853")
     if torque is not None:
         uf.check_call("torque", torque, (0.0, L.copy(), q.copy(), *params), (3,),
                       when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")

@@ -31,7 +31,7 @@ from rotframe.problem.frame import frame_spec, origin_spec
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params",
-           "number", "sequence_of_callables"]
+           "number", "run_grid", "sequence_of_callables"]
 
 #: Methods of a user's particle problem (names are case-insensitive)
 PARTICLE_METHODS = ("dop853", "rk4")
@@ -112,6 +112,37 @@ def check_params(params):
             raise ScenarioError(f"params[{k}]: {p!r}; allowed: numbers and float arrays")
         out.append(np.ascontiguousarray(arr))
     return tuple(out)
+
+
+def run_grid(duration, samples, rtol, step, *, fixed, what, particles=1):
+    """A run's checked settings, ``(duration, samples, times (samples + 1,), rtol, hfix)``, within the work limits.
+
+    ``hfix`` is the fixed step of a fixed-step method (``fixed``): ``step`` (default a twentieth
+    of the sample interval) shortened to divide the sample interval; 0.0 for DOP853. A bad value
+    is a ScenarioError in one line; a run over the work limits a LimitError (`rotframe.limits`).
+    """
+    from rotframe import limits
+
+    duration = number(duration, "duration", "s")
+    if not (math.isfinite(duration) and duration > 0):
+        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
+    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
+    if not (1e-15 <= rtol < 1):
+        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
+    samples = DEFAULT_SAMPLES if samples is None else samples
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
+    samples = int(samples)
+    steps, hfix = samples, 0.0
+    if fixed:
+        step = duration / samples / 20 if step is None else number(step, "step", "s")
+        if not (math.isfinite(step) and step > 0) or step < 1e-300:
+            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
+        per = max(1, math.ceil((duration / samples) / step - 1e-9))
+        hfix = (duration / samples) / per
+        steps = per * samples
+    limits.check_run(steps=steps, samples=samples + 1, particles=particles, what=what)
+    return duration, samples, np.linspace(0.0, duration, samples + 1), rtol, hfix
 
 
 def number(value, key, unit):
@@ -304,11 +335,10 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     from rotframe import limits
 
     method = canonical_method(method, PARTICLE_METHODS, "dop853")
-    duration = number(duration, "duration", "s")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
     r, v = _states(r0, v0)
     N = r.shape[0]
+    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method == "rk4",
+                                                    what=f"method {method}", particles=N)
     frame = frame_spec(omega, omega_dot)
     origin = origin_spec(origin_acceleration)
     for spec, what in ((frame, "omega"), (origin, "origin_acceleration")):
@@ -321,24 +351,6 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if not callable(g):
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
-    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
-    if not (1e-15 <= rtol < 1):
-        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
-    samples = DEFAULT_SAMPLES if samples is None else samples
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
-    samples = int(samples)
-    times = np.linspace(0.0, duration, samples + 1)
-    hfix = 0.0
-    if method == "rk4":
-        step = duration / samples / 20 if step is None else number(step, "step", "s")
-        if not (math.isfinite(step) and step > 0) or step < 1e-300:
-            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
-        per = max(1, math.ceil((duration / samples) / step - 1e-9))
-        hfix = (duration / samples) / per
-        limits.check_run(steps=per * samples, samples=samples + 1, particles=N, what="method rk4")
-    else:
-        limits.check_run(steps=samples, samples=samples + 1, particles=N, what="method dop853")
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0)

@@ -22,7 +22,8 @@ already on the GPU (no transfers; rotframe's through
 [`rotframe.particles.gpu.GpuLaunch`][rotframe.particles.gpu.GpuLaunch]).
 
 ``of_ceiling`` is rotframe's rate over the faster hand-written kernel's (the
-goal is 0.5 or more), ``kernel_of_ceiling`` the same for the kernels alone, ``vs_jax_vmap`` over JAX's where JAX ran on the same GPU
+goal is 0.5 or more), ``kernel_of_ceiling`` the same for the kernels alone,
+``vs_jax_vmap`` over JAX's where JAX ran on the same GPU
 (the goal is 10 or more; null with a note where JAX ran elsewhere or is not
 installed). ``same_work``: every final state agrees with the numba kernel's to
 round-off and no particle landed. On numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``)
@@ -144,8 +145,9 @@ def _case(method, rk4, event, n, steps, quick):
     rows = []
     for (name, _, _), (state, landed), wall in zip(cases, results, walls):
         same, rel, note = same_state(state, landed, ref)
-        rows.append({"scenario": "gpu-ensemble", "method": f"{name}: {label}", "setting": what + ", host arrays in and out",
-                     "wall_s": wall, "error": math.nan, "error_kind": "throughput (best of repeats)", "nfev": int(total),
+        rows.append({"scenario": "gpu-ensemble", "method": f"{name}: {label}",
+                     "setting": what + ", host arrays in and out", "wall_s": wall, "error": math.nan,
+                     "error_kind": "throughput (best of repeats)", "nfev": int(total),
                      "particle_steps_per_s": total / wall, "integrator": method, "event": event,
                      "same_work": same, "same_work_max_rel": rel, "same_work_note": note})
     alone = _kernels_alone(model, duration, ground, method, run, numba_kernel, r0, v0, (g, w, c, s, h, steps),
