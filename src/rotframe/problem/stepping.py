@@ -122,7 +122,7 @@ def first_step(t, y, K, yt, rtol, atol, P, F, G, span):
 
 
 @jit
-def locate(method, k, t, y, h, g_lo, g_hi, Kb, ytb, ylo, yhi, ybuf, P, F, G):
+def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, P, F, G):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
     Returns tau in (0, h]; ``yhi`` holds the state there. The crossing is bracketed to round-off
@@ -130,8 +130,6 @@ def locate(method, k, t, y, h, g_lo, g_hi, Kb, ytb, ylo, yhi, ybuf, P, F, G):
     """
     lo = 0.0
     hi = h
-    for j in range(D):
-        ylo[j] = y[j]
     rhs(t, y, Kb[0], P, F, G)
     # yhi holds the full step's end on entry
     for _ in range(200):
@@ -143,11 +141,8 @@ def locate(method, k, t, y, h, g_lo, g_hi, Kb, ytb, ylo, yhi, ybuf, P, F, G):
         if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
             lo = mid
             g_lo = gm
-            for j in range(D):
-                ylo[j] = ybuf[j]
         else:
             hi = mid
-            g_hi = gm
             for j in range(D):
                 yhi[j] = ybuf[j]
     return hi
@@ -155,18 +150,16 @@ def locate(method, k, t, y, h, g_lo, g_hi, Kb, ytb, ylo, yhi, ybuf, P, F, G):
 
 @jit
 def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                rtol, atol, hfix, EDIR, ETERM, P, F, G):
+                rtol, atol, hfix, EDIR, ETERM, P, F, G, K, Kb, V):
+    # K, Kb (13, D) stages and V (7, D) state vectors: scratch of the calling block, made once for all its particles
     n = T.shape[0]
-    K = np.empty((13, D))
-    Kb = np.empty((13, D))
-    y = np.empty(D)
-    yt = np.empty(D)
-    yn = np.empty(D)
-    ytb = np.empty(D)
-    ylo = np.empty(D)
-    yhi = np.empty(D)
-    ybuf = np.empty(D)
-    yev = np.empty(D)
+    y = V[0]
+    yt = V[1]
+    yn = V[2]
+    ytb = V[3]
+    yhi = V[4]
+    ybuf = V[5]
+    yev = V[6]
     for j in range(D):
         y[j] = Y[i, j]
     t = TC[i]
@@ -235,7 +228,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
                 for j in range(D):
                     yhi[j] = yn[j]
-                tau = locate(method, k, t, y, t_new - t, g_old, g_new, Kb, ytb, ylo, yhi, ybuf, P, F, G)
+                tau = locate(method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, P, F, G)
                 m = EVN[i]
                 if m < EVT.shape[1]:
                     EVT[i, m] = t + tau
@@ -300,10 +293,13 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
 @jit
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
             atol, hfix, EDIR, ETERM, P, F, G):
+    K = np.empty((13, D))
+    Kb = np.empty((13, D))
+    V = np.empty((7, D))
     for i in range(lo, hi):
         if ST[i] == 0:
             advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G)
+                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G, K, Kb, V)
 
 
 @jit
