@@ -4,7 +4,6 @@ import json
 import logging
 import math
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -20,6 +19,7 @@ from rotframe.app import runner
 
 from rotframe.app import sweep  # noqa: E402
 from rotframe.errors import IntegrationError, ScenarioError  # noqa: E402
+from workers import busy_worker_killer  # noqa: E402
 
 REPO_SCENARIOS = __import__("pathlib").Path(__file__).resolve().parents[1] / "scenarios"
 
@@ -192,15 +192,8 @@ def test_a_lost_worker_costs_no_rows(cluster, tmp_path, monkeypatch):
     client = cluster
     pids = client.run(os.getpid)
     spec = sweep.parse_spec("foucault", sets={"duration": "300"}, grid=["latitude=-80:80:24"])
-    killed = []
-
-    def kill_a_busy_worker(done, total):
-        if killed:
-            return
-        busy = [w for w, keys in client.processing().items() if keys and w in pids]
-        victim = (busy or sorted(pids))[0]
-        os.kill(pids[victim], signal.SIGKILL)
-        killed.append(victim)
+    kill_a_busy_worker = busy_worker_killer(client, pids)
+    killed = kill_a_busy_worker.killed
 
     res = sweep.run_sweep(spec, "dask.parquet", client=client, batch_rows=2, on_batch=kill_a_busy_worker,
                           plots=False, recording=False)

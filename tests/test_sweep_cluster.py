@@ -31,6 +31,7 @@ distributed = pytest.importorskip("distributed")
 pq = pytest.importorskip("pyarrow.parquet")
 
 from rotframe.app import sweep  # noqa: E402
+from workers import busy_worker_killer  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 # a task may see one worker die under it (a second death is KilledWorker), and a worker holds one task at a time,
@@ -206,15 +207,8 @@ def test_a_worker_killed_mid_sweep_costs_no_rows(cluster, tmp_path, monkeypatch)
     client = cluster.client
     pids = cluster.worker_pids()
     spec = sweep.parse_spec(str(toml), samples=16, vary=["speed=normal(1600,5)"], seed=4)
-    killed = []
-
-    def kill_a_busy_worker(done, total):
-        if killed:
-            return
-        busy = [w for w, keys in client.processing().items() if keys and w in pids]
-        victim = (busy or sorted(pids))[0]
-        os.kill(pids[victim], signal.SIGKILL)
-        killed.append(victim)
+    kill_a_busy_worker = busy_worker_killer(client, pids)
+    killed = kill_a_busy_worker.killed
 
     res = sweep.run_sweep(spec, "dask.parquet", client=client, batch_rows=2, on_batch=kill_a_busy_worker,
                           plots=False, recording=False)
