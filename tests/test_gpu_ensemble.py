@@ -175,10 +175,9 @@ def test_the_gpu_model_structure_is_the_run_s_own_model(k):
 
     model = _models()[k]
     P, wt, wv = model.pack(), model.omega.times, model.omega.values
-    source = gpu._structure_source(P, wt, wv)
-    made = {"PackedModel": packed.PackedModel}
-    exec(source, made)
     host = packed.unpack.py_func(P, wt, wv)
+    made = {"PackedModel": packed.PackedModel}
+    exec(gpu._structure_source(host), made)
     assert made["structured"](host) == host
     # every field that is neither a switch nor zero is read, not frozen (so another run's values pass through)
     other = host._replace(**{f: 1.25 for f, v in zip(host._fields, host)

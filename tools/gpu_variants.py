@@ -51,7 +51,7 @@ def main(n=2**20, steps=16384, h=1e-3):
     model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(np.array(w)), g=np.array(g))
     P = model.pack()
     wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
-    structure = gpu._structure_source(P, wt, wv)
+    structure = gpu._structure_source(packed.unpack.py_func(P, wt, wv))
     c, s = ceiling.rotation_cos_sin(w, h)
     blocks = (n + 127) // 128
     d = {k: cuda.to_device(a) for k, a in dict(r=r0, v=v0, P=P, wt=wt, wv=wv, wint=wint).items()}

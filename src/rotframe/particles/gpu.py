@@ -23,12 +23,14 @@ it against the CPU ensemble on a machine without a GPU.
 
 from __future__ import annotations
 
+import functools
 import math
 import types
 
 import numpy as np
 
-__all__ = ["available", "require", "launches", "device_function", "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
+__all__ = ["available", "require", "check_method", "launches", "launch_shape", "device_function",
+           "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
 
 #: the particle methods the GPU runs (the fixed-step ones)
 GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
@@ -53,6 +55,22 @@ def available() -> bool:
 def launches() -> int:
     """How many ensembles this process has run on the GPU (a run that asked for the GPU and ran none is told)."""
     return _LAUNCHES[0]
+
+
+def launch_shape(n) -> tuple:
+    """``(blocks, threads per block)`` of a launch with one thread for each of ``n`` particles."""
+    return (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK, _THREADS_PER_BLOCK
+
+
+def check_method(method) -> str:
+    """``method``'s canonical name if the GPU runs it (`GPU_METHODS`); ScenarioError in one line otherwise."""
+    from rotframe.errors import ScenarioError
+    from rotframe.particles.integrators import canonical_method
+
+    method = canonical_method(method)
+    if method not in GPU_METHODS:
+        raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
+    return method
 
 
 def require(what="device"):
@@ -89,6 +107,7 @@ def device_function(kernel):
     return done
 
 
+@functools.cache
 def _inline_options():
     """Every device function inlined into its caller (``forceinline``, where numba's CUDA target has it).
 
@@ -163,10 +182,11 @@ def _ensemble_kernel_source(r, v, t0, h, n_steps, P, wt, wv, wint, events, out, 
     out[p, 0], out[p, 1], out[p, 2], out[p, 3], out[p, 4], out[p, 5] = state
 
 
-def _structure_source(P, wt, wv):
+def _structure_source(host):
     """Python source of ``structured(m)``: the packed model with its structure as constants.
 
-    ``m`` is `rotframe.particles.packed.unpack`'s model of this run, read on the GPU.
+    ``host`` is `rotframe.particles.packed.unpack`'s model of this run, unpacked on the host;
+    ``m`` is the same, read on the GPU.
     Every field that is a switch (a boolean, the gravity mode) or zero in this run is
     written as its value, the others are read from ``m``: with every device function
     inlined, the compiler drops the terms the model does not have and keeps no
@@ -177,7 +197,6 @@ def _structure_source(P, wt, wv):
     """
     from rotframe.particles import packed
 
-    host = packed.unpack.py_func(P, wt, wv)
     parts = []
     for name, value in zip(packed.PackedModel._fields, host):
         if isinstance(value, (bool, np.bool_)):
@@ -259,16 +278,12 @@ class GpuLaunch:
     def __init__(self, model, duration, event, *, method, run):
         from numba import cuda
 
-        from rotframe.errors import ScenarioError
         from rotframe.particles import packed
         from rotframe.particles.chunked import steps_per_sample
-        from rotframe.particles.integrators import METHODS, canonical_method
+        from rotframe.particles.integrators import METHODS
 
         require()
-        method = canonical_method(method)
-        if method not in GPU_METHODS:
-            raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
-        info = METHODS[method]
+        info = METHODS[check_method(method)]
         samples = max(1, int(run.get("samples") or 1))
         dt = duration / samples
         sps = steps_per_sample(dt, run.get("step"))
@@ -277,14 +292,13 @@ class GpuLaunch:
         P = model.pack()
         wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
         table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
-        steady = bool(np.all(wv == wv[0]))
-        sphere = True if P[packed.I_PLEN] > 0.0 else None
-        self.kernel = _kernel(info.code, True if info.code == 2 else None, sphere, event is not None, steady,
-                              _structure_source(P, wt, wv))
+        host = packed.unpack.py_func(P, wt, wv)  # the model as the kernel unpacks it: its switches, here
+        self.kernel = _kernel(info.code, True if info.code == 2 else None, True if host.length > 0.0 else None,
+                              event is not None, bool(host.steady), _structure_source(host))
         self.settings = [cuda.to_device(a) for a in (P, wt, wv, wint, table)]
 
     def __call__(self, r, v, out, ev_t):
-        blocks = (r.shape[0] + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
+        blocks, threads = launch_shape(r.shape[0])
         _LAUNCHES[0] += 1
         if blocks:
-            self.kernel[blocks, _THREADS_PER_BLOCK](r, v, 0.0, self.h, self.steps, *self.settings, out, ev_t)
+            self.kernel[blocks, threads](r, v, 0.0, self.h, self.steps, *self.settings, out, ev_t)

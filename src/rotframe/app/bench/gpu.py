@@ -46,8 +46,6 @@ __all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL"]
 CEILING_GOAL = 0.5
 JAX_GOAL = 10.0
 
-_THREADS_PER_BLOCK = 128
-
 
 def gpu_rows(quick):
     """The rows of ``rotframe bench gpu`` (see the module docstring); ScenarioError without a GPU."""
@@ -172,8 +170,9 @@ def _case(method, rk4, event, n, steps, quick):
         mine["jax_goal_met"] = bool(mine["vs_jax_vmap"] >= JAX_GOAL)
     else:
         mine["vs_jax_vmap"] = None
-        notes.append(f"JAX ran on {jax_device}, not this GPU: no ratio" if jax_rows else "")
-    mine["notes"] = "; ".join(n for n in notes if n)
+        if jax_rows:
+            notes.append(f"JAX ran on {jax_device}, not this GPU: no ratio")
+    mine["notes"] = "; ".join(notes)
     return rows
 
 
@@ -187,14 +186,14 @@ def _kernels_alone(model, duration, event, method, run, hand, r0, v0, hand_args,
     """
     from numba import cuda
 
-    from rotframe.particles.gpu import GpuLaunch
+    from rotframe.particles.gpu import GpuLaunch, launch_shape
 
     launch = GpuLaunch(model, duration, event, method=method, run=run)
     n = len(r0)
     d_r0, d_v0 = cuda.to_device(r0), cuda.to_device(v0)
     out, ev_t = cuda.device_array((n, 6)), cuda.device_array(n)
     r, v = cuda.device_array_like(d_r0), cuda.device_array_like(d_v0)
-    blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
+    shape = launch_shape(n)
 
     def ours():
         launch(d_r0, d_v0, out, ev_t)
@@ -203,7 +202,7 @@ def _kernels_alone(model, duration, event, method, run, hand, r0, v0, hand_args,
     def theirs():
         r.copy_to_device(d_r0)
         v.copy_to_device(d_v0)
-        hand[blocks, _THREADS_PER_BLOCK](r, v, *hand_args)
+        hand[shape](r, v, *hand_args)
         cuda.synchronize()
 
     ours()
@@ -236,9 +235,10 @@ def _host_to_host(kernel, r0, v0, g, w, c, s, h, steps):
     """A numba CUDA kernel's call from host arrays to host arrays: the final ``(r, v)``."""
     from numba import cuda
 
+    from rotframe.particles.gpu import launch_shape
+
     r, v = cuda.to_device(r0), cuda.to_device(v0)
-    blocks = (len(r0) + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
-    kernel[blocks, _THREADS_PER_BLOCK](r, v, g, w, c, s, h, steps)
+    kernel[launch_shape(len(r0))](r, v, g, w, c, s, h, steps)
     return r.copy_to_host(), v.copy_to_host()
 
 
@@ -303,6 +303,8 @@ def _cuda_c_ceiling(rk4, ground, notes):
     if config.ENABLE_CUDASIM:
         notes.append("CUDA C kernel: not on the simulator")
         return None
+    from rotframe.particles.gpu import launch_shape
+
     try:
         import cupy
     except ImportError:
@@ -317,9 +319,9 @@ def _cuda_c_ceiling(rk4, ground, notes):
     def call(r0, v0, g, w, c, s, h, steps):
         r, v = cupy.asarray(r0), cupy.asarray(v0)
         n = len(r0)
-        blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
-        kernel((blocks,), (_THREADS_PER_BLOCK,), (r, v, np.int64(n), *map(np.float64, g), *map(np.float64, w),
-                                                  np.float64(c), np.float64(s), np.float64(h), np.int64(steps)))
+        blocks, threads = launch_shape(n)
+        kernel((blocks,), (threads,), (r, v, np.int64(n), *map(np.float64, g), *map(np.float64, w),
+                                       np.float64(c), np.float64(s), np.float64(h), np.int64(steps)))
         return cupy.asnumpy(r), cupy.asnumpy(v)
 
     return call

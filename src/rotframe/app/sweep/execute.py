@@ -219,15 +219,14 @@ def _check_gpu_sweep(scn, spec, path):
     """
     if _device_now() != "gpu":
         return
-    from rotframe.particles.gpu import GPU_METHODS
-    from rotframe.particles.integrators import canonical_method
+    from rotframe.particles.gpu import check_method
 
     if path != "ensemble":
         raise ScenarioError(f"device: 'gpu' for a sweep of {scn.name}, which runs one run a row (the GPU runs "
                             "the ensembles of scenes such as tower-drop); use --device cpu")
     method = spec.method or scn.with_values(dict(spec.sets))["run"].get("method")
-    if method is not None and canonical_method(method) not in GPU_METHODS:
-        raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
+    if method is not None:
+        check_method(method)
 
 
 def _device_now():
