@@ -150,3 +150,19 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
     where = f"{caller}: " if caller else ""
     units = f" ({unit})" if unit else ""
     raise error_cls(f"{where}{name} = {shown} has shape {a.shape}; it must be {allowed}{units}")
+
+
+def refuse_units(value, key: str, error_cls: type[Exception] = ValueError, depth: int = 0) -> None:
+    """Refuse a value that carries a unit (an astropy Quantity, or a list or tuple holding one).
+
+    The numerical core takes plain float64 in SI; `numpy.asarray` would drop a Quantity's unit
+    without a word (milliseconds read as seconds). The Python doors convert Quantities first
+    (`rotframe.app.quantities.to_si`), so one that reaches the core was not converted: it is
+    refused in one line naming ``key``.
+    """
+    if hasattr(value, "unit") and hasattr(value, "to_value"):
+        raise error_cls(f"{key}: a Quantity ({value.unit}) is not converted here; pass plain SI numbers (the "
+                        "public doors, rotframe.simulate and simulate_body, convert Quantities)")
+    if depth < 4 and isinstance(value, (list, tuple)):
+        for k, item in enumerate(value):
+            refuse_units(item, f"{key}[{k}]", error_cls, depth + 1)

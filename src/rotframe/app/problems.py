@@ -50,18 +50,20 @@ def _summary(name, params, terms, method, steps, diagnostics, warnings, notes, t
     return summary
 
 
-def _si(value, unit, key):
-    """An astropy Quantity converted to ``unit`` (a plain value passes through: SI already)."""
-    if value is None or not (hasattr(value, "unit") and hasattr(value, "to_value")):
-        return value
-    from astropy import units as u
-
+def _atol_si(atol):
+    """``atol`` in SI: 6 values, 3 in m (r) then 3 in m/s (v); a single Quantity is ambiguous and refused."""
+    from rotframe.app.quantities import holds_quantity, is_quantity, to_si
     from rotframe.errors import ScenarioError
 
-    try:
-        return value.to_value(u.Unit(unit), equivalencies=u.dimensionless_angles())
-    except u.UnitConversionError:
-        raise ScenarioError(f"{key}: {value} cannot be converted to {unit}") from None
+    if not holds_quantity(atol):
+        return atol
+    if is_quantity(atol) and getattr(atol, "ndim", 0) == 0:
+        raise ScenarioError(f"atol={atol}: one Quantity cannot be both a length and a speed; give 6 values, "
+                            "3 in m (r) then 3 in m/s (v), or plain SI numbers")
+    values = list(atol)
+    if len(values) != 6:
+        raise ScenarioError(f"atol: {len(values)} values; 6 are expected, 3 in m (r) then 3 in m/s (v)")
+    return [to_si(a, "m" if k < 3 else "m/s", f"atol[{k}]") for k, a in enumerate(values)]
 
 
 def _progress(progress, label):
@@ -102,7 +104,10 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         Initial positions (m) and velocities (m/s) in the frame; N particles at once (one of
         them may be (3,), shared by all).
     duration : float
-        Seconds. Each length, speed, time and rate may also be an astropy Quantity (converted).
+        Seconds. Every input with a unit may also be an astropy Quantity, converted to SI:
+        vectors, lists of Quantities, the tables' times and vectors, ``atol`` (3 values in m,
+        then 3 in m/s) and ``params`` (each in SI base units, angles in radians). A function's
+        return must be plain numbers in SI.
     forces : sequence of callables or `rotframe.problem.particles.Force`
         ``f(t, r, v, *params) -> (ax, ay, az)``, m/s^2, frame axes (``Force(f, axes="inertial")``
         for inertial axes; ``potential=U`` for the energy or Jacobi diagnostic).
@@ -139,6 +144,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     from rotframe.errors import IntegrationError, ScenarioError
     from rotframe.particles.trajectory import RunInterrupted
     from rotframe.problem.particles import ProblemRun, simulate_particles
+    from rotframe.app.quantities import params_si, to_si, vector_or_table_si
 
     t0 = time.perf_counter()
     from rotframe.problem.particles import sequence_of_callables
@@ -149,10 +155,12 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
 
     bar = _progress(progress, "simulate")
     try:
-        omega = _si(omega, "rad/s", "omega")
-        r0, v0 = _si(r0, "m", "r0"), _si(v0, "m/s", "v0")
-        duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
-        origin_acceleration = _si(origin_acceleration, "m/s2", "origin_acceleration")
+        omega = vector_or_table_si(omega, "rad/s", "omega")
+        r0, v0 = to_si(r0, "m", "r0"), to_si(v0, "m/s", "v0")
+        duration, step = to_si(duration, "s", "duration"), to_si(step, "s", "step")
+        rtol, atol = to_si(rtol, "", "rtol"), _atol_si(atol)
+        origin_acceleration = vector_or_table_si(origin_acceleration, "m/s2", "origin_acceleration")
+        frame_attitude, params = to_si(frame_attitude, "", "frame_attitude"), params_si(params)
         with threads_scope(threads):
             run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
                                      origin_acceleration=origin_acceleration, events=events, method=method,
@@ -228,8 +236,11 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     from rotframe.scenes.user_problem import BodyProblemScene
 
     t0 = time.perf_counter()
-    inertia, L0 = _si(inertia, "kg m2", "inertia"), _si(L0, "kg m2/s", "L0")
-    duration, step = _si(duration, "s", "duration"), _si(step, "s", "step")
+    from rotframe.app.quantities import params_si, to_si
+
+    inertia, L0, q0 = to_si(inertia, "kg m2", "inertia"), to_si(L0, "kg m2/s", "L0"), to_si(q0, "", "q0")
+    duration, step, rtol = to_si(duration, "s", "duration"), to_si(step, "s", "step"), to_si(rtol, "", "rtol")
+    params = params_si(params)
     bar = _progress(progress, "simulate_body")
     try:
         run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,

@@ -10,7 +10,8 @@ plain number.
 
 from __future__ import annotations
 
-__all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities"]
+__all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities", "is_quantity", "holds_quantity",
+           "to_si", "is_table", "vector_or_table_si", "params_si"]
 
 
 class NotAQuantity(ValueError):
@@ -90,3 +91,92 @@ def as_quantities(values, units) -> dict:
         except ValueError:
             out[name] = value
     return out
+
+
+def is_quantity(value) -> bool:
+    """An astropy Quantity (or anything that carries a unit and converts like one)."""
+    return hasattr(value, "unit") and hasattr(value, "to_value")
+
+
+def holds_quantity(value, depth: int = 0) -> bool:
+    """``value`` is a Quantity, or a list, tuple or object array that holds one (at any depth up to 4)."""
+    if is_quantity(value):
+        return True
+    if depth > 4:
+        return False
+    if isinstance(value, (list, tuple)):
+        return any(holds_quantity(item, depth + 1) for item in value)
+    if getattr(value, "dtype", None) is not None and getattr(value.dtype, "hasobject", False):
+        return any(holds_quantity(item, depth + 1) for item in value.flat)
+    return False
+
+
+def to_si(value, unit: str, key: str):
+    """``value`` with every Quantity in it converted to ``unit`` (a number, a list or a vector of them).
+
+    The one converter of the Python doors (`rotframe.simulate`, `rotframe.simulate_body`): a
+    plain value passes unchanged (SI already); a Quantity, or a list or tuple holding some, is
+    converted element by element (angles as radians), so that no Quantity reaches the numerical
+    core with its unit dropped. A Quantity of another dimension is a one-line `ScenarioError`
+    naming ``key``, its unit and ``unit``.
+    """
+    if not holds_quantity(value):
+        return value
+    if is_quantity(value):
+        import astropy.units as u
+
+        from rotframe.errors import ScenarioError
+
+        try:
+            return value.to_value(u.Unit(unit) if unit else u.dimensionless_unscaled,
+                                  equivalencies=u.dimensionless_angles())
+        except (u.UnitsError, TypeError, ValueError):
+            shown = " ".join(str(value).split())[:60]
+            raise ScenarioError(f"{key}: {value.unit.to_string() or 'dimensionless'} cannot be converted to "
+                                f"{unit or 'a plain number'} ({shown})") from None
+    import numpy as np
+
+    converted = [to_si(item, unit, f"{key}[{k}]") for k, item in enumerate(np.asarray(value, dtype=object)
+                                                                           if not isinstance(value, (list, tuple))
+                                                                           else value)]
+    return converted
+
+
+def is_table(value) -> bool:
+    """``(times (n,), vectors (n, 3))``: the table form of omega and the origin's acceleration."""
+    import numpy as np
+
+    return (isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1
+            and np.ndim(value[1]) == 2)
+
+
+def vector_or_table_si(value, unit: str, key: str):
+    """A 3-vector or a table ``(times, vectors)`` in SI: times in s, vectors in ``unit``; other forms unchanged."""
+    if callable(value) or hasattr(value, "trajectory"):
+        return value  # a function (its return is checked: plain numbers) or a rigid-body Result
+    if is_table(value):
+        return (to_si(value[0], "s", f"{key} (the table's times)"), to_si(value[1], unit, f"{key} (the table's vectors)"))
+    return to_si(value, unit, key)
+
+
+def params_si(params, key: str = "params"):
+    """``params`` with each Quantity in SI base units (astropy's ``.si``: km/h -> m/s, deg -> rad).
+
+    A user's function receives plain numbers; rotframe cannot know which unit it wants but SI,
+    the unit of everything else it is given.
+    """
+    if not holds_quantity(params):
+        return params
+    if is_quantity(params):  # one Quantity array: its values are the parameters
+        params = list(params)
+    if not isinstance(params, (list, tuple)):
+        return params
+
+    def si(item, where):
+        if is_quantity(item):
+            return to_si(item, item.si.unit.to_string(), where)
+        if isinstance(item, (list, tuple)) and holds_quantity(item):
+            return [si(x, f"{where}[{j}]") for j, x in enumerate(item)]
+        return item
+
+    return tuple(si(item, f"{key}[{k}]") for k, item in enumerate(params))

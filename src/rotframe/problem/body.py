@@ -25,6 +25,7 @@ from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import build_module
 from rotframe.problem.particles import STATUS, canonical_method
+from rotframe.validation import refuse_units
 
 __all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES", "Torque"]
 
@@ -80,6 +81,7 @@ class BodyRun:
 
 
 def _inertia(inertia):
+    refuse_units(inertia, "inertia", ScenarioError)
     try:
         I = np.asarray(inertia, dtype=float)
     except (TypeError, ValueError):
@@ -103,7 +105,7 @@ def _inertia(inertia):
 def _header(nparams):
     args = "".join(f", P[{j}]" for j in range(nparams))
     return (f"\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n"
-            + f"    a = torque_fn(t, y[0:3], y[3:7]{args})\n    return a[0], a[1], a[2]\n")
+            + f"    a = torque_fn(t, readonly(y[0:3]), readonly(y[3:7]){args})\n    return a[0], a[1], a[2]\n")
 
 
 _FREE_HEADER = "\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n    return 0.0, 0.0, 0.0\n"
@@ -137,6 +139,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if method in KICK_METHODS and np.any(I != np.diag(np.diag(I))):
         raise ScenarioError(f"method={method!r} turns about the principal axes: give the 3 principal moments (a "
                             "diagonal inertia), or use dop853 or rk4")
+    refuse_units(L0, "L0", ScenarioError)
+    refuse_units(q0, "q0", ScenarioError)
     try:
         L = np.asarray(L0, dtype=float)
         q = np.asarray(q0, dtype=float)
@@ -163,9 +167,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         fn = numba.njit(uf.plain_function(torque), error_model="numpy") if jit else uf.plain_function(torque)
         functions = {"torque_fn": fn}
         header = _header(len(params))
-        key = uf.fingerprint(torque) + f"|{len(params)}"
+        key, cache_note = uf.cache_key([("torque", torque)], f"|{len(params)}")
     else:
-        functions, header, key = {}, _FREE_HEADER, "free"
+        functions, header, key, cache_note = {}, _FREE_HEADER, "free", None
     module = build_module("body", key, functions, header, BODY_SOURCE, compiled=jit)
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
@@ -184,7 +188,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     def call(budget):
         module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
                        st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
-                       (np.zeros(3),))
+                       (np.zeros(3),), np.empty(0))
 
     try:
         while True:
@@ -220,17 +224,20 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             dt = hfix if method != "dop853" else 10.0 * float(H[0])
             for tp in (t_bad, t_bad + 1e-3 * dt, t_bad + 0.5 * dt, t_bad + dt):
                 try:  # as plain Python the torque may raise where compiled it gave NaN (math.sqrt(-1))
-                    a = np.asarray(uf.plain_function(torque)(tp, y[0, :3].copy(), y[0, 3:].copy(), *params), float)
+                    a = np.asarray(uf.plain_function(torque)(tp, *uf.read_only_args((y[0, :3], y[0, 3:])),
+                                                             *params), float)
                 except Exception as exc:  # the user's function, reported in the message
-                    blame = (f"; torque ({uf.display_name(torque)}) raised {type(exc).__name__}: {exc} "
-                             f"at t = {tp:.9g} s")
+                    blame = "; " + uf.raised_message("torque", torque, exc, f"at t = {tp:.9g} s")
                     break
                 if a.shape == (3,) and not np.all(np.isfinite(a)):
                     blame = f"; torque ({uf.display_name(torque)}) returned {a.tolist()} at t = {tp:.9g} s"
                     break
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
-    return _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
+    run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
+    if cache_note and jit:
+        run.notes.append(cache_note)
+    return run
 
 
 def _torque_raised(exc, call, saved, y, TC, H, st, torque):
@@ -269,7 +276,8 @@ def _run(times, Y, method, st, I, complete, params, torque, compile_s, warnings,
         diagnostics["momentum_rel_drift"] = float(np.max(np.abs(Lm - Lm[0])) / Lm[0]) if Lm[0] else 0.0
     else:
         f = uf.plain_function(torque)
-        torque_samples = np.array([np.asarray(f(t, L[i], q[i], *params), float) for i, t in enumerate(times)])
+        torque_samples = np.array([np.asarray(f(t, *uf.read_only_args((L[i], q[i])), *params), float)
+                                   for i, t in enumerate(times)])
         notes.append("a torque acts: energy and |L| are not conserved, and not reported")
     warnings = list(warnings)
     if not jit:

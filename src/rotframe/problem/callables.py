@@ -8,13 +8,16 @@ new driver.
 
 The fingerprint (`fingerprint`) covers the function's code object (bytecode, constants,
 names, nested code), its defaults and closure values, and, recursively, every global it
-names that is a function, a numba dispatcher or a plain value (number, string, tuple, array);
-numba's version too. A module the function reaches through an attribute (``np.sin``) is
-named, not hashed.
+names, each by value: numba freezes every value a compiled function reads, so a value that
+changed must give a new driver. Numbers and numpy scalars are hashed by type and bytes, arrays
+by their bytes, a module by the attributes the code names (``cfg.K``), functions by their code
+and what they read; numba's version too. A value that cannot be hashed by value raises
+`Unfingerprintable`, and the problem's driver is then compiled for this run alone, not cached.
 """
 
 from __future__ import annotations
 
+import enum
 import hashlib
 import types
 
@@ -22,7 +25,8 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["fingerprint", "plain_function", "display_name", "check_call", "UserFunctionError"]
+__all__ = ["fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call", "UserFunctionError", "read_only_args",
+           "raised_message", "readonly_view", "readonly_array"]
 
 
 class UserFunctionError(ScenarioError):
@@ -42,10 +46,24 @@ def display_name(f) -> str:
     return f"{module}.{name}" if module and module not in ("__main__", "builtins") else name
 
 
-def _feed(h, obj, seen, depth=0):
-    if depth > 20:
-        h.update(b"<deep>")
-        return
+class Unfingerprintable(Exception):
+    """A value a user function reads that rotframe cannot hash by value (its driver is then not cached)."""
+
+
+#: deeper than this, a value is not hashed but refused (never skipped)
+_MAX_DEPTH = 60
+
+
+def _feed(h, obj, seen, names=(), depth=0):
+    """Hash ``obj`` by value into ``h``; ``names``: the attribute names the code that reads it uses.
+
+    numba freezes every global, closure value and default a compiled function reads, so each is
+    hashed by its value: numbers and numpy scalars by type and bytes, arrays by their bytes, a
+    module by the attributes the code names (``cfg.K`` hashes ``cfg.K``'s value), functions by
+    their code and what that reads. A value of any other kind raises `Unfingerprintable`.
+    """
+    if depth > _MAX_DEPTH:
+        raise Unfingerprintable(f"values nested deeper than {_MAX_DEPTH} levels")
     if isinstance(obj, types.CodeType):
         h.update(b"code")
         h.update(obj.co_code)
@@ -53,43 +71,79 @@ def _feed(h, obj, seen, depth=0):
         h.update(repr(obj.co_varnames).encode())
         h.update(repr(obj.co_freevars).encode())
         for c in obj.co_consts:
-            _feed(h, c, seen, depth + 1)
+            _feed(h, c, seen, names, depth + 1)
         return
     target = plain_function(obj)
     if isinstance(target, types.FunctionType):
         if id(target) in seen:
-            h.update(b"<seen>")
+            h.update(f"<seen {target.__qualname__}>".encode())
             return
         seen.add(id(target))
+        code_names = _global_names(target.__code__)
         h.update(f"fn {target.__module__}.{target.__qualname__}".encode())
-        _feed(h, target.__code__, seen, depth + 1)
-        _feed(h, target.__defaults__, seen, depth + 1)
+        _feed(h, target.__code__, seen, code_names, depth + 1)
+        _feed(h, target.__defaults__, seen, code_names, depth + 1)
+        _feed(h, target.__kwdefaults__, seen, code_names, depth + 1)
         for cell in target.__closure__ or ():
             try:
-                _feed(h, cell.cell_contents, seen, depth + 1)
+                value = cell.cell_contents
             except ValueError:  # an empty cell
                 h.update(b"<empty>")
-        for name in _global_names(target.__code__):
+                continue
+            _feed(h, value, seen, code_names, depth + 1)
+        for name in code_names:
             if name in target.__globals__:
                 h.update(f"global {name}".encode())
-                _feed(h, target.__globals__[name], seen, depth + 1)
+                _feed(h, target.__globals__[name], seen, code_names, depth + 1)
+        return
+    if isinstance(obj, np.generic):  # before the Python numbers: np.float64 is a float
+        h.update(f"scalar {obj.dtype.str} ".encode())
+        h.update(obj.tobytes())
+        return
+    if obj is None or obj is Ellipsis or isinstance(obj, (bool, int, float, complex, str, bytes)):
+        h.update(f"{type(obj).__module__}.{type(obj).__qualname__} {obj!r}".encode())
         return
     if isinstance(obj, np.ndarray):
-        h.update(f"array {obj.dtype} {obj.shape}".encode())
+        if obj.dtype.hasobject:
+            raise Unfingerprintable("an array of Python objects")
+        h.update(f"array {obj.dtype.str} {obj.shape}".encode())
         h.update(np.ascontiguousarray(obj).tobytes())
         return
     if isinstance(obj, (tuple, list)):
-        h.update(f"seq {len(obj)}".encode())
+        h.update(f"seq {type(obj).__qualname__} {len(obj)}".encode())
         for item in obj:
-            _feed(h, item, seen, depth + 1)
+            _feed(h, item, seen, names, depth + 1)
         return
-    if obj is None or isinstance(obj, (bool, int, float, complex, str, bytes)):
-        h.update(repr(obj).encode())
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):  # keyword defaults
+        h.update(f"dict {len(obj)}".encode())
+        for key in sorted(obj):
+            h.update(key.encode())
+            _feed(h, obj[key], seen, names, depth + 1)
         return
     if isinstance(obj, types.ModuleType):
+        if id(obj) in seen:
+            h.update(f"<seen module {obj.__name__}>".encode())
+            return
+        seen.add(id(obj))
         h.update(f"module {obj.__name__}".encode())
+        for name in names:  # what the code can read of it: cfg.K, np.pi, math.sin
+            if name in vars(obj):
+                h.update(f"attr {name}".encode())
+                _feed(h, vars(obj)[name], seen, names, depth + 1)
         return
-    h.update(f"object {type(obj).__module__}.{type(obj).__qualname__}".encode())
+    if isinstance(obj, enum.EnumMeta):  # numba freezes the members of an Enum class it reads
+        h.update(f"enum {obj.__module__}.{obj.__qualname__}".encode())
+        for member in obj:
+            _feed(h, (member.name, member.value), seen, names, depth + 1)
+        return
+    if isinstance(obj, type):
+        h.update(f"type {obj.__module__}.{obj.__qualname__}".encode())
+        return
+    if isinstance(obj, (types.BuiltinFunctionType, np.ufunc)):  # math.sin, np.sin: code, not values
+        module = getattr(obj, "__module__", None) or type(obj).__name__
+        h.update(f"builtin {module}.{getattr(obj, '__qualname__', obj.__name__)}".encode())
+        return
+    raise Unfingerprintable(f"a value of type {type(obj).__module__}.{type(obj).__qualname__}")
 
 
 def _global_names(code):
@@ -101,7 +155,13 @@ def _global_names(code):
 
 
 def fingerprint(*functions) -> str:
-    """A hex digest that changes when any of ``functions`` (or what they call) changes."""
+    """A hex digest that changes when any of ``functions`` (or what they read) changes.
+
+    Raises
+    ------
+    Unfingerprintable
+        A function reads a value that cannot be hashed by value (then its driver is not cached).
+    """
     import numba
 
     h = hashlib.sha256(f"numba {numba.__version__}".encode())
@@ -111,16 +171,40 @@ def fingerprint(*functions) -> str:
     return h.hexdigest()[:20]
 
 
+def cache_key(roles, extra: str):
+    """The driver's cache key from the fingerprints of ``roles`` (``[(role, function)]``), and a note.
+
+    Returns ``(key, None)``, or ``(None, note)`` when a function reads a value that cannot be
+    hashed by value: the driver is then compiled for this run alone (never reused with a stale
+    value), and the note says which function and why.
+    """
+    try:
+        return fingerprint(*(f for _, f in roles)) + extra, None
+    except Unfingerprintable:
+        pass
+    for role, f in roles:
+        try:
+            fingerprint(f)
+        except Unfingerprintable as exc:
+            return None, (f"{role} ({display_name(f)}) reads {exc}, which rotframe cannot fingerprint: its "
+                          "driver was compiled for this run alone (not cached)")
+    return None, "a user function reads a value rotframe cannot fingerprint: its driver was not cached"
+
+
 def check_call(role: str, f, args, shape, *, when: str) -> np.ndarray:
     """Call the plain Python ``f(*args)`` once and check its result's shape and finiteness.
 
     ``role`` names the argument (``forces[0]``), ``when`` the time and state (for messages).
     Returns the value as a float64 array.
     """
+    args = read_only_args(args)
     try:
         out = plain_function(f)(*args)
     except Exception as exc:  # the user's function: whatever it raises is reported in one line
-        raise UserFunctionError(f"{role} ({display_name(f)}) raised {type(exc).__name__}: {exc} {when}") from None
+        raise UserFunctionError(raised_message(role, f, exc, when)) from None
+    if hasattr(out, "unit") or (isinstance(out, (tuple, list)) and any(hasattr(x, "unit") for x in out)):
+        raise UserFunctionError(f"{role} ({display_name(f)}) returned a Quantity {when}; a function returns plain "
+                                "numbers in SI (m/s^2, rad/s, N m): its unit would be dropped")
     try:
         arr = np.asarray(out, dtype=float)
     except (TypeError, ValueError):
@@ -132,6 +216,42 @@ def check_call(role: str, f, args, shape, *, when: str) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise UserFunctionError(f"{role} ({display_name(f)}) returned {arr.tolist()} {when} (not finite)")
     return arr
+
+
+def readonly_view(a):
+    """A view of ``a`` that cannot be written (the plain-Python twin of `rotframe.problem.readonly.readonly`)."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
+def readonly_array(a) -> np.ndarray:
+    """A read-only float64 copy of ``a`` (a parameter, or an argument of a probe outside the drivers)."""
+    out = np.array(a, dtype=float)
+    out.flags.writeable = False
+    return out
+
+
+def read_only_args(args) -> tuple:
+    """``args`` with each array a read-only float64 copy: a function's arguments are never its to write."""
+    return tuple(readonly_array(a) if isinstance(a, np.ndarray) and a.flags.writeable else a for a in args)
+
+
+#: what a write into a read-only argument says, in numpy (plain Python) and in numba (compiling)
+_WRITE_SIGNS = ("assignment destination is read-only", "setitem(readonly array", "readonly array")
+
+
+def writes_into_arguments(text: str) -> bool:
+    """The message of a function that wrote into its read-only arguments (numpy's or numba's)."""
+    return any(sign in text for sign in _WRITE_SIGNS)
+
+
+def raised_message(role: str, f, exc: BaseException, when: str) -> str:
+    """One line for a user function that raised: a write into its arguments is named as such."""
+    if writes_into_arguments(str(exc)):
+        return (f"{role} ({display_name(f)}) writes into one of its arguments {when}; they are read-only (the "
+                "integrator's own state): work on a copy (r = r.copy())")
+    return f"{role} ({display_name(f)}) raised {type(exc).__name__}: {exc} {when}"
 
 
 def numba_reason(exc: BaseException) -> str:
@@ -150,10 +270,13 @@ def diagnose_compile(roles_and_functions, sample_args) -> str | None:
     import numba
 
     for role, f in roles_and_functions:
-        args = sample_args(role)
+        args = read_only_args(sample_args(role))  # as the drivers pass them: read-only
         try:
             numba.njit(plain_function(f))(*args)
         except numba.core.errors.NumbaError as exc:
+            if writes_into_arguments(str(exc)):
+                return (f"{role} ({display_name(f)}) writes into one of its arguments; they are read-only (the "
+                        "integrator's own state): work on a copy (r = r.copy())")
             return f"{role} ({display_name(f)}): numba cannot compile it: {numba_reason(exc)}"
         except Exception:  # it compiled; what it does at run time is checked elsewhere
             continue

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import itertools
 import os
 import sys
 import tempfile
@@ -60,8 +61,9 @@ import numpy as np
 from numba import njit
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as error_norm
+from rotframe.problem.readonly import readonly
 
-jit = njit(cache=True, error_model="numpy", nogil=True)
+jit = njit(cache={cache}, error_model="numpy", nogil=True)
 """
 
 _HEADER_PLAIN = """\
@@ -69,6 +71,7 @@ import math
 import numpy as np
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as _norm
+from rotframe.problem.callables import readonly_view as readonly
 
 error_norm = _norm.py_func
 
@@ -78,21 +81,28 @@ def jit(f):
 """
 
 
-def build_module(kind: str, key_material: str, functions: dict, header: str, body: str, *, compiled: bool):
-    """The generated module for one problem: imported from the cache (compiled) or built in memory (plain).
+def build_module(kind: str, key_material, functions: dict, header: str, body: str, *, compiled: bool):
+    """The generated module for one problem: imported from the cache (compiled) or built in memory.
 
     Parameters
     ----------
     kind : str
         ``"particle"`` or ``"body"`` (part of the module's name).
-    key_material : str
+    key_material : str or None
         The fingerprints of the functions and the structure; with the sources, it names the file.
+        None: a function reads a value that cannot be fingerprinted
+        (`rotframe.problem.callables.Unfingerprintable`), so the driver is compiled for this call
+        alone, in memory, never cached or reused.
     functions : dict
         Global name -> the user's function (a numba dispatcher when ``compiled``, else plain Python).
     header, body : str
         The problem's own definitions and the fixed driver source.
     """
-    source = (_HEADER_COMPILED if compiled else _HEADER_PLAIN) + "\nA, B, C, E3, E5 = _coefficients()\n"
+    cached = compiled and key_material is not None
+    head = _HEADER_COMPILED.format(cache=cached) if compiled else _HEADER_PLAIN
+    source = head + "\nA, B, C, E3, E5 = _coefficients()\n"
+    if key_material is None:
+        key_material = f"uncached {os.getpid()} {next(_UNCACHED)}"
     digest = hashlib.sha256((key_material + header + body + source).encode()).hexdigest()[:24]
     name = f"rotframe_{kind}_problem_{digest}"
     ENTRIES[digest] = functions
@@ -101,9 +111,9 @@ def build_module(kind: str, key_material: str, functions: dict, header: str, bod
         + header + body
     if name in sys.modules:
         return sys.modules[name]
-    if not compiled:
+    if not cached:
         module = types.ModuleType(name)
-        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # plain Python, nothing cached
+        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # nothing on disk
         return module
     folder = cache_dir()
     path = folder / f"{name}.py"
@@ -120,3 +130,7 @@ def build_module(kind: str, key_material: str, functions: dict, header: str, bod
         sys.modules.pop(name, None)
         raise
     return module
+
+
+#: numbers the uncached drivers of this process (each its own module)
+_UNCACHED = itertools.count()

@@ -38,9 +38,9 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 from rotframe.problem.callables import check_call, plain_function
-from rotframe.validation import check_vector3
+from rotframe.validation import check_vector3, refuse_units
 
-__all__ = ["FrameSpec", "frame_spec", "origin_spec", "KINDS"]
+__all__ = ["FrameSpec", "frame_spec", "origin_spec", "stop_times", "KINDS"]
 
 KINDS = ("constant", "table", "function", "body")
 
@@ -69,6 +69,32 @@ class FrameSpec:
     t_range: tuple = (-math.inf, math.inf)
     is_constant: bool = False
     notes: list = field(default_factory=list)
+    #: for ``body``: the order in h (sample interval) of a trajectory's error from the interpolant
+    #: (6 for the quintic Hermite of a free body, 4 where omega'' comes from differences: a torque)
+    order: int = 0
+
+    def coarsened(self):
+        """The same body frame from every other sample (None for another kind, or too few samples).
+
+        Comparing a run in this frame with the run in the full one estimates the error that the
+        frame's interpolation between samples makes (`rotframe.problem.particles`, Richardson).
+        """
+        if self.kind != "body" or self.data[0].size < 5:
+            return None
+        times, w, wd, wdd = self.data
+        keep = np.arange(0, times.size, 2)
+        if keep[-1] != times.size - 1:
+            keep = np.append(keep, times.size - 1)
+        tc, wc, wdc = times[keep], w[keep], wd[keep]
+        wddc = np.gradient(wdc, tc, axis=0) if self.order == 4 else wdd[keep]
+        return FrameSpec("body", tuple(np.ascontiguousarray(a) for a in (tc, wc, wdc, wddc)), t_range=self.t_range,
+                         order=self.order)
+
+    def knots(self) -> np.ndarray:
+        """Times where the vector's higher derivatives jump: a table's knots, a body's samples (else none)."""
+        if self.kind in ("table", "body"):
+            return np.asarray(self.data[0], dtype=float)
+        return np.empty(0)
 
     def vector_at(self, t):
         """The vector and its derivative at times ``t`` (numpy, for analysis and tests): two (n, 3) arrays."""
@@ -97,6 +123,18 @@ class FrameSpec:
         der = np.array([np.asarray(fd(float(tt)), dtype=float) if fd is not None
                         else central_difference(f, float(tt), h) for tt in t])
         return out, der
+
+
+def stop_times(specs, duration: float) -> np.ndarray:
+    """The sorted knots of ``specs`` inside (0, duration): no integrator step may cross one.
+
+    A spline or Hermite interpolant is smooth between its knots only; a step across a knot
+    integrates a function whose higher derivatives jump, and loses its order (a finer table then
+    gives a larger error). The drivers end a step on each (``S`` of `rotframe.problem.stepping`).
+    """
+    knots = np.concatenate([spec.knots() for spec in specs] + [np.empty(0)])
+    knots = np.unique(knots[(knots > 0.0) & (knots < duration)])
+    return np.ascontiguousarray(knots, dtype=float)
 
 
 def derivative_step(f) -> float:
@@ -156,6 +194,8 @@ def _quintic_basis_derivative(s):
 
 def _table(value, what):
     times, vectors = value
+    refuse_units(times, f"{what} (the table's times)", ScenarioError)
+    refuse_units(vectors, f"{what} (the table's vectors)", ScenarioError)
     times = np.asarray(times, dtype=float)
     vectors = np.asarray(vectors, dtype=float)
     if times.ndim != 1 or times.size < 2 or vectors.shape != (times.size, 3):
@@ -206,7 +246,7 @@ def _body(result, what):
         wdd = np.gradient(wd, times, axis=0)
         notes.append("the body had a torque: omega'' between samples from differences of omega' (cubic accuracy)")
     return FrameSpec("body", tuple(np.ascontiguousarray(a) for a in (times, w, wd, wdd)),
-                     t_range=(times[0], times[-1]), notes=notes)
+                     t_range=(times[0], times[-1]), notes=notes, order=6 if torque is None else 4)
 
 
 def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
@@ -234,6 +274,7 @@ def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
         return _body(value, what)
     if isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1 and np.ndim(value[1]) == 2:
         return _table(value, what)
+    refuse_units(value, what, ScenarioError)
     return FrameSpec("constant", (np.ascontiguousarray(check_vector3(value, what, ScenarioError)),), is_constant=True)
 
 

@@ -27,8 +27,10 @@ from rotframe.particles.trajectory import RunInterrupted, Trajectory
 from rotframe.problem import callables as uf
 from rotframe.problem.codegen import build_module
 from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
-from rotframe.problem.frame import frame_spec, origin_spec
+from rotframe.problem.frame import frame_spec, origin_spec, stop_times
+from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
+from rotframe.validation import refuse_units
 
 __all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params",
            "number", "run_grid", "sequence_of_callables"]
@@ -102,6 +104,7 @@ def _as_force(f, k):
 
 
 def check_params(params):
+    refuse_units(params, "params", ScenarioError)
     out = []
     for k, p in enumerate(params):
         if isinstance(p, (bool, int, float, np.integer, np.floating)):
@@ -110,7 +113,7 @@ def check_params(params):
         arr = np.asarray(p, dtype=float) if not isinstance(p, str) else None
         if arr is None or arr.dtype != np.float64:
             raise ScenarioError(f"params[{k}]: {p!r}; allowed: numbers and float arrays")
-        out.append(np.ascontiguousarray(arr))
+        out.append(uf.readonly_array(arr))  # C-contiguous, and no user function may write into it
     return tuple(out)
 
 
@@ -147,6 +150,7 @@ def run_grid(duration, samples, rtol, step, *, fixed, what, particles=1):
 
 def number(value, key, unit):
     """``value`` as a float, or a one-line ScenarioError naming ``key`` and the unit expected."""
+    refuse_units(value, key, ScenarioError)
     if isinstance(value, bool):
         raise ScenarioError(f"{key}={value!r}: a number ({unit}) is expected")
     try:
@@ -168,6 +172,7 @@ def sequence_of_callables(value, key):
 
 
 def _array(value, key):
+    refuse_units(value, key, ScenarioError)
     try:
         return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -197,7 +202,7 @@ def _header(frame, origin, forces, events, nparams, D):
     src = [f"\nD = {D}\nNE = {len(events)}\n", SEARCH_SOURCE,
            vector_source("frame_rates", frame.kind, True, "omega_fn", "omega_dot_fn" if len(frame.funcs) > 1 else ""),
            vector_source("origin_acceleration", origin.kind, False, "origin_fn")]
-    body = ["", "@jit", "def user_acceleration(t, y, P):", "    r = y[0:3]", "    v = y[3:6]",
+    body = ["", "@jit", "def user_acceleration(t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])",
             "    ax = 0.0", "    ay = 0.0", "    az = 0.0"]
     for k, f in enumerate(forces):
         body.append(f"    a = force_{k}(t, r, v{args})")
@@ -212,12 +217,12 @@ def _header(frame, origin, forces, events, nparams, D):
             body += ["    ax += a[0]", "    ay += a[1]", "    az += a[2]"]
     body.append("    return ax, ay, az")
     src.append("\n".join(body) + "\n")
-    ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = y[0:3]", "    v = y[3:6]"]
+    ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])"]
     for k in range(len(events)):
         ev.append(f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))")
     ev.append("    return 0.0")
     src.append("\n".join(ev) + "\n")
-    pot = ["", "@jit", "def potential(t, y, P):", "    r = y[0:3]", "    u = 0.0"]
+    pot = ["", "@jit", "def potential(t, y, P):", "    r = readonly(y[0:3])", "    u = 0.0"]
     for k, f in enumerate(forces):
         if f.potential is not None:
             pot.append(f"    u += float(potential_{k}(t, r{args}))")
@@ -286,10 +291,10 @@ def _blame(forces, params, t, y, dt=0.0):
     for k, f in enumerate(forces):
         for tp in probes:
             try:
-                a = np.asarray(uf.plain_function(f.accel)(tp, r.copy(), v.copy(), *params), dtype=float)
+                a = np.asarray(uf.plain_function(f.accel)(tp, *uf.read_only_args((r, v)), *params), dtype=float)
             except Exception as exc:  # the user's function, reported in the message
-                return (f"; forces[{k}] ({uf.display_name(f.accel)}) raised {type(exc).__name__}: {exc} "
-                        f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
+                return "; " + uf.raised_message(f"forces[{k}]", f.accel, exc,
+                                                f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
             if a.shape == (3,) and not np.all(np.isfinite(a)):
                 return (f"; forces[{k}] ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {tp:.9g} s, "
                         f"r = {r.tolist()}, v = {v.tolist()}")
@@ -301,6 +306,7 @@ def _scales(r, v, duration, rtol, atol, D):
     steps, and its numbers, do not depend on the other particles of the ensemble."""
     N = r.shape[0]
     if atol is not None:
+        refuse_units(atol, "atol", ScenarioError)
         a = np.asarray(atol, dtype=float)
         if a.ndim == 0:
             a = np.full(6, float(a))
@@ -357,7 +363,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
     roles = _roles(frame, origin, forces, events)
-    key = uf.fingerprint(*(f for _, f in roles)) + f"|{[f.axes for f in forces]}|{len(params)}"
+    key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
     header = _header(frame, origin, forces, events, len(params), D)
     module = build_module("particle", key, _bind(frame, origin, forces, events, jit), header, PARTICLE_SOURCE,
                           compiled=jit)
@@ -365,10 +371,14 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     y[:, :3] = r
     y[:, 3:6] = v
     if D == 10:
-        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else np.asarray(frame_attitude, float)
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else _array(frame_attitude, "frame_attitude")
+        if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
+            raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
+                                "numbers, not all 0")
         if frame_attitude is None and frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
+    y0_first = y[:1].copy()
     F = frame.data  # for a function: ([h, 0, 0],), the step of its derived omega'
     G = origin.data if origin.kind != "function" else (np.zeros(3),)
     atol_arr = _scales(r, v, duration, rtol, atol, D)
@@ -391,7 +401,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             module.start_events(0.0, y, state["GPREV"], params)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
-        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G)
+        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G, stop_times((frame, origin), duration))
         while True:
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
@@ -431,11 +441,16 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         partial = _trajectory(times, OUT, state, events, method, good)
         raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
                                "samples up to there are kept", t_reached=t_bad, partial=partial)
-    warnings, notes, diagnostics = [], list(frame.notes), {}
+    warnings, notes, diagnostics = [], list(frame.notes) + ([cache_note] if cache_note and jit else []), {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
     _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagnostics, notes)
+    try:
+        frame_interpolation(module, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
+                            warnings, notes)
+    except KeyboardInterrupt:
+        raise RunInterrupted(traj) from None
     if D == 10:
         traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
     dropped = int(np.sum(np.maximum(state["EVN"] - max_events, 0)))

@@ -15,6 +15,11 @@ header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
   time on the method's own discrete trajectory (as the built-in ground event,
   docs/physics/events.md). The earliest terminal crossing ends the particle; samples after
   it keep the state at the event.
+* Stops: ``S``, sorted times inside the run where the right-hand side is not smooth (the knots
+  of an omega or origin table, the samples of a body frame: the interpolant's higher
+  derivatives jump there). No step crosses one: a step that would is cut to end on it, as
+  DifferentialEquations.jl's ``tstops``, so each step integrates a smooth function and keeps its
+  order; RK4's grid goes on from the knot. Without this, a finer table gave larger errors.
 * ``atol`` is (N, D), one row per particle (its own scales).
 * Each particle is integrated alone, ``budget`` steps per call, so results do not depend on
   the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
@@ -122,6 +127,23 @@ def first_step(t, y, K, yt, rtol, atol, P, F, G, span):
 
 
 @jit
+def next_stop(S, t):
+    """The first stop time in the sorted S after t (inf if none): a knot where the right-hand side is not smooth."""
+    n = S.shape[0]
+    if n == 0 or S[n - 1] <= t:
+        return math.inf
+    lo = 0
+    hi = n - 1
+    while lo < hi:  # the first S[k] > t
+        mid = (lo + hi) // 2
+        if S[mid] > t:
+            hi = mid
+        else:
+            lo = mid + 1
+    return S[lo]
+
+
+@jit
 def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, P, F, G):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
@@ -150,7 +172,7 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, P, F, G):
 
 @jit
 def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                rtol, atol, hfix, EDIR, ETERM, P, F, G, K, Kb, V):
+                rtol, atol, hfix, EDIR, ETERM, P, F, G, S, K, Kb, V):
     # K, Kb (13, D) stages and V (7, D) state vectors: scratch of the calling block, made once for all its particles
     n = T.shape[0]
     y = V[0]
@@ -183,15 +205,29 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             idx += 1
             sub = 0
             continue
+        # a step ends on the next sample or the next stop (a knot of a table or a body frame), whichever is first
+        stop = next_stop(S, t)
+        at_knot = stop < T[idx]
+        target = stop if at_knot else T[idx]
         if method == 0:
-            span = T[idx] - t
+            span = target - t
             hh = h if h < span else span
             landing = hh == span
         else:
-            hh = hfix
-            sub += 1
-            landing = sub * hfix >= (T[idx] - T[idx - 1]) * (1.0 - 1e-12)
-        take_step(method, t, y, hh, T[idx] if landing else t + hh, K, yt, yn, P, F, G)
+            interval = T[idx] - T[idx - 1]
+            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
+            last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
+            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
+            if at_knot and stop < grid_next:
+                hh = stop - t  # to the knot; the grid goes on from there
+                landing = True
+            else:
+                at_knot = False
+                target = T[idx]
+                hh = hfix if on_grid else grid_next - t
+                sub += 1
+                landing = last
+        take_step(method, t, y, hh, target if landing else t + hh, K, yt, yn, P, F, G)
         steps += 1
         NSTEP[i] += 1
         NFEV[i] += 12 if method == 0 else 3 if method == 1 else 2
@@ -214,7 +250,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         if not ok:
             status = 3
             break
-        t_new = T[idx] if landing else t + hh
+        t_new = target if landing else t + hh
         if method != 0 and not landing:
             t_new = T[idx - 1] + sub * hfix
         # events over (t, t_new]: every crossing located; the earliest terminal one ends the particle
@@ -292,14 +328,14 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
 
 @jit
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
-            atol, hfix, EDIR, ETERM, P, F, G):
+            atol, hfix, EDIR, ETERM, P, F, G, S):
     K = np.empty((13, D))
     Kb = np.empty((13, D))
     V = np.empty((7, D))
     for i in range(lo, hi):
         if ST[i] == 0:
             advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G, K, Kb, V)
+                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G, S, K, Kb, V)
 
 
 @jit
