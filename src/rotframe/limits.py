@@ -3,9 +3,10 @@
 A run is refused, in one line with the estimate and the limit, when it would
 take more integration steps than `Limits.max_steps` (about a minute of
 compiled work for one particle) or keep more output samples than
-`Limits.max_samples` (memory); a sweep when it has more rows than
-`Limits.max_rows`. The command line raises them with ``--max-steps``,
-``--max-samples`` and ``--max-rows``.
+`Limits.max_samples` (memory), or allocate more than `Limits.max_memory` bytes in
+all; a sweep when it has more rows than `Limits.max_rows`. The command line raises them
+with ``--max-steps``, ``--max-samples``, ``--max-memory`` and ``--max-rows``; Python with
+``with rotframe.limits.applied(rotframe.limits.current().with_overrides(max_steps=1e10)):``.
 
 The limits in force are held in a `contextvars.ContextVar` set for the
 duration of one command (`applied`), so nothing outlives it; code that
@@ -39,11 +40,15 @@ class Limits:
         Output samples of one run (each particle's state, 48 bytes, twice over while analysed).
     max_rows : float
         Rows of one sweep.
+    max_memory : float
+        Bytes of the large arrays one run allocates together (samples, event slots, per-particle
+        state), counted before they are made (`rotframe.problem.pacing.check_memory`).
     """
 
     max_steps: float = 2e9
     max_samples: float = 5e6
     max_rows: float = 2e6
+    max_memory: float = 4e9
 
     def with_overrides(self, **kw) -> "Limits":
         return replace(self, **{k: float(v) for k, v in kw.items() if v is not None})

@@ -137,7 +137,16 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
         One line: ``[caller: ]name = VALUE has shape S; it must be ...`` (e.g.
         ``(..., 3)``, ``3 finite numbers (m)``).
     """
-    a = np.asarray(value, dtype=np.float64)
+    where = f"{caller}: " if caller else ""
+    units = f" ({unit})" if unit else ""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):  # text, a ragged list, complex, an object
+        shown = " ".join(str(value).split())[:60]
+        raise error_cls(f"{where}{name} = {shown!r} is not numbers; it must be "
+                        f"{'(..., 3) numbers' if stack else '3 numbers'}{units}") from None
+    if np.iscomplexobj(value):
+        raise error_cls(f"{where}{name} = {value!r} is complex; it must be real{units}")
     shape_ok = (a.ndim >= 1 and a.shape[-1] == 3) if stack else a.shape == (3,)
     if shape_ok and (not finite or np.all(np.isfinite(a))):
         return a
@@ -147,8 +156,6 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
     allowed = "(..., 3)" if stack else "3 numbers"
     if finite:
         allowed = ("finite, " if stack else "3 finite numbers") + (allowed if stack else "")
-    where = f"{caller}: " if caller else ""
-    units = f" ({unit})" if unit else ""
     raise error_cls(f"{where}{name} = {shown} has shape {a.shape}; it must be {allowed}{units}")
 
 

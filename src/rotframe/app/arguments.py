@@ -29,6 +29,8 @@ def add_limits(q, rows=False):
                    help="refuse a run of more integration steps than N (default 2e9)")
     q.add_argument("--max-samples", type=positive_count, default=None, metavar="N",
                    help="refuse a run that keeps more output samples than N (default 5e6)")
+    q.add_argument("--max-memory", type=positive_count, default=None, metavar="BYTES",
+                   help="refuse a run whose arrays need more than BYTES in all (default 4e9)")
     if rows:
         q.add_argument("--max-rows", type=positive_count, default=None, metavar="N",
                        help="refuse a sweep of more rows than N (default 2e6)")

@@ -241,7 +241,7 @@ def _limits(args):
 
     return limits.applied(limits.current().with_overrides(
         max_steps=getattr(args, "max_steps", None), max_samples=getattr(args, "max_samples", None),
-        max_rows=getattr(args, "max_rows", None)))
+        max_rows=getattr(args, "max_rows", None), max_memory=getattr(args, "max_memory", None)))
 
 
 def _threads(args):
@@ -309,7 +309,10 @@ def _run(args) -> int:
         _error((message or "run failed") + "; nothing was computed, so nothing was recorded")
         return status
     try:
-        summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets)
+        if len(result.trajectory.times) < 2:  # stopped at its first sample: nothing to analyse
+            summary = runner.summarize_minimal(scn, values, result, {"simulate_s": simulate_s})
+        else:
+            summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets)
     except KeyboardInterrupt as exc:  # during the analysis: keep the trajectory as a partial recording
         scope.note(exc)
         status = scope.exit_code

@@ -145,6 +145,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     from rotframe.particles.trajectory import RunInterrupted
     from rotframe.problem.particles import ProblemRun, simulate_particles
     from rotframe.app.quantities import params_si, to_si, vector_or_table_si
+    from rotframe.app.signals import InterruptScope
 
     t0 = time.perf_counter()
     from rotframe.problem.particles import sequence_of_callables
@@ -161,7 +162,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         rtol, atol = to_si(rtol, "", "rtol"), _atol_si(atol)
         origin_acceleration = vector_or_table_si(origin_acceleration, "m/s2", "origin_acceleration")
         frame_attitude, params = to_si(frame_attitude, "", "frame_attitude"), params_si(params)
-        with threads_scope(threads):
+        with threads_scope(threads), InterruptScope():  # SIGTERM stops the run as Ctrl-C does
             run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
                                      origin_acceleration=origin_acceleration, events=events, method=method,
                                      rtol=rtol, step=step, samples=samples, omega_dot=omega_dot, atol=atol,
@@ -242,9 +243,13 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     duration, step, rtol = to_si(duration, "s", "duration"), to_si(step, "s", "step"), to_si(rtol, "", "rtol")
     params = params_si(params)
     bar = _progress(progress, "simulate_body")
+    from rotframe.app.signals import InterruptScope
+
     try:
-        run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params,
-                                  method=method, rtol=rtol, step=step, samples=samples, jit=jit, progress=bar)
+        with InterruptScope():  # SIGTERM stops the run as Ctrl-C does
+            run = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque,
+                                      params=params, method=method, rtol=rtol, step=step, samples=samples, jit=jit,
+                                      progress=bar)
     finally:
         if progress is True:
             bar.close()

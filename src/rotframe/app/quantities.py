@@ -11,7 +11,7 @@ plain number.
 from __future__ import annotations
 
 __all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities", "is_quantity", "holds_quantity",
-           "to_si", "is_table", "vector_or_table_si", "params_si"]
+           "to_si", "vector_or_table_si", "params_si"]
 
 
 class NotAQuantity(ValueError):
@@ -142,16 +142,10 @@ def to_si(value, unit: str, key: str):
     return converted
 
 
-def is_table(value) -> bool:
-    """``(times (n,), vectors (n, 3))``: the table form of omega and the origin's acceleration."""
-    import numpy as np
-
-    return (isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1
-            and np.ndim(value[1]) == 2)
-
-
 def vector_or_table_si(value, unit: str, key: str):
     """A 3-vector or a table ``(times, vectors)`` in SI: times in s, vectors in ``unit``; other forms unchanged."""
+    from rotframe.problem.frame import is_table
+
     if callable(value) or hasattr(value, "trajectory"):
         return value  # a function (its return is checked: plain numbers) or a rigid-body Result
     if is_table(value):

@@ -387,8 +387,8 @@ class Recording:
     def finish(self, complete: bool = True) -> Path:
         """Encode, write through a temporary file and rename to the final or partial name.
 
-        Raises `rotframe.app.outputs.OutputError` (nothing left behind) when the
-        file cannot be written. If the write is interrupted, ``finish(complete=False)``
+        ``complete`` may be a callable, asked once the bytes are encoded. Raises
+        `rotframe.app.outputs.OutputError` (nothing left behind) when the file cannot be written. If the write is interrupted, ``finish(complete=False)``
         may be called again: the encoded bytes are kept until a write succeeds.
         """
         from rotframe.app.outputs import write_bytes_atomic
@@ -396,6 +396,8 @@ class Recording:
         if self._done:
             return self.final
         data = self._encoded()
+        if callable(complete):  # decided once the bytes are ready (a signal held meanwhile makes it a partial)
+            complete = complete()
         final = self.path if complete else partial_path(self.path)
         write_bytes_atomic(final, data, what="recording")
         self._done = True

@@ -183,24 +183,28 @@ def record_result(scn, values, result, summary, path, complete=True, scene=None)
     from rotframe import scenes
     from rotframe.app.record import Recording
 
+    from rotframe.app.signals import deferred
+
     scene = scene if scene is not None else scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}
-    rec = Recording(path, scn.name)
-    try:
-        scene.record(rec, params, result)
-        rec.text("scenario", summary_markdown(scn, summary))
-        rec.blueprint()
-    except BaseException as exc:
-        if isinstance(exc, KeyboardInterrupt):
-            exc.recording = rec.finish(complete=False)  # what was logged, finalized as the partial
-        else:
-            rec.abandon() if isinstance(exc, Exception) and not complete else rec.finish(complete=False)
-        raise
-    try:
-        return rec.finish(complete=complete)
-    except KeyboardInterrupt as exc:  # interrupted while writing: the same bytes go to the partial name
-        exc.recording = rec.finish(complete=False) if complete else None
-        raise
+    # a signal while recording is held until the file is written whole (a recording cut short is unreadable, and
+    # the run in it lost); then raised, with the file's path on it (`rotframe.app.signals.deferred`)
+    with deferred() as held:
+        rec = Recording(path, scn.name)
+        try:
+            scene.record(rec, params, result)
+            rec.text("scenario", summary_markdown(scn, summary))
+            rec.blueprint()
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt):  # a script's own Ctrl-C (no scope): what was logged, as partial
+                exc.recording = rec.finish(complete=False)
+            else:
+                rec.abandon() if isinstance(exc, Exception) and not complete else rec.finish(complete=False)
+            raise
+        # a stopped command never writes the final name: asked once the bytes are ready
+        final = rec.finish(complete=lambda: complete and not held.signalled)
+        held.attach(recording=final)
+    return final
 
 
 def summary_markdown(scn, summary) -> str:

@@ -12,11 +12,12 @@ SIGTERM.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
 
-__all__ = ["Terminated", "InterruptScope", "EXIT_SIGINT", "EXIT_SIGTERM"]
+__all__ = ["Terminated", "InterruptScope", "EXIT_SIGINT", "EXIT_SIGTERM", "deferred"]
 
 EXIT_SIGINT, EXIT_SIGTERM = 130, 143
 
@@ -47,6 +48,9 @@ class InterruptScope:
         #: instead of a traceback from the interpreter's shutdown or a death by signal
         self.final = final
         self.exit_status = 0
+        #: inside `deferred` blocks: a signal is held (``pending``) until the block ends
+        self.deferring = 0
+        self.pending = None
         self._previous = {}
         self._active = False
 
@@ -57,12 +61,18 @@ class InterruptScope:
             return
         self.terminated = True
         self.interrupted = True
+        if self.deferring:
+            self.pending = Terminated
+            return
         raise Terminated()
 
     def _on_int(self, signum, frame):
         if self.closing:
             return
         self.interrupted = True
+        if self.deferring:
+            self.pending = self.pending or KeyboardInterrupt
+            return
         raise KeyboardInterrupt()
 
     def _on_late(self, signum, frame):
@@ -97,6 +107,7 @@ class InterruptScope:
             os.kill(os.getpid(), sig)
 
     def __enter__(self):
+        _SCOPES.append(self)
         self._active = True
         self._previous_hook = sys.unraisablehook
         sys.unraisablehook = self._unraisable
@@ -113,6 +124,8 @@ class InterruptScope:
         return self
 
     def __exit__(self, *exc):
+        if self in _SCOPES:
+            _SCOPES.remove(self)
         self._active = False
         if sys.unraisablehook == self._unraisable:
             sys.unraisablehook = self._previous_hook
@@ -141,3 +154,52 @@ class InterruptScope:
     def verb(self) -> str:
         """'terminated' or 'interrupted', for the one-line message."""
         return "terminated" if self.terminated else "interrupted"
+
+
+#: the scopes in force in this process, innermost last
+_SCOPES: list = []
+
+
+class _Held:
+    """What a `deferred` block holds: the signal's exception, raised when the block ends, with ``attached`` on it."""
+
+    def __init__(self, scope=None):
+        self.attached = {}
+        self._scope = scope
+
+    @property
+    def signalled(self) -> bool:
+        """A signal arrived during the block (it will be raised when the block ends)."""
+        return self._scope is not None and self._scope.pending is not None
+
+    def attach(self, **values):
+        """Attributes for the held exception (``recording=path``: the file the block wrote)."""
+        self.attached.update(values)
+
+
+@contextlib.contextmanager
+def deferred():
+    """Hold Ctrl-C and SIGTERM while the block runs; raise the held one when it ends.
+
+    For work that must not be cut in the middle, whatever the signal: writing a recording (a
+    file cut short by a signal is unreadable, and the run it holds is lost). Every signal during
+    the block is held, a second SIGTERM too, and the exception it would have raised is raised
+    when the block ends, with the attributes given to `_Held.attach`. Outside an
+    `InterruptScope` (a script's own call), the block runs as it is.
+    """
+    scope = _SCOPES[-1] if _SCOPES else None
+    held = _Held(scope)
+    if scope is None:
+        yield held
+        return
+    scope.deferring += 1
+    try:
+        yield held
+    finally:
+        scope.deferring -= 1
+        if not scope.deferring and scope.pending is not None:
+            exc = scope.pending()
+            scope.pending = None
+            for key, value in held.attached.items():
+                setattr(exc, key, value)
+            raise exc

@@ -170,7 +170,7 @@ class KernelSetup:
         return evb.args()
 
     def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None,
-             sps=None):
+             sps=None, times=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
@@ -179,7 +179,9 @@ class KernelSetup:
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
         of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
         `sps`) let a fixed-step call start inside a sample interval and take part
-        of it (`one_sample_in_pieces`).
+        of it (`one_sample_in_pieces`). ``times`` (adaptive only) replaces the sample times
+        the call lands on: the probe's short spans, or the pieces of a long sample interval
+        (`run_chunked`).
 
         More particles than one block (`rotframe.particles.threads.BLOCK`) run in
         blocks on every core (`rotframe.particles.blocks.run_blocks`),
@@ -210,7 +212,7 @@ class KernelSetup:
             return n_done, bad, nfev, k * n_done
         h0 = self.h0 if h0 is None else h0
         end = first + 1 + max(count, 1)
-        times = self.times[first + 1:end]
+        times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
         steady = self.steady_args is not None
         if steady and r.shape[0] > threads.BLOCK:
             # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py):
@@ -287,6 +289,63 @@ class KernelSetup:
         return 1, -1, nfev, sps
 
 
+#: an adaptive call is kept under this many particle-steps (about a tenth of a second)
+CALL_STEPS = 2e5
+#: the probe's spans: from the first sample interval over 4^PROBE_DEPTH up, by factors of 4, until it took
+#: PROBE_STEPS steps (a span of 1e15 s is never integrated whole to learn its cost)
+PROBE_DEPTH = 24
+PROBE_STEPS = 2000
+
+
+def _probe(setup, r, v, alive, evb, atol, h_state, out_r, out_v, whole):
+    """Steps per particle an adaptive method takes over one sample interval, measured in bounded calls.
+
+    The first sample interval is probed from a short span up (its 4^-24 part, then 4 times longer at
+    each try) until a try took `PROBE_STEPS` steps or covered the interval; the count is scaled to
+    the whole interval. Each try is a fraction of a second however long the interval, so that a
+    signal is seen. The tries run on copies, so the run's own calls do not depend on them; where
+    the run is that one interval (``whole``), the last try is the run's own call on its arrays.
+
+    Returns ``(steps per sample interval, the run's own call's result or None)``.
+    """
+    t0, t1 = float(setup.times[0]), float(setup.times[1])
+    dt = t1 - t0
+    scratch = np.empty((1, r.shape[0], 3))
+    for k in range(PROBE_DEPTH, -1, -1):
+        end = t1 if k == 0 else t0 + dt / 4.0 ** k
+        if k > 0 and not end > t0:
+            continue
+        if k == 0 and whole:
+            result = setup.call(r, v, alive, 0, 1, out_r, out_v, evb, atol, h_state)
+            return float(result[3]), result
+        steps = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, scratch, scratch.copy(),
+                           EventBuffers(r.shape[0], evb.max_events), atol, h_state.copy(), times=np.array([end]))[3]
+        if k == 0 or steps >= PROBE_STEPS:
+            return float(steps) * dt / (end - t0), None
+    return 1.0, None
+
+
+def _pieces(per_sample, n):
+    """Pieces of a sample interval such that each is at most `CALL_STEPS` particle-steps (1: the interval whole)."""
+    return int(max(1, math.ceil(float(per_sample) * max(n, 1) / CALL_STEPS)))
+
+
+def _sample_in_pieces(setup, r, v, alive, done, pieces, out_r, out_v, evb, atol, h_state):
+    """One sample interval of an adaptive method landed on in ``pieces`` equal parts, a call each (`call`'s return)."""
+    t0, t1 = float(setup.times[done]), float(setup.times[done + 1])
+    steps = nfev = 0
+    for j in range(1, pieces + 1):
+        end = t1 if j == pieces else t0 + (t1 - t0) * j / pieces
+        start = t0 + (t1 - t0) * (j - 1) / pieces
+        n_done, bad, nf, st = setup.call(r, v, alive, done, 1, out_r[:1], out_v[:1], evb, atol, h_state,
+                                         t0=start, times=np.array([end]))
+        steps += st
+        nfev += nf
+        if n_done < 1 or bad >= 0:
+            return 0, bad, nfev, steps
+    return 1, -1, nfev, steps
+
+
 def _adaptive_chunk(info, per_sample, samples, n):
     """Samples per call of an adaptive kernel that took ``per_sample`` steps over its first sample.
 
@@ -351,6 +410,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     done = 0
     nfev = 0
     steps = 0
+    pieces = 1
     first = None  # the result of a first call already made on the run's own arrays
     try:
         compile_s = setup.warm_up()
@@ -358,12 +418,9 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             # an adaptive method's cost is known only once it ran: a probe of the first sample
             # interval projects the work and sizes the calls. On copies (the run itself is untouched,
             # so its chunks do not depend on the probe), except when that interval is the whole run
-            if samples == 1:
-                probe = first = setup.call(r, v, alive, 0, 1, out_r[1:2], out_v[1:2], evb, atol, h_state)
-            else:
-                probe = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, out_r[1:2].copy(), out_v[1:2].copy(),
-                                   EventBuffers(n, evb.max_events), atol, h_state.copy())
-            chunk = min(chunk, _adaptive_chunk(info, probe[3], samples, n))
+            per_sample, first = _probe(setup, r, v, alive, evb, atol, h_state, out_r[1:2], out_v[1:2], samples == 1)
+            chunk = min(chunk, _adaptive_chunk(info, per_sample, samples, n))
+            pieces = _pieces(per_sample, n)
         # fixed steps: calls of equal length (within a sample), no short last call that is all dispatch
         # (an adaptive method's last step in a call ends on the call's last sample: its calls keep their cut)
         calls = -(-samples // chunk) if info.kind == "fixed" else None
@@ -374,6 +431,11 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             sl = slice(done + 1, done + 1 + m)
             if first is not None:
                 (n_done, bad, nf, st), first = first, None
+            elif info.kind != "fixed" and pieces > 1:
+                # a sample interval of more steps than a call should take: landed on in pieces (a number fixed by
+                # the probe, so the same on every run), each a call of its own, so that signals are seen
+                n_done, bad, nf, st = _sample_in_pieces(setup, r, v, alive, done, pieces, out_r[sl], out_v[sl], evb,
+                                                        atol, h_state)
             elif info.kind == "fixed" and cost > CALL_EVALS:
                 # one sample interval is more than a chunk of work: advance it in pieces, so that
                 # Python regains control (signals, progress) between them

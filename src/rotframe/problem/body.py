@@ -24,6 +24,7 @@ from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import build_module
+from rotframe.problem.pacing import Pacer
 from rotframe.problem.particles import STATUS, canonical_method
 from rotframe.validation import refuse_units
 
@@ -116,7 +117,6 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
     import time
 
-    from rotframe import limits
     from rotframe.problem.particles import check_params, run_grid
 
     attitude_only = bool(getattr(torque, "attitude_only", False))
@@ -156,6 +156,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
     if torque is not None and not callable(torque):
         raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
+    uf.check_flag(jit, "jit")
+    if torque is not None:
+        uf.check_compilable("torque", torque, jit)
     params = check_params(params)
     if method == "exact":
         return _exact(I, L, q, times)
@@ -190,11 +193,13 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                        st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
                        (np.zeros(3),), np.empty(0))
 
+    pacer = Pacer("simulate_body", duration)  # calls sized in time: signals and progress between them
     try:
         while True:
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
+            budget = pacer.start()
             try:
-                call(20000)
+                call(budget)
             except Exception as exc:
                 import numba
 
@@ -202,15 +207,15 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                     reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
                     raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to "
                                                "run it in plain Python (slow)") from None
-                _torque_raised(exc, call, saved, y, TC, H, st, torque)
+                _torque_raised(exc, call, saved, y, TC, H, st, torque, budget)
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
+            pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
             if progress is not None:
                 progress(float(st["IDX"][0]) / n)
             if st["ST"][0] != 0:
                 break
-            if float(st["NSTEP"][0]) > limits.current().max_steps:
-                raise limits.LimitError(f"simulate_body: more than {limits.current().max_steps:.3g} steps")
+            pacer.check(st["NSTEP"], TC, H if method == "dop853" else np.zeros(1))
     except KeyboardInterrupt:
         k = max(int(st["IDX"][0]), 1)
         raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, torque, compile_s or 0.0,
@@ -240,14 +245,14 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     return run
 
 
-def _torque_raised(exc, call, saved, y, TC, H, st, torque):
+def _torque_raised(exc, call, saved, y, TC, H, st, torque, budget):
     """The torque raised inside a compiled call: replay the call one step at a time to give the time and state."""
     y[...], TC[...], H[...] = saved[0], saved[1], saved[2]
     for key, a in saved[3].items():
         st[key][...] = a
     what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     where = f"after t = {float(TC[0]):.9g} s"
-    for _ in range(20001):
+    for _ in range(int(budget) + 1):
         t, yi = float(TC[0]), y[0].copy()
         try:
             call(1)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import enum
 import hashlib
+import re
 import types
 
 import numpy as np
@@ -26,7 +27,8 @@ import numpy as np
 from rotframe.errors import ScenarioError
 
 __all__ = ["fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call", "UserFunctionError", "read_only_args",
-           "raised_message", "readonly_view", "readonly_array"]
+           "raised_message", "readonly_view", "readonly_array", "check_flag",
+           "check_compilable"]
 
 
 class UserFunctionError(ScenarioError):
@@ -191,6 +193,27 @@ def cache_key(roles, extra: str):
     return None, "a user function reads a value rotframe cannot fingerprint: its driver was not cached"
 
 
+def check_flag(value, key: str) -> bool:
+    """A True/False argument (``jit``), refused in one line when it is anything else (``"no"`` is truthy)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise UserFunctionError(f"{key}={value!r}: True or False")
+    return bool(value)
+
+
+def check_compilable(role: str, f, jit: bool) -> None:
+    """A function numba can compile is a plain ``def`` (or a numba dispatcher); anything else is refused by name.
+
+    A ``functools.partial``, a bound method or an object with ``__call__`` runs with ``jit=False`` only.
+    """
+    target = plain_function(f)
+    if not callable(target):
+        raise UserFunctionError(f"{role}: {str(f)[:60]!r} is not callable")
+    if jit and not isinstance(target, types.FunctionType):
+        kind = type(target).__module__ + "." + type(target).__qualname__
+        raise UserFunctionError(f"{role}: a {kind} ({display_name(f)}) is not a function numba can compile; write "
+                                "it as a def (bound values go in params=, or a closure), or pass jit=False")
+
+
 def check_call(role: str, f, args, shape, *, when: str) -> np.ndarray:
     """Call the plain Python ``f(*args)`` once and check its result's shape and finiteness.
 
@@ -254,15 +277,30 @@ def raised_message(role: str, f, exc: BaseException, when: str) -> str:
     return f"{role} ({display_name(f)}) raised {type(exc).__name__}: {exc} {when}"
 
 
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+#: lines of numba's message that frame its reason rather than give it
+_FRAMING = ("Failed in ", "During:", "File ", "^", "Traceback", "- Resolution failure", "<source missing",
+            "Enable logging", "This error may have been caused", "There are ", "For more information",
+            "Rewrite ", "raised from ", "No implementation of function Function(<built-in function setitem>)")
+
+
 def numba_reason(exc: BaseException) -> str:
-    """numba's reason for a failed compile, in one line (its first informative line)."""
-    text = str(exc)
-    for line in text.splitlines():
-        line = line.strip()
-        if line and not line.startswith(("During:", "File ", "^", "Traceback", "- Resolution failure",
-                                         "[1m", "\x1b")):
-            return line[:300]
-    return type(exc).__name__
+    """numba's reason for a failed compile, in one line: its informative lines, without colour codes.
+
+    numba starts with the pipeline step that failed ("Failed in nopython mode pipeline (step:
+    nopython frontend)"), which says where, not why; the lines after it say why ("Untyped global
+    name 'cfg': Cannot determine Numba type of <class 'Cfg'>").
+    """
+    lines = [" ".join(_ANSI.sub("", line).split()) for line in str(exc).splitlines()]
+    useful = []
+    for line in lines:
+        if line.startswith("File "):  # the source lines that follow are context, not the reason
+            break
+        if line and not line.startswith(_FRAMING):
+            useful.append(line)
+    if not useful:
+        return type(exc).__name__
+    return "; ".join(useful[:2])[:300]
 
 
 def diagnose_compile(roles_and_functions, sample_args) -> str | None:

@@ -40,7 +40,7 @@ from rotframe.errors import ScenarioError
 from rotframe.problem.callables import check_call, plain_function
 from rotframe.validation import check_vector3, refuse_units
 
-__all__ = ["FrameSpec", "frame_spec", "origin_spec", "stop_times", "KINDS"]
+__all__ = ["FrameSpec", "frame_spec", "origin_spec", "stop_times", "is_table", "KINDS"]
 
 KINDS = ("constant", "table", "function", "body")
 
@@ -196,8 +196,12 @@ def _table(value, what):
     times, vectors = value
     refuse_units(times, f"{what} (the table's times)", ScenarioError)
     refuse_units(vectors, f"{what} (the table's vectors)", ScenarioError)
-    times = np.asarray(times, dtype=float)
-    vectors = np.asarray(vectors, dtype=float)
+    try:
+        times = np.asarray(times, dtype=float)
+        vectors = np.asarray(vectors, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{what}: a table is (times (n,), vectors (n, 3)) of real numbers; got "
+                            f"{' '.join(str(value).split())[:80]!r} (ragged, text or complex)") from None
     if times.ndim != 1 or times.size < 2 or vectors.shape != (times.size, 3):
         raise ScenarioError(f"{what}: a table is (times (n,), vectors (n, 3)) with n >= 2; got shapes "
                             f"{times.shape} and {vectors.shape}")
@@ -249,6 +253,21 @@ def _body(result, what):
                      t_range=(times[0], times[-1]), notes=notes, order=6 if torque is None else 4)
 
 
+def is_table(value) -> bool:
+    """``(times, vectors)``: a pair whose first entry is 1-D and whose second is a sequence of sequences (even ragged)."""
+    if not (isinstance(value, (tuple, list)) and len(value) == 2):
+        return False
+    try:
+        first = np.ndim(value[0]) == 1
+    except ValueError:  # ragged
+        return False
+    second = value[1]
+    try:
+        return first and np.ndim(second) == 2
+    except ValueError:  # a ragged (n, 3): a table still, refused by _table in one line
+        return first and len(second) > 0 and all(hasattr(row, "__len__") for row in second)
+
+
 def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
     """Normalise a frame's angular velocity (rad/s, frame axes) to a `FrameSpec`.
 
@@ -272,7 +291,7 @@ def frame_spec(value, omega_dot=None, what="omega") -> FrameSpec:
         raise ScenarioError(f"{what}_dot is only for a callable {what}")
     if hasattr(value, "trajectory"):
         return _body(value, what)
-    if isinstance(value, (tuple, list)) and len(value) == 2 and np.ndim(value[0]) == 1 and np.ndim(value[1]) == 2:
+    if is_table(value):
         return _table(value, what)
     refuse_units(value, what, ScenarioError)
     return FrameSpec("constant", (np.ascontiguousarray(check_vector3(value, what, ScenarioError)),), is_constant=True)

@@ -29,6 +29,7 @@ from rotframe.problem.codegen import build_module
 from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
+from rotframe.problem.pacing import Pacer, check_knots, check_memory
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 from rotframe.validation import refuse_units
 
@@ -104,17 +105,44 @@ def _as_force(f, k):
 
 
 def check_params(params):
+    """``params`` as a tuple of floats and read-only float64 arrays, or a one-line ScenarioError naming the entry."""
     refuse_units(params, "params", ScenarioError)
+    if isinstance(params, (str, bytes, dict)) or not isinstance(params, (tuple, list, np.ndarray)):
+        raise ScenarioError(f"params={str(params)[:60]!r}: a tuple of numbers or float arrays, such as params=(4.0,) "
+                            "(passed to every function after t, r, v)")
     out = []
     for k, p in enumerate(params):
-        if isinstance(p, (bool, int, float, np.integer, np.floating)):
+        if isinstance(p, (bool, int, float, np.integer, np.floating)) and not isinstance(p, np.bool_):
             out.append(float(p))
             continue
-        arr = np.asarray(p, dtype=float) if not isinstance(p, str) else None
-        if arr is None or arr.dtype != np.float64:
-            raise ScenarioError(f"params[{k}]: {p!r}; allowed: numbers and float arrays")
+        arr = None
+        if not isinstance(p, (str, bytes, dict, complex, np.complexfloating)):
+            try:
+                arr = np.asarray(p)
+            except (TypeError, ValueError):  # a ragged list
+                arr = None
+        if arr is None or arr.dtype.kind not in "iuf" or arr.size == 0:
+            raise ScenarioError(f"params[{k}]: {str(p)[:60]!r}; allowed: a real number or a non-empty array of real "
+                                "numbers (not complex, ragged, text or a dict)")
+        if not np.all(np.isfinite(arr)):
+            raise ScenarioError(f"params[{k}]: not finite")
         out.append(uf.readonly_array(arr))  # C-contiguous, and no user function may write into it
     return tuple(out)
+
+
+def check_event(g, k):
+    """An event's ``direction`` (its sign) and ``terminal``, checked: ``(float, bool)``."""
+    direction = getattr(g, "direction", 0) or 0
+    terminal = getattr(g, "terminal", False)
+    if isinstance(direction, (str, bytes, bool, complex)) or not isinstance(direction, (int, float, np.integer,
+                                                                                        np.floating)):
+        raise ScenarioError(f"events[{k}].direction = {direction!r}: a number, its sign taken: 1 (rising), -1 "
+                            "(falling) or 0 (both)")
+    if not math.isfinite(float(direction)):
+        raise ScenarioError(f"events[{k}].direction = {direction!r}: a finite number (1, -1 or 0)")
+    if not isinstance(terminal, (bool, np.bool_)) and terminal not in (0, 1):
+        raise ScenarioError(f"events[{k}].terminal = {terminal!r}: True or False")
+    return float(np.sign(direction)), bool(terminal)
 
 
 def run_grid(duration, samples, rtol, step, *, fixed, what, particles=1):
@@ -306,8 +334,7 @@ def _scales(r, v, duration, rtol, atol, D):
     steps, and its numbers, do not depend on the other particles of the ensemble."""
     N = r.shape[0]
     if atol is not None:
-        refuse_units(atol, "atol", ScenarioError)
-        a = np.asarray(atol, dtype=float)
+        a = _array(atol, "atol")
         if a.ndim == 0:
             a = np.full(6, float(a))
         if a.shape != (6,) or not np.all(a > 0):
@@ -338,9 +365,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     """
     import time
 
-    from rotframe import limits
-
     method = canonical_method(method, PARTICLE_METHODS, "dop853")
+    uf.check_flag(jit, "jit")
     r, v = _states(r0, v0)
     N = r.shape[0]
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method == "rk4",
@@ -363,10 +389,17 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
     roles = _roles(frame, origin, forces, events)
+    for role, f in roles:
+        uf.check_compilable(role, f, jit)
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
     header = _header(frame, origin, forces, events, len(params), D)
     module = build_module("particle", key, _bind(frame, origin, forces, events, jit), header, PARTICLE_SOURCE,
                           compiled=jit)
+    slots = max_events if events else 1  # event records: none are kept without events
+    n = samples + 1
+    check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
+                              "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
+    check_knots("simulate", stop_times((frame, origin), duration).size, N)
     y = np.zeros((N, D))
     y[:, :3] = r
     y[:, 3:6] = v
@@ -382,17 +415,16 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     F = frame.data  # for a function: ([h, 0, 0],), the step of its derived omega'
     G = origin.data if origin.kind != "function" else (np.zeros(3),)
     atol_arr = _scales(r, v, duration, rtol, atol, D)
-    n = samples + 1
     OUT = np.full((n, N, D), np.nan)
     state = dict(TC=np.zeros(N), H=np.zeros(N), IDX=np.zeros(N, np.int64), SUB=np.zeros(N, np.int64),
-                 ST=np.zeros(N, np.int64), EVT=np.full((N, max_events), np.nan), EVY=np.zeros((N, max_events, D)),
-                 EVK=np.zeros((N, max_events), np.int64), EVN=np.zeros(N, np.int64),
+                 ST=np.zeros(N, np.int64), EVT=np.full((N, slots), np.nan), EVY=np.zeros((N, slots, D)),
+                 EVK=np.zeros((N, slots), np.int64), EVN=np.zeros(N, np.int64),
                  GPREV=np.zeros((N, max(len(events), 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
-    EDIR = np.array([float(np.sign(getattr(g, "direction", 0) or 0)) for g in events] or [0.0])
-    ETERM = np.array([bool(getattr(g, "terminal", False)) for g in events] or [False])
-    budget = max(16, int(2e5 // max(N, 1)))  # about 0.1 s of work a call: signals and progress between calls
+    settings = [check_event(g, k) for k, g in enumerate(events)]
+    EDIR = np.array([d for d, _ in settings] or [0.0])
+    ETERM = np.array([t for _, t in settings] or [False])
+    pacer = Pacer("simulate", duration)  # calls sized in time: signals and progress between them
     code = 0 if method == "dop853" else 1
-    lim = limits.current()
     t0 = time.perf_counter()
     compile_s = 0.0
     first = True
@@ -405,6 +437,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         while True:
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
+            budget = pacer.start()
             try:
                 advance_blocks(module.advance, N, before + (budget,) + after)
             except Exception as exc:
@@ -417,6 +450,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             if first:
                 compile_s = time.perf_counter() - t0
                 first = False
+            pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
@@ -424,9 +458,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                 break
             if np.all(ST != 0):
                 break
-            if float(np.sum(state["NSTEP"])) > lim.max_steps:
-                raise limits.LimitError(f"simulate: more than {lim.max_steps:.3g} integration steps; lower rtol's "
-                                        "demand or the duration, or raise the limit (--max-steps)")
+            running = ST == 0
+            pacer.check(state["NSTEP"][running], state["TC"][running],
+                        state["H"][running] if method == "dop853" else np.zeros(int(np.sum(running))))
     except KeyboardInterrupt:
         traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])))
         raise RunInterrupted(traj) from None

@@ -243,7 +243,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             else:
                 h = hh * 0.1
             rejected = True
-            if h < 1e-14 * max(abs(t), abs(T[n - 1] - T[0])):
+            if h < 1e-14 * abs(t) or h < 1e-290:  # below round-off of t (the run's span has no say in that)
                 status = 4 if ok else 3
                 break
             continue

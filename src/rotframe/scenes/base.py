@@ -193,15 +193,27 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
     re-raises with a SceneResult in ``exc.partial`` that can be analysed and
     recorded like a complete one.
     """
+    return guarded(finish, integrate_particles, model, r0, v0, duration, method=method, step=step or run.get("step"),
+                   rtol=run_setting(run, "rtol"), samples=int(run_setting(run, "samples")), events=events,
+                   progress=progress)
+
+
+def guarded(finish, func, *args, **kwargs):
+    """Run ``func`` and build the scene's result with ``finish(trajectory)``, even when the run stops early.
+
+    The one home of a scene's early stop: an `IntegrationError` or `RunInterrupted` (a signal, a
+    limit reached as the run goes) re-raises with ``exc.partial`` made by ``finish`` from the
+    trajectory up to the stop (None when nothing was computed), so that the partial is analysed
+    and recorded like a complete result, whichever integrator ran (a scene's own kernels, or
+    `rotframe.problem` for the scenes built on the API).
+    """
     try:
-        traj = integrate_particles(model, r0, v0, duration, method=method, step=step or run.get("step"),
-                                   rtol=run_setting(run, "rtol"), samples=int(run_setting(run, "samples")),
-                                   events=events, progress=progress)
+        traj = func(*args, **kwargs)
     except (IntegrationError, RunInterrupted) as exc:
-        if exc.partial is not None and len(exc.partial.times):
-            exc.partial = finish(exc.partial)
-        else:
-            exc.partial = None
+        partial = getattr(exc, "partial", None)
+        if hasattr(partial, "trajectory"):  # already a result
+            partial = partial.trajectory
+        exc.partial = finish(partial) if partial is not None and len(partial.times) else None
         raise
     return finish(traj)
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.problem.particles import Force, simulate_particles
-from rotframe.scenes.base import SceneResult, run_setting, with_parameters
+from rotframe.scenes.base import SceneResult, guarded, run_setting, with_parameters
 
 __all__ = ["Cr3bpParameters", "PARAMETERS", "METHODS", "simulate", "analyse", "record", "lagrange_points",
            "ROUTH_MU", "zero_velocity_curve", "jacobi_constant"]
@@ -135,14 +135,17 @@ def simulate(p, terms, method, run, progress):
     v0 = np.asarray(p.velocity, dtype=float)
     duration = 2 * math.pi * float(p.periods)
     method = method or DEFAULT_METHOD
-    run_out = simulate_particles(omega=[0.0, 0.0, 1.0], r0=r0, v0=v0, duration=duration,
-                                 forces=[Force(gravity, potential=gravity_potential, name="two primaries")],
-                                 params=(mu,), method=method, rtol=run_setting(run, "rtol"),
-                                 step=run.get("step"), samples=int(run_setting(run, "samples")), progress=progress)
-    traj = run_out.trajectory
-    return SceneResult(traj, list(terms), traj.method, traj.steps, traj.nfev,
-                       extras={"diagnostics": run_out.diagnostics, "notes": run_out.notes, "L4": L4,
-                               "warnings": run_out.warnings})
+
+    def finish(run_out):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(run_out, "trajectory", run_out)
+        extras = {"diagnostics": getattr(run_out, "diagnostics", {}), "notes": getattr(run_out, "notes", []),
+                  "L4": L4, "warnings": getattr(run_out, "warnings", [])}
+        return SceneResult(traj, list(terms), traj.method, traj.steps, traj.nfev, extras=extras)
+
+    return guarded(finish, simulate_particles, omega=[0.0, 0.0, 1.0], r0=r0, v0=v0, duration=duration,
+                   forces=[Force(gravity, potential=gravity_potential, name="two primaries")], params=(mu,),
+                   method=method, rtol=run_setting(run, "rtol"), step=run.get("step"),
+                   samples=int(run_setting(run, "samples")), progress=progress)
 
 
 def _collinear_by_brent(mu):

@@ -10,7 +10,7 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
-from rotframe.scenes.base import MethodNames
+from rotframe.scenes.base import MethodNames, guarded
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6|8]`` the
 #: Lie-Poisson splitting of orders 2, 4, 6, 8, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
@@ -366,16 +366,6 @@ def _check_finite(traj):
         raise IntegrationError(f"non-finite state after t = {traj.times[max(bad - 1, 0)]:.6g} s",
                                t_reached=float(traj.times[max(bad - 1, 0)]), partial=_truncate(traj, bad))
     return traj
-
-
-def guarded(finish, func, *args, **kwargs):
-    """Run ``func``; wrap its (partial) trajectory with ``finish`` even when it fails."""
-    try:
-        traj = func(*args, **kwargs)
-    except (IntegrationError, RunInterrupted) as exc:
-        exc.partial = finish(exc.partial) if exc.partial is not None else None
-        raise
-    return finish(traj)
 
 
 def initial_attitude_zxz(phi, theta, psi):

@@ -25,7 +25,7 @@ import numpy as np
 from rotframe.problem.body import simulate_rigid_body
 from rotframe.rigid.observables import body_to_space
 from rotframe.problem.particles import simulate_particles
-from rotframe.scenes.base import SceneResult, run_setting, with_parameters
+from rotframe.scenes.base import SceneResult, guarded, run_setting, with_parameters
 
 __all__ = ["TumblingBallParameters", "PARAMETERS", "METHODS", "simulate", "analyse", "record", "BODY_SAMPLES_PER_S"]
 
@@ -66,14 +66,17 @@ def simulate(p, terms, method, run, progress):
     body = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, method="exact", samples=n_body)
     r0 = np.asarray(p.position, dtype=float)
     v0 = np.asarray(p.velocity, dtype=float)
-    ball = simulate_particles(omega=body, r0=r0, v0=v0, duration=duration, method=method or DEFAULT_METHOD,
-                              rtol=run_setting(run, "rtol"), step=run.get("step"),
-                              samples=int(run_setting(run, "samples")), progress=progress)
-    traj = ball.trajectory
-    return SceneResult(traj, list(terms), traj.method, traj.steps, traj.nfev,
-                       extras={"body": body, "w0": w0, "r0": r0, "v0": v0, "notes": ball.notes,
-                               "rtol": run_setting(run, "rtol") if traj.method == "dop853" else 1e-6,
-                               "warnings": ball.warnings})
+
+    def finish(ball):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(ball, "trajectory", ball)
+        return SceneResult(traj, list(terms), traj.method, traj.steps, traj.nfev,
+                           extras={"body": body, "w0": w0, "r0": r0, "v0": v0, "notes": getattr(ball, "notes", []),
+                                   "rtol": run_setting(run, "rtol") if traj.method == "dop853" else 1e-6,
+                                   "warnings": getattr(ball, "warnings", [])})
+
+    return guarded(finish, simulate_particles, omega=body, r0=r0, v0=v0, duration=duration,
+                   method=method or DEFAULT_METHOD, rtol=run_setting(run, "rtol"), step=run.get("step"),
+                   samples=int(run_setting(run, "samples")), progress=progress)
 
 
 def oracle(body, times, r0, v0, w0):

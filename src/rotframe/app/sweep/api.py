@@ -10,6 +10,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 __all__ = ["sweep"]
 
 
@@ -76,6 +78,7 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     from rotframe.particles.ensemble import device_scope, threads_scope
 
     require("pandas", "rotframe.sweep")
+    _check_arguments(grid, vary, points, samples, seed, client)
     with threads_scope(threads), device_scope(device):
         return _sweep(name_or_path, grid, vary, points, samples, seed, client, out, fixed)
 
@@ -93,6 +96,48 @@ def _sweep(name_or_path, grid, vary, points, samples, seed, client, out, fixed):
     with tempfile.TemporaryDirectory(prefix="rotframe-sweep-") as tmp:
         return run_sweep(spec, Path(tmp) / f"{spec.name}.parquet", client=client, plots=False,
                          recording=False).table.to_pandas()
+
+
+def _check_arguments(grid, vary, points, samples, seed, client):
+    """Every argument of `sweep` checked at the door: one ScenarioError line naming it, the value and what is allowed."""
+    from rotframe.errors import ScenarioError
+
+    for name, value in (("grid", grid), ("vary", vary)):
+        if value is not None and not isinstance(value, dict):
+            raise ScenarioError(f"{name}={str(value)[:60]!r}: a dict, parameter -> "
+                                + ("a sequence of values" if name == "grid" else "a distribution string"))
+    for key, values in (grid or {}).items():
+        if isinstance(values, (str, bytes)) or not hasattr(values, "__len__") or isinstance(values, dict):
+            raise ScenarioError(f"grid: {key!r} = {str(values)[:60]!r}: a sequence of values, such as [50, 100] "
+                                f"(one value: pass {key}=... instead)")
+    for key, value in (vary or {}).items():
+        if not isinstance(value, str):
+            raise ScenarioError(f"vary: {key!r} = {str(value)[:60]!r}: a distribution string, \"normal(MEAN,SD)\" "
+                                "or \"uniform(LO,HI)\"")
+    if points is not None and not (isinstance(points, dict) or hasattr(points, "columns")):
+        raise ScenarioError(f"points={str(points)[:60]!r}: a pandas DataFrame or a dict of equal-length arrays")
+    for name, value, least in (("samples", samples, 1), ("seed", seed, 0)):
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+            raise ScenarioError(f"{name}={value!r}: a whole number >= {least}")
+    if client is not None:
+        _check_client(client)
+
+
+def _check_client(client):
+    from rotframe.errors import ScenarioError
+
+    try:
+        from distributed import Client
+    except Exception:  # distributed missing or broken: no client can be one of its Clients
+        Client = None
+    if Client is None or not isinstance(client, Client):
+        raise ScenarioError(f"client={str(client)[:60]!r}: a distributed.Client (for an address, "
+                            "use rotframe sweep --scheduler ADDRESS, or Client(ADDRESS))")
+    status = str(getattr(client, "status", "running"))
+    if status not in ("running", "connecting", "newly-created"):
+        raise ScenarioError(f"client: the distributed.Client is {status}; give an open one")
 
 
 def _plain(value):

@@ -209,6 +209,15 @@ def python_spec(scenario, *, sets=None, grid=None, vary=None, points=None, sampl
     return spec
 
 
+def _documented_unit(values, unit, key):
+    """Grid values with any Quantity converted to the parameter's documented unit (never stripped)."""
+    from rotframe.app.quantities import _ASTROPY_SPELLING, holds_quantity, to_si
+
+    if not holds_quantity(values):
+        return values
+    return to_si(values, _ASTROPY_SPELLING.get(unit, unit) if unit else "", key)
+
+
 def _grid_spec(scenario, sets, grid, method):
     from rotframe.app import scenario as sc
 
@@ -217,6 +226,7 @@ def _grid_spec(scenario, sets, grid, method):
     axes = []
     for name, values in grid.items():
         key = _parse_key(scn, "grid", str(name))
+        values = _documented_unit(values, scn.parameters[key.param].unit, f"grid: {name!r}")
         try:
             arr = np.atleast_1d(np.asarray(values, dtype=np.float64))
         except (TypeError, ValueError):

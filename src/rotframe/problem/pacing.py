@@ -1,0 +1,122 @@
+"""How a user's problem is paced: compiled calls sized in time, the work estimated before and as it goes.
+
+A compiled driver call holds the thread until it returns, and Python sees a signal (Ctrl-C,
+SIGTERM) and reports progress only between calls. Calls sized in steps made a slow user
+function (0.2 ms an evaluation) hold a signal for minutes. `Pacer` sizes them in time instead:
+the first call takes a few steps (it compiles, too), each later one as many steps as about
+`CALL_SECONDS` of work took before. The numbers do not depend on where a call ends: the drivers
+keep everything a step needs in their arrays (`rotframe.problem.stepping`).
+
+The work is estimated against `rotframe.limits`:
+
+* before the run: a fixed step's count exactly (`rotframe.problem.particles.run_grid`), and at
+  least one step per knot of a table or body frame (`check_knots`);
+* as it goes (`Pacer.check`), within the first calls (a fraction of a second): each particle's
+  steps so far plus its remaining span over its current step, once DOP853's step has settled
+  (`SETTLED_STEPS`). No a-priori bound holds for an adaptive step (a polynomial solution is
+  integrated exactly in a few growing steps), so this one is measured.
+
+An estimate over ``max_steps`` is refused with a `rotframe.limits.LimitError` in one line,
+as ``rotframe run`` refuses a scene's run, instead of running for hours. `check_memory` counts
+every large array a run allocates, not only its samples.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+__all__ = ["Pacer", "CALL_SECONDS", "check_knots", "check_memory"]
+
+#: wall time of one compiled call once paced: signals and progress are seen at least this often
+CALL_SECONDS = 0.1
+#: steps of the first call (which also compiles the driver)
+FIRST_BUDGET = 16
+#: the running estimate refuses only after this many steps per particle (DOP853's step has settled by then)
+SETTLED_STEPS = 32
+
+
+class Pacer:
+    """The step budget of each compiled call, and the running work estimate.
+
+    Parameters
+    ----------
+    what : str
+        The caller, for messages (``"simulate"``).
+    duration : float
+        The run's span (s).
+    """
+
+    def __init__(self, what: str, duration: float):
+        self.what = what
+        self.duration = float(duration)
+        self.budget = FIRST_BUDGET
+        self.calls = 0
+        self._started = 0.0
+
+    def start(self) -> int:
+        """Mark a call's start; returns its budget (steps per particle)."""
+        self._started = time.perf_counter()
+        return self.budget
+
+    def done(self, steps_in_call: float) -> None:
+        """After a call that took ``steps_in_call`` steps (all particles): size the next one to CALL_SECONDS."""
+        elapsed = time.perf_counter() - self._started
+        self.calls += 1
+        if self.calls == 1 or steps_in_call <= 0:  # the first call compiled: its time says nothing of a step's
+            return
+        if elapsed <= 0.0:
+            self.budget = min(self.budget * 8, 1_000_000)
+            return
+        wanted = self.budget * CALL_SECONDS / elapsed
+        self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
+
+    def check(self, steps, t_reached, h) -> None:
+        """Refuse the run when each particle's steps so far plus its remaining span over its step exceed max_steps.
+
+        ``steps``, ``t_reached``, ``h``: per-particle arrays (h <= 0 for a fixed-step method, whose
+        steps were counted before the run).
+        """
+        from rotframe import limits
+
+        lim = limits.current()
+        h = np.asarray(h, dtype=float)
+        steps = np.asarray(steps, dtype=float)
+        if not np.any(h > 0.0) or float(np.min(steps)) < SETTLED_STEPS:
+            return
+        remaining = np.where(h > 0.0, np.maximum(self.duration - np.asarray(t_reached, float), 0.0) / np.where(
+            h > 0.0, h, 1.0), 0.0)
+        estimate = float(np.sum(steps) + np.sum(remaining))
+        if estimate > lim.max_steps:
+            raise limits.LimitError(
+                f"{self.what}: about {estimate:.3g} integration steps (estimated from the step size after "
+                f"{int(np.sum(steps))} steps), over the limit of {lim.max_steps:.3g}; shorten duration, loosen rtol, "
+                "or raise the limit (rotframe.limits.applied, --max-steps N)")
+
+
+def check_knots(what: str, knots: int, particles: int = 1) -> None:
+    """Refuse before the run a frame with more knots than max_steps allows: no step crosses a knot."""
+    from rotframe import limits
+
+    lim = limits.current()
+    estimate = float(knots) * max(int(particles), 1)
+    if estimate > lim.max_steps:
+        raise limits.LimitError(
+            f"{what}: at least {estimate:.3g} integration steps (each of the frame's {knots} knots ends a step, for "
+            f"each of {particles} particle(s)), over the limit of {lim.max_steps:.3g}; a coarser table or fewer "
+            "particles, or raise the limit (rotframe.limits.applied, --max-steps N)")
+
+
+def check_memory(what: str, arrays: dict) -> None:
+    """Refuse a run whose arrays (name -> bytes) together exceed the memory limit, naming the largest."""
+    from rotframe import limits
+
+    lim = limits.current()
+    total = float(sum(arrays.values()))
+    if total > lim.max_memory:
+        largest = max(arrays, key=arrays.get)
+        raise limits.LimitError(
+            f"{what}: its arrays need about {total / 1e9:.3g} GB ({largest}: {arrays[largest] / 1e9:.3g} GB), over the "
+            f"limit of {lim.max_memory / 1e9:.3g} GB; fewer particles, samples or event slots, or raise the limit "
+            "(--max-memory BYTES)")
