@@ -319,7 +319,7 @@ class _Full:
 
 
 def _inject(monkeypatch, err_no, room=1024):
-    from rotframe.app import outputs
+    from rotframe import files as outputs  # the one writer
 
     real = open
 

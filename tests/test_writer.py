@@ -94,7 +94,10 @@ def test_every_writer_goes_through_the_door(tmp_path, result, monkeypatch, capsy
         seen.append(Path(final).name)
         return real(final, write, what)
 
+    from rotframe import files
+
     monkeypatch.setattr(outputs, "write_atomic", spy)
+    monkeypatch.setattr(files, "write_atomic", spy)  # the one writer, which outputs re-exports
     for kind in KINDS:
         if kind == "parquet" and not _has_pyarrow():
             continue

@@ -475,11 +475,9 @@ class Result:
 
     def to_dataframe(self):
         """The trajectory as a pandas DataFrame ([`TrajectoryArrays.columns`][rotframe.app.api.TrajectoryArrays.columns]); needs pandas."""
-        try:
-            import pandas as pd
-        except ImportError:
-            raise ImportError("to_dataframe() needs pandas: python -m pip install pandas") from None
-        return pd.DataFrame(self.trajectory.columns())
+        from rotframe.app.optional import need
+
+        return need("pandas", "to_dataframe()").DataFrame(self.trajectory.columns())
 
     def show(self, path: str | Path | None = None):
         """Show the recording: in Jupyter, rerun's viewer in the notebook; elsewhere, say how to open it.

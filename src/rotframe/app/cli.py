@@ -121,6 +121,12 @@ def _failure(exc) -> int:
     except (KeyboardInterrupt, SystemExit):
         raise
     except Exception as exc:  # noqa: BLE001 -- a bug: one line, the traceback only on request
+        from rotframe.app.optional import missing_package
+
+        message = missing_package(exc)  # an optional package broken at import, where no need() guarded it
+        if message is not None:
+            _error(message)
+            return EXIT_INPUT
         if os.environ.get("ROTFRAME_DEBUG"):
             raise
         _error(f"internal error ({type(exc).__name__}: {_one_line(exc)}); set ROTFRAME_DEBUG=1 for the traceback "

@@ -148,7 +148,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     from rotframe.app.signals import InterruptScope
 
     t0 = time.perf_counter()
-    from rotframe.problem.particles import sequence_of_callables
+    from rotframe.problem.arguments import sequence_of_callables
 
     forces = sequence_of_callables(forces, "forces")
     events = sequence_of_callables(events, "events")

@@ -11,7 +11,7 @@ plain number.
 from __future__ import annotations
 
 __all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities", "is_quantity", "holds_quantity",
-           "to_si", "vector_or_table_si", "params_si"]
+           "to_si", "vector_or_table_si", "params_si", "astropy_unit"]
 
 
 class NotAQuantity(ValueError):
@@ -91,6 +91,11 @@ def as_quantities(values, units) -> dict:
         except ValueError:
             out[name] = value
     return out
+
+
+def astropy_unit(unit: str) -> str:
+    """A summary unit string as astropy spells it (``"sidereal day"`` -> ``"sday"``)."""
+    return _ASTROPY_SPELLING.get(unit, unit)
 
 
 def is_quantity(value) -> bool:

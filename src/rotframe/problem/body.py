@@ -23,9 +23,10 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
-from rotframe.problem.codegen import build_module
+from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.particles import STATUS, canonical_method
+from rotframe.problem.arguments import canonical_method, check_params, run_grid
+from rotframe.problem.particles import STATUS
 from rotframe.validation import refuse_units
 
 __all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES", "Torque"]
@@ -117,7 +118,6 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
     import time
 
-    from rotframe.problem.particles import check_params, run_grid
 
     attitude_only = bool(getattr(torque, "attitude_only", False))
     if isinstance(torque, Torque):
@@ -173,7 +173,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         key, cache_note = uf.cache_key([("torque", torque)], f"|{len(params)}")
     else:
         functions, header, key, cache_note = {}, _FREE_HEADER, "free", None
-    module = build_module("body", key, functions, header, BODY_SOURCE, compiled=jit)
+    cache_notes = [cache_note] if cache_note and jit else []
+    driver = Driver(lambda: build_module("body", key, functions, header, BODY_SOURCE, compiled=jit, notes=cache_notes),
+                    cache_notes)
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
     OUT = np.full((n, 1, 7), np.nan)
@@ -189,7 +191,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     t0 = time.perf_counter()
     compile_s = None
     def call(budget):
-        module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+        driver.module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
                        st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
                        (np.zeros(3),), np.empty(0))
 
@@ -203,6 +205,11 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             except Exception as exc:
                 import numba
 
+                if compile_s is None and driver.rebuild(exc):  # numba's cache of the driver was damaged: rebuilt
+                    y[...], TC[...], H[...] = saved[0], saved[1], saved[2]
+                    for key_, a in saved[3].items():
+                        st[key_][...] = a
+                    continue
                 if isinstance(exc, numba.core.errors.NumbaError):
                     reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
                     raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to "
@@ -240,8 +247,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
-    if cache_note and jit:
-        run.notes.append(cache_note)
+    run.notes.extend(cache_notes)
     return run
 
 

@@ -11,8 +11,11 @@ so the same functions find the same file, compiled, in the next process, and an 
 function makes a new one.
 
 Where the files go: ``$ROTFRAME_CACHE_DIR``, else ``$XDG_CACHE_HOME/rotframe/problems``, else
-``~/.cache/rotframe/problems``; a folder that cannot be written falls back to a temporary one
-(the drivers then compile once per process).
+``~/.cache/rotframe/problems``; a folder that cannot be written falls back to a temporary one,
+and where neither can be written the driver compiles in memory (once per process), with a note.
+The files are written through `rotframe.files` (atomic). A damaged entry (a source that is not
+UTF-8, a folder in its place, numba's cache files truncated or garbage) is dropped and rebuilt,
+with a note (`is_cache_damage`, `drop_cached`); a cache never fails a run.
 
 With ``jit=False`` the same source runs as plain Python (no numba at all): slow, for a
 function numba cannot compile.
@@ -24,35 +27,134 @@ import hashlib
 import importlib.util
 import itertools
 import os
+import shutil
 import sys
 import tempfile
 import types
 from pathlib import Path
 
-__all__ = ["ENTRIES", "cache_dir", "build_module"]
+__all__ = ["ENTRIES", "cache_dir", "build_module", "is_cache_damage", "drop_cached", "Driver"]
 
 #: fingerprint -> {global name: function} for the generated modules of this process
 ENTRIES: dict[str, dict] = {}
 
 
-def cache_dir() -> Path:
-    """The folder of the generated driver modules (created if missing)."""
+def cache_dir(notes=None) -> Path | None:
+    """The folder of the generated driver modules (created if missing), or None when none can be written.
+
+    The configured folder, else a temporary one; each must take a real write (a probe of a few
+    kilobytes through `rotframe.files`, so that a full disk shows). None means no caching: the
+    drivers compile in memory, once per process, and ``notes`` says why.
+    """
     env = os.environ.get("ROTFRAME_CACHE_DIR")
     if env:
         base = Path(env)
     else:
         xdg = os.environ.get("XDG_CACHE_HOME")
         base = (Path(xdg) if xdg else Path.home() / ".cache") / "rotframe" / "problems"
+    fallback = Path(tempfile.gettempdir()) / f"rotframe-problems-{os.getuid() if hasattr(os, 'getuid') else 0}"
+    for folder in (base, fallback):
+        if _writable(folder):
+            return folder
+    if notes is not None:
+        notes.append(f"the compiled-driver cache cannot be written ({base} nor {fallback}): the driver was "
+                     "compiled in memory, not cached")
+    return None
+
+
+def _writable(folder: Path) -> bool:
+    from rotframe.files import OutputError, write_bytes_atomic
+
     try:
-        base.mkdir(parents=True, exist_ok=True)
-        probe = base / f".probe-{os.getpid()}"
-        probe.write_text("")
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".probe-{os.getpid()}"
+        write_bytes_atomic(probe, b"rotframe driver cache probe\n" * 256, what="driver cache probe")
         probe.unlink()
-        return base
+        return True
+    except (OSError, OutputError):
+        return False
+
+
+def _cached_text(path: Path, notes) -> str | None:
+    """The driver file's text, or None: missing, or damaged (not UTF-8, a folder in its place) and dropped."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return None
+    except (OSError, UnicodeDecodeError) as exc:  # a damaged entry: dropped, then written anew
+        _remove(path)
+        notes.append(f"a damaged compiled-driver cache entry ({path.name}: {type(exc).__name__}) was dropped and "
+                     "rebuilt")
+        return None
+
+
+def _remove(path: Path) -> None:
+    try:
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink()
     except OSError:
-        fallback = Path(tempfile.gettempdir()) / f"rotframe-problems-{os.getuid() if hasattr(os, 'getuid') else 0}"
-        fallback.mkdir(parents=True, exist_ok=True)
-        return fallback
+        pass
+
+
+def is_cache_damage(exc: BaseException) -> bool:
+    """An exception raised while numba loaded or saved a driver's cache (truncated or garbage files, a full disk)."""
+    import pickle
+
+    if isinstance(exc, pickle.UnpicklingError):
+        return True
+    tb = exc.__traceback__
+    while tb is not None:
+        if tb.tb_frame.f_code.co_filename.replace("\\", "/").endswith("numba/core/caching.py"):
+            return True
+        tb = tb.tb_next
+    return False
+
+
+class Driver:
+    """A problem's generated module, rebuilt once if numba's cache of it turns out damaged.
+
+    ``build()`` makes the module (`build_module`); `call` runs one of its functions, and on an
+    exception that `is_cache_damage` recognises drops the files, rebuilds, notes it and calls again.
+    """
+
+    def __init__(self, build, notes):
+        self._build = build
+        self.notes = notes
+        self.module = build()
+        self.rebuilt = False
+
+    def rebuild(self, exc) -> bool:
+        """After ``exc``: drop and rebuild once if it is cache damage (True), else False."""
+        if self.rebuilt or not is_cache_damage(exc):
+            return False
+        drop_cached(self.module)
+        self.notes.append(f"the compiled-driver cache of this problem was damaged ({type(exc).__name__}): dropped and "
+                          "rebuilt")
+        self.module = self._build()
+        self.rebuilt = True
+        return True
+
+    def call(self, name, *args):
+        try:
+            return getattr(self.module, name)(*args)
+        except Exception as exc:
+            if not self.rebuild(exc):
+                raise
+            return getattr(self.module, name)(*args)
+
+
+def drop_cached(module) -> None:
+    """Remove a driver's files (its source and numba's cache of it) and forget it in this process."""
+    sys.modules.pop(module.__name__, None)
+    path = getattr(module, "__file__", None)
+    if not path:
+        return
+    path = Path(path)
+    for cached in (path.parent / "__pycache__").glob(f"{module.__name__}.*"):
+        _remove(cached)
+    _remove(path)
 
 
 _HEADER_COMPILED = """\
@@ -81,7 +183,8 @@ def jit(f):
 """
 
 
-def build_module(kind: str, key_material, functions: dict, header: str, body: str, *, compiled: bool):
+def build_module(kind: str, key_material, functions: dict, header: str, body: str, *, compiled: bool,
+                 notes=None):
     """The generated module for one problem: imported from the cache (compiled) or built in memory.
 
     Parameters
@@ -97,38 +200,47 @@ def build_module(kind: str, key_material, functions: dict, header: str, body: st
         Global name -> the user's function (a numba dispatcher when ``compiled``, else plain Python).
     header, body : str
         The problem's own definitions and the fixed driver source.
+    notes : list, optional
+        Receives a line for what the cache could not do (a damaged entry rebuilt, no cache
+        writable): never a failure, the driver is then compiled in memory.
     """
-    cached = compiled and key_material is not None
+    notes = [] if notes is None else notes
+    folder = cache_dir(notes) if compiled and key_material is not None else None
+    cached = folder is not None
     head = _HEADER_COMPILED.format(cache=cached) if compiled else _HEADER_PLAIN
     source = head + "\nA, B, C, E3, E5 = _coefficients()\n"
-    if key_material is None:
+    if not cached:
         key_material = f"uncached {os.getpid()} {next(_UNCACHED)}"
     digest = hashlib.sha256((key_material + header + body + source).encode()).hexdigest()[:24]
     name = f"rotframe_{kind}_problem_{digest}"
     ENTRIES[digest] = functions
     binding = "".join(f"{g} = _ENTRIES[{digest!r}][{g!r}]\n" for g in functions)
-    text = f'"""Generated by rotframe.problem.codegen for one problem; safe to delete."""\n' + source + binding \
+    text = '"""Generated by rotframe.problem.codegen for one problem; safe to delete."""\n' + source + binding \
         + header + body
     if name in sys.modules:
         return sys.modules[name]
-    if not cached:
-        module = types.ModuleType(name)
-        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # nothing on disk
+    if cached:
+        path = folder / f"{name}.py"
+        if _cached_text(path, notes) != text:
+            from rotframe.files import OutputError, write_text_atomic
+
+            try:
+                write_text_atomic(path, text, what="compiled-driver cache entry")
+            except OutputError as exc:
+                notes.append(f"the compiled-driver cache could not be written ({exc}): the driver was compiled in "
+                             "memory, not cached")
+                return build_module(kind, None, functions, header, body, compiled=compiled, notes=notes)
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        try:
+            spec.loader.exec_module(module)
+        except BaseException:
+            sys.modules.pop(name, None)
+            raise
         return module
-    folder = cache_dir()
-    path = folder / f"{name}.py"
-    if not path.is_file() or path.read_text(encoding="utf-8") != text:
-        tmp = folder / f".{name}.{os.getpid()}.tmp"
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)  # atomic: a concurrent process sees the old file or the new one
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        sys.modules.pop(name, None)
-        raise
+    module = types.ModuleType(name)
+    exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # nothing on disk
     return module
 
 

@@ -9,7 +9,7 @@ keep everything a step needs in their arrays (`rotframe.problem.stepping`).
 
 The work is estimated against `rotframe.limits`:
 
-* before the run: a fixed step's count exactly (`rotframe.problem.particles.run_grid`), and at
+* before the run: a fixed step's count exactly (`rotframe.problem.arguments.run_grid`), and at
   least one step per knot of a table or body frame (`check_knots`);
 * as it goes (`Pacer.check`), within the first calls (a fraction of a second): each particle's
   steps so far plus its remaining span over its current step, once DOP853's step has settled
@@ -54,6 +54,7 @@ class Pacer:
         self.budget = FIRST_BUDGET
         self.calls = 0
         self._started = 0.0
+        self._over = False
 
     def start(self) -> int:
         """Mark a call's start; returns its budget (steps per particle)."""
@@ -73,26 +74,31 @@ class Pacer:
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
     def check(self, steps, t_reached, h) -> None:
-        """Refuse the run when each particle's steps so far plus its remaining span over its step exceed max_steps.
+        """Refuse the run when its steps so far plus the rest at each particle's pace so far exceed max_steps.
 
-        ``steps``, ``t_reached``, ``h``: per-particle arrays (h <= 0 for a fixed-step method, whose
-        steps were counted before the run).
+        ``steps``, ``t_reached``, ``h``: per-particle arrays of the running particles (``h`` <= 0: a
+        fixed step, whose steps were counted before the run). The pace is a particle's average
+        step so far, not its last (which shrinks near a singularity, where the run is about to fail
+        and say why); an estimate over the limit at two checks in a row is refused.
         """
         from rotframe import limits
 
         lim = limits.current()
-        h = np.asarray(h, dtype=float)
         steps = np.asarray(steps, dtype=float)
-        if not np.any(h > 0.0) or float(np.min(steps)) < SETTLED_STEPS:
+        t_reached = np.asarray(t_reached, dtype=float)
+        adaptive = np.asarray(h, dtype=float) > 0.0
+        if not np.any(adaptive) or float(np.min(steps)) < SETTLED_STEPS:
             return
-        remaining = np.where(h > 0.0, np.maximum(self.duration - np.asarray(t_reached, float), 0.0) / np.where(
-            h > 0.0, h, 1.0), 0.0)
+        pace = np.where(adaptive & (t_reached > 0.0), t_reached / np.maximum(steps, 1.0), np.inf)
+        remaining = np.maximum(self.duration - t_reached, 0.0) / pace
         estimate = float(np.sum(steps) + np.sum(remaining))
-        if estimate > lim.max_steps:
+        over = estimate > lim.max_steps
+        if over and self._over:
             raise limits.LimitError(
-                f"{self.what}: about {estimate:.3g} integration steps (estimated from the step size after "
-                f"{int(np.sum(steps))} steps), over the limit of {lim.max_steps:.3g}; shorten duration, loosen rtol, "
-                "or raise the limit (rotframe.limits.applied, --max-steps N)")
+                f"{self.what}: about {estimate:.3g} integration steps (at the pace of its first {int(np.sum(steps))} "
+                f"steps), over the limit of {lim.max_steps:.3g}; shorten duration, loosen rtol, or raise the limit "
+                "(rotframe.limits.applied, --max-steps N)")
+        self._over = over
 
 
 def check_knots(what: str, knots: int, particles: int = 1) -> None:

@@ -17,7 +17,6 @@ attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,21 +24,19 @@ import numpy as np
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory
 from rotframe.problem import callables as uf
-from rotframe.problem.codegen import build_module
+from rotframe.problem.arguments import (array_of, canonical_method, check_event, check_params, run_grid,
+                                        sequence_of_callables)
+from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.pacing import Pacer, check_knots, check_memory
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
-from rotframe.validation import refuse_units
 
-__all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "canonical_method", "check_params",
-           "number", "run_grid", "sequence_of_callables"]
+__all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "advance_blocks"]
 
 #: Methods of a user's particle problem (names are case-insensitive)
 PARTICLE_METHODS = ("dop853", "rk4")
-DEFAULT_RTOL = 1e-10
-DEFAULT_SAMPLES = 1000
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
 
 
@@ -81,15 +78,6 @@ class ProblemRun:
     compile_s: float = 0.0
 
 
-def canonical_method(method, allowed, default):
-    """``method`` in lower case, checked against ``allowed`` (``None``: ``default``)."""
-    if method is None:
-        return default
-    if not isinstance(method, str) or method.lower() not in allowed:
-        raise ScenarioError(f"method={method!r}: allowed: {', '.join(allowed)} (any case)")
-    return method.lower()
-
-
 def _as_force(f, k):
     if isinstance(f, Force):
         force = f
@@ -104,112 +92,9 @@ def _as_force(f, k):
     return force
 
 
-def check_params(params):
-    """``params`` as a tuple of floats and read-only float64 arrays, or a one-line ScenarioError naming the entry."""
-    refuse_units(params, "params", ScenarioError)
-    if isinstance(params, (str, bytes, dict)) or not isinstance(params, (tuple, list, np.ndarray)):
-        raise ScenarioError(f"params={str(params)[:60]!r}: a tuple of numbers or float arrays, such as params=(4.0,) "
-                            "(passed to every function after t, r, v)")
-    out = []
-    for k, p in enumerate(params):
-        if isinstance(p, (bool, int, float, np.integer, np.floating)) and not isinstance(p, np.bool_):
-            out.append(float(p))
-            continue
-        arr = None
-        if not isinstance(p, (str, bytes, dict, complex, np.complexfloating)):
-            try:
-                arr = np.asarray(p)
-            except (TypeError, ValueError):  # a ragged list
-                arr = None
-        if arr is None or arr.dtype.kind not in "iuf" or arr.size == 0:
-            raise ScenarioError(f"params[{k}]: {str(p)[:60]!r}; allowed: a real number or a non-empty array of real "
-                                "numbers (not complex, ragged, text or a dict)")
-        if not np.all(np.isfinite(arr)):
-            raise ScenarioError(f"params[{k}]: not finite")
-        out.append(uf.readonly_array(arr))  # C-contiguous, and no user function may write into it
-    return tuple(out)
-
-
-def check_event(g, k):
-    """An event's ``direction`` (its sign) and ``terminal``, checked: ``(float, bool)``."""
-    direction = getattr(g, "direction", 0) or 0
-    terminal = getattr(g, "terminal", False)
-    if isinstance(direction, (str, bytes, bool, complex)) or not isinstance(direction, (int, float, np.integer,
-                                                                                        np.floating)):
-        raise ScenarioError(f"events[{k}].direction = {direction!r}: a number, its sign taken: 1 (rising), -1 "
-                            "(falling) or 0 (both)")
-    if not math.isfinite(float(direction)):
-        raise ScenarioError(f"events[{k}].direction = {direction!r}: a finite number (1, -1 or 0)")
-    if not isinstance(terminal, (bool, np.bool_)) and terminal not in (0, 1):
-        raise ScenarioError(f"events[{k}].terminal = {terminal!r}: True or False")
-    return float(np.sign(direction)), bool(terminal)
-
-
-def run_grid(duration, samples, rtol, step, *, fixed, what, particles=1):
-    """A run's checked settings, ``(duration, samples, times (samples + 1,), rtol, hfix)``, within the work limits.
-
-    ``hfix`` is the fixed step of a fixed-step method (``fixed``): ``step`` (default a twentieth
-    of the sample interval) shortened to divide the sample interval; 0.0 for DOP853. A bad value
-    is a ScenarioError in one line; a run over the work limits a LimitError (`rotframe.limits`).
-    """
-    from rotframe import limits
-
-    duration = number(duration, "duration", "s")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ScenarioError(f"duration={duration!r}: must be finite and > 0 (s)")
-    rtol = DEFAULT_RTOL if rtol is None else number(rtol, "rtol", "relative")
-    if not (1e-15 <= rtol < 1):
-        raise ScenarioError(f"rtol={rtol!r}: allowed 1e-15 <= rtol < 1")
-    samples = DEFAULT_SAMPLES if samples is None else samples
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
-    samples = int(samples)
-    steps, hfix = samples, 0.0
-    if fixed:
-        step = duration / samples / 20 if step is None else number(step, "step", "s")
-        if not (math.isfinite(step) and step > 0) or step < 1e-300:
-            raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
-        per = max(1, math.ceil((duration / samples) / step - 1e-9))
-        hfix = (duration / samples) / per
-        steps = per * samples
-    limits.check_run(steps=steps, samples=samples + 1, particles=particles, what=what)
-    return duration, samples, np.linspace(0.0, duration, samples + 1), rtol, hfix
-
-
-def number(value, key, unit):
-    """``value`` as a float, or a one-line ScenarioError naming ``key`` and the unit expected."""
-    refuse_units(value, key, ScenarioError)
-    if isinstance(value, bool):
-        raise ScenarioError(f"{key}={value!r}: a number ({unit}) is expected")
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{key}={value!r}: a number ({unit}) is expected") from None
-
-
-def sequence_of_callables(value, key):
-    """``forces=f`` or ``events=g`` alone is taken as a list of one."""
-    if value is None:
-        return []
-    if callable(value):
-        return [value]
-    try:
-        return list(value)
-    except TypeError:
-        raise ScenarioError(f"{key}={value!r}: a list of functions is expected") from None
-
-
-def _array(value, key):
-    refuse_units(value, key, ScenarioError)
-    try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{key}: {str(value)[:80]!r} is not numbers") from None
-
-
 def _states(r0, v0):
-    r = np.atleast_2d(_array(r0, "r0"))
-    v = np.atleast_2d(_array(v0, "v0"))
+    r = np.atleast_2d(array_of(r0, "r0"))
+    v = np.atleast_2d(array_of(v0, "v0"))
     if r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and 1 in (r.shape[0], v.shape[0]):
         n = max(r.shape[0], v.shape[0])  # one start position with N velocities, or the other way round
         r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
@@ -334,7 +219,7 @@ def _scales(r, v, duration, rtol, atol, D):
     steps, and its numbers, do not depend on the other particles of the ensemble."""
     N = r.shape[0]
     if atol is not None:
-        a = _array(atol, "atol")
+        a = array_of(atol, "atol")
         if a.ndim == 0:
             a = np.full(6, float(a))
         if a.shape != (6,) or not np.all(a > 0):
@@ -393,8 +278,10 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         uf.check_compilable(role, f, jit)
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
     header = _header(frame, origin, forces, events, len(params), D)
-    module = build_module("particle", key, _bind(frame, origin, forces, events, jit), header, PARTICLE_SOURCE,
-                          compiled=jit)
+    cache_notes = [cache_note] if cache_note and jit else []
+
+    driver = Driver(lambda: build_module("particle", key, _bind(frame, origin, forces, events, jit), header,
+                                         PARTICLE_SOURCE, compiled=jit, notes=cache_notes), cache_notes)
     slots = max_events if events else 1  # event records: none are kept without events
     n = samples + 1
     check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
@@ -404,7 +291,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     y[:, :3] = r
     y[:, 3:6] = v
     if D == 10:
-        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else _array(frame_attitude, "frame_attitude")
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else array_of(frame_attitude, "frame_attitude")
         if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
             raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
                                 "numbers, not all 0")
@@ -430,7 +317,14 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     first = True
     try:
         if events:
-            module.start_events(0.0, y, state["GPREV"], params)
+            try:
+                driver.call("start_events", 0.0, y, state["GPREV"], params)
+            except Exception as exc:
+                import numba
+
+                if isinstance(exc, numba.core.errors.NumbaError):
+                    _compile_failure(exc, roles, params, r[0], v[0], frame)
+                raise
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
         after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G, stop_times((frame, origin), duration))
@@ -439,13 +333,16 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             saved["Y"] = y.copy()
             budget = pacer.start()
             try:
-                advance_blocks(module.advance, N, before + (budget,) + after)
+                advance_blocks(driver.module.advance, N, before + (budget,) + after)
             except Exception as exc:
                 import numba
 
+                if first and driver.rebuild(exc):  # numba's cache of the driver was damaged: rebuilt, run again
+                    _restore(y, state, saved)
+                    continue
                 if isinstance(exc, numba.core.errors.NumbaError):
                     _compile_failure(exc, roles, params, r[0], v[0], frame)
-                _raised_later(exc, module, y, saved, {"before": before, "after": after, "budget": budget}, forces,
+                _raised_later(exc, driver.module, y, saved, {"before": before, "after": after, "budget": budget}, forces,
                               params, method, hfix, times, OUT, state, events)
             if first:
                 compile_s = time.perf_counter() - t0
@@ -475,13 +372,13 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         partial = _trajectory(times, OUT, state, events, method, good)
         raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
                                "samples up to there are kept", t_reached=t_bad, partial=partial)
-    warnings, notes, diagnostics = [], list(frame.notes) + ([cache_note] if cache_note and jit else []), {}
+    warnings, notes, diagnostics = [], list(frame.notes) + cache_notes, {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
-    _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagnostics, notes)
+    _energy_diagnostics(driver, traj, OUT, params, frame, origin, forces, diagnostics, notes)
     try:
-        frame_interpolation(module, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
+        frame_interpolation(driver.module, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
                             warnings, notes)
     except KeyboardInterrupt:
         raise RunInterrupted(traj) from None
@@ -527,6 +424,13 @@ def advance_blocks(advance, N, args):
 _REPLAYED = ("TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
 
 
+def _restore(y, state, saved):
+    """The state arrays as they were before a driver call (``saved``), for a replay or a retry."""
+    y[...] = saved["Y"]
+    for key in _REPLAYED:
+        state[key][...] = saved[key]
+
+
 def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events):
     """A user function raised inside a compiled call: find the step, name the function, give time and state.
 
@@ -535,9 +439,7 @@ def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, tim
     raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
     ``.partial`` keep the samples up to that step).
     """
-    y[...] = saved["Y"]
-    for key in _REPLAYED:
-        state[key][...] = saved[key]
+    _restore(y, state, saved)
     what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     where = ""
     for i in np.flatnonzero(state["ST"] == 0):
@@ -618,7 +520,7 @@ def _event_names(events):
     return names
 
 
-def _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagnostics, notes):
+def _energy_diagnostics(driver, traj, OUT, params, frame, origin, forces, diagnostics, notes):
     """Energy (inertial frame) or Jacobi integral (steadily rotating frame) and its relative drift."""
     if not forces or any(f.potential is None for f in forces):
         return
@@ -629,7 +531,7 @@ def _energy_diagnostics(module, traj, OUT, params, frame, origin, forces, diagno
     w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
     rotating = bool(np.any(w != 0.0))
     F = frame.data
-    E = module.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), params, F, rotating)
+    E = driver.call("energies", traj.times, np.ascontiguousarray(OUT[: traj.times.size]), params, F, rotating)
     traj.extras["energy"] = E
     name = "jacobi" if rotating else "energy"
     E0 = E[0]

@@ -211,11 +211,11 @@ def python_spec(scenario, *, sets=None, grid=None, vary=None, points=None, sampl
 
 def _documented_unit(values, unit, key):
     """Grid values with any Quantity converted to the parameter's documented unit (never stripped)."""
-    from rotframe.app.quantities import _ASTROPY_SPELLING, holds_quantity, to_si
+    from rotframe.app.quantities import astropy_unit, holds_quantity, to_si
 
     if not holds_quantity(values):
         return values
-    return to_si(values, _ASTROPY_SPELLING.get(unit, unit) if unit else "", key)
+    return to_si(values, astropy_unit(unit) if unit else "", key)
 
 
 def _grid_spec(scenario, sets, grid, method):

@@ -92,10 +92,10 @@ def exclusive(files):
 
 
 def require(module, what):
-    import importlib.util
+    """Import the optional ``module`` now, or a one-line error naming it and its extra (`rotframe.app.optional`)."""
+    from rotframe.app.optional import need
 
-    if importlib.util.find_spec(module) is None:
-        raise ScenarioError(f"{what} needs the {module!r} package: pip install 'rotframe[sweep]'")
+    need(module, what)
 
 
 def read_table(path):
