@@ -65,9 +65,34 @@ def simulate(p, terms, method, run, progress):
 
 
 def flip_times(times, w):
-    """Times at which w changes sign (linear interpolation between samples)."""
-    k = np.nonzero(np.sign(w[:-1]) * np.sign(w[1:]) < 0)[0]
-    return times[k] + (times[k + 1] - times[k]) * w[k] / (w[k] - w[k + 1])
+    """Times at which w changes sign: linear interpolation between samples of opposite signs.
+
+    A flip can land on a sample (by symmetry: a run of 4.5 periods puts the middle flip on the middle
+    sample, w = 0 there exactly): a zero between samples of opposite signs is the flip's time
+    (the middle of a run of zeros), and zeros at the run's ends are flips at their time (omega_mid
+    passes through 0 at a flip, it never touches it and returns: Euler's equations give it a
+    non-zero slope there).
+    """
+    times = np.asarray(times, dtype=float)
+    w = np.asarray(w, dtype=float)
+    nz = np.flatnonzero(w != 0.0)
+    if nz.size == 0:
+        return np.array([])
+    sign = np.sign(w[nz])
+    change = np.flatnonzero(sign[:-1] != sign[1:])
+    a, b = nz[change], nz[change + 1]
+    adjacent = b == a + 1
+    interpolated = times[a] + (times[b] - times[a]) * w[a] / np.where(adjacent, w[a] - w[b], 1.0)
+    on_samples = 0.5 * (times[np.minimum(a + 1, b)] + times[np.maximum(b - 1, a)])  # the run of zeros' middle
+    inner = np.where(adjacent, interpolated, on_samples)
+    ends = []
+    if nz[0] > 0:  # the run starts at a flip
+        ends.append((0.5 * (times[0] + times[nz[0] - 1]), 0))
+    if nz[-1] < w.size - 1:  # the run ends at a flip
+        ends.append((0.5 * (times[nz[-1] + 1] + times[-1]), 1))
+    first = [t for t, where in ends if where == 0]
+    last = [t for t, where in ends if where == 1]
+    return np.concatenate([first, inner, last])
 
 
 def _flip_tolerance(traj, inertia, mid, n_intervals, interval, method):

@@ -20,7 +20,7 @@ import numpy as np
 from rotframe import analytic
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, method_rel_error, particle_methods, reject_subnormal, rel_drift,
-                                  run_particles, with_parameters)
+                                  run_particles, run_setting, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -64,6 +64,7 @@ DIVERGED = 0.1
 @with_parameters(TurntableParameters)
 def simulate(p, terms, method, run, progress):
     from rotframe.errors import IntegrationError
+    from rotframe.particles.integrators import remedy
 
     reject_subnormal(p)
     model, omega, r0, v0, T = _setup(p, terms)
@@ -87,7 +88,8 @@ def simulate(p, terms, method, run, progress):
         partial = finish(traj.truncated(good))
         raise IntegrationError(f"the {traj.method} run diverged: {err[bad[0]]:.3g} m from the exact inertial line "
                                f"at t = {traj.times[bad[0]]:.6g} s, more than {DIVERGED:g} of the motion's size "
-                               f"{size[bad[0]]:.3g} m (a smaller step or another method may hold it)",
+                               f"{size[bad[0]]:.3g} m; "
+                               + remedy(traj.method, step=traj.extras.get("step"), rtol=run_setting(run, "rtol")),
                                t_reached=float(traj.times[good - 1]), partial=partial)
     return result
 
