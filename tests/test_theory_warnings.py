@@ -22,7 +22,7 @@ from rotframe.particles.model import OmegaSchedule, ParticleModel
 
 OMEGA = 2 * math.pi * 1.00273781191135448 / 86400.0
 SCENARIOS = ["turntable", "tower-drop", "foucault", "inertial-oscillation", "projectile", "free-top",
-             "dzhanibekov", "heavy-top"]
+             "dzhanibekov", "heavy-top", "cr3bp", "tumbling-ball"]
 
 
 def run(name, method=None, terms=None, **sets):
@@ -339,3 +339,9 @@ def test_default_metrics_are_unchanged(name):
         assert s["metrics"][key] == pytest.approx(before, rel=REL.get(name, 1e-12), abs=1e-15), key
     if name == "turntable":  # the exact flow: round-off of a path of a few metres (the splitting was 1.2e-10)
         assert s["metrics"]["position_error_m"] < 1e-13
+
+
+def test_every_scenario_is_in_the_no_warning_list():
+    import rotframe
+
+    assert set(SCENARIOS) == set(rotframe.scenarios())
