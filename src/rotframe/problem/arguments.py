@@ -42,6 +42,8 @@ def check_params(params):
     out = []
     for k, p in enumerate(params):
         if isinstance(p, (bool, int, float, np.integer, np.floating)) and not isinstance(p, np.bool_):
+            if not math.isfinite(float(p)):
+                raise ScenarioError(f"params[{k}] = {p!r}: not finite; allowed: finite real numbers")
             out.append(float(p))
             continue
         arr = None
