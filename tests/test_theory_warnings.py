@@ -332,7 +332,7 @@ BEFORE = {
 REL = {"foucault": 2e-6}
 
 
-@pytest.mark.parametrize("name", SCENARIOS)
+@pytest.mark.parametrize("name", sorted(BEFORE))
 def test_default_metrics_are_unchanged(name):
     s = run(name)
     for key, before in BEFORE[name].items():
@@ -342,6 +342,7 @@ def test_default_metrics_are_unchanged(name):
 
 
 def test_every_scenario_is_in_the_no_warning_list():
-    import rotframe
+    from pathlib import Path
 
-    assert set(SCENARIOS) == set(rotframe.scenarios())
+    shipped = {p.stem for p in (Path(__file__).resolve().parents[1] / "scenarios").glob("*.toml")}
+    assert set(SCENARIOS) == shipped

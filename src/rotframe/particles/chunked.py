@@ -21,6 +21,7 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles import threads
+from rotframe.particles.advice import remedy
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
 __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
@@ -453,14 +454,12 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
                     f"(method {info.name})", t_reached=float(times[good - 1]), partial=partial)
             bad_k = _energy_growth(model, guard, times, out_r, out_v, done + 1, done + 1 + m)
             if bad_k is not None:
-                from rotframe.particles.integrators import remedy
-
                 partial = Trajectory(times, out_r, out_v, info.name, steps, nfev).truncated(bad_k)
                 evb.attach(partial, events)
                 raise IntegrationError(
                     f"unstable step: the inertial speed of a particle under no real force grew by more than "
                     f"{GROWTH_LIMIT:g} (relative) by t = {times[bad_k]:.6g} s (method {info.name}); "
-                    + remedy(info.name, step=setup.h, rtol=setup.rtol),
+                    + remedy(info.kind, step=setup.h, rtol=setup.rtol),
                     t_reached=float(times[bad_k - 1]), partial=partial)
             done += m
             if progress is not None:

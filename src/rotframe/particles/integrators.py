@@ -84,26 +84,6 @@ ALIASES = {"splitting": "rotation-splitting", "splitting4": "rotation-splitting4
 METHOD_NAMES = tuple(METHODS) + tuple(ALIASES)
 
 
-def remedy(method: str, step=None, rtol=None) -> str:
-    """What to change when a run of ``method`` went unstable or diverged: advice that fits the method.
-
-    A fixed step: a smaller step, or the adaptive method; DOP853: a tighter rtol (its step is
-    its own); the exact flow: nothing of the integrator's (the model itself is at fault).
-
-    >>> remedy("rk4", step=0.5)
-    'use a smaller step (now 0.5 s) or dop853'
-    >>> remedy("dop853", rtol=1e-6)
-    'tighten rtol (now 1e-06), or shorten the run'
-    """
-    info = METHODS.get(ALIASES.get(str(method).lower(), str(method).lower()))
-    kind = info.kind if info is not None else "fixed"
-    if kind == "adaptive":
-        return f"tighten rtol{f' (now {rtol:.3g})' if rtol else ''}, or shorten the run"
-    if kind == "exact":
-        return "the exact flow has no step to change: check the model's parameters"
-    return f"use a smaller step{f' (now {step:.3g} s)' if step else ''} or dop853"
-
-
 def canonical_method(name: str) -> str:
     """The `METHODS` key of a particle method given by its name or an alias (`ALIASES`), in any case.
 

@@ -222,7 +222,6 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
                 hh = stop - t  # to the knot; the grid goes on from there
                 landing = True
             else:
-                at_knot = False
                 target = T[idx]
                 hh = hfix if on_grid else grid_next - t
                 sub += 1

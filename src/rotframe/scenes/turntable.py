@@ -64,7 +64,8 @@ DIVERGED = 0.1
 @with_parameters(TurntableParameters)
 def simulate(p, terms, method, run, progress):
     from rotframe.errors import IntegrationError
-    from rotframe.particles.integrators import remedy
+    from rotframe.particles.advice import remedy
+    from rotframe.particles.integrators import METHODS, canonical_method
 
     reject_subnormal(p)
     model, omega, r0, v0, T = _setup(p, terms)
@@ -89,7 +90,8 @@ def simulate(p, terms, method, run, progress):
         raise IntegrationError(f"the {traj.method} run diverged: {err[bad[0]]:.3g} m from the exact inertial line "
                                f"at t = {traj.times[bad[0]]:.6g} s, more than {DIVERGED:g} of the motion's size "
                                f"{size[bad[0]]:.3g} m; "
-                               + remedy(traj.method, step=traj.extras.get("step"), rtol=run_setting(run, "rtol")),
+                               + remedy(METHODS[canonical_method(traj.method)].kind, step=traj.extras.get("step"),
+                                        rtol=run_setting(run, "rtol")),
                                t_reached=float(traj.times[good - 1]), partial=partial)
     return result
 
