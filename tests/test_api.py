@@ -201,7 +201,7 @@ def test_to_dataframe():
     pytest.importorskip("pandas")
     r = rotframe.run("dzhanibekov", duration=10)
     df = r.to_dataframe()
-    assert list(df.columns[:4]) == ["time_s", "L1", "L2", "L3"] and len(df) == len(r.trajectory.times)
+    assert list(df.columns[:4]) == ["time_s", "L1_kg_m2_s", "L2_kg_m2_s", "L3_kg_m2_s"] and len(df) == len(r.trajectory.times)
 
 
 def test_progress_callback_and_bar(capsys):
@@ -292,4 +292,4 @@ def test_csv_export_reads_back_with_pandas(tmp_path):
     for name, values in cols.items():
         assert np.array_equal(df[name].to_numpy(), np.asarray(values)), name  # %.17g round-trips float64
     body = rotframe.run("dzhanibekov", duration=5).export(tmp_path / "b.csv")
-    assert list(pd.read_csv(body).columns) == ["time_s", "L1", "L2", "L3", "qx", "qy", "qz", "qw"]
+    assert list(pd.read_csv(body).columns) == ["time_s", "L1_kg_m2_s", "L2_kg_m2_s", "L3_kg_m2_s", "qx", "qy", "qz", "qw"]

@@ -200,7 +200,7 @@ def test_body_result_surface(tmp_path):
     assert isinstance(res, rotframe.Result) and res.method == "dop853"
     assert res.trajectory.L.shape == (21, 3) and res.trajectory.q.shape == (21, 4)
     df = res.to_dataframe()
-    assert len(df) == 21 and {"time_s", "L1", "qw"} <= set(df.columns)
+    assert len(df) == 21 and {"time_s", "L1_kg_m2_s", "qw"} <= set(df.columns)
     assert '"method": "dop853"' in res.to_json()
     npz = res.export(tmp_path / "body.npz")
     assert npz.is_file()

@@ -325,7 +325,8 @@ class TrajectoryArrays:
         """The samples as a table of 1-D columns (long format: one row per sample and particle).
 
         Particles: ``time_s, particle, x_m, y_m, z_m, vx_m_s, vy_m_s, vz_m_s``;
-        bodies: ``time_s, L1, L2, L3`` (kg m^2/s, body axes), ``qx, qy, qz, qw``.
+        bodies: ``time_s, L1_kg_m2_s, L2_kg_m2_s, L3_kg_m2_s`` (body axes), ``qx, qy, qz, qw``
+        (a unit quaternion, dimensionless: no unit in its name). Every name with a unit ends in it.
         """
         import numpy as np
 
@@ -340,7 +341,7 @@ class TrajectoryArrays:
         if self.kind == "body":
             cols = {"time_s": self.times}
             for k in range(3):
-                cols[f"L{k + 1}"] = self.L[:, k]
+                cols[f"L{k + 1}_kg_m2_s"] = self.L[:, k]
             for k, name in enumerate(("qx", "qy", "qz", "qw")):
                 cols[name] = self.q[:, k]
             return cols
