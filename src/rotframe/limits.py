@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["Limits", "LimitError", "DEFAULT", "current", "applied", "check_run", "check_rows"]
+__all__ = ["Limits", "LimitError", "DEFAULT", "current", "applied", "check_run", "check_rows", "check_memory"]
 
 
 class LimitError(ScenarioError):
@@ -98,3 +98,15 @@ def check_rows(rows: float, what: str = "sweep") -> None:
     if float(rows) > lim.max_rows:
         raise LimitError(f"{what}: {_fmt(float(rows))} rows, over the limit of {_fmt(lim.max_rows)}; use fewer "
                          "points, or raise the limit with --max-rows N")
+
+
+def check_memory(what: str, arrays: dict) -> None:
+    """Refuse a run whose arrays (name -> bytes) together exceed the memory limit, naming the largest."""
+    lim = current()
+    total = float(sum(arrays.values()))
+    if total > lim.max_memory:
+        largest = max(arrays, key=arrays.get)
+        raise LimitError(
+            f"{what}: its arrays need about {total / 1e9:.3g} GB ({largest}: {arrays[largest] / 1e9:.3g} GB), over the "
+            f"limit of {lim.max_memory / 1e9:.3g} GB; fewer particles, samples or event slots, or raise the limit "
+            "(--max-memory BYTES)")

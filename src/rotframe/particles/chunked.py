@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe import limits
 from rotframe.particles import threads
 from rotframe.particles.advice import remedy
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
@@ -389,7 +390,10 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
         if traj is not None:
             return traj
     # no event: no records (a (N, 64) table of them would cost more than a short run)
-    evb = EventBuffers(n, max_events if events else 0)
+    slots = max_events if events else 0
+    limits.check_memory(f"method {info.name}", {"samples (r and v at each sample)": 48.0 * (samples + 1) * n,
+                                                "event slots": 64.0 * n * slots, "state (r, v, alive)": 56.0 * n})
+    evb = EventBuffers(n, slots)
     alive = np.ones(n, dtype=np.bool_)
     out_r = np.empty((samples + 1, n, 3))
     out_v = np.empty((samples + 1, n, 3))

@@ -17,8 +17,8 @@ The work is estimated against `rotframe.limits`:
   integrated exactly in a few growing steps), so this one is measured.
 
 An estimate over ``max_steps`` is refused with a `rotframe.limits.LimitError` in one line,
-as ``rotframe run`` refuses a scene's run, instead of running for hours. `check_memory` counts
-every large array a run allocates, not only its samples.
+as ``rotframe run`` refuses a scene's run, instead of running for hours. `rotframe.limits.check_memory`
+counts every large array a run allocates, not only its samples.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-__all__ = ["Pacer", "CALL_SECONDS", "check_knots", "check_memory"]
+__all__ = ["Pacer", "CALL_SECONDS", "check_knots"]
 
 #: wall time of one compiled call once paced: signals and progress are seen at least this often
 CALL_SECONDS = 0.1
@@ -112,17 +112,3 @@ def check_knots(what: str, knots: int, particles: int = 1) -> None:
             f"{what}: at least {estimate:.3g} integration steps (each of the frame's {knots} knots ends a step, for "
             f"each of {particles} particle(s)), over the limit of {lim.max_steps:.3g}; a coarser table or fewer "
             "particles, or raise the limit (rotframe.limits.applied, --max-steps N)")
-
-
-def check_memory(what: str, arrays: dict) -> None:
-    """Refuse a run whose arrays (name -> bytes) together exceed the memory limit, naming the largest."""
-    from rotframe import limits
-
-    lim = limits.current()
-    total = float(sum(arrays.values()))
-    if total > lim.max_memory:
-        largest = max(arrays, key=arrays.get)
-        raise limits.LimitError(
-            f"{what}: its arrays need about {total / 1e9:.3g} GB ({largest}: {arrays[largest] / 1e9:.3g} GB), over the "
-            f"limit of {lim.max_memory / 1e9:.3g} GB; fewer particles, samples or event slots, or raise the limit "
-            "(--max-memory BYTES)")

@@ -30,7 +30,8 @@ from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
-from rotframe.problem.pacing import Pacer, check_knots, check_memory
+from rotframe.limits import check_memory
+from rotframe.problem.pacing import Pacer, check_knots
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "advance_blocks"]
