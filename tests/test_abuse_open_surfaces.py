@@ -343,8 +343,14 @@ SLOW = textwrap.dedent('''
         for k in range(100000):  # about 0.1 ms an evaluation
             acc += 1e-12 * k
         return -r[0] + 0.0 * acc, -r[1], -r[2]
+    said = []
+    def progress(fraction):  # called between compiled calls: the run is compiled and going
+        if not said:
+            said.append(True)
+            print("running", flush=True)
     try:
-        rotframe.simulate(omega=[0, 0, 1], r0=[1, 0, 0], v0=[0, 1, 0], duration=1e5, forces=[slow], samples=100)
+        rotframe.simulate(omega=[0, 0, 1], r0=[1, 0, 0], v0=[0, 1, 0], duration=1e5, forces=[slow], samples=100,
+                          progress=progress)
         print("finished")
     except RunInterrupted as exc:
         print("interrupted", exc.partial is not None)
@@ -357,7 +363,8 @@ def test_a_signal_inside_a_slow_compiled_call_is_answered_in_a_second(tmp_path, 
     proc = subprocess.Popen([sys.executable, "-c", SLOW], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=env, cwd=tmp_path)
     try:
-        time.sleep(8.0)  # compiled and running (a compile may take several seconds on a busy machine)
+        assert proc.stdout.readline().strip() == "running"  # compiled, and inside its calls
+        time.sleep(1.0)
         sent = time.perf_counter()
         proc.send_signal(getattr(signal, sig))
         out, err = proc.communicate(timeout=30)
@@ -365,5 +372,5 @@ def test_a_signal_inside_a_slow_compiled_call_is_answered_in_a_second(tmp_path, 
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert out.startswith("interrupted True"), (out, err)
+    assert out.startswith("interrupted True"), (out, err)  # the first line was read above
     assert answered < 3.0
