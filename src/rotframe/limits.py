@@ -21,7 +21,8 @@ from dataclasses import dataclass, replace
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["Limits", "LimitError", "DEFAULT", "current", "applied", "check_run", "check_rows", "check_memory"]
+__all__ = ["Limits", "LimitError", "DEFAULT", "current", "applied", "check_run", "check_rows", "check_memory",
+           "check_pace"]
 
 
 class LimitError(ScenarioError):
@@ -98,6 +99,29 @@ def check_rows(rows: float, what: str = "sweep") -> None:
     if float(rows) > lim.max_rows:
         raise LimitError(f"{what}: {_fmt(float(rows))} rows, over the limit of {_fmt(lim.max_rows)}; use fewer "
                          "points, or raise the limit with --max-rows N")
+
+
+def check_pace(what: str, duration: float, steps, t_reached, repeated: bool = False) -> bool:
+    """The running work estimate of an adaptive run: its steps so far plus the rest at each particle's pace.
+
+    The pace is a particle's average step so far, not its last (which shrinks near a singularity,
+    where the run is about to fail and say why). Returns whether the estimate is over max_steps;
+    raises `LimitError` when it is and was at the previous check too (``repeated``).
+    """
+    import numpy as np
+
+    lim = current()
+    steps = np.asarray(steps, dtype=float)
+    t_reached = np.asarray(t_reached, dtype=float)
+    pace = np.where(t_reached > 0.0, t_reached / np.maximum(steps, 1.0), np.inf)
+    remaining = np.maximum(float(duration) - t_reached, 0.0) / pace
+    estimate = float(np.sum(steps) + np.sum(remaining))
+    over = estimate > lim.max_steps
+    if over and repeated:
+        raise LimitError(f"{what}: about {_fmt(estimate)} integration steps (at the pace of its first "
+                         f"{int(np.sum(steps))} steps), over the limit of {_fmt(lim.max_steps)}; shorten duration, "
+                         "loosen rtol, or raise the limit (rotframe.limits.applied, --max-steps N)")
+    return over
 
 
 def check_memory(what: str, arrays: dict) -> None:

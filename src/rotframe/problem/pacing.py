@@ -11,9 +11,9 @@ The work is estimated against `rotframe.limits`:
 
 * before the run: a fixed step's count exactly (`rotframe.problem.arguments.run_grid`), and at
   least one step per knot of a table or body frame (`check_knots`);
-* as it goes (`Pacer.check`), within the first calls (a fraction of a second): each particle's
-  steps so far plus its remaining span over its current step, once DOP853's step has settled
-  (`SETTLED_STEPS`). No a-priori bound holds for an adaptive step (a polynomial solution is
+* as it goes (`Pacer.check`, the rule in `rotframe.limits.check_pace`), within the first calls
+  (a fraction of a second): each particle's steps so far plus its remaining span at its average
+  pace, once DOP853's step has settled (`SETTLED_STEPS`). No a-priori bound holds for an adaptive step (a polynomial solution is
   integrated exactly in a few growing steps), so this one is measured.
 
 An estimate over ``max_steps`` is refused with a `rotframe.limits.LimitError` in one line,
@@ -74,31 +74,19 @@ class Pacer:
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
     def check(self, steps, t_reached, h) -> None:
-        """Refuse the run when its steps so far plus the rest at each particle's pace so far exceed max_steps.
+        """Refuse the run when its projected steps exceed max_steps at two checks in a row (`rotframe.limits.check_pace`).
 
         ``steps``, ``t_reached``, ``h``: per-particle arrays of the running particles (``h`` <= 0: a
-        fixed step, whose steps were counted before the run). The pace is a particle's average
-        step so far, not its last (which shrinks near a singularity, where the run is about to fail
-        and say why); an estimate over the limit at two checks in a row is refused.
+        fixed step, whose steps were counted before the run).
         """
         from rotframe import limits
 
-        lim = limits.current()
         steps = np.asarray(steps, dtype=float)
-        t_reached = np.asarray(t_reached, dtype=float)
         adaptive = np.asarray(h, dtype=float) > 0.0
         if not np.any(adaptive) or float(np.min(steps)) < SETTLED_STEPS:
             return
-        pace = np.where(adaptive & (t_reached > 0.0), t_reached / np.maximum(steps, 1.0), np.inf)
-        remaining = np.maximum(self.duration - t_reached, 0.0) / pace
-        estimate = float(np.sum(steps) + np.sum(remaining))
-        over = estimate > lim.max_steps
-        if over and self._over:
-            raise limits.LimitError(
-                f"{self.what}: about {estimate:.3g} integration steps (at the pace of its first {int(np.sum(steps))} "
-                f"steps), over the limit of {lim.max_steps:.3g}; shorten duration, loosen rtol, or raise the limit "
-                "(rotframe.limits.applied, --max-steps N)")
-        self._over = over
+        self._over = limits.check_pace(self.what, self.duration, steps[adaptive],
+                                       np.asarray(t_reached, dtype=float)[adaptive], repeated=self._over)
 
 
 def check_knots(what: str, knots: int, particles: int = 1) -> None:
