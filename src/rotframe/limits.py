@@ -43,7 +43,7 @@ class Limits:
         Rows of one sweep.
     max_memory : float
         Bytes of the large arrays one run allocates together (samples, event slots, per-particle
-        state), counted before they are made (`rotframe.problem.pacing.check_memory`).
+        state), counted before they are made (`check_memory`).
     """
 
     max_steps: float = 2e9

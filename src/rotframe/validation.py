@@ -139,14 +139,14 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
     """
     where = f"{caller}: " if caller else ""
     units = f" ({unit})" if unit else ""
+    if np.iscomplexobj(value):  # before the conversion, which would drop the imaginary part with a warning
+        raise error_cls(f"{where}{name} = {value!r} is complex; it must be real{units}")
     try:
         a = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):  # text, a ragged list, complex, an object
         shown = " ".join(str(value).split())[:60]
         raise error_cls(f"{where}{name} = {shown!r} is not numbers; it must be "
                         f"{'(..., 3) numbers' if stack else '3 numbers'}{units}") from None
-    if np.iscomplexobj(value):
-        raise error_cls(f"{where}{name} = {value!r} is complex; it must be real{units}")
     shape_ok = (a.ndim >= 1 and a.shape[-1] == 3) if stack else a.shape == (3,)
     if shape_ok and (not finite or np.all(np.isfinite(a))):
         return a

@@ -315,10 +315,7 @@ def _run(args) -> int:
         _error((message or "run failed") + "; nothing was computed, so nothing was recorded")
         return status
     try:
-        if len(result.trajectory.times) < 2:  # stopped at its first sample: nothing to analyse
-            summary = runner.summarize_minimal(scn, values, result, {"simulate_s": simulate_s})
-        else:
-            summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets)
+        summary = runner.summarize(scn, values, result, {"simulate_s": simulate_s}, given=sets)
     except KeyboardInterrupt as exc:  # during the analysis: keep the trajectory as a partial recording
         scope.note(exc)
         status = scope.exit_code

@@ -2,7 +2,7 @@
 
 Each optional package belongs to an extra of ``pyproject.toml``. `need` imports it for a feature
 and turns any failure (not installed, or installed but broken: a wheel built for another numpy,
-a missing shared library) into a `rotframe.errors.ScenarioError` naming the package, what needed
+a missing shared library) into a `rotframe.errors.MissingExtraError` naming the package, what needed
 it, why, and the extra that installs it, so that the command exits with code 2 and one line
 instead of an internal error. `missing_package` lets the command line's last resort say the same
 for an import that failed where no `need` guarded it.
@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import importlib
 
-from rotframe.errors import ScenarioError
+from rotframe.errors import MissingExtraError
 
-__all__ = ["EXTRAS", "need", "missing_package", "OptionalPackageError"]
+__all__ = ["EXTRAS", "need", "missing_package"]
 
 #: top-level package -> the extra of pyproject.toml that installs it
 EXTRAS = {"pyarrow": "sweep", "pandas": "sweep", "matplotlib": "plot", "distributed": "sweep", "dask": "sweep",
@@ -22,16 +22,15 @@ EXTRAS = {"pyarrow": "sweep", "pandas": "sweep", "matplotlib": "plot", "distribu
           "diffrax": "bench", "cupy": "bench", "mpmath": "test"}
 
 
-class OptionalPackageError(ScenarioError):
-    """An optional package that a feature needs is missing or cannot be imported."""
+def need(module: str, what: str, extra: str | None = None):
+    """Import ``module`` (``"pyarrow.parquet"``) for ``what`` (``"rotframe sweep"``); a one-line error if it fails.
 
-
-def need(module: str, what: str):
-    """Import ``module`` (``"pyarrow.parquet"``) for ``what`` (``"rotframe sweep"``); a one-line error if it fails."""
+    ``extra``: the extra to name when not the package's own in `EXTRAS` (parquet export: ``export``).
+    """
     try:
         return importlib.import_module(module)
     except Exception as exc:  # ImportError, or whatever a broken package raises while importing
-        raise OptionalPackageError(_message(module, what, exc)) from None
+        raise MissingExtraError(_message(module, what, exc, extra)) from None
 
 
 def _culprit(exc: BaseException) -> str | None:
@@ -52,9 +51,9 @@ def _culprit(exc: BaseException) -> str | None:
     return found
 
 
-def _message(module: str, what: str, exc: BaseException) -> str:
+def _message(module: str, what: str, exc: BaseException, extra: str | None = None) -> str:
     top = _culprit(exc) or module.split(".")[0]
-    extra = EXTRAS.get(top)
+    extra = extra or EXTRAS.get(top)
     install = f"pip install 'rotframe[{extra}]'" if extra else f"pip install {top}"
     if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] == top:
         why = "is not installed"

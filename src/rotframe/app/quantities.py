@@ -139,12 +139,7 @@ def to_si(value, unit: str, key: str):
             shown = " ".join(str(value).split())[:60]
             raise ScenarioError(f"{key}: {value.unit.to_string() or 'dimensionless'} cannot be converted to "
                                 f"{unit or 'a plain number'} ({shown})") from None
-    import numpy as np
-
-    converted = [to_si(item, unit, f"{key}[{k}]") for k, item in enumerate(np.asarray(value, dtype=object)
-                                                                           if not isinstance(value, (list, tuple))
-                                                                           else value)]
-    return converted
+    return [to_si(item, unit, f"{key}[{k}]") for k, item in enumerate(value)]  # a list, tuple or object array
 
 
 def vector_or_table_si(value, unit: str, key: str):

@@ -388,8 +388,9 @@ class Recording:
         """Encode, write through a temporary file and rename to the final or partial name.
 
         ``complete`` may be a callable, asked once the bytes are encoded. Raises
-        `rotframe.app.outputs.OutputError` (nothing left behind) when the file cannot be written. If the write is interrupted, ``finish(complete=False)``
-        may be called again: the encoded bytes are kept until a write succeeds.
+        `rotframe.app.outputs.OutputError` (nothing left behind) when the file cannot be
+        written. If the write is interrupted, ``finish(complete=False)`` may be called again:
+        the encoded bytes are kept until a write succeeds.
         """
         from rotframe.app.outputs import write_bytes_atomic
 

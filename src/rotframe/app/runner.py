@@ -72,10 +72,13 @@ def summarize(scn, values, result, timing, given=()):
     accuracy for an exact theory, the approximation's accuracy otherwise; a metric
     with no tolerance is compared with an indicative theory only), plus the
     scene's own warnings, plus one for each run setting in ``given`` (the keys the
-    caller set) that the method does not read (`unused_settings`).
+    caller set) that the method does not read (`unused_settings`). A run stopped at its first
+    sample has nothing to analyse: its summary is `summarize_minimal`'s.
     """
     from rotframe import scenes
 
+    if len(result.trajectory.times) < 2:
+        return summarize_minimal(scn, values, result, timing)
     scene = scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}
     analysis = scene.analyse(params, result)
@@ -182,7 +185,6 @@ def record_result(scn, values, result, summary, path, complete=True, scene=None)
     """
     from rotframe import scenes
     from rotframe.app.record import Recording
-
     from rotframe.app.signals import deferred
 
     scene = scene if scene is not None else scenes.get(scn.scene)
@@ -201,8 +203,11 @@ def record_result(scn, values, result, summary, path, complete=True, scene=None)
             else:
                 rec.abandon() if isinstance(exc, Exception) and not complete else rec.finish(complete=False)
             raise
-        # a stopped command never writes the final name: asked once the bytes are ready
-        final = rec.finish(complete=lambda: complete and not held.signalled)
+        try:  # a stopped command never writes the final name: asked once the bytes are ready
+            final = rec.finish(complete=lambda: complete and not held.signalled)
+        except KeyboardInterrupt as exc:  # a script's own Ctrl-C while writing: the same bytes as the partial
+            exc.recording = rec.finish(complete=False) if complete else None
+            raise
         held.attach(recording=final)
     return final
 

@@ -352,15 +352,13 @@ def _adaptive_chunk(info, per_sample, samples, n):
     """Samples per call of an adaptive kernel that took ``per_sample`` steps over its first sample.
 
     The run's total is projected from that rate and refused (`rotframe.limits`) when it
-    is over the work limit; a call is kept under about 2e5 particle-steps (a tenth of a
+    is over the work limit; a call is kept under `CALL_STEPS` particle-steps (a tenth of a
     second), so that Python regains control (signals, progress) that often.
     """
-    from rotframe import limits
-
     per_sample = max(float(per_sample), 1.0)
     limits.check_run(steps=per_sample * samples, particles=n,
                      what=f"method {info.name} (projected from its first sample interval)")
-    return int(max(1.0, 2e5 / (per_sample * max(n, 1))))
+    return int(max(1.0, CALL_STEPS / (per_sample * max(n, 1))))
 
 
 def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=False, owned=False):

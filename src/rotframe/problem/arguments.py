@@ -17,7 +17,7 @@ from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 from rotframe.validation import refuse_units
 
-__all__ = ["canonical_method", "check_params", "check_event", "run_grid", "number", "sequence_of_callables",
+__all__ = ["canonical_method", "check_params", "check_event", "run_grid", "number", "sequence_of_callables", "check_flag",
            "array_of", "DEFAULT_RTOL", "DEFAULT_SAMPLES"]
 
 DEFAULT_RTOL = 1e-10
@@ -59,6 +59,13 @@ def check_params(params):
             raise ScenarioError(f"params[{k}]: not finite")
         out.append(uf.readonly_array(arr))  # C-contiguous, and no user function may write into it
     return tuple(out)
+
+
+def check_flag(value, key: str) -> bool:
+    """A True/False argument (``jit``), refused in one line when it is anything else (``"no"`` is truthy)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ScenarioError(f"{key}={value!r}: True or False")
+    return bool(value)
 
 
 def check_event(g, k):

@@ -25,7 +25,7 @@ from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.arguments import canonical_method, check_params, run_grid
+from rotframe.problem.arguments import canonical_method, check_flag, check_params, run_grid
 from rotframe.problem.particles import STATUS
 from rotframe.validation import refuse_units
 
@@ -156,7 +156,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
     if torque is not None and not callable(torque):
         raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
-    uf.check_flag(jit, "jit")
+    check_flag(jit, "jit")
     if torque is not None:
         uf.check_compilable("torque", torque, jit)
     params = check_params(params)
@@ -195,7 +195,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                        st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
                        (np.zeros(3),), np.empty(0))
 
-    pacer = Pacer("simulate_body", duration)  # calls sized in time: signals and progress between them
+    pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:
         while True:
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
@@ -206,9 +206,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                 import numba
 
                 if compile_s is None and driver.rebuild(exc):  # numba's cache of the driver was damaged: rebuilt
-                    y[...], TC[...], H[...] = saved[0], saved[1], saved[2]
-                    for key_, a in saved[3].items():
-                        st[key_][...] = a
+                    _restore(saved, y, TC, H, st)
                     continue
                 if isinstance(exc, numba.core.errors.NumbaError):
                     reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
@@ -222,7 +220,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                 progress(float(st["IDX"][0]) / n)
             if st["ST"][0] != 0:
                 break
-            pacer.check(st["NSTEP"], TC, H if method == "dop853" else np.zeros(1))
+            pacer.check(st["NSTEP"], TC)
     except KeyboardInterrupt:
         k = max(int(st["IDX"][0]), 1)
         raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, torque, compile_s or 0.0,
@@ -251,11 +249,16 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     return run
 
 
-def _torque_raised(exc, call, saved, y, TC, H, st, torque, budget):
-    """The torque raised inside a compiled call: replay the call one step at a time to give the time and state."""
+def _restore(saved, y, TC, H, st):
+    """The body's state as it was before a driver call (``saved``), for a replay or a retry."""
     y[...], TC[...], H[...] = saved[0], saved[1], saved[2]
     for key, a in saved[3].items():
         st[key][...] = a
+
+
+def _torque_raised(exc, call, saved, y, TC, H, st, torque, budget):
+    """The torque raised inside a compiled call: replay the call one step at a time to give the time and state."""
+    _restore(saved, y, TC, H, st)
     what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     where = f"after t = {float(TC[0]):.9g} s"
     for _ in range(int(budget) + 1):

@@ -26,9 +26,9 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call", "UserFunctionError", "read_only_args",
-           "raised_message", "readonly_view", "readonly_array", "check_flag",
-           "check_compilable"]
+__all__ = ["fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call",
+           "check_compilable", "UserFunctionError", "read_only_args", "raised_message", "readonly_view",
+           "readonly_array"]
 
 
 class UserFunctionError(ScenarioError):
@@ -191,13 +191,6 @@ def cache_key(roles, extra: str):
             return None, (f"{role} ({display_name(f)}) reads {exc}, which rotframe cannot fingerprint: its "
                           "driver was compiled for this run alone (not cached)")
     return None, "a user function reads a value rotframe cannot fingerprint: its driver was not cached"
-
-
-def check_flag(value, key: str) -> bool:
-    """A True/False argument (``jit``), refused in one line when it is anything else (``"no"`` is truthy)."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise UserFunctionError(f"{key}={value!r}: True or False")
-    return bool(value)
 
 
 def check_compilable(role: str, f, jit: bool) -> None:

@@ -23,6 +23,7 @@ function numba cannot compile.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
 import itertools
@@ -43,8 +44,9 @@ def cache_dir(notes=None) -> Path | None:
     """The folder of the generated driver modules (created if missing), or None when none can be written.
 
     The configured folder, else a temporary one; each must take a real write (a probe of a few
-    kilobytes through `rotframe.files`, so that a full disk shows). None means no caching: the
-    drivers compile in memory, once per process, and ``notes`` says why.
+    kilobytes through `rotframe.files`, so that a full disk shows), tried once per folder and
+    process (a later failure to write a driver is caught where it is written). None means no
+    caching: the drivers compile in memory, once per process, and ``notes`` says why.
     """
     env = os.environ.get("ROTFRAME_CACHE_DIR")
     if env:
@@ -62,6 +64,7 @@ def cache_dir(notes=None) -> Path | None:
     return None
 
 
+@functools.lru_cache(maxsize=None)
 def _writable(folder: Path) -> bool:
     from rotframe.files import OutputError, write_bytes_atomic
 

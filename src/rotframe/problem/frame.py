@@ -77,7 +77,7 @@ class FrameSpec:
         """The same body frame from every other sample (None for another kind, or too few samples).
 
         Comparing a run in this frame with the run in the full one estimates the error that the
-        frame's interpolation between samples makes (`rotframe.problem.particles`, Richardson).
+        frame's interpolation between samples makes (`rotframe.problem.frame_error`, Richardson).
         """
         if self.kind != "body" or self.data[0].size < 5:
             return None

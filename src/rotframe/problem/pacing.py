@@ -10,7 +10,7 @@ keep everything a step needs in their arrays (`rotframe.problem.stepping`).
 The work is estimated against `rotframe.limits`:
 
 * before the run: a fixed step's count exactly (`rotframe.problem.arguments.run_grid`), and at
-  least one step per knot of a table or body frame (`check_knots`);
+  least one step per knot of a table or body frame (`rotframe.limits.check_run`);
 * as it goes (`Pacer.check`, the rule in `rotframe.limits.check_pace`), within the first calls
   (a fraction of a second): each particle's steps so far plus its remaining span at its average
   pace, once DOP853's step has settled (`SETTLED_STEPS`). No a-priori bound holds for an adaptive step (a polynomial solution is
@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-__all__ = ["Pacer", "CALL_SECONDS", "check_knots"]
+__all__ = ["Pacer", "CALL_SECONDS"]
 
 #: wall time of one compiled call once paced: signals and progress are seen at least this often
 CALL_SECONDS = 0.1
@@ -46,11 +46,15 @@ class Pacer:
         The caller, for messages (``"simulate"``).
     duration : float
         The run's span (s).
+    adaptive : bool
+        An adaptive step, whose work is estimated as the run goes (a fixed step's was counted
+        before the run).
     """
 
-    def __init__(self, what: str, duration: float):
+    def __init__(self, what: str, duration: float, adaptive: bool):
         self.what = what
         self.duration = float(duration)
+        self.adaptive = bool(adaptive)
         self.budget = FIRST_BUDGET
         self.calls = 0
         self._started = 0.0
@@ -67,36 +71,17 @@ class Pacer:
         self.calls += 1
         if self.calls == 1 or steps_in_call <= 0:  # the first call compiled: its time says nothing of a step's
             return
-        if elapsed <= 0.0:
-            self.budget = min(self.budget * 8, 1_000_000)
-            return
-        wanted = self.budget * CALL_SECONDS / elapsed
+        wanted = self.budget * CALL_SECONDS / max(elapsed, 1e-9)
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
-    def check(self, steps, t_reached, h) -> None:
+    def check(self, steps, t_reached) -> None:
         """Refuse the run when its projected steps exceed max_steps at two checks in a row (`rotframe.limits.check_pace`).
 
-        ``steps``, ``t_reached``, ``h``: per-particle arrays of the running particles (``h`` <= 0: a
-        fixed step, whose steps were counted before the run).
+        ``steps``, ``t_reached``: per-particle arrays of the running particles.
         """
         from rotframe import limits
 
         steps = np.asarray(steps, dtype=float)
-        adaptive = np.asarray(h, dtype=float) > 0.0
-        if not np.any(adaptive) or float(np.min(steps)) < SETTLED_STEPS:
+        if not self.adaptive or steps.size == 0 or float(np.min(steps)) < SETTLED_STEPS:
             return
-        self._over = limits.check_pace(self.what, self.duration, steps[adaptive],
-                                       np.asarray(t_reached, dtype=float)[adaptive], repeated=self._over)
-
-
-def check_knots(what: str, knots: int, particles: int = 1) -> None:
-    """Refuse before the run a frame with more knots than max_steps allows: no step crosses a knot."""
-    from rotframe import limits
-
-    lim = limits.current()
-    estimate = float(knots) * max(int(particles), 1)
-    if estimate > lim.max_steps:
-        raise limits.LimitError(
-            f"{what}: at least {estimate:.3g} integration steps (each of the frame's {knots} knots ends a step, for "
-            f"each of {particles} particle(s)), over the limit of {lim.max_steps:.3g}; a coarser table or fewer "
-            "particles, or raise the limit (rotframe.limits.applied, --max-steps N)")
+        self._over = limits.check_pace(self.what, self.duration, steps, t_reached, repeated=self._over)

@@ -24,14 +24,14 @@ import numpy as np
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory
 from rotframe.problem import callables as uf
-from rotframe.problem.arguments import (array_of, canonical_method, check_event, check_params, run_grid,
+from rotframe.problem.arguments import (array_of, canonical_method, check_event, check_flag, check_params, run_grid,
                                         sequence_of_callables)
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
-from rotframe.limits import check_memory
-from rotframe.problem.pacing import Pacer, check_knots
+from rotframe.limits import check_memory, check_run
+from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "simulate_particles", "PARTICLE_METHODS", "ProblemRun", "advance_blocks"]
@@ -252,7 +252,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     import time
 
     method = canonical_method(method, PARTICLE_METHODS, "dop853")
-    uf.check_flag(jit, "jit")
+    check_flag(jit, "jit")
     r, v = _states(r0, v0)
     N = r.shape[0]
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method == "rk4",
@@ -287,7 +287,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     n = samples + 1
     check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
                               "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
-    check_knots("simulate", stop_times((frame, origin), duration).size, N)
+    stops = stop_times((frame, origin), duration)
+    check_run(steps=stops.size, particles=N, what="simulate (the frame's knots each end a step)")
     y = np.zeros((N, D))
     y[:, :3] = r
     y[:, 3:6] = v
@@ -311,7 +312,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     settings = [check_event(g, k) for k, g in enumerate(events)]
     EDIR = np.array([d for d, _ in settings] or [0.0])
     ETERM = np.array([t for _, t in settings] or [False])
-    pacer = Pacer("simulate", duration)  # calls sized in time: signals and progress between them
+    pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     code = 0 if method == "dop853" else 1
     t0 = time.perf_counter()
     compile_s = 0.0
@@ -328,7 +329,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                 raise
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
-        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G, stop_times((frame, origin), duration))
+        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G, stops)
         while True:
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
@@ -357,8 +358,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             if np.all(ST != 0):
                 break
             running = ST == 0
-            pacer.check(state["NSTEP"][running], state["TC"][running],
-                        state["H"][running] if method == "dop853" else np.zeros(int(np.sum(running))))
+            pacer.check(state["NSTEP"][running], state["TC"][running])
     except KeyboardInterrupt:
         traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])))
         raise RunInterrupted(traj) from None

@@ -85,13 +85,8 @@ def flip_times(times, w):
     interpolated = times[a] + (times[b] - times[a]) * w[a] / np.where(adjacent, w[a] - w[b], 1.0)
     on_samples = 0.5 * (times[np.minimum(a + 1, b)] + times[np.maximum(b - 1, a)])  # the run of zeros' middle
     inner = np.where(adjacent, interpolated, on_samples)
-    ends = []
-    if nz[0] > 0:  # the run starts at a flip
-        ends.append((0.5 * (times[0] + times[nz[0] - 1]), 0))
-    if nz[-1] < w.size - 1:  # the run ends at a flip
-        ends.append((0.5 * (times[nz[-1] + 1] + times[-1]), 1))
-    first = [t for t, where in ends if where == 0]
-    last = [t for t, where in ends if where == 1]
+    first = [0.5 * (times[0] + times[nz[0] - 1])] if nz[0] > 0 else []  # the run starts at a flip
+    last = [0.5 * (times[nz[-1] + 1] + times[-1])] if nz[-1] < w.size - 1 else []  # the run ends at one
     return np.concatenate([first, inner, last])
 
 

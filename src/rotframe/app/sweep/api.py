@@ -74,10 +74,10 @@ def sweep(name_or_path, *, grid=None, vary=None, points=None, samples=None, seed
     >>> list(df["height"])
     [50.0, 100.0, 150.0]
     """
-    from rotframe.app.sweep.store import require
+    from rotframe.app.optional import need
     from rotframe.particles.ensemble import device_scope, threads_scope
 
-    require("pandas", "rotframe.sweep")
+    need("pandas", "rotframe.sweep")
     _check_arguments(grid, vary, points, samples, seed, client)
     with threads_scope(threads), device_scope(device):
         return _sweep(name_or_path, grid, vary, points, samples, seed, client, out, fixed)

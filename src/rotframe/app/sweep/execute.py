@@ -25,7 +25,8 @@ from rotframe.app.sweep.cluster import SweepLost, quiet_dask_logs
 from rotframe.app.sweep.plots import write_plots
 from rotframe.app.sweep.recording import write_recording
 from rotframe.app.sweep.spec import SweepSpec, points_of, sweep_points
-from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, require, write_part
+from rotframe.app.optional import need
+from rotframe.app.sweep.store import SweepFiles, exclusive, merge, prepare, write_part
 from rotframe.errors import ScenarioError
 
 __all__ = ["SweepResult", "SweepInterrupted", "SweepLost", "run_sweep", "check_scheduler", "scheduler_from_env",
@@ -137,7 +138,7 @@ def run_sweep(spec: SweepSpec, out=None, *, workers=None, scheduler=None, client
         ``out`` not ending in ``.parquet``; ``--resume`` of a different sweep; an unreachable scheduler.
     """
     t_start = time.perf_counter()
-    require("pyarrow", "rotframe sweep")
+    need("pyarrow", "rotframe sweep")
     files = SweepFiles.for_spec(spec, out)
     check_task_timeout(task_timeout)
     where = {"workers": workers, "scheduler": scheduler, "scheduler_file": scheduler_file, "client": client,
@@ -400,7 +401,7 @@ def _connect(workers, scheduler, scheduler_file=None):
     import logging
     import warnings
 
-    require("distributed", "--scheduler" if (scheduler or scheduler_file) else "--workers")
+    need("distributed", "--scheduler" if (scheduler or scheduler_file) else "--workers")
     from distributed import Client, LocalCluster
 
     if scheduler_file:

@@ -20,7 +20,7 @@ import numpy as np
 from rotframe.app.messages import one_line as _one_line
 from rotframe.errors import RotframeError, ScenarioError
 
-__all__ = ["META_KEY", "SweepFiles", "check_outputs", "exclusive", "require", "read_table", "prepare", "write_part",
+__all__ = ["META_KEY", "SweepFiles", "check_outputs", "exclusive", "read_table", "prepare", "write_part",
            "merge", "metric_columns", "column", "read_tracks"]
 
 
@@ -89,13 +89,6 @@ def exclusive(files):
             os.close(fd)
 
     return lock()
-
-
-def require(module, what):
-    """Import the optional ``module`` now, or a one-line error naming it and its extra (`rotframe.app.optional`)."""
-    from rotframe.app.optional import need
-
-    need(module, what)
 
 
 def read_table(path):
