@@ -116,14 +116,19 @@ SIMULATE = {
 }
 
 
-@pytest.mark.parametrize("case", sorted(SIMULATE))
-def test_simulate_refuses_in_one_line(case):
-    changes, needle = SIMULATE[case]
+def refused_in_one_line(call, kwargs, needle):
+    """``call(**kwargs)`` raises a RotframeError of one line that holds ``needle``."""
     with pytest.raises(RotframeError) as info:
-        rotframe.simulate(**{**BASE, **changes})
+        call(**kwargs)
     message = str(info.value)
     assert needle in message, message
     assert "\n" not in message and len(message) < 700
+
+
+@pytest.mark.parametrize("case", sorted(SIMULATE))
+def test_simulate_refuses_in_one_line(case):
+    changes, needle = SIMULATE[case]
+    refused_in_one_line(rotframe.simulate, {**BASE, **changes}, needle)
 
 
 def torque_free(t, L, q):
@@ -151,11 +156,7 @@ SIMULATE_BODY = {
 @pytest.mark.parametrize("case", sorted(SIMULATE_BODY))
 def test_simulate_body_refuses_in_one_line(case):
     changes, needle = SIMULATE_BODY[case]
-    with pytest.raises(RotframeError) as info:
-        rotframe.simulate_body(**{**BODY, **changes})
-    message = str(info.value)
-    assert needle in message, message
-    assert "\n" not in message and len(message) < 700
+    refused_in_one_line(rotframe.simulate_body, {**BODY, **changes}, needle)
 
 
 SWEEP = {
@@ -176,11 +177,7 @@ SWEEP = {
 @pytest.mark.parametrize("case", sorted(SWEEP))
 def test_sweep_refuses_in_one_line(case):
     kwargs, needle = SWEEP[case]
-    with pytest.raises(RotframeError) as info:
-        rotframe.sweep("tower-drop", **kwargs)
-    message = str(info.value)
-    assert needle in message, message
-    assert "\n" not in message
+    refused_in_one_line(functools.partial(rotframe.sweep, "tower-drop"), kwargs, needle)
 
 
 def test_sweep_refuses_a_closed_client():
