@@ -83,12 +83,17 @@ def write_trajectory(traj, path: str | Path, summary: Mapping[str, Any] | None =
 
 
 def _pyarrow(path):
-    """(pyarrow, pyarrow.parquet), or a one-line MissingExtraError naming the ``export`` extra.
+    """(pyarrow, pyarrow.parquet), or a one-line ScenarioError naming the ``export`` extra.
 
     Any failure to import (missing, or a broken install raising something other than
     ImportError) is reported the same way.
     """
-    from rotframe.app.optional import need
-
-    what = f"--export {str(path)!r} (parquet; .npz and .csv need nothing)"
-    return need("pyarrow", what, extra="export"), need("pyarrow.parquet", what, extra="export")
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except Exception as exc:  # noqa: BLE001 -- a broken install raises anything; the remedy is the same
+        why = "is not installed" if isinstance(exc, ImportError) else \
+            f"failed to import ({type(exc).__name__}: {str(exc).splitlines()[0][:120] if str(exc) else ''})"
+        raise ScenarioError(f"--export {str(path)!r}: parquet needs pyarrow, which {why}; install the export "
+                            'extra (python -m pip install "rotframe[export]"); .npz and .csv need nothing') from None
+    return pa, pq

@@ -25,7 +25,7 @@ EXTRAS = {"pyarrow": "sweep", "pandas": "sweep", "matplotlib": "plot", "distribu
 def need(module: str, what: str, extra: str | None = None):
     """Import ``module`` (``"pyarrow.parquet"``) for ``what`` (``"rotframe sweep"``); a one-line error if it fails.
 
-    ``extra``: the extra to name when not the package's own in `EXTRAS` (parquet export: ``export``).
+    ``extra``: the extra to name when not the package's own in `EXTRAS`.
     """
     try:
         return importlib.import_module(module)
