@@ -225,7 +225,7 @@ def test_a_run_that_asked_for_the_gpu_and_had_no_ensemble_says_so():
 
 
 @pytest.mark.parametrize("args, expected", [
-    (["tower-drop", "--grid", "height=20:60:3", "--method", "dop853"], "method: 'dop853' on device 'gpu'"),
+    (["tower-drop", "--grid", "height=20:60:3", "--method", "dop853"], "method='dop853' does not run on the GPU"),
     (["foucault", "--grid", "latitude=10:60:3"], "device: 'gpu' for a sweep of foucault"),
 ])
 def test_a_gpu_sweep_no_row_could_run_on_the_gpu_is_refused_up_front(tmp_path, args, expected):

@@ -50,14 +50,15 @@ _LAZY = {
     "simulate_body": "rotframe.app.problems",
     "Force": "rotframe.problem.particles",
     "Torque": "rotframe.problem.body",
+    "methods": "rotframe.method_registry",
     "sweep": "rotframe.app.sweep.api",
     "RotframeError": "rotframe.errors",
     "ScenarioError": "rotframe.errors",
     "IntegrationError": "rotframe.errors",
     "RotframeWarning": "rotframe.errors",
 }
-_SUBMODULES = ("analytic", "app", "earth", "errors", "frames", "limits", "numerics", "particles",
-               "problem", "rigid", "scenes", "validation")
+_SUBMODULES = ("analytic", "app", "earth", "errors", "forces", "frames", "limits", "method_registry", "numerics",
+               "particles", "problem", "rigid", "scenes", "validation")
 
 #: Where the modules of the first, flat layout live now: ``rotframe.inertia`` and
 #: ``from rotframe import integrators`` keep working (``import rotframe.inertia`` does not).

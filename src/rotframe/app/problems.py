@@ -75,8 +75,8 @@ def _progress(progress, label):
 def _describe(f):
     from rotframe.problem.callables import display_name
 
-    accel = getattr(f, "accel", f)
-    return display_name(accel)
+    name = getattr(f, "name", "")  # a built-in term (rotframe.forces) or a named Force
+    return name if isinstance(name, str) and name else display_name(getattr(f, "accel", f))
 
 
 def _result(scn, scene, scene_result, summary):

@@ -2,7 +2,7 @@
 
 One home for the remedy a failure's message ends with, so that it never contradicts the run (a
 DOP853 run was once told to "use a smaller step or dop853"). It takes the method's kind, as
-`rotframe.particles.integrators.MethodInfo` gives it: ``"fixed"``, ``"adaptive"`` or ``"exact"``.
+`rotframe.method_registry.Method.step` gives it: ``"fixed"``, ``"adaptive"`` or ``"exact"``.
 """
 
 from __future__ import annotations

@@ -69,7 +69,7 @@ class KernelSetup:
     Parameters
     ----------
     model : ParticleModel
-    info : MethodInfo
+    info : rotframe.method_registry.Method
         A fixed-step or adaptive entry of `rotframe.particles.integrators.METHODS`.
     duration : float
         Simulated time (s), > 0.
@@ -100,8 +100,11 @@ class KernelSetup:
         self.wt_arg = None if model.omega.is_constant else self.wt
         self.events = tuple(events)
         self.ev_tab = event_table(self.events) if self.events else None
+        from rotframe.particles.kernels import EVALS_PER_STEP, loop_code
+
+        self.code = loop_code(info.name)  # the integer the compiled loops branch on (-1 for dop853)
         # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere
-        self.rk4 = True if info.kind == "fixed" and info.code == 2 else None
+        self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.steady_args = None  # (q, tab) of the specialised DOP853 driver, where the model allows it
         self.fixed = info.kind == "fixed"
@@ -117,7 +120,7 @@ class KernelSetup:
         if info.kind == "fixed":
             self.sps = steps_per_sample(dt, step)
             self.h = dt / self.sps
-            self.evals_per_step = (3 if info.code == 1 else 4 if info.code == 2 else 1)
+            self.evals_per_step = EVALS_PER_STEP[info.name]
         else:
             from rotframe.numerics.dop853 import coefficients
             from rotframe.particles.dop853_steady import is_steady_model, steady_parameters, steady_tableau
@@ -195,7 +198,7 @@ class KernelSetup:
         if self.fixed and r.shape[0] <= threads.BLOCK:
             # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
             k = self.sps if sps is None else sps
-            n_done, bad, nfev = kernel(self.info.code, r, v, alive, start, self.h, k, count, *self._model_args,
+            n_done, bad, nfev = kernel(self.code, r, v, alive, start, self.h, k, count, *self._model_args,
                                        out_r, out_v, *records, *self._family)
             return n_done, bad, nfev, k * n_done
         from rotframe.particles.blocks import run_blocks
@@ -206,7 +209,7 @@ class KernelSetup:
             k = self.sps if sps is None else sps
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(self.info.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                return kernel(self.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
                               self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
                               max_events, self.rk4, self.sphere) + (k * count,)
 

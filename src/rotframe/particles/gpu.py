@@ -29,11 +29,13 @@ import types
 
 import numpy as np
 
+from rotframe import method_registry as registry
+
 __all__ = ["available", "require", "check_method", "launches", "launch_shape", "device_function",
            "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
 
 #: the particle methods the GPU runs (the fixed-step ones)
-GPU_METHODS = ("rotation-splitting", "rotation-splitting4", "rk4")
+GPU_METHODS = registry.names("particle scenes", gpu=True)
 
 #: threads per block of the kernel
 _THREADS_PER_BLOCK = 128
@@ -64,13 +66,7 @@ def launch_shape(n) -> tuple:
 
 def check_method(method) -> str:
     """``method``'s canonical name if the GPU runs it (`GPU_METHODS`); ScenarioError in one line otherwise."""
-    from rotframe.errors import ScenarioError
-    from rotframe.particles.integrators import canonical_method
-
-    method = canonical_method(method)
-    if method not in GPU_METHODS:
-        raise ScenarioError(f"method: {method!r} on device 'gpu'; the GPU runs {', '.join(GPU_METHODS)}")
-    return method
+    return registry.check(method, "particle scenes", gpu=True)
 
 
 def require(what="device"):
@@ -281,6 +277,7 @@ class GpuLaunch:
         from rotframe.particles import packed
         from rotframe.particles.chunked import steps_per_sample
         from rotframe.particles.integrators import METHODS
+        from rotframe.particles.kernels import loop_code
 
         require()
         info = METHODS[check_method(method)]
@@ -293,7 +290,7 @@ class GpuLaunch:
         wt, wv, wint = model.omega.times, model.omega.values, model.omega.cumulative()
         table = np.array([event.row() if event is not None else [0.0] * 5], dtype=np.float64)
         host = packed.unpack.py_func(P, wt, wv)  # the model as the kernel unpacks it: its switches, here
-        self.kernel = _kernel(info.code, True if info.code == 2 else None, True if host.length > 0.0 else None,
+        self.kernel = _kernel(loop_code(info.name), True if info.name == "rk4" else None, True if host.length > 0.0 else None,
                               event is not None, bool(host.steady), _structure_source(host))
         self.settings = [cuda.to_device(a) for a in (P, wt, wv, wint, table)]
 

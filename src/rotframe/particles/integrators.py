@@ -39,11 +39,11 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rotframe import method_registry as registry
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.chunked import KernelSetup, run_chunked, sample_times, steps_per_sample
 from rotframe.particles.trajectory import Event, RunInterrupted, Trajectory
@@ -58,27 +58,13 @@ if TYPE_CHECKING:  # names used only in annotations
 __all__ = ["METHODS", "ALIASES", "METHOD_NAMES", "canonical_method", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
 
 
-@dataclass(frozen=True)
-class MethodInfo:
-    name: str
-    order: int
-    kind: str  # "fixed", "adaptive" or "exact"
-    conserves: str
-    code: int = -1
-
-
-METHODS = {
-    "rotation-splitting": MethodInfo("rotation-splitting", 2, "fixed",
-                                     "|v| under Coriolis, pendulum constraint; time-reversible", 0),
-    "rotation-splitting4": MethodInfo("rotation-splitting4", 4, "fixed", "as rotation-splitting", 1),
-    "rk4": MethodInfo("rk4", 4, "fixed", "nothing exactly", 2),
-    "dop853": MethodInfo("dop853", 8, "adaptive", "nothing exactly; error per step below rtol"),
-    "exact": MethodInfo("exact", 0, "exact", "everything (the exact flow of a linear or force-free model)"),
-}
+#: The methods of the scenes' particle models, read from the one registry
+#: (`rotframe.method_registry`): name -> `rotframe.method_registry.Method`.
+METHODS = {m.name: m for m in registry.methods("particle scenes")}
 
 #: Former names of particle methods, still accepted everywhere a particle method is named:
 #: alias -> the `METHODS` key. (The heavy top's ``splitting``/``splitting4`` are other methods.)
-ALIASES = {"splitting": "rotation-splitting", "splitting4": "rotation-splitting4"}
+ALIASES = registry.names("particle scenes").aliases
 
 #: Every name a particle method may be given by: the `METHODS` keys, then the `ALIASES`.
 METHOD_NAMES = tuple(METHODS) + tuple(ALIASES)
@@ -97,11 +83,7 @@ def canonical_method(name: str) -> str:
     >>> canonical_method("splitting4"), canonical_method("DOP853")
     ('rotation-splitting4', 'dop853')
     """
-    name = name.lower() if isinstance(name, str) else name
-    name = ALIASES.get(name, name)
-    if name not in METHODS:
-        raise ScenarioError(f"method: unknown {name!r}; allowed: {', '.join(METHOD_NAMES)}")
-    return name
+    return registry.check(name, "particle scenes")
 
 
 def default_method(model: ParticleModel, events: Sequence[Event] = (), otherwise: str = "rotation-splitting") -> str:

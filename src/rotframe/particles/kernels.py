@@ -34,7 +34,18 @@ _acceleration = _inline(state_acceleration.py_func)
 _position_acceleration = _inline(position_acceleration.py_func)
 from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 
-__all__ = ["make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
+#: The integer each fixed-step method is compiled under (this module's loops branch on it). The
+#: methods are named everywhere else (`rotframe.method_registry`); `loop_code` turns a name into it.
+_LOOP_CODES = {"rotation-splitting": 0, "rotation-splitting4": 1, "rk4": 2}
+#: Force evaluations per step of each fixed-step method (the splittings' kicks, RK4's stages).
+EVALS_PER_STEP = {"rotation-splitting": 1, "rotation-splitting4": 3, "rk4": 4}
+
+
+def loop_code(name: str) -> int:
+    """The code the compiled loops know the fixed-step method ``name`` by (-1: not one of theirs, dop853)."""
+    return _LOOP_CODES.get(name, -1)
+
+__all__ = ["loop_code", "EVALS_PER_STEP", "make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
 
 # numba compiles a separate version of a function for every constant it is called with

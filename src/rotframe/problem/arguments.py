@@ -17,20 +17,11 @@ from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 from rotframe.validation import refuse_units
 
-__all__ = ["canonical_method", "check_params", "check_event", "run_grid", "number", "sequence_of_callables", "check_flag",
+__all__ = ["check_params", "check_event", "run_grid", "number", "sequence_of_callables", "check_flag",
            "array_of", "DEFAULT_RTOL", "DEFAULT_SAMPLES"]
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_SAMPLES = 1000
-
-
-def canonical_method(method, allowed, default):
-    """``method`` in lower case, checked against ``allowed`` (``None``: ``default``)."""
-    if method is None:
-        return default
-    if not isinstance(method, str) or method.lower() not in allowed:
-        raise ScenarioError(f"method={method!r}: allowed: {', '.join(allowed)} (any case)")
-    return method.lower()
 
 
 def check_params(params):

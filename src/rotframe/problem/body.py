@@ -25,20 +25,18 @@ from rotframe.problem import callables as uf
 from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.arguments import canonical_method, check_flag, check_params, run_grid
+from rotframe import method_registry as registry
+from rotframe.problem.arguments import check_flag, check_params, run_grid
 from rotframe.problem.particles import STATUS
 from rotframe.validation import refuse_units
 
-__all__ = ["simulate_rigid_body", "BODY_METHODS", "BodyRun", "SPLITTING_NAMES", "Torque"]
+__all__ = ["simulate_rigid_body", "BodyRun", "Torque"]
 
-#: Methods of a user's rigid body (names are case-insensitive) and their driver codes
-BODY_METHODS = ("dop853", "rk4", "exact", "lie-poisson", "lie-poisson4")
+#: The integer the compiled body driver branches on, for each method it steps (the names are
+#: `rotframe.method_registry`'s; ``exact`` is the elliptic flow, not the driver)
 _CODES = {"dop853": 0, "rk4": 1, "lie-poisson": 2, "lie-poisson4": 3}
 #: Lie-Poisson splittings: the torque as a kick at fixed attitude (a torque of (t, q) alone)
 KICK_METHODS = ("lie-poisson", "lie-poisson4")
-#: Splitting methods of the built-in scenes that a user's body does not have
-SPLITTING_NAMES = ("lie-poisson6", "lie-poisson8", "rotation-splitting",
-                   "top-splitting", "top-splitting4", "top-splitting6", "top-splitting8")
 
 
 @dataclass(frozen=True)
@@ -122,11 +120,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     attitude_only = bool(getattr(torque, "attitude_only", False))
     if isinstance(torque, Torque):
         torque = torque.func
-    name = method.lower() if isinstance(method, str) else None
-    if name in SPLITTING_NAMES:
-        what = f" and cannot take torque={uf.display_name(torque)}" if torque is not None else ""
-        raise ScenarioError(f"method={method!r} is a built-in scene's splitting{what}; simulate_body takes "
-                            f"{', '.join(BODY_METHODS)}")
+    name = registry.check(method, "bodies", default="dop853",
+                          nor=f"torque={uf.display_name(torque)}" if torque is not None else "")
     if torque is not None and name == "exact":
         raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: the exact flow is the "
                             "free body's; use dop853, rk4, or a Lie-Poisson splitting for a torque of (t, q) alone")
@@ -134,7 +129,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: it splits the torque as a "
                             "kick at fixed attitude, exact only for a torque of (t, q) alone; mark such a torque "
                             "rotframe.Torque(f, attitude_only=True), or use dop853 or rk4")
-    method = canonical_method(method, BODY_METHODS, "dop853")
+    method = name
     I = _inertia(inertia)
     if method in KICK_METHODS and np.any(I != np.diag(np.diag(I))):
         raise ScenarioError(f"method={method!r} turns about the principal axes: give the 3 principal moments (a "

@@ -9,6 +9,7 @@ tableau ``A, B, C, E3, E5`` and error norm ``error_norm``::
     frame_rates(t, F) -> (wx, wy, wz, ex, ey, ez)    omega and omega' in frame axes
     origin_acceleration(t, G) -> (ax, ay, az)        the frame origin's acceleration
     user_acceleration(t, y, P) -> (ax, ay, az)       the sum of the user's forces, frame axes
+    constrain(y, ax, ay, az) -> (ax, ay, az)         the total kept on a pendulum's sphere (or as it is)
     event_value(k, t, y, P) -> float                 event k's function
     potential(t, y, P) -> float                      the sum of the forces' potentials
 
@@ -19,7 +20,7 @@ when a force is given in inertial axes, by the frame's attitude ``(qx, qy, qz, q
 
 Equation of motion (docs/physics/rotating-frames.md)::
 
-    r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)
+    r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)   [+ the string's tension]
 
 Each particle is integrated alone (its own steps, its own events), so the samples do not
 depend on how many threads share the ensemble (blocks of particles on threads). A call advances
@@ -60,12 +61,13 @@ def rhs(t, y, dy, P, F, G):
     ay -= ez * x - ex * z
     az -= ex * yy - ey * x
     ox, oy, oz = origin_acceleration(t, G)
+    ax, ay, az = constrain(y, ax - ox, ay - oy, az - oz)
     dy[0] = vx
     dy[1] = vy
     dy[2] = vz
-    dy[3] = ax - ox
-    dy[4] = ay - oy
-    dy[5] = az - oz
+    dy[3] = ax
+    dy[4] = ay
+    dy[5] = az
     if D == 10:
         attitude_rate(y, dy, 6, wx, wy, wz)
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.method_registry import MethodNames, names
 from rotframe.scenes.run_settings import RUN_DEFAULTS, run_setting
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
@@ -122,47 +123,9 @@ def with_parameters(cls, position=0):
 # ---------------------------------------------------------------------------
 
 
-class MethodNames(tuple):
-    """A scene's method names: the canonical ones in order, plus old names (aliases) that it still accepts.
-
-    A tuple of the canonical names (iterating, printing and ``len`` see only
-    those, so messages and ``rotframe show`` list them), whose ``in`` also
-    accepts an alias; `canonical` maps an alias to its name, which is the
-    name a run reports (the JSON ``method``). Names are matched without regard
-    to case (scipy's ``"DOP853"`` is ``dop853``).
-    """
-
-    def __new__(cls, names, aliases=None):
-        self = super().__new__(cls, names)
-        self.aliases = dict(aliases or {})
-        unknown = [a for a, target in self.aliases.items() if not tuple.__contains__(self, target)]
-        if unknown:
-            raise ValueError(f"MethodNames: aliases {unknown} point to no method of {tuple(self)}")
-        return self
-
-    def __contains__(self, name) -> bool:
-        if not isinstance(name, str):
-            return False
-        name = name.lower()
-        return tuple.__contains__(self, name) or name in self.aliases
-
-    def canonical(self, name):
-        """The canonical name of ``name`` (any case; itself when it is one; unknown names and None unchanged)."""
-        if not isinstance(name, str) or name not in self:
-            return name
-        name = name.lower()
-        return self.aliases.get(name, name)
-
-
 def particle_methods() -> MethodNames:
-    """The particle integrators' names, from their registry (``rotframe.particles.integrators``).
-
-    Canonical names are the keys of ``integrators.METHODS``; old names are its
-    ``ALIASES`` ({old: canonical}) where the registry has them.
-    """
-    from rotframe.particles import integrators
-
-    return MethodNames(tuple(integrators.METHODS), integrators.ALIASES)
+    """The names of the methods that run the scenes' particle models, with their old names (`rotframe.method_registry`)."""
+    return names("particle scenes")
 
 
 @dataclass

@@ -10,20 +10,17 @@ import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.integrators import RunInterrupted
-from rotframe.scenes.base import MethodNames, guarded
+from rotframe.method_registry import names
+from rotframe.scenes.base import guarded
 
 #: Methods of the free body; ``exact`` is the elliptic-function flow, ``lie-poisson[4|6|8]`` the
 #: Lie-Poisson splitting of orders 2, 4, 6, 8, ``dop853`` the compiled adaptive Dormand-Prince 8(5,3)
 #: (`rotframe.rigid.adaptive.rigid_dop853`, relative tolerance ``rtol`` of the run).
-FREE_METHODS = MethodNames(("exact", "lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "rk4",
-                            "dop853"))
+FREE_METHODS = names("free body")
 #: Methods of the heavy top: ``top-splitting[4|6|8]`` (exact free symmetric-top flow and gravity kick,
 #: orders 2, 4, 6, 8), ``rk4`` and the adaptive ``dop853``; the old names ``splitting``, ``splitting4``,
 #: ``splitting6`` are still accepted.
-HEAVY_METHODS = MethodNames(("top-splitting", "top-splitting4", "top-splitting6", "top-splitting8", "rk4",
-                             "dop853"),
-                            {"splitting": "top-splitting", "splitting4": "top-splitting4",
-                             "splitting6": "top-splitting6"})
+HEAVY_METHODS = names("heavy top")
 
 #: Relative tolerance of ``dop853`` when the run names none (the scenario default of ``rtol``).
 DEFAULT_RTOL = 1e-10

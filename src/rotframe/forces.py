@@ -1,0 +1,232 @@
+"""The built-in terms, as the same kind of object as your own force (``rotframe.forces``).
+
+Each factory returns a [`rotframe.Force`][rotframe.problem.particles.Force] (or, for the
+pendulum, the string's constraint) that ``rotframe.simulate`` takes in its ``forces`` list
+beside your own::
+
+    import rotframe
+    from rotframe import forces
+
+    def wind(t, r, v):                       # your own term: m/s^2 in the frame's axes
+        return 0.0, 0.3 * (1.0 - abs(r[2]) / 100.0), 0.0
+
+    res = rotframe.simulate(omega=[0.0, 4.6e-5, 5.7e-5], r0=[0, 0, 50.0], v0=[20.0, 0, 30.0],
+                            duration=5.0, forces=[forces.gravity([0, 0, -9.81]),
+                                                  forces.drag(quadratic=4e-5), wind])
+
+A built-in term goes the same way into the same compiled driver as your force (its function
+is plain arithmetic on ``t, r, v``, compiled with numba like yours), so a built-in term and a
+force of yours that does the same arithmetic give the same trajectory to the last bit
+(``tests/test_forces.py``). Their physics is that of the scenes' model terms
+([`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel]), checked
+against the scenes' compiled kernels in the same test file; each factory's docstring names the
+scene term it is. A term's constants are compiled into its function: a run with other
+constants compiles its driver once (cached on disk like any other). A value you vary from run
+to run is cheaper as a ``params`` entry of a force of your own.
+
+The frame's own terms (Coriolis, centrifugal, Euler, the origin's acceleration) are not terms
+to add: ``rotframe.simulate`` adds them from ``omega`` and ``origin_acceleration``.
+
+=========================  ===============================  =======================
+factory                     acceleration (frame axes)        the scenes' term
+=========================  ===============================  =======================
+``gravity(g)``              ``g``                            ``gravity``
+``altitude_gravity(g0, R)`` ``-g0 (R / (R + z))^2 z_hat``    ``altitude-gravity``
+``central_gravity(gm, c)``  ``-GM (r - c) / |r - c|^3``      ``central-gravity``
+``drag(linear, quadratic,`` ``-(k1 + k2 |v|) rho(z) v``      ``linear-drag``,
+``scale_height)``                                            ``quadratic-drag``
+``spring(k, anchor)``       ``-k (r - anchor)``              ``spring`` (horizontal)
+``pendulum(length, pivot)`` the string's tension             ``pendulum``
+``lorentz(q_over_m, B, E)`` ``(q/m) (E + v x B)``            (none)
+=========================  ===============================  =======================
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+from rotframe.problem.particles import Force, StringConstraint
+
+__all__ = ["Force", "gravity", "altitude_gravity", "central_gravity", "drag", "spring", "pendulum", "lorentz"]
+
+
+def _finite(name, **values):
+    for key, v in values.items():
+        try:
+            arr = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            raise ScenarioError(f"{name}: {key}={v!r} is not a number") from None
+        if not np.all(np.isfinite(arr)):
+            raise ScenarioError(f"{name}: {key}={np.asarray(v).tolist()} is not finite")
+
+
+def _vector(name, key, value):
+    _finite(name, **{key: value})
+    arr = np.asarray(value, dtype=float)
+    if arr.size != 3:
+        raise ScenarioError(f"{name}: {key}={arr.tolist()} must be 3 numbers (x, y, z)")
+    return tuple(float(c) for c in arr.reshape(3))
+
+
+def gravity(g) -> Force:
+    """Uniform gravity: ``a = g`` (m/s^2, the frame's axes); ``U = -g . r``. The scenes' term ``gravity``.
+
+    Examples
+    --------
+    >>> gravity([0.0, 0.0, -9.81]).accel(0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    (0.0, 0.0, -9.81)
+    """
+    gx, gy, gz = _vector("gravity", "g", g)
+
+    def gravity(t, r, v):
+        return gx, gy, gz
+
+    def potential(t, r):
+        return -(gx * r[0] + gy * r[1] + gz * r[2])
+
+    return Force(gravity, potential=potential, name="gravity")
+
+
+def altitude_gravity(g0, radius) -> Force:
+    """Gravity falling off with height z above a flat ground: ``a_z = -g0 (R / (R + z))^2``.
+
+    ``U = -g0 R^2 / (R + z)``. The scenes' term ``altitude-gravity`` (g0 in m/s^2, R in m).
+    """
+    _finite("altitude_gravity", g0=g0, radius=radius)
+    g0, R = float(g0), float(radius)
+    if not R > 0:
+        raise ScenarioError(f"altitude_gravity: radius={R!r} must be > 0 (m)")
+
+    def gravity(t, r, v):
+        s = R / (R + r[2])
+        return 0.0, 0.0, -g0 * s * s
+
+    def potential(t, r):
+        return -g0 * R * R / (R + r[2])
+
+    return Force(gravity, potential=potential, name="altitude-gravity")
+
+
+def central_gravity(gm, centre) -> Force:
+    """Gravity of a point mass at ``centre``: ``a = -GM (r - c) / |r - c|^3``; ``U = -GM / |r - c|``.
+
+    The scenes' term ``central-gravity`` is this one with ``c = (0, 0, -R)``, Earth's centre
+    below a local frame on its surface (GM in m^3/s^2, c in m).
+    """
+    _finite("central_gravity", gm=gm)
+    GM = float(gm)
+    cx, cy, cz = _vector("central_gravity", "centre", centre)
+
+    def gravity(t, r, v):
+        dx = r[0] - cx
+        dy = r[1] - cy
+        dz = r[2] - cz
+        d2 = dx * dx + dy * dy + dz * dz
+        f = -GM / (d2 * math.sqrt(d2))
+        return f * dx, f * dy, f * dz
+
+    def potential(t, r):
+        dx = r[0] - cx
+        dy = r[1] - cy
+        dz = r[2] - cz
+        return -GM / math.sqrt(dx * dx + dy * dy + dz * dz)
+
+    return Force(gravity, potential=potential, name="central-gravity")
+
+
+def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
+    """Air drag: ``a = -(k1 + k2 |v|) rho(z) v`` with ``rho = exp(-z / H)`` (1 for ``H = 0``).
+
+    The scenes' terms ``linear-drag`` (``linear`` = k1, 1/s) and ``quadratic-drag``
+    (``quadratic`` = k2, 1/m), over an exponential atmosphere of scale height ``H`` (m).
+    ``v`` is the velocity relative to the frame: still air turning with it.
+
+    Examples
+    --------
+    >>> ax, ay, az = drag(quadratic=0.01).accel(0.0, [0.0, 0.0, 0.0], [3.0, 4.0, 0.0])
+    >>> round(ax, 12), round(ay, 12)                    # -k2 |v| v with |v| = 5 m/s
+    (-0.15, -0.2)
+    """
+    _finite("drag", linear=linear, quadratic=quadratic, scale_height=scale_height)
+    k1, k2, H = float(linear), float(quadratic), float(scale_height)
+    if k1 < 0 or k2 < 0 or H < 0:
+        raise ScenarioError(f"drag: linear={k1!r}, quadratic={k2!r}, scale_height={H!r}; each must be >= 0")
+    if k1 == 0.0 and k2 == 0.0:
+        raise ScenarioError("drag: give linear=k1 (1/s) or quadratic=k2 (1/m), or both")
+    name = "linear-drag" if k2 == 0.0 else "quadratic-drag" if k1 == 0.0 else "linear-drag, quadratic-drag"
+
+    def drag(t, r, v):
+        air = math.exp(-r[2] / H) if H > 0.0 else 1.0
+        c = (k1 + k2 * math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])) * air
+        return -c * v[0], -c * v[1], -c * v[2]
+
+    return Force(drag, name=name)
+
+
+def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
+    """A linear spring (per unit mass): ``a = -k (r - anchor)``; ``U = k |r - anchor|^2 / 2``.
+
+    ``k`` in 1/s^2 (the spring constant over the mass: the square of the angular frequency).
+    With ``horizontal=True`` only x and y are pulled back, ``a = -k (x - x_a, y - y_a, 0)``:
+    the scenes' term ``spring``, the small-angle pendulum (``k = g / L``).
+    """
+    _finite("spring", k=k)
+    k = float(k)
+    ax_, ay_, az_ = _vector("spring", "anchor", anchor)
+    vertical = 0.0 if horizontal else 1.0
+
+    def spring(t, r, v):
+        return -k * (r[0] - ax_), -k * (r[1] - ay_), -k * vertical * (r[2] - az_)
+
+    def potential(t, r):
+        dx = r[0] - ax_
+        dy = r[1] - ay_
+        dz = r[2] - az_
+        return 0.5 * k * (dx * dx + dy * dy + vertical * dz * dz)
+
+    return Force(spring, potential=potential, name="spring")
+
+
+def pendulum(length, pivot=(0.0, 0.0, 0.0)) -> StringConstraint:
+    """The pendulum's string: the particle stays at ``length`` (m) from ``pivot`` (m, frame axes).
+
+    Not a force but a constraint: its tension is whatever keeps the particle on the sphere
+    under every other term, the frame's included. The scenes' term ``pendulum``. Start the
+    particle on the sphere, with no velocity along the string; add gravity yourself.
+
+    Examples
+    --------
+    A Foucault pendulum 67 m long at 49 degrees north (ENU axes, the pivot above the origin)::
+
+        lat = np.radians(49.0)
+        w = 7.292115e-5 * np.array([0.0, np.cos(lat), np.sin(lat)])
+        res = rotframe.simulate(omega=w, r0=[1.0, 0.0, 67.0 - np.sqrt(67.0**2 - 1.0)], v0=[0, 0, 0],
+                                duration=600.0, forces=[forces.gravity([0, 0, -9.81]),
+                                                        forces.pendulum(67.0, pivot=[0, 0, 67.0])])
+    """
+    _finite("pendulum", length=length)
+    L = float(length)
+    if not L > 0:
+        raise ScenarioError(f"pendulum: length={L!r} must be > 0 (m)")
+    return StringConstraint(L, _vector("pendulum", "pivot", pivot))
+
+
+def lorentz(q_over_m, B, E=(0.0, 0.0, 0.0)) -> Force:
+    """The Lorentz force per unit mass, ``a = (q/m) (E + v x B)``, in uniform fields (the frame's axes).
+
+    ``v`` is relative to the frame: these are the fields of a co-rotating plasma, where the
+    corotation electric field cancels ``omega x r``. q/m in C/kg, B in T, E in V/m.
+    """
+    _finite("lorentz", q_over_m=q_over_m)
+    qm = float(q_over_m)
+    bx, by, bz = _vector("lorentz", "B", B)
+    ex, ey, ez = _vector("lorentz", "E", E)
+
+    def force(t, r, v):
+        return (qm * (ex + v[1] * bz - v[2] * by), qm * (ey + v[2] * bx - v[0] * bz),
+                qm * (ez + v[0] * by - v[1] * bx))
+
+    return Force(force, name="Lorentz force")
