@@ -94,11 +94,12 @@ _REGISTRY = (
            "a linear particle model with constant coefficients or a force-free one (only the frame's terms); "
            "a torque-free body", ("particle scenes", "bodies", "free body")),
     Method("rotation-splitting", 2, "fixed", _ROTATION,
-           "the scenes' particle terms in a frame turning about a fixed axis (the rotation as an exact flow, "
-           "linear drag and the pendulum as flows, the rest as kicks)", ("particle scenes",), gpu=True,
-           aliases=("splitting",)),
+           "the frame's Coriolis term as an exact rotation of v (exact for omega of fixed direction over a "
+           "step), forces of (t, r) alone as kicks; in the scenes also linear drag and the pendulum as flows; "
+           "refuses a force that reads v or is given in inertial axes", ("particle scenes", "particles"),
+           gpu=True, aliases=("splitting",)),
     Method("rotation-splitting4", 4, "fixed", _ROTATION + " (Yoshida's triple jump of rotation-splitting)",
-           "as rotation-splitting", ("particle scenes",), gpu=True, aliases=("splitting4",)),
+           "as rotation-splitting", ("particle scenes", "particles"), gpu=True, aliases=("splitting4",)),
     Method("lie-poisson", 2, "fixed", _LIE_POISSON,
            "principal axes; a torque of (t, q) alone, as a kick at fixed attitude", ("bodies", "free body")),
     Method("lie-poisson4", 4, "fixed", _LIE_POISSON, "as lie-poisson", ("bodies", "free body")),
@@ -130,7 +131,7 @@ def methods(runs: str | None = None) -> list:
     Examples
     --------
     >>> [m.name for m in methods("particles")]
-    ['rk4', 'dop853']
+    ['rotation-splitting', 'rotation-splitting4', 'rk4', 'dop853']
     >>> get("rotation-splitting4").order, get("rotation-splitting4").gpu
     (4, True)
     """

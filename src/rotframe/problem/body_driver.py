@@ -89,9 +89,6 @@ def strang(t, h, yn, P, F):
     yn[2] += 0.5 * h * tz
 
 
-TRIPLE_JUMP = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))  # Yoshida's fourth-order weights w1, w0 = 1 - 2 w1
-
-
 @jit
 def own_step(method, t, y, h, yn, P, F, G):
     """Method 2: the Strang splitting (order 2); method 3: Yoshida's triple jump of it (order 4)."""
@@ -100,8 +97,8 @@ def own_step(method, t, y, h, yn, P, F, G):
     if method == 2:
         strang(t, h, yn, P, F)
     else:
-        w1 = TRIPLE_JUMP
-        w0 = 1.0 - 2.0 * w1
+        w1 = YOSHIDA4_OUTER  # Yoshida's triple jump (rotframe.numerics.composition)
+        w0 = YOSHIDA4_INNER
         strang(t, w1 * h, yn, P, F)
         strang(t + w1 * h, w0 * h, yn, P, F)
         strang(t + (w1 + w0) * h, w1 * h, yn, P, F)

@@ -40,6 +40,35 @@ def plain_function(f):
     return getattr(f, "py_func", f)
 
 
+def reads_argument(f, index: int) -> bool:
+    """Whether the function ``f`` may read its argument number ``index`` (0-based), from its bytecode.
+
+    True when the code loads the argument's name anywhere (a read, or a pass to another
+    function), when an inner function captures it, or when ``index`` falls in ``*args``; so a
+    False is certain: the argument is never looked at. Used to find the forces of ``(t, r)`` alone
+    that a splitting can take as kicks.
+
+    Examples
+    --------
+    >>> reads_argument(lambda t, r, v: (0.0, 0.0, -r[2]), 2), reads_argument(lambda t, r, v: v, 2)
+    (False, True)
+    """
+    import dis
+
+    code = getattr(plain_function(f), "__code__", None)
+    if code is None or index >= code.co_argcount:
+        return True
+    name = code.co_varnames[index]
+    if name in code.co_cellvars:
+        return True
+    for ins in dis.get_instructions(code):
+        if ins.opname.startswith("LOAD_FAST") or ins.opname == "DELETE_FAST":
+            value = ins.argval
+            if value == name or (isinstance(value, tuple) and name in value):
+                return True
+    return False
+
+
 def display_name(f) -> str:
     """``module.qualname`` of a user function, for messages."""
     f = plain_function(f)

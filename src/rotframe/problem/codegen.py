@@ -167,6 +167,8 @@ from numba import njit
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as error_norm
 from rotframe.problem.readonly import readonly
+from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
+from rotframe.numerics.rotation import rodrigues_rotate
 
 jit = njit(cache={cache}, error_model="numpy", nogil=True)
 """
@@ -177,8 +179,11 @@ import numpy as np
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
 from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as _norm
 from rotframe.problem.callables import readonly_view as readonly
+from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
+from rotframe.numerics.rotation import rodrigues_rotate as _rodrigues
 
 error_norm = _norm.py_func
+rodrigues_rotate = _rodrigues.py_func
 
 def jit(f):
     return f

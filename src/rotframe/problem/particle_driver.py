@@ -73,10 +73,59 @@ def rhs(t, y, dy, P, F, G):
 
 
 @jit
+def kick_acceleration(t, y, P, F, G):
+    """What the splittings kick with: the forces (of t and r alone) and the frame's terms of position,
+    centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
+    wx, wy, wz, ex, ey, ez = frame_rates(t, F)
+    x = y[0]
+    yy = y[1]
+    z = y[2]
+    ax, ay, az = user_acceleration(t, y, P)
+    wr = wx * x + wy * yy + wz * z
+    w2 = wx * wx + wy * wy + wz * wz
+    ox, oy, oz = origin_acceleration(t, G)
+    ax += w2 * x - wr * wx - (ey * z - ez * yy) - ox
+    ay += w2 * yy - wr * wy - (ez * x - ex * z) - oy
+    az += w2 * z - wr * wz - (ex * yy - ey * x) - oz
+    return ax, ay, az, wx, wy, wz
+
+
+@jit
+def rotation_strang(t, h, yn, P, F, G):
+    """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
+    drift h/2, kick h/2, the Coriolis flow v' = -2 w x v (v turned by -2 |w| h about w, with w at the
+    step's middle: exact for a constant omega, symmetric always), kick h/2, drift h/2."""
+    hh = 0.5 * h
+    for j in range(3):
+        yn[j] += hh * yn[j + 3]
+    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yn, P, F, G)
+    vx = yn[3] + hh * ax
+    vy = yn[4] + hh * ay
+    vz = yn[5] + hh * az
+    w = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if w > 0.0:
+        angle = -2.0 * w * h
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, math.cos(angle), math.sin(angle))
+    yn[3] = vx + hh * ax
+    yn[4] = vy + hh * ay
+    yn[5] = vz + hh * az
+    for j in range(3):
+        yn[j] += hh * yn[j + 3]
+
+
+@jit
 def own_step(method, t, y, h, yn, P, F, G):
-    """A particle has no method of its own beyond DOP853 and RK4 (never called)."""
+    """Method 2: the rotation splitting (order 2); method 3: Yoshida's triple jump of it (order 4)."""
     for j in range(D):
         yn[j] = y[j]
+    if method == 2:
+        rotation_strang(t, h, yn, P, F, G)
+    else:
+        w1 = YOSHIDA4_OUTER  # Yoshida's triple jump (rotframe.numerics.composition)
+        w0 = YOSHIDA4_INNER
+        rotation_strang(t, w1 * h, yn, P, F, G)
+        rotation_strang(t + w1 * h, w0 * h, yn, P, F, G)
+        rotation_strang(t + (w1 + w0) * h, w1 * h, yn, P, F, G)
 
 
 @jit

@@ -37,6 +37,9 @@ from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
 
+#: The integer the generated driver branches on (`rotframe.problem.stepping.take_step`), for each method it
+#: steps; the names are `rotframe.method_registry`'s.
+_CODES = {"dop853": 0, "rk4": 1, "rotation-splitting": 2, "rotation-splitting4": 3}
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
 
 
@@ -109,6 +112,19 @@ def _as_force(f, k):
     if not callable(force.accel) or (force.potential is not None and not callable(force.potential)):
         raise ScenarioError(f"forces[{k}]: accel and potential must be callables")
     return force
+
+
+def _check_splitting(method, forces, constraint):
+    """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes."""
+    for k, f in enumerate(forces):
+        why = ("reads v: a kick is exact only for a force of (t, r) alone" if uf.reads_argument(f.accel, 2)
+               else "is given in inertial axes" if f.axes == "inertial" else "")
+        if why:
+            raise ScenarioError(f"method={method!r} cannot take forces[{k}] ({f.name or uf.display_name(f.accel)}): "
+                                f"it {why}; use dop853 or rk4")
+    if constraint is not None:
+        raise ScenarioError(f"method={method!r} cannot take the pendulum's string in rotframe.simulate yet (the "
+                            "scenes' foucault runs it on the sphere); use dop853 or rk4")
 
 
 def _one_constraint(terms, r, v):
@@ -318,7 +334,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     check_flag(jit, "jit")
     r, v = _states(r0, v0)
     N = r.shape[0]
-    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method == "rk4",
+    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method != "dop853",
                                                     what=f"method {method}", particles=N)
     frame = frame_spec(omega, omega_dot)
     origin = origin_spec(origin_acceleration)
@@ -334,6 +350,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if not callable(g):
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
+    if method.startswith("rotation-splitting"):
+        _check_splitting(method, forces, constraint)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0)
@@ -378,7 +396,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     EDIR = np.array([d for d, _ in settings] or [0.0])
     ETERM = np.array([t for _, t in settings] or [False])
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
-    code = 0 if method == "dop853" else 1
+    code = _CODES[method]
     t0 = time.perf_counter()
     compile_s = 0.0
     first = True
@@ -433,7 +451,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         good = int(state["IDX"][i])
         t_bad = float(state["TC"][i])
         # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
-        dt_failed = hfix if method == "rk4" else 10.0 * float(state["H"][i])
+        dt_failed = hfix if method != "dop853" else 10.0 * float(state["H"][i])
         why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i], dt_failed)
         partial = _trajectory(times, OUT, state, events, method, good)
         raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
@@ -514,7 +532,7 @@ def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, tim
             try:
                 module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
-                dt = hfix if method == "rk4" else float(state["H"][i])
+                dt = hfix if method != "dop853" else float(state["H"][i])
                 blame = _blame(forces, params, t, yi, dt)
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
