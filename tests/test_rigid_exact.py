@@ -121,3 +121,23 @@ def test_a_first_run_does_not_compile_the_flow(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr[-2000:]
+
+
+def test_free_body_exact_compiles_the_flow_when_a_process_needs_it_twice(monkeypatch):
+    """The first call of a process takes the numpy path (no compile for one call); the second compiles the
+    flow (cached on disk), as do all later calls; the scenes' reference path never compiles it."""
+    from rotframe.rigid import exact_flow, free_body
+
+    calls = []
+    real = exact_flow.flow_into
+    monkeypatch.setattr(exact_flow, "flow_ready", lambda: False)
+    monkeypatch.setattr(exact_flow, "flow_into", lambda *a: calls.append(1) or real(*a))
+    monkeypatch.setattr(free_body, "_CALLS", [0])
+    I, L0, q0, t = [1.0, 2.0, 3.0], [0.3, 0.1, 1.0], [0.0, 0.0, 0.0, 1.0], np.linspace(0.0, 5.0, 7)
+    first = free_body.free_body_exact(I, L0, q0, t)
+    assert calls == []
+    second = free_body.free_body_exact(I, L0, q0, t)
+    assert calls == [1]
+    free_body.free_body_exact_ready(I, L0, q0, t)  # the scenes' and simulate_body's path: only where ready
+    assert calls == [1]
+    assert np.max(np.abs(first[0] - second[0])) < 1e-13 and np.max(np.abs(first[1] - second[1])) < 1e-13

@@ -20,7 +20,7 @@ Each function lives in a module of one concept; this module only gathers them:
 from __future__ import annotations
 
 from rotframe.rigid.checks import InvalidStateError
-from rotframe.rigid.free_body import elliptic_period, free_body_exact
+from rotframe.rigid.free_body import elliptic_period, free_body_closed_form, free_body_exact
 from rotframe.rigid.heavy_top import (
     free_symmetric_precession,
     heavy_top_splitting,
@@ -34,6 +34,7 @@ from rotframe.rigid.torqued import lie_poisson, rigid_rhs, rigid_rk4, torqued_sp
 __all__ = [
     "InvalidStateError",
     "free_body_exact",
+    "free_body_closed_form",
     "lie_poisson",
     "torqued_splitting",
     "heavy_top_splitting",

@@ -105,7 +105,7 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
         # the elliptic-function flow of rigid.free_body (not the compiled rigid.exact_flow, which agrees to
         # round-off only: the scenes' numbers stay those of the reference implementation)
         t0 = time.perf_counter()
-        rigid.free_body_exact(inertia, L0, q0, times[:1])  # check every input once; load the kernels
+        rigid.free_body_closed_form(inertia, L0, q0, times[:1])  # check every input once; load the kernels
         compile_s = time.perf_counter() - t0
         out_L = np.empty((samples + 1, 3))
         out_q = np.empty((samples + 1, 4))
@@ -113,7 +113,8 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
         try:
             for start in range(0, samples + 1, SAMPLES_PER_CALL):
                 stop = min(samples + 1, start + SAMPLES_PER_CALL)
-                out_L[start:stop], out_q[start:stop] = rigid.free_body_exact(inertia, L0, q0, times[start:stop])
+                chunk = times[start:stop]
+                out_L[start:stop], out_q[start:stop] = rigid.free_body_closed_form(inertia, L0, q0, chunk)
                 done = stop
                 if progress:
                     progress(stop / (samples + 1))
