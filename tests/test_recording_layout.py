@@ -150,3 +150,42 @@ def test_error_series_are_also_logged_as_log10_of_their_size(tmp_path):
     assert np.allclose(logs[nonzero], np.log10(np.abs(raw[nonzero])))
     assert np.all(logs[~nonzero] == -18.0)
     assert np.max(logs) < -12  # round-off of the exact solution: visible on a log axis, not 0.000 000 000 4
+
+
+def _views(container):
+    """The views of a blueprint's container, depth first."""
+    import rerun.blueprint as rrb
+
+    if isinstance(container, rrb.Container):
+        for item in container.contents:
+            yield from _views(item)
+    else:
+        yield container
+
+
+@pytest.mark.parametrize("name", sorted(SCENES) + ["cr3bp", "tumbling-ball"])
+def test_every_time_series_opens_on_the_whole_run(name, tmp_path, monkeypatch):
+    """rerun's default shows a window around the time cursor (a minute of Foucault's hour): every time-series
+    view of every scene's blueprint shows all its data, its time axis from 0 to the run's last time."""
+    from rotframe.app import record
+
+    sent = []
+    original = record.Recording.blueprint
+
+    def spy(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        sent.append(self)
+
+    monkeypatch.setattr(record.Recording, "blueprint", spy)
+    params = SCENES.get(name, ({},))[0]
+    path = rotframe.run(name, **params).record(tmp_path / f"{name}.rrd")
+    (rec,) = sent
+    logged = [c for info in _read(path).values() for c in info["columns"].get("sim_time", [])]
+    end_ns = max(max(int(t.value) for t in column) for column in logged)  # the last time in the file
+    series = [v for v in _views(rec.sent_blueprint.root_container) if type(v).__name__ == "TimeSeriesView"]
+    assert series, name
+    for view in series:
+        ranges = view.properties["VisibleTimeRanges"].ranges.as_arrow_array().to_pylist()
+        assert ranges == [{"timeline": record.TIMELINE, "range": {"start": None, "end": None}}], (name, ranges)
+        axis = view.properties["TimeAxis"].view_range.as_arrow_array().to_pylist()
+        assert axis[0]["start"] == 0 and abs(axis[0]["end"] - end_ns) <= 1, (name, axis)

@@ -45,6 +45,8 @@ __all__ = ["Recording", "default_path", "series_kind", "is_error_series", "playb
 
 #: seconds of viewing a run's whole timeline takes at the blueprint's playback speed (at least 1x)
 PLAYBACK_TARGET_S = 30.0
+#: the timeline every series is logged on (a duration, s)
+TIMELINE = "sim_time"
 #: where log10 of an error series draws an exact zero (below float64 round-off, 1e-16)
 LOG10_FLOOR = -18.0
 
@@ -110,7 +112,7 @@ def _time_column(times):
     import rerun as rr
 
     ns = np.round(np.asarray(times, dtype=np.float64) * 1e9).astype(np.int64)
-    return rr.TimeColumn("sim_time", duration=ns.astype("timedelta64[ns]"))
+    return rr.TimeColumn(TIMELINE, duration=ns.astype("timedelta64[ns]"))
 
 
 class Recording:
@@ -138,6 +140,7 @@ class Recording:
         self._data = None
         self.final = None
         self._t_end = 0.0  # the latest time logged: the timeline the blueprint plays
+        self.sent_blueprint = None  # the blueprint sent (`blueprint`), None before
         self._view: dict = {}  # the 3D view's eye and contents, set by the scene (`view`)
 
     # -- logging -------------------------------------------------------------
@@ -151,15 +154,18 @@ class Recording:
                 self._t_end = max(self._t_end, last)
         return _time_column(times)
 
-    def view(self, eye=None, look_at=None, up=(0.0, 0.0, 1.0), contents=None, playback_s=None):
+    def view(self, eye=None, look_at=None, up=(0.0, 0.0, 1.0), contents=None, playback_s=None,
+             playback_speed=None):
         """How the 3D view opens: an orbital eye at ``eye`` looking at ``look_at`` (world coordinates).
 
         ``contents`` (entity paths under ``world``, rerun's ``+ path`` / ``- path``
         expressions) limits what the view shows; ``playback_s`` is the simulated
         time the phenomenon takes, played in `PLAYBACK_TARGET_S` seconds (default:
-        the whole timeline).
+        the whole timeline); ``playback_speed`` sets the speed itself instead, below 1 for
+        slow motion (a top spinning 48 turns a second).
         """
-        self._view = {"eye": eye, "look_at": look_at, "up": up, "contents": contents, "playback_s": playback_s}
+        self._view = {"eye": eye, "look_at": look_at, "up": up, "contents": contents, "playback_s": playback_s,
+                      "playback_speed": playback_speed}
 
     def points(self, entity, times, positions, radius=None, color=None, trail=True):
         """Points per sample at ``entity``; ``positions`` (n, 3) or (n, N, 3), m."""
@@ -353,11 +359,18 @@ class Recording:
         groups: dict[str, list[str]] = {}
         for entity, kind in self._series:
             groups.setdefault(kind, []).append(entity)
+        # every time series shows the whole run: all its data visible, the axis from 0 to the last time
+        # (rerun's default window around the cursor shows a minute of an hour-long run)
+        whole = dict(time_ranges=[rrb.VisibleTimeRange(TIMELINE, start=rrb.TimeRangeBoundary.infinite(),
+                                                       end=rrb.TimeRangeBoundary.infinite())],
+                     axis_x=rrb.archetypes.TimeAxis(view_range=rr.TimeRange(
+                         start=rrb.TimeRangeBoundary.absolute(seconds=0.0),
+                         end=rrb.TimeRangeBoundary.absolute(seconds=float(self._t_end)))))
         if groups:
-            views = [rrb.TimeSeriesView(origin="/", name=kind, contents=[f"+ /{e.strip('/')}/**" for e in entities])
-                     for kind, entities in groups.items()]
+            views = [rrb.TimeSeriesView(origin="/", name=kind, contents=[f"+ /{e.strip('/')}/**" for e in entities],
+                                        **whole) for kind, entities in groups.items()]
         else:
-            views = [rrb.TimeSeriesView(origin=f"/{s}", name=s) for s in series]
+            views = [rrb.TimeSeriesView(origin=f"/{s}", name=s, **whole) for s in series]
         view = self._view
         eye = None
         if view.get("eye") is not None:
@@ -369,16 +382,18 @@ class Recording:
         world = rrb.Spatial3DView(origin="/world", name="world", contents=view.get("contents") or "$origin/**",
                                   eye_controls=eye)
         span = view.get("playback_s") or self._t_end
+        speed = view.get("playback_speed") or playback_speed(span)
         bp = rrb.Blueprint(
             rrb.Horizontal(
                 world,
                 rrb.Vertical(*views, rrb.TextDocumentView(origin="/scenario", name="summary")),
                 column_shares=[3, 2],
             ),
-            rrb.TimePanel(state="collapsed", timeline="sim_time", playback_speed=playback_speed(span),
+            rrb.TimePanel(state="collapsed", timeline=TIMELINE, playback_speed=speed,
                           play_state=rrb.components.PlayState.Playing, loop_mode=rrb.components.LoopMode.All),
             collapse_panels=True,
         )
+        self.sent_blueprint = bp  # what the viewer opens on (tests read it)
         self.rec.send_blueprint(bp)
 
     # -- finishing -----------------------------------------------------------

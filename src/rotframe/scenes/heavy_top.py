@@ -264,6 +264,9 @@ def record(rec, p, result):
     rec.frame_axes("world/frame", p.length, labels=("x", "y", "z (up)"))
     E = rigid.energy(result.extras["inertia"], traj.L) + p.mass * p.g * p.length * np.cos(theta)
     rec.scalars("diagnostics/energy_rel_error", t, (E[idx] - E[0]) / abs(E[0]))
+    # slow motion: the spin (tens of turns a second) plays at about 2 turns a second, which the eye follows
+    spin = abs(p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0)))  # rad/s about the symmetry axis
+    rec.view(playback_speed=min(1.0, 2.0 * 2.0 * math.pi / max(spin, 1e-12)))
 
 
 @with_parameters(HeavyTopParameters)
