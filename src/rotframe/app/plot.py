@@ -106,6 +106,51 @@ def plot_result(result, path: str | Path | None = None):
     return fig
 
 
+#: Scenes whose frame is the local East-North-Up frame on the rotating Earth
+_ENU_SCENES = ("tower-drop", "foucault", "inertial-oscillation", "projectile")
+
+
+def _horizontal_axes(result):
+    """The words for a picture's x and y: east and north on Earth, the frame's own name elsewhere."""
+    if result.scenario.scene in _ENU_SCENES:
+        return "x (east)", "y (north)"
+    if result.scenario.scene == "turntable":
+        return "x (turntable)", "y (turntable)"
+    return "x", "y"
+
+
+def _turntable(result, ax1, ax2) -> bool:
+    """The curl on the table, and the same motion seen from the lab: the straight line it is measured against."""
+    import numpy as np
+
+    traj = result.trajectory
+    omega = getattr(result, "_scene_result", None) and result._scene_result.extras.get("omega")
+    if traj.kind != "particles" or omega is None:
+        return False
+    r = traj.r[:, 0]
+    theta = np.asarray(omega.angle(traj.times), dtype=float).reshape(-1)
+    c, s = np.cos(theta), np.sin(theta)
+    lab = np.stack([c * r[:, 0] - s * r[:, 1], s * r[:, 0] + c * r[:, 1]], axis=1)  # table -> inertial axes
+    R = float(result.params["table_radius"])
+    phi = np.linspace(0.0, 2.0 * np.pi, 181)
+    for ax, (x, y), title, words in ((ax1, (r[:, 0], r[:, 1]), "on the turntable: the path curls",
+                                      ("x (turntable)", "y (turntable)")),
+                                     (ax2, (lab[:, 0], lab[:, 1]), "from the lab: a straight line",
+                                      ("X (inertial)", "Y (inertial)"))):
+        ax.plot(R * np.cos(phi), R * np.sin(phi), color="0.75", lw=0.8, label="the table's rim")
+        ax.plot(x, y, color="C1", lw=1.2, label="the puck")
+        ax.plot(x[0], y[0], "o", color="green", ms=4)
+        ax.plot(x[-1], y[-1], "s", color="red", ms=4)
+        ax.set_xlabel(f"{words[0]} [m]")
+        ax.set_ylabel(f"{words[1]} [m]")
+        ax.set_title(title + " (o start, s end)", fontsize=9)
+        ax.set_aspect("equal", adjustable="datalim")
+    ax2.plot([lab[0, 0], lab[-1, 0]], [lab[0, 1], lab[-1, 1]], "--", color="0.3", lw=0.8,
+             label="straight line (the exact answer)")
+    ax2.legend(fontsize=7, loc="best")
+    return True
+
+
 def _generic(result, ax1, ax2) -> None:
     import numpy as np
 
@@ -122,8 +167,9 @@ def _generic(result, ax1, ax2) -> None:
             ax1.plot(r[:, k, 0] / scale, r[:, k, 1] / scale, lw=0.8)
             ax1.plot(r[0, k, 0] / scale, r[0, k, 1] / scale, "o", color="green", ms=4)
             ax1.plot(r[-1, k, 0] / scale, r[-1, k, 1] / scale, "s", color="red", ms=4)
-        ax1.set_xlabel(f"x (east) [{unit}]")
-        ax1.set_ylabel(f"y (north) [{unit}]")
+        x_word, y_word = _horizontal_axes(result)
+        ax1.set_xlabel(f"{x_word} [{unit}]")
+        ax1.set_ylabel(f"{y_word} [{unit}]")
         ax1.set_title("path seen from above (o start, s end)")
         ax1.set_aspect("equal", adjustable="datalim")
         t_scale, t_unit = _time_unit(times)
@@ -343,5 +389,5 @@ def _tumbling_ball(result, ax1, ax2) -> bool:
 
 
 #: scene -> function drawing its two panels (False: fall back to the generic picture)
-_SCENE_PICTURES = {"foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top, "cr3bp": _cr3bp,
+_SCENE_PICTURES = {"turntable": _turntable, "foucault": _foucault, "projectile": _projectile, "heavy-top": _heavy_top, "cr3bp": _cr3bp,
                    "tumbling-ball": _tumbling_ball}

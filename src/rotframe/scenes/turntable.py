@@ -154,14 +154,30 @@ def record(rec, p, result):
     traj = result.trajectory
     rec.points("world/puck", traj.times, traj.r[:, 0], radius=0.03, color=[240, 120, 40])
     rec.points("world/oracle", traj.times, result.extras["oracle"], radius=0.015, color=[80, 80, 80], trail=False)
+    # the whole curl from the first frame, faint (the trail above grows with time over it)
+    rec.line("world/path_on_the_table", traj.r[:, 0], color=[240, 120, 40, 90])
     phi = np.linspace(0, 2 * np.pi, 181)
     R = p.table_radius
     rec.line("world/turntable", np.stack([R * np.cos(phi), R * np.sin(phi), 0 * phi], axis=1), color=[120, 120, 200])
-    rec.frame_axes("world/frame", 0.5 * R, labels=("x (turntable)", "y (turntable)", "z (spin axis)"))
-    _record_inertial_axes(rec, traj.times, result.extras["omega"], 0.8 * R)
+    rec.frame_axes("world/frame", 0.6 * R, labels=("x (turntable)", "y (turntable)", "z (spin axis)"))
+    _record_inertial_axes(rec, traj.times, result.extras["omega"], 1.1 * R)
+    # the straight line the puck runs along in inertial space, drawn in the inertial axes (which turn
+    # backwards under the table): the curl on the table is this line seen from the turning table
+    theta = np.asarray(result.extras["omega"].angle(traj.times[[0, -1]]), dtype=float).reshape(-1)
+    ends = np.array([_turn_z(traj.r[k, 0], theta[j]) for j, k in enumerate((0, -1))])
+    rec.static("world/inertial_axes/straight_line", "LineStrips3D", strips=[ends], colors=[[200, 200, 200]],
+               radii=[0.008], labels=["the puck's straight path in inertial space"])
+    size = max(R, float(np.nanmax(np.abs(traj.r[:, 0, :2]))))
+    rec.view(eye=(0.8 * size, -1.2 * size, 1.5 * size), look_at=(0.0, 0.0, 0.0))  # from above and aside: the whole curl
     err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
     rec.scalars("diagnostics/position_error_m", traj.times, err)
     rec.scalars("diagnostics/inertial_speed_rel_error", traj.times, _inertial_speed(result) / _inertial_speed(result)[0] - 1)
+
+
+def _turn_z(r, angle):
+    """``r`` turned by ``angle`` about z: turntable components into inertial ones (the table has turned by angle)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * r[0] - s * r[1], s * r[0] + c * r[1], r[2]])
 
 
 def _record_inertial_axes(rec, times, omega, length):
