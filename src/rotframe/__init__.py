@@ -48,7 +48,7 @@ _LAZY = {
     "register_scene": "rotframe.app.api",
     "simulate": "rotframe.app.problems",
     "simulate_body": "rotframe.app.problems",
-    "Force": "rotframe.problem.particles",
+    "Force": "rotframe.problem.terms",
     "Torque": "rotframe.problem.body",
     "methods": "rotframe.method_registry",
     "sweep": "rotframe.app.sweep.api",

@@ -301,8 +301,8 @@ class Recording:
     def frame_axes(self, entity, length, labels=("E", "N", "U"), omega=None):
         """Static axes of the frame the scene is seen in (labelled), and its rotation vector if given.
 
-        ``omega`` (3,) rad/s in that frame: drawn as an arrow of length
-        ``length`` along it, labelled with its size.
+        ``omega`` (3,) rad/s in that frame: drawn as an arrow of twice ``length``
+        along it, labelled with its size.
         """
         import rerun as rr
 
@@ -313,7 +313,8 @@ class Recording:
             w = np.asarray(omega, dtype=np.float64)
             norm = float(np.linalg.norm(w))
             if norm > 0:
-                self.rec.log(f"{entity}/omega", rr.Arrows3D(vectors=[(1.2 * L * w / norm).astype(np.float32)],
+                # twice the axes: its label (at the middle) clears those of the axes it lies between (N and U)
+                self.rec.log(f"{entity}/omega", rr.Arrows3D(vectors=[(2.0 * L * w / norm).astype(np.float32)],
                                                             colors=[[250, 200, 40]],
                                                             labels=[f"omega ({norm:.4g} rad/s)"]), static=True)
 

@@ -33,6 +33,7 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
+from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, constraint_source, one_constraint
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
@@ -41,49 +42,6 @@ __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "adv
 #: steps; the names are `rotframe.method_registry`'s.
 _CODES = {"dop853": 0, "rk4": 1, "rotation-splitting": 2, "rotation-splitting4": 3}
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
-
-
-@dataclass(frozen=True)
-class Force:
-    """A user force with what rotframe should know about it.
-
-    Attributes
-    ----------
-    accel : callable
-        ``accel(t, r, v, *params) -> (ax, ay, az)``, m/s^2.
-    potential : callable, optional
-        ``U(t, r, *params)``, J/kg, with ``accel = -grad U`` (frame axes); enables the energy
-        or Jacobi diagnostic.
-    axes : str
-        ``"frame"`` (default: the frame's axes) or ``"inertial"``.
-    name : str, optional
-        For messages and the run's list of terms (the built-in terms of `rotframe.forces` give
-        the scenes' names for them).
-    """
-
-    accel: object
-    potential: object = None
-    axes: str = "frame"
-    name: str = ""
-
-    def __call__(self, *args):
-        return self.accel(*args)
-
-
-@dataclass(frozen=True)
-class StringConstraint:
-    """A particle held at distance ``length`` from a fixed ``pivot`` by a taut string (the pendulum's term).
-
-    Not a force of its own: the string's tension is whatever keeps ``|r - pivot| = length``
-    under every other term. The driver removes the normal part of the total acceleration
-    ``a`` (the frame's terms included) and adds the centripetal one (the index-1 form, exact on
-    the sphere): ``a <- a - (a . n + |v_t|^2 / length) n`` with ``n = (r - pivot) / length``.
-    Made by `rotframe.forces.pendulum`; it does no work, so it adds nothing to the energy.
-    """
-
-    length: float
-    pivot: tuple
-    name: str = "pendulum"
 
 
 @dataclass
@@ -96,59 +54,6 @@ class ProblemRun:
     notes: list
     frame: object
     compile_s: float = 0.0
-
-
-def _as_force(f, k):
-    if isinstance(f, StringConstraint):
-        return f
-    if isinstance(f, Force):
-        force = f
-    elif callable(f):
-        force = Force(f, potential=getattr(f, "potential", None), axes=getattr(f, "axes", "frame"))
-    else:
-        raise ScenarioError(f"forces[{k}]: {f!r} is not callable (a function f(t, r, v, *params) -> (3,))")
-    if force.axes not in ("frame", "inertial"):
-        raise ScenarioError(f"forces[{k}]: axes={force.axes!r}; allowed: 'frame', 'inertial'")
-    if not callable(force.accel) or (force.potential is not None and not callable(force.potential)):
-        raise ScenarioError(f"forces[{k}]: accel and potential must be callables")
-    return force
-
-
-def _check_splitting(method, forces, constraint):
-    """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes."""
-    for k, f in enumerate(forces):
-        why = ("reads v: a kick is exact only for a force of (t, r) alone" if uf.reads_argument(f.accel, 2)
-               else "is given in inertial axes" if f.axes == "inertial" else "")
-        if why:
-            raise ScenarioError(f"method={method!r} cannot take forces[{k}] ({f.name or uf.display_name(f.accel)}): "
-                                f"it {why}; use dop853 or rk4")
-    if constraint is not None:
-        raise ScenarioError(f"method={method!r} cannot take the pendulum's string in rotframe.simulate yet (the "
-                            "scenes' foucault runs it on the sphere); use dop853 or rk4")
-
-
-def _one_constraint(terms, r, v):
-    """The run's `StringConstraint` (at most one), its particles checked to start on the string's sphere."""
-    found = [(k, f) for k, f in enumerate(terms) if isinstance(f, StringConstraint)]
-    if len(found) > 1:
-        raise ScenarioError(f"forces[{found[1][0]}]: a second pendulum; a particle hangs on one string")
-    if not found:
-        return None
-    k, c = found[0]
-    d = np.linalg.norm(r - np.asarray(c.pivot), axis=1)
-    bad = np.flatnonzero(np.abs(d - c.length) > 1e-9 * c.length)
-    if bad.size:
-        i = int(bad[0])
-        raise ScenarioError(f"r0: particle {i} is {d[i]:.9g} m from the pivot of forces[{k}] (pendulum), not its "
-                            f"length {c.length:.9g} m; start it on the string's sphere")
-    n = (r - np.asarray(c.pivot)) / c.length
-    radial = np.abs(np.sum(v * n, axis=1))
-    bad = np.flatnonzero(radial > 1e-9 * np.maximum(np.linalg.norm(v, axis=1), 1e-300))
-    if bad.size:
-        i = int(bad[0])
-        raise ScenarioError(f"v0: particle {i} moves along the string of forces[{k}] (pendulum) at "
-                            f"{radial[i]:.3g} m/s; a taut string allows only velocities across it")
-    return c
 
 
 def _states(r0, v0):
@@ -166,26 +71,6 @@ def _states(r0, v0):
 
 def _call_args(nparams):
     return "".join(f", P[{j}]" for j in range(nparams))
-
-
-def _constraint_source(constraint):
-    """``constrain(y, ax, ay, az)``: the total acceleration kept on the string's sphere (`StringConstraint`), or as it is."""
-    if constraint is None:
-        return "\n@jit\ndef constrain(y, ax, ay, az):\n    return ax, ay, az\n"
-    px, py, pz = (repr(float(c)) for c in constraint.pivot)
-    L = repr(float(constraint.length))
-    return f"""
-@jit
-def constrain(y, ax, ay, az):
-    # the string (rotframe.problem.particles.StringConstraint): a <- a - (a . n + |v_t|^2 / L) n
-    nx = (y[0] - {px}) / {L}
-    ny = (y[1] - {py}) / {L}
-    nz = (y[2] - {pz}) / {L}
-    an = ax * nx + ay * ny + az * nz
-    vn = y[3] * nx + y[4] * ny + y[5] * nz
-    c = an + (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] - vn * vn) / {L}
-    return ax - c * nx, ay - c * ny, az - c * nz
-"""
 
 
 def _header(frame, origin, forces, events, nparams, D, constraint=None):
@@ -209,7 +94,7 @@ def _header(frame, origin, forces, events, nparams, D, constraint=None):
             body += ["    ax += a[0]", "    ay += a[1]", "    az += a[2]"]
     body.append("    return ax, ay, az")
     src.append("\n".join(body) + "\n")
-    src.append(_constraint_source(constraint))
+    src.append(constraint_source(constraint))
     ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])"]
     for k in range(len(events)):
         ev.append(f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))")
@@ -342,16 +227,16 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if spec.t_range[1] < duration or spec.t_range[0] > 0.0:
             raise ScenarioError(f"{what}: defined for t in [{spec.t_range[0]:g}, {spec.t_range[1]:g}] s, "
                                 f"not over the run's [0, {duration:g}] s")
-    terms = [_as_force(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
+    terms = [as_term(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
     forces = [f for f in terms if isinstance(f, Force)]
-    constraint = _one_constraint(terms, r, v)
+    constraint = one_constraint(terms, r, v)
     events = sequence_of_callables(events, "events")
     for k, g in enumerate(events):
         if not callable(g):
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
     if method.startswith("rotation-splitting"):
-        _check_splitting(method, forces, constraint)
+        check_splitting(method, forces, constraint)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0)

@@ -174,3 +174,29 @@ def record(rec, p, result):
     idx = record_body(rec, traj, inertia)
     w = traj.L[idx] / inertia
     rec.scalars("diagnostics/pole_offset_urad", traj.times[idx], 1e6 * np.hypot(w[:, 0], w[:, 1]) / w[:, 2])
+    _record_wobble_magnified(rec, traj, idx)
+
+
+def _record_wobble_magnified(rec, traj, idx):
+    """The symmetry axis's circle about L, magnified by a power of ten to a third of the axis (labelled with it).
+
+    The wobble of the defaults is a microradian: drawn true to scale, the axis and L coincide. The
+    tip of the unit symmetry axis e3 is drawn at ``n + M (e3 - (e3 . n) n)``, n the unit L in space.
+    """
+    from rotframe.rigid import dynamics as rigid
+
+    t = traj.times[idx]
+    e3 = rigid.body_to_space(traj.q[idx], np.array([0.0, 0.0, 1.0]))
+    Ls = rigid.angular_momentum_space(traj.q[idx], traj.L[idx])
+    n = Ls / np.maximum(np.linalg.norm(Ls, axis=1), 1e-300)[:, None]
+    off = e3 - np.sum(e3 * n, axis=1)[:, None] * n
+    size = float(np.max(np.linalg.norm(off, axis=1)))
+    if not size > 0.0:
+        return
+    magnify = 10.0 ** round(math.log10(0.3 / size))
+    tips = n + magnify * off
+    label = f"symmetry axis tip about L, x{magnify:.0e} (a {size:.2g} rad wobble)"
+    rec.line("world/wobble_magnified/circle", tips, color=[120, 170, 255, 120])
+    rec.points("world/wobble_magnified", t, tips, radius=0.02, color=[120, 170, 255], trail=False)
+    rec.static("world/wobble_magnified/label", "Points3D", positions=[tips[0]], radii=[0.001], labels=[label],
+               show_labels=True)

@@ -393,7 +393,7 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
     Logged to ``rec``, the [`rotframe.app.record.Recording`][rotframe.app.record.Recording] passed in.
 
     ``world/angular_momentum`` is an arrow along L (space frame) at each
-    sample, scaled to 1.5 ``axis_length``: fixed for a free body, turning for
+    sample, scaled to 2 ``axis_length``: fixed for a free body, turning for
     a torqued one (``L_label`` says which).
     """
     from rotframe.numerics.sampling import decimate
@@ -409,7 +409,8 @@ def record_body(rec, traj, inertia, name="body", axis_length=1.0, mass=1.0,
     half *= axis_length * 0.6 / half.max()
     rec.static(f"world/{name}/shape", "Boxes3D", half_sizes=[half], colors=[[200, 170, 90, 160]])
     Ls = rigid.angular_momentum_space(traj.q[idx], traj.L[idx])
-    scale = 1.5 * axis_length / max(float(np.linalg.norm(Ls[0])), 1e-300)
+    # twice the body axes: its label (at the arrow's middle) clears theirs where L lies along an axis (dzhanibekov)
+    scale = 2.0 * axis_length / max(float(np.linalg.norm(Ls[0])), 1e-300)
     rec.segments("world/angular_momentum", t, np.zeros_like(Ls), scale * Ls, color=[250, 250, 250])
     rec.static("world/angular_momentum", "Arrows3D", labels=[L_label], show_labels=True)
     Lb = traj.L[idx] / np.maximum(np.linalg.norm(traj.L[idx], axis=1), 1e-300)[:, None]
