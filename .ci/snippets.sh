@@ -4,4 +4,4 @@
 # run here is marked on its page with the reason, which pytest prints (-rs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-python -m pytest -q -rs -p no:cacheprovider README.md docs/guide
+python -m pytest -q -rs -n 0 -p no:cacheprovider README.md docs/guide

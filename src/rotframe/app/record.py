@@ -14,7 +14,7 @@
   numbers of different sizes do not share an axis.
 * Error and drift series (names with ``error`` or ``drift``) near round-off would
   print as ``0.000 000 000 4`` on an axis: beside each, ``diagnostics/log10_<name>``
-  holds the base-10 logarithm of its size (exact zeros drawn at
+  holds the base-10 logarithm of its largest size so far, an envelope (exact zeros drawn at
   `LOG10_FLOOR`), and the blueprint's error view shows those.
 * Playback: the blueprint's time panel plays the run in about
   `PLAYBACK_TARGET_S` seconds (an hour of Foucault's pendulum, 304 days of the
@@ -268,19 +268,24 @@ class Recording:
         self._series.append((entity, kind or series_kind(entity)))
 
     def _log10(self, entity, times, vals):
-        """``diagnostics/log10_<name>``: log10 of the size of an error series, shown in place of it."""
+        """``diagnostics/log10_<name>``: log10 of the largest size of an error series so far, shown in place of it.
+
+        The envelope reads as the drift it is (a round-off error's own size jumps between
+        exact zeros and 1e-16 from sample to sample: a comb of spikes down to the floor); the
+        series itself stays at ``entity``.
+        """
         import rerun as rr
 
         from rotframe.app.units import quantity_unit
 
         head, _, name = entity.rstrip("/").rpartition("/")
-        size = np.abs(vals)
+        size = np.fmax.accumulate(np.where(np.isfinite(vals), np.abs(vals), 0.0)) if vals.size else np.abs(vals)
         with np.errstate(divide="ignore", invalid="ignore"):
             logs = np.where(size > 0, np.log10(np.where(size > 0, size, 1.0)), LOG10_FLOOR)
         logs = np.where(np.isfinite(vals), np.maximum(logs, LOG10_FLOOR), np.nan)
         path = f"{head}/log10_{name}" if head else f"log10_{name}"
         self.rec.send_columns(path, indexes=[self._time(times)], columns=rr.Scalars.columns(scalars=logs))
-        self.rec.log(path, rr.SeriesLines(names=[f"log10 |{name}|"]), static=True)
+        self.rec.log(path, rr.SeriesLines(names=[f"log10 of the largest |{name}| so far"]), static=True)
         unit = quantity_unit(name) or ""
         self._series.append((path, f"errors: log10 of their size{' in ' + unit if unit else ' (relative)'}"))
 

@@ -126,13 +126,20 @@ def record(rec, p, result):
     traj = result.trajectory
     ex = result.extras
     exact, line = oracle(ex["body"], traj.times, ex["r0"], ex["v0"], ex["w0"])
-    rec.points("world/body_frame/ball", traj.times, traj.r[:, 0], radius=0.03, color=[230, 90, 40])
+    size = max(float(np.max(np.abs(traj.r[:, 0]))), float(np.max(np.abs(line))), 1.0)
+    # everything sized to the path (tens of metres): the balls, the body's axes, and a label on each path
+    # that says what it is, so the curl is read as the straight line seen from the tumbling body
+    rec.points("world/body_frame/ball", traj.times, traj.r[:, 0], radius=0.012 * size, color=[230, 90, 40])
     rec.line("world/body_frame/path", traj.r[:, 0], color=[230, 90, 40])
+    rec.static("world/body_frame/path_label", "Points3D", positions=[traj.r[-1, 0]], radii=[0.004 * size],
+               labels=["the ball seen from the tumbling body's axes: it curls (Coriolis, centrifugal, Euler)"],
+               show_labels=True)
     rec.line("world/space/straight_line", line, color=[60, 140, 230])
-    rec.points("world/space/ball", traj.times, line, radius=0.03, color=[60, 140, 230])
+    rec.points("world/space/ball", traj.times, line, radius=0.012 * size, color=[60, 140, 230])
+    rec.static("world/space/line_label", "Points3D", positions=[line[-1]], radii=[0.004 * size],
+               labels=["the same ball in space: a straight line"], show_labels=True)
     body = ex["body"]
-    rec.body("world/space/body", body.times, body.q, axis_length=0.8)
+    rec.body("world/space/body", body.times, body.q, axis_length=0.25 * size)
     rec.scalars("diagnostics/position_error_m", traj.times, np.linalg.norm(traj.r[:, 0] - exact, axis=1))
     rec.scalars("diagnostics/omega_body/2", body.times, body.L[:, 1] / p.i2)
-    size = max(float(np.max(np.abs(traj.r[:, 0]))), float(np.max(np.abs(line))), 1.0)
     rec.view(eye=(1.2 * size, -1.6 * size, 1.0 * size), look_at=(0.0, 0.0, 0.0))
