@@ -83,3 +83,17 @@ def test_a_fixed_step_particle_method_has_the_order_the_registry_states(name):
               for h in (0.02, 0.01)]
     measured = np.log2(errors[0] / errors[1])
     assert abs(measured - registry.get(name).order) < 0.3, (name, measured, errors)
+
+
+def test_the_generated_drivers_codes_are_the_ones_their_source_says():
+    """The integer codes stay inside the modules that build the drivers, and the driver source's comments
+    (``stepping.take_step``: 0 DOP853, 1 RK4, 2 and 3 a driver's own splittings) say what they are."""
+    from rotframe.problem import body, particles, stepping
+
+    for codes in (particles._CODES, body._CODES):
+        assert codes["dop853"] == 0 and codes["rk4"] == 1
+        assert sorted(c for c in codes.values() if c >= 2) == [2, 3]
+        assert set(codes) <= {m.name for m in registry.methods()}
+    assert "methods 2 and 3" in stepping.__doc__
+    assert "if method == 0:\n        dop853_step" in stepping.SOURCE and "elif method == 1:\n        rk4_step" in stepping.SOURCE
+    assert "2 or 3 (the body's or the particle's splittings" in stepping.SOURCE

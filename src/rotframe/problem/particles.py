@@ -3,7 +3,8 @@
 `simulate_particles` is the numerical core of ``rotframe.simulate``: float64 arrays in
 SI units, no printing, no files. It builds (or finds in the cache) a driver compiled for the
 problem's functions (`rotframe.problem.codegen`), integrates every particle on its own
-(DOP853 with Hairer's step control, or RK4 at a fixed step), locates the events by bisection
+(DOP853 with Hairer's step control; RK4 or the rotation splittings of order 2 and 4 at a fixed
+step, the splittings with the forces as kicks: `rotframe.problem.terms.check_splitting`), locates the events by bisection
 on the method's own re-steps, and reports the energy or the Jacobi integral where the forces
 give their potentials.
 

@@ -8,8 +8,9 @@ header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
 * DOP853: Hairer's step control (dop853.f: safety 0.9, growth at most 1/0.333, shrink at
   most 6, no growth right after a rejection) and starting step (hinit); a step never passes
   the next sample time, so every sample is a step's end.
-* RK4 (method 1), and a driver's own fixed-step methods (``own_step``, methods 2 and up: the
-  rigid body's Lie-Poisson splittings): a fixed step that divides each sample interval.
+* RK4 (method 1), and a driver's own fixed-step methods (``own_step``, methods 2 and 3: the
+  rigid body's Lie-Poisson splittings, the particle's rotation splittings, each of order 2 and
+  its Yoshida triple jump): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
   length, each trial a re-step from the step's start by the same method, to round-off in
   time on the method's own discrete trajectory (as the built-in ground event,
@@ -88,7 +89,7 @@ def take_step(method, t, y, h, t_end, K, yt, yn, P, F, G):
         dop853_step(t, y, h, t_end, K, yt, yn, P, F, G)
     elif method == 1:
         rk4_step(t, y, h, K, yt, yn, P, F, G)
-    else:  # a driver's own fixed-step method (the body's splittings, 2 and 4)
+    else:  # a driver's own fixed-step method, 2 or 3 (the body's or the particle's splittings, orders 2 and 4)
         own_step(method, t, y, h, yn, P, F, G)
 
 

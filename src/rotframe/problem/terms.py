@@ -64,6 +64,8 @@ class StringConstraint:
 
 
 def as_term(f, k):
+    """Entry ``k`` of ``forces=`` as a `Force` (a plain function gets its ``axes``/``potential`` attributes) or the
+    `StringConstraint` it is; a one-line ScenarioError for anything else."""
     if isinstance(f, StringConstraint):
         return f
     if isinstance(f, Force):
@@ -125,7 +127,7 @@ def constraint_source(constraint):
     return f"""
 @jit
 def constrain(y, ax, ay, az):
-    # the string (rotframe.problem.particles.StringConstraint): a <- a - (a . n + |v_t|^2 / L) n
+    # the string (rotframe.problem.terms.StringConstraint): a <- a - (a . n + |v_t|^2 / L) n
     nx = (y[0] - {px}) / {L}
     ny = (y[1] - {py}) / {L}
     nz = (y[2] - {pz}) / {L}
