@@ -131,12 +131,13 @@ def record(rec, p, result):
     # that says what it is, so the curl is read as the straight line seen from the tumbling body
     rec.points("world/body_frame/ball", traj.times, traj.r[:, 0], radius=0.012 * size, color=[230, 90, 40])
     rec.line("world/body_frame/path", traj.r[:, 0], color=[230, 90, 40])
-    rec.static("world/body_frame/path_label", "Points3D", positions=[traj.r[-1, 0]], radii=[0.004 * size],
+    far = int(np.argmax(np.linalg.norm(traj.r[:, 0], axis=1)))  # labels where the two paths are apart
+    rec.static("world/body_frame/path_label", "Points3D", positions=[traj.r[far, 0]], radii=[0.004 * size],
                labels=["the ball seen from the tumbling body's axes: it curls (Coriolis, centrifugal, Euler)"],
                show_labels=True)
     rec.line("world/space/straight_line", line, color=[60, 140, 230])
     rec.points("world/space/ball", traj.times, line, radius=0.012 * size, color=[60, 140, 230])
-    rec.static("world/space/line_label", "Points3D", positions=[line[-1]], radii=[0.004 * size],
+    rec.static("world/space/line_label", "Points3D", positions=[line[len(line) // 2]], radii=[0.004 * size],
                labels=["the same ball in space: a straight line"], show_labels=True)
     body = ex["body"]
     rec.body("world/space/body", body.times, body.q, axis_length=0.25 * size)
