@@ -138,6 +138,6 @@ def test_free_body_exact_compiles_the_flow_when_a_process_needs_it_twice(monkeyp
     assert calls == []
     second = free_body.free_body_exact(I, L0, q0, t)
     assert calls == [1]
-    free_body.free_body_exact_ready(I, L0, q0, t)  # the scenes' and simulate_body's path: only where ready
+    free_body.free_body_closed_form(I, L0, q0, t)  # the scenes' and simulate_body's path: never the compiled one
     assert calls == [1]
     assert np.max(np.abs(first[0] - second[0])) < 1e-13 and np.max(np.abs(first[1] - second[1])) < 1e-13

@@ -71,32 +71,25 @@ def free_body_exact(
     ([`rotframe.rigid.exact_flow.flow_ready`][rotframe.rigid.exact_flow.flow_ready]); otherwise the first call of a process
     takes the numpy path (a single call does not pay a compile of some 8 s), and the second call
     compiles it and caches it, so every later call, in this process or any other, is compiled.
-    Every other case (two equal moments, the separatrix, rotation about the middle axis,
-    ``L = 0``, a zero moment) and the refusal of invalid input are
+    The scenes and ``rotframe.simulate_body`` call `free_body_closed_form` itself: a few calls of
+    many samples each, and numbers that do not depend on what the disk cache holds (the two
+    paths agree to round-off, not to the bit). Every other case (two equal moments, the
+    separatrix, rotation about the middle axis, ``L = 0``, a zero moment) and the refusal of invalid input are
     [`free_body_closed_form`][rotframe.rigid.free_body.free_body_closed_form]'s, whose docstring states the formulas, parameters and
     results. The two agree to round-off (``tests/test_rigid_exact.py``).
     """
-    _CALLS[0] += 1
-    return free_body_exact_ready(inertia, L0_body, q0, times, compile=_CALLS[0] > 1)
-
-
-#: Calls of `free_body_exact` in this process: the second compiles the flow (or loads it from the disk cache).
-_CALLS = [0]
-
-
-def free_body_exact_ready(inertia, L0_body, q0, times, *, compile=False):
-    """`free_body_exact` by the compiled flow where it is ready (or ``compile``), else by the numpy path.
-
-    The scenes call this with ``compile=False``: a scene's first run never pays the flow's compile
-    (its calls are few and long, where the numpy path is as fast per sample).
-    """
     from rotframe.rigid import exact_flow
 
-    if compile or exact_flow.flow_ready():
+    _CALLS[0] += 1
+    if _CALLS[0] > 1 or exact_flow.flow_ready():  # needed twice, or compiled already: the compiled flow
         fast = exact_flow.flow_into(inertia, L0_body, q0, times)
         if fast is not None:
             return fast
     return free_body_closed_form(inertia, L0_body, q0, times)
+
+
+#: Calls of `free_body_exact` in this process: the second compiles the flow (or loads it from the disk cache).
+_CALLS = [0]
 
 
 def free_body_closed_form(
