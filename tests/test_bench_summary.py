@@ -220,3 +220,22 @@ def test_the_work_bound_is_the_fewest_evaluations_at_the_level_times_our_cost():
     summ = {r["level"]: r for r in level_summary(ours + peer)}
     row = summ[level]
     assert row["bound_ratio"] == pytest.approx(b["bound_ratio"]) and "the bound is x" in row["note"]
+
+
+def test_the_problem_start_up_rows_time_three_runs_against_their_goals(monkeypatch):
+    """The first problem ever (both caches empty), a new problem and a changed force, each against its goal."""
+    from rotframe.app.bench import problem_startup
+
+    calls = []
+
+    def child(env, k1, k2):
+        calls.append((env["NUMBA_CACHE_DIR"], env["ROTFRAME_CACHE_DIR"], k1, k2))
+        return {"first": 0.4 if len(calls) == 2 else 4.0, "changed": 0.25}
+
+    monkeypatch.setattr(problem_startup, "_child", child)
+    rows = problem_startup.problem_startup_rows()
+    assert [r["setting"] for r in rows] == ["first problem ever", "new problem", "changed force"]
+    assert [r["wall_s"] for r in rows] == [4.0, 0.4, 0.25]
+    assert [r["goal_met"] for r in rows] == [False, True, True]
+    assert calls[0][:2] == calls[1][:2]  # the second process finds what the first one cached
+    assert len({c for call in calls for c in call[2:]}) == 4  # a new force every time: nothing found by chance

@@ -73,6 +73,42 @@ def rhs(t, y, dy, P, F, G):
 
 
 @jit
+def energies(T, OUT, P, F, rotating):
+    """Energy (rotating = False) or the Jacobi integral (rotating = True) per sample and particle, per unit mass."""
+    n = OUT.shape[0]
+    N = OUT.shape[1]
+    E = np.empty((n, N))
+    for a in range(n):
+        wx, wy, wz, ex, ey, ez = frame_rates(T[a], F)
+        for i in range(N):
+            y = OUT[a, i]
+            kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
+            e = kin + potential(T[a], y, P)
+            if rotating:
+                cx = wy * y[2] - wz * y[1]
+                cy = wz * y[0] - wx * y[2]
+                cz = wx * y[1] - wy * y[0]
+                e -= 0.5 * (cx * cx + cy * cy + cz * cz)
+            E[a, i] = e
+    return E
+'''
+
+SOURCE = SOURCE + STEPPING_SOURCE
+
+#: ``own_step`` of a driver run by DOP853 or RK4: never called, and nothing to compile (the method is
+#: an argument of the compiled loop, so every branch of ``take_step`` is compiled: a driver for those
+#: two methods leaves the splittings out of its source, and its first run compiles in seconds less)
+PLAIN_OWN_STEP = r'''
+@jit
+def own_step(method, t, y, h, yn, P, F, G):
+    """DOP853 and RK4 need no step of the driver's own (never called)."""
+    for j in range(D):
+        yn[j] = y[j]
+'''
+
+#: ``own_step`` of a driver run by a rotation splitting (methods 2 and 3), with what it kicks with
+SPLITTING_OWN_STEP = r'''
+@jit
 def kick_acceleration(t, y, P, F, G):
     """What the splittings kick with: the forces (of t and r alone) and the frame's terms of position,
     centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
@@ -126,27 +162,5 @@ def own_step(method, t, y, h, yn, P, F, G):
         rotation_strang(t, w1 * h, yn, P, F, G)
         rotation_strang(t + w1 * h, w0 * h, yn, P, F, G)
         rotation_strang(t + (w1 + w0) * h, w1 * h, yn, P, F, G)
-
-
-@jit
-def energies(T, OUT, P, F, rotating):
-    """Energy (rotating = False) or the Jacobi integral (rotating = True) per sample and particle, per unit mass."""
-    n = OUT.shape[0]
-    N = OUT.shape[1]
-    E = np.empty((n, N))
-    for a in range(n):
-        wx, wy, wz, ex, ey, ez = frame_rates(T[a], F)
-        for i in range(N):
-            y = OUT[a, i]
-            kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
-            e = kin + potential(T[a], y, P)
-            if rotating:
-                cx = wy * y[2] - wz * y[1]
-                cy = wz * y[0] - wx * y[2]
-                cz = wx * y[1] - wy * y[0]
-                e -= 0.5 * (cx * cx + cy * cy + cz * cz)
-            E[a, i] = e
-    return E
 '''
 
-SOURCE = SOURCE + STEPPING_SOURCE

@@ -35,6 +35,7 @@ from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
 from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, constraint_source, one_constraint
+from rotframe.problem.particle_driver import PLAIN_OWN_STEP, SPLITTING_OWN_STEP
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
@@ -74,8 +75,9 @@ def _call_args(nparams):
     return "".join(f", P[{j}]" for j in range(nparams))
 
 
-def _header(frame, origin, forces, events, nparams, D, constraint=None):
-    """The problem's own definitions: frame evaluators, the forces' sum, the string, the events, the potential."""
+def _header(frame, origin, forces, events, nparams, D, constraint=None, splitting=False):
+    """The problem's own definitions: frame evaluators, the forces' sum, the string, the events, the potential,
+    and the driver's own step (the rotation splittings where the run takes one, else a stub)."""
     args = _call_args(nparams)
     src = [f"\nD = {D}\nNE = {len(events)}\n", SEARCH_SOURCE,
            vector_source("frame_rates", frame.kind, True, "omega_fn", "omega_dot_fn" if len(frame.funcs) > 1 else ""),
@@ -96,6 +98,7 @@ def _header(frame, origin, forces, events, nparams, D, constraint=None):
     body.append("    return ax, ay, az")
     src.append("\n".join(body) + "\n")
     src.append(constraint_source(constraint))
+    src.append(SPLITTING_OWN_STEP if splitting else PLAIN_OWN_STEP)
     ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])"]
     for k in range(len(events)):
         ev.append(f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))")
@@ -247,7 +250,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     for role, f in roles:
         uf.check_compilable(role, f, jit)
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
-    header = _header(frame, origin, forces, events, len(params), D, constraint)
+    header = _header(frame, origin, forces, events, len(params), D, constraint,
+                     splitting=method.startswith("rotation-splitting"))
     cache_notes = [cache_note] if cache_note and jit else []
 
     driver = Driver(lambda: build_module("particle", key, _bind(frame, origin, forces, events, jit), header,

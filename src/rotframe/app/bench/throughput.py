@@ -416,7 +416,8 @@ def startup_rows(scenarios=None):
     the goal of a first run counts (`STARTUP_GOALS`: cold 3 s beyond imports, warm 1 s in
     all). The warm time is the median of three runs after one that fills the cache; the cold
     one is a run with an empty numba cache (``NUMBA_CACHE_DIR`` set to a new folder), as in a
-    fresh environment.
+    fresh environment. With every scenario, the rows of a problem of your own follow
+    (`rotframe.app.bench.problem_startup`).
     """
     from rotframe.scenes import SCENES
 
@@ -436,6 +437,10 @@ def startup_rows(scenarios=None):
                          "run": name, "wall_s": wall, "error": math.nan, "error_kind": "start-up", "nfev": 0,
                          "import_s": import_s, "beyond_imports_s": wall - import_s, "goal_s": goal,
                          "goal_met": bool(counted <= goal)})
+    if scenarios is None:  # and a problem of your own: the first ever, a new one, a changed force
+        from rotframe.app.bench.problem_startup import problem_startup_rows
+
+        rows += problem_startup_rows()
     return rows
 
 
