@@ -142,7 +142,9 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
 
     The scenes' terms ``linear-drag`` (``linear`` = k1, 1/s) and ``quadratic-drag``
     (``quadratic`` = k2, 1/m), over an exponential atmosphere of scale height ``H`` (m).
-    ``v`` is the velocity relative to the frame: still air turning with it.
+    ``v`` is the velocity relative to the frame: still air turning with it. Under the rotation
+    splittings it runs as its exact flow at fixed position (the direction of ``v`` kept, its speed
+    decaying in closed form), as the scenes' drag does, not as a kick.
 
     Examples
     --------
@@ -163,7 +165,7 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
         c = (k1 + k2 * math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])) * air
         return -c * v[0], -c * v[1], -c * v[2]
 
-    return Force(drag, name=name)
+    return Force(drag, name=name, flow=("drag", k1, k2, H))
 
 
 def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:

@@ -129,8 +129,9 @@ def kick_acceleration(t, y, P, F, G):
 @jit
 def rotation_strang(t, h, yn, P, F, G):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
-    drift h/2, kick h/2, the Coriolis flow v' = -2 w x v (v turned by -2 |w| h about w, with w at the
-    step's middle: exact for a constant omega, symmetric always), kick h/2, drift h/2."""
+    drift h/2, kick h/2, a drag term's exact flow h/2, the Coriolis flow v' = -2 w x v (v turned by
+    -2 |w| h about w, with w at the step's middle: exact for a constant omega, symmetric always),
+    the drag flow h/2, kick h/2, drift h/2."""
     hh = 0.5 * h
     for j in range(3):
         yn[j] += hh * yn[j + 3]
@@ -138,10 +139,13 @@ def rotation_strang(t, h, yn, P, F, G):
     vx = yn[3] + hh * ax
     vy = yn[4] + hh * ay
     vz = yn[5] + hh * az
+    k1, k2 = drag_rates(yn)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
     if w > 0.0:
         angle = -2.0 * w * h
         vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, math.cos(angle), math.sin(angle))
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     yn[3] = vx + hh * ax
     yn[4] = vy + hh * ay
     yn[5] = vz + hh * az

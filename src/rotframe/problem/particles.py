@@ -34,7 +34,8 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, constraint_source, one_constraint
+from rotframe.problem.terms import (Force, StringConstraint, as_term, check_splitting, constraint_source, drag_source,
+                                    one_constraint)
 from rotframe.problem.particle_driver import PLAIN_OWN_STEP, SPLITTING_OWN_STEP
 from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
 
@@ -85,6 +86,8 @@ def _header(frame, origin, forces, events, nparams, D, constraint=None, splittin
     body = ["", "@jit", "def user_acceleration(t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])",
             "    ax = 0.0", "    ay = 0.0", "    az = 0.0"]
     for k, f in enumerate(forces):
+        if splitting and f.flow:  # a term with an exact flow is not a kick: drag_flow below
+            continue
         body.append(f"    a = force_{k}(t, r, v{args})")
         if f.axes == "inertial":  # R^T a with R = R(q): a - 2 s (u x a) + 2 u x (u x a)
             body += ["    qx = y[6]", "    qy = y[7]", "    qz = y[8]", "    qs = y[9]",
@@ -98,6 +101,7 @@ def _header(frame, origin, forces, events, nparams, D, constraint=None, splittin
     body.append("    return ax, ay, az")
     src.append("\n".join(body) + "\n")
     src.append(constraint_source(constraint))
+    src.append(drag_source(next((f for f in forces if f.flow), None) if splitting else None))
     src.append(SPLITTING_OWN_STEP if splitting else PLAIN_OWN_STEP)
     ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])"]
     for k in range(len(events)):

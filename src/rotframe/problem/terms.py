@@ -17,7 +17,8 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "constraint_source"]
+__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "constraint_source",
+           "drag_source"]
 
 
 @dataclass(frozen=True)
@@ -36,12 +37,17 @@ class Force:
     name : str, optional
         For messages and the run's list of terms (the built-in terms of `rotframe.forces` give
         the scenes' names for them).
+    flow : tuple, optional
+        The term's exact flow, where it has one that the splittings use instead of a kick:
+        ``("drag", k1, k2, H)`` for `rotframe.forces.drag` (`drag_source`). Set by the built-in
+        terms; a force of your own leaves it empty.
     """
 
     accel: object
     potential: object = None
     axes: str = "frame"
     name: str = ""
+    flow: tuple = ()
 
     def __call__(self, *args):
         return self.accel(*args)
@@ -83,8 +89,14 @@ def as_term(f, k):
 
 def check_splitting(method, forces, constraint):
     """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes."""
+    flows = [k for k, f in enumerate(forces) if f.flow]
+    if len(flows) > 1:
+        raise ScenarioError(f"method={method!r} cannot take forces[{flows[1]}] ({forces[flows[1]].name}): one drag "
+                            "term a run: give linear and quadratic to one rotframe.forces.drag, or use dop853 or rk4")
     for k, f in enumerate(forces):
-        why = ("reads v: a kick is exact only for a force of (t, r) alone" if uf.reads_argument(f.accel, 2)
+        why = ("" if f.flow else
+               "reads v: a kick is exact only for a force of (t, r) alone (rotframe.forces.drag, which has an "
+               "exact flow, runs under the splittings)" if uf.reads_argument(f.accel, 2)
                else "is given in inertial axes" if f.axes == "inertial" else "")
         if why:
             raise ScenarioError(f"method={method!r} cannot take forces[{k}] ({f.name or uf.display_name(f.accel)}): "
@@ -116,6 +128,45 @@ def one_constraint(terms, r, v):
         raise ScenarioError(f"v0: particle {i} moves along the string of forces[{k}] (pendulum) at "
                             f"{radial[i]:.3g} m/s; a taut string allows only velocities across it")
     return c
+
+
+def drag_source(force):
+    """``drag_rates(y)`` and ``drag_flow(vx, vy, vz, k1, k2, h)``: the exact flow of a drag term for the splittings.
+
+    ``force.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v`` with ``rho = exp(-z / H)``
+    (1 for ``H = 0``) at fixed position keeps the direction of ``v`` and takes its speed ``s`` to
+    ``s / (1 + k2 s h)`` (``k1 = 0``) or ``k1 s e / (k1 + k2 s (1 - e))``, ``e = exp(-k1 h)`` (the
+    scenes' `rotframe.particles.forces.drag_flow`, written again here for the generated driver).
+    Without a drag term: rates of zero and the identity, compiled to nothing.
+    """
+    if force is None:
+        return ("\n@jit\ndef drag_rates(y):\n    return 0.0, 0.0\n"
+                "\n@jit\ndef drag_flow(vx, vy, vz, k1, k2, h):\n    return vx, vy, vz\n")
+    _, k1, k2, H = force.flow
+    air = f"math.exp(-y[2] / {float(H)!r})" if H > 0 else "1.0"
+    return f"""
+@jit
+def drag_rates(y):
+    # the drag term's coefficients at the particle's height (rotframe.problem.terms.drag_source)
+    air = {air}
+    return {float(k1)!r} * air, {float(k2)!r} * air
+
+
+@jit
+def drag_flow(vx, vy, vz, k1, k2, h):
+    if k1 == 0.0 and k2 == 0.0:
+        return vx, vy, vz
+    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+    if speed == 0.0:
+        return vx, vy, vz
+    if k1 == 0.0:
+        new = speed / (1.0 + k2 * speed * h)
+    else:
+        e = math.exp(-k1 * h)
+        new = k1 * speed * e / (k1 + k2 * speed * (1.0 - e))
+    f = new / speed
+    return vx * f, vy * f, vz * f
+"""
 
 
 def constraint_source(constraint):
