@@ -12,10 +12,6 @@ import pytest
 from rotframe.particles.integrators import Event, integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-#: one worker compiles this file's driver variants, and the others find them compiled in its process
-#: (pytest-xdist ``--dist loadgroup``): split across workers, each would compile them again
-pytestmark = pytest.mark.xdist_group("compiled particle drivers")
-
 NEVER = Event("never", "r", 0, 1e9, 0, False)
 
 

@@ -18,10 +18,6 @@ from rotframe.errors import IntegrationError
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-#: one worker compiles this file's driver variants, and the others find them compiled in its process
-#: (pytest-xdist ``--dist loadgroup``): split across workers, each would compile them again
-pytestmark = pytest.mark.xdist_group("compiled particle drivers")
-
 G = np.array([0.0, 0.1, -9.81])
 PEND = {"pendulum_length": 10.0, "pivot": np.array([0.5, -0.2, 10.0])}
 
