@@ -169,6 +169,7 @@ from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error
 from rotframe.problem.readonly import readonly
 from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
 from rotframe.numerics.rotation import rodrigues_rotate
+from rotframe.particles.forces import drag_flow
 
 jit = njit(cache={cache}, error_model="numpy", nogil=True)
 """
@@ -181,9 +182,11 @@ from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error
 from rotframe.problem.callables import readonly_view as readonly
 from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
 from rotframe.numerics.rotation import rodrigues_rotate as _rodrigues
+from rotframe.particles.forces import drag_flow as _drag_flow
 
 error_norm = _norm.py_func
 rodrigues_rotate = _rodrigues.py_func
+drag_flow = _drag_flow.py_func
 
 def jit(f):
     return f

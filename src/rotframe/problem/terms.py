@@ -131,17 +131,15 @@ def one_constraint(terms, r, v):
 
 
 def drag_source(force):
-    """``drag_rates(y)`` and ``drag_flow(vx, vy, vz, k1, k2, h)``: the exact flow of a drag term for the splittings.
+    """``drag_rates(y)``: a drag term's coefficients at the particle's height, for the splittings' exact flow.
 
     ``force.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v`` with ``rho = exp(-z / H)``
-    (1 for ``H = 0``) at fixed position keeps the direction of ``v`` and takes its speed ``s`` to
-    ``s / (1 + k2 s h)`` (``k1 = 0``) or ``k1 s e / (k1 + k2 s (1 - e))``, ``e = exp(-k1 h)`` (the
-    scenes' `rotframe.particles.forces.drag_flow`, written again here for the generated driver).
-    Without a drag term: rates of zero and the identity, compiled to nothing.
+    (1 for ``H = 0``). The flow itself at fixed position is the scenes' own
+    `rotframe.particles.forces.drag_flow`, which every generated driver imports. Without a drag
+    term the rates are zero and the flow the identity.
     """
     if force is None:
-        return ("\n@jit\ndef drag_rates(y):\n    return 0.0, 0.0\n"
-                "\n@jit\ndef drag_flow(vx, vy, vz, k1, k2, h):\n    return vx, vy, vz\n")
+        return "\n@jit\ndef drag_rates(y):\n    return 0.0, 0.0\n"
     _, k1, k2, H = force.flow
     air = f"math.exp(-y[2] / {float(H)!r})" if H > 0 else "1.0"
     return f"""
@@ -150,22 +148,6 @@ def drag_rates(y):
     # the drag term's coefficients at the particle's height (rotframe.problem.terms.drag_source)
     air = {air}
     return {float(k1)!r} * air, {float(k2)!r} * air
-
-
-@jit
-def drag_flow(vx, vy, vz, k1, k2, h):
-    if k1 == 0.0 and k2 == 0.0:
-        return vx, vy, vz
-    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-    if speed == 0.0:
-        return vx, vy, vz
-    if k1 == 0.0:
-        new = speed / (1.0 + k2 * speed * h)
-    else:
-        e = math.exp(-k1 * h)
-        new = k1 * speed * e / (k1 + k2 * speed * (1.0 - e))
-    f = new / speed
-    return vx * f, vy * f, vz * f
 """
 
 
