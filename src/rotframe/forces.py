@@ -48,6 +48,7 @@ import math
 import numpy as np
 
 from rotframe.errors import ScenarioError
+from rotframe.validation import check_vector3
 from rotframe.problem.particles import Force, StringConstraint
 
 __all__ = ["Force", "gravity", "altitude_gravity", "central_gravity", "drag", "spring", "pendulum", "lorentz"]
@@ -64,11 +65,8 @@ def _finite(name, **values):
 
 
 def _vector(name, key, value):
-    _finite(name, **{key: value})
-    arr = np.asarray(value, dtype=float)
-    if arr.size != 3:
-        raise ScenarioError(f"{name}: {key}={arr.tolist()} must be 3 numbers (x, y, z)")
-    return tuple(float(c) for c in arr.reshape(3))
+    """A 3-vector argument as three floats (`rotframe.validation.check_vector3`: its one-line refusal)."""
+    return tuple(float(c) for c in check_vector3(value, key, ScenarioError, caller=name))
 
 
 def gravity(g) -> Force:

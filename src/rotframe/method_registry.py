@@ -79,7 +79,7 @@ class Method:
 
     @property
     def kind(self) -> str:
-        """``step`` under the name the particle integrators read it by (``info.kind``)."""
+        """``step`` under the name the particle integrators' public ``METHODS`` entries had (``MethodInfo.kind``)."""
         return self.step
 
 

@@ -279,7 +279,7 @@ class Recording:
         from rotframe.app.units import quantity_unit
 
         head, _, name = entity.rstrip("/").rpartition("/")
-        size = np.fmax.accumulate(np.where(np.isfinite(vals), np.abs(vals), 0.0)) if vals.size else np.abs(vals)
+        size = np.maximum.accumulate(np.where(np.isfinite(vals), np.abs(vals), 0.0))
         with np.errstate(divide="ignore", invalid="ignore"):
             logs = np.where(size > 0, np.log10(np.where(size > 0, size, 1.0)), LOG10_FLOOR)
         logs = np.where(np.isfinite(vals), np.maximum(logs, LOG10_FLOOR), np.nan)

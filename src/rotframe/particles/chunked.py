@@ -107,7 +107,7 @@ class KernelSetup:
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.steady_args = None  # (q, tab) of the specialised DOP853 driver, where the model allows it
-        self.fixed = info.kind == "fixed"
+        self.fixed = info.step == "fixed"
         # the arguments of every fixed-step driver call that do not change (unpacked into it)
         self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
         self._family = (self.rk4, self.sphere)
@@ -117,7 +117,7 @@ class KernelSetup:
         self.times = sample_times(duration, samples)
         self.rtol = float(rtol)
         self.atol = atol
-        if info.kind == "fixed":
+        if info.step == "fixed":
             self.sps = steps_per_sample(dt, step)
             self.h = dt / self.sps
             self.evals_per_step = EVALS_PER_STEP[info.name]
@@ -146,7 +146,7 @@ class KernelSetup:
         else:
             from rotframe.particles import drivers
 
-            kernel = drivers.run_fixed if self.info.kind == "fixed" else drivers.run_dop853
+            kernel = drivers.run_fixed if self.info.step == "fixed" else drivers.run_dop853
         self._kernel = kernel
         return kernel
 
@@ -205,7 +205,7 @@ class KernelSetup:
 
         ev_t, ev_r, ev_v, ev_count, ev_which, max_events = records
         per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
-        if self.info.kind == "fixed":
+        if self.info.step == "fixed":
             k = self.sps if sps is None else sps
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
@@ -386,7 +386,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     info = setup.info
     samples, times, events = setup.samples, setup.times, setup.events
     n = r0.shape[0]
-    if progress is None and info.kind == "fixed" and n <= threads.BLOCK and owned:
+    if progress is None and info.step == "fixed" and n <= threads.BLOCK and owned:
         traj = _run_once(setup, model, r0, v0, max_events, records)
         if traj is not None:
             return traj
@@ -403,7 +403,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     r = r0 if owned else r0.copy()
     v = v0 if owned else v0.copy()
     r0, v0 = out_r[0], out_v[0]  # the initial state, kept (r, v advance in place)
-    if info.kind == "fixed":
+    if info.step == "fixed":
         cost = setup.sps * n * setup.evals_per_step
         atol = 0.0
         h_state = None
@@ -420,7 +420,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     first = None  # the result of a first call already made on the run's own arrays
     try:
         compile_s = setup.warm_up()
-        if info.kind != "fixed":
+        if info.step != "fixed":
             # an adaptive method's cost is known only once it ran: a probe of the first sample
             # interval projects the work and sizes the calls. On copies (the run itself is untouched,
             # so its chunks do not depend on the probe), except when that interval is the whole run
@@ -429,7 +429,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             pieces = _pieces(per_sample, n)
         # fixed steps: calls of equal length (within a sample), no short last call that is all dispatch
         # (an adaptive method's last step in a call ends on the call's last sample: its calls keep their cut)
-        calls = -(-samples // chunk) if info.kind == "fixed" else None
+        calls = -(-samples // chunk) if info.step == "fixed" else None
         call = 0
         while done < samples:
             call += 1
@@ -437,12 +437,12 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             sl = slice(done + 1, done + 1 + m)
             if first is not None:
                 (n_done, bad, nf, st), first = first, None
-            elif info.kind != "fixed" and pieces > 1:
+            elif info.step != "fixed" and pieces > 1:
                 # a sample interval of more steps than a call should take: landed on in pieces (a number fixed by
                 # the probe, so the same on every run), each a call of its own, so that signals are seen
                 n_done, bad, nf, st = _sample_in_pieces(setup, r, v, alive, done, pieces, out_r[sl], out_v[sl], evb,
                                                         atol, h_state)
-            elif info.kind == "fixed" and cost > CALL_EVALS:
+            elif info.step == "fixed" and cost > CALL_EVALS:
                 # one sample interval is more than a chunk of work: advance it in pieces, so that
                 # Python regains control (signals, progress) between them
                 n_done, bad, nf, st = setup.one_sample_in_pieces(r, v, alive, done, out_r[sl], out_v[sl], evb, n)
@@ -464,7 +464,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
                 raise IntegrationError(
                     f"unstable step: the inertial speed of a particle under no real force grew by more than "
                     f"{GROWTH_LIMIT:g} (relative) by t = {times[bad_k]:.6g} s (method {info.name}); "
-                    + remedy(info.kind, step=setup.h, rtol=setup.rtol),
+                    + remedy(info.step, step=setup.h, rtol=setup.rtol),
                     t_reached=float(times[bad_k - 1]), partial=partial)
             done += m
             if progress is not None:

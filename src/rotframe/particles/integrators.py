@@ -164,7 +164,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         raise ScenarioError("initial state: the parameters give a non-finite position or velocity "
                             "(a parameter too large?)")
     samples = max(1, int(samples))
-    if info.kind != "exact":
+    if info.step != "exact":
         setup = _setup(model, info, duration, samples, step, rtol, atol, events, r0.shape[0])
         return run_chunked(setup, model, r0, v0, progress, max_events, records, owned=True)
     _check_work(info, duration, step, samples, r0.shape[0], model)
@@ -229,11 +229,11 @@ def _check_work(info, duration, step, samples, n, model):
     from rotframe import limits
 
     steps = 0.0
-    if info.kind == "fixed":
+    if info.step == "fixed":
         # in floats: a step far below the sample interval gives a count beyond any integer a float holds
         per = (duration / samples) / float(step) if step else 20.0
         steps = float(samples) * math.ceil(per) if per < 1e300 else math.inf
-    elif info.kind == "adaptive":
+    elif info.step == "adaptive":
         # the least an adaptive method can take, from the model's own rates (a closed form, before any
         # compiling or probing): no step spans more than MAX_RAD_PER_STEP of its fastest oscillation
         steps = duration * fastest_rate(model) / MAX_RAD_PER_STEP

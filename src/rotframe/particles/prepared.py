@@ -69,7 +69,7 @@ class PreparedRun:
         self.samples = samples = max(1, int(samples))
         self.n = n = int(n)
         self.nfev = 0
-        if self.info.kind == "exact":
+        if self.info.step == "exact":
             from rotframe.particles.chunked import sample_times
             from rotframe.particles.linear import ExactFlow
 
@@ -112,7 +112,7 @@ class PreparedRun:
 
     def run(self, r0, v0):
         """(r, v) samples (samples + 1, n, 3) from initial positions and velocities (n, 3) or (3,)."""
-        if self.info.kind == "exact":
+        if self.info.step == "exact":
             return self._run_exact(r0, v0)
         n, samples = self.n, self.samples
         out_r = np.empty((samples + 1, n, 3))
@@ -124,7 +124,7 @@ class PreparedRun:
         self.alive[:] = True
         self.evb.reset()
         self.h_state[:] = 0.0
-        atol = self.setup.abs_tol(r, v) if self.info.kind == "adaptive" else 0.0
+        atol = self.setup.abs_tol(r, v) if self.info.step == "adaptive" else 0.0
         n_done, bad, self.nfev, _ = self.setup.call(r, v, self.alive, 0, samples, out_r[1:], out_v[1:], self.evb,
                                                     atol, self.h_state)
         if n_done < samples or bad >= 0:

@@ -359,8 +359,8 @@ def method_rel_error(traj, time_scale):
 
     h = traj.extras.get("step") or 0.0
     info = METHODS.get(particle_methods().canonical(traj.method))
-    order = info.order if info is not None and info.kind == "fixed" else None
-    if info is not None and info.kind == "adaptive":
+    order = info.order if info is not None and info.step == "fixed" else None
+    if info is not None and info.step == "adaptive":
         return 1e-8
     if order is None or not h or not time_scale > 0:
         return 1e-9

@@ -83,9 +83,9 @@ def simulate(p, terms, method, run, progress):
     model, r0, v0, g, Omega = build(p, terms)
     T = p.duration
     period = 2 * math.pi * math.sqrt(p.length / g)
-    need = int(SAMPLES_PER_PERIOD * T / period)
+    need = SAMPLES_PER_PERIOD * T / period  # a float: a huge duration makes it inf, not an int's overflow
     resolved = need <= MAX_SAMPLES
-    samples = max(int(run.get("samples") or 0), min(need, MAX_SAMPLES))
+    samples = max(int(run.get("samples") or 0), int(min(need, MAX_SAMPLES)))
     run = dict(run, samples=samples)
     # unless a method is named: the linearised (small-angle) model by its exact propagator, the full
     # pendulum by dop853, the cheapest for its stated accuracy in `rotframe bench foucault`

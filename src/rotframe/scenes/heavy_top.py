@@ -81,8 +81,13 @@ def _nutation_period_estimate(p):
     tp = turning_points(p)
     if tp is not None and len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0:
         return float(tp[2])
-    w3 = p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
+    w3 = spin_rate(p)
     return 2 * math.pi * p.i1 / (p.i3 * abs(w3)) if w3 else math.inf
+
+
+def spin_rate(p):
+    """omega3 (rad/s), the spin about the symmetry axis at the start: psidot0 + phidot0 cos(theta0) (ZXZ rates)."""
+    return p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
 
 
 @with_parameters(HeavyTopParameters)
@@ -162,7 +167,7 @@ def analyse(p, result):
     theta = tilt(traj)
     args = (p.i1, p.i3, p.mass, p.length, p.g)
     threshold = rigid.sleeping_top_threshold(*args)
-    w3 = p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0))
+    w3 = spin_rate(p)
     dt = float(traj.times[1] - traj.times[0]) if len(traj.times) > 1 else math.inf
     h = traj.extras.get("step") or dt
     amplitude = float(theta.max() - theta.min())
@@ -265,8 +270,7 @@ def record(rec, p, result):
     E = rigid.energy(result.extras["inertia"], traj.L) + p.mass * p.g * p.length * np.cos(theta)
     rec.scalars("diagnostics/energy_rel_error", t, (E[idx] - E[0]) / abs(E[0]))
     # slow motion: the spin (tens of turns a second) plays at about 2 turns a second, which the eye follows
-    spin = abs(p.psidot0 + p.phidot0 * math.cos(math.radians(p.theta0)))  # rad/s about the symmetry axis
-    rec.view(playback_speed=min(1.0, 2.0 * 2.0 * math.pi / max(spin, 1e-12)))
+    rec.view(playback_speed=min(1.0, 2.0 * 2.0 * math.pi / max(abs(spin_rate(p)), 1e-12)))
 
 
 @with_parameters(HeavyTopParameters)

@@ -90,7 +90,7 @@ def simulate(p, terms, method, run, progress):
         raise IntegrationError(f"the {traj.method} run diverged: {err[bad[0]]:.3g} m from the exact inertial line "
                                f"at t = {traj.times[bad[0]]:.6g} s, more than {DIVERGED:g} of the motion's size "
                                f"{size[bad[0]]:.3g} m; "
-                               + remedy(METHODS[canonical_method(traj.method)].kind, step=traj.extras.get("step"),
+                               + remedy(METHODS[canonical_method(traj.method)].step, step=traj.extras.get("step"),
                                         rtol=run_setting(run, "rtol")),
                                t_reached=float(traj.times[good - 1]), partial=partial)
     return result
