@@ -207,3 +207,13 @@ def test_a_pendulum_must_start_on_its_string():
     with pytest.raises(ScenarioError, match="a second pendulum"):
         simulate_particles(omega=[0, 0, 0], r0=[0.0, 0.0, 0.0], v0=[0, 0, 0], duration=1.0,
                            forces=[forces.pendulum(2.0, [0, 0, 2.0]), forces.pendulum(2.0, [0, 0, 2.0])])
+
+
+def test_a_force_after_the_string_is_named_by_the_users_own_number():
+    """The string is no force of the driver's; a message about the force after it still says forces[1]."""
+    def broken(t, r, v):
+        return 0.0, 0.0
+
+    with pytest.raises(ScenarioError, match=r"forces\[1\]"):
+        simulate_particles(omega=[0, 0, 0], r0=[0.0, 0.0, 0.0], v0=[0, 0, 0], duration=1.0,
+                           forces=[forces.pendulum(2.0, [0, 0, 2.0]), broken])

@@ -140,7 +140,7 @@ def _bind(frame, origin, forces, events, compiled):
     return functions
 
 
-def _roles(frame, origin, forces, events):
+def _roles(frame, origin, forces, events, labels):
     roles = []
     if frame.kind == "function":
         roles.append(("omega", frame.funcs[0]))
@@ -148,24 +148,24 @@ def _roles(frame, origin, forces, events):
             roles.append(("omega_dot", frame.funcs[1]))
     if origin.kind == "function":
         roles.append(("origin_acceleration", origin.funcs[0]))
-    roles += [(f"forces[{k}]", f.accel) for k, f in enumerate(forces)]
-    roles += [(f"forces[{k}].potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
+    roles += [(labels[k], f.accel) for k, f in enumerate(forces)]
+    roles += [(f"{labels[k]}.potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
     roles += [(f"events[{k}]", g) for k, g in enumerate(events)]
     return roles
 
 
-def _check_functions(forces, events, params, r, v, t0):
+def _check_functions(forces, events, params, r, v, t0, labels):
     """Each force, potential and event once, in plain Python, at the start: shape, finiteness, raises."""
     when = f"at t = {t0:g} s, r = {r.tolist()}, v = {v.tolist()}"
     for k, f in enumerate(forces):
-        uf.check_call(f"forces[{k}]", f.accel, (t0, r.copy(), v.copy(), *params), (3,), when=when)
+        uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *params), (3,), when=when)
         if f.potential is not None:
-            uf.check_call(f"forces[{k}].potential", f.potential, (t0, r.copy(), *params), (), when=when)
+            uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *params), (), when=when)
     for k, g in enumerate(events):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
 
-def _blame(forces, params, t, y, dt=0.0):
+def _blame(forces, params, t, y, dt, labels):
     """After a non-finite state: which force gives a non-finite value (or raises) near the last finite state.
 
     The force is probed at the last finite state, at ``t`` and at times inside the failed step
@@ -179,10 +179,10 @@ def _blame(forces, params, t, y, dt=0.0):
             try:
                 a = np.asarray(uf.plain_function(f.accel)(tp, *uf.read_only_args((r, v)), *params), dtype=float)
             except Exception as exc:  # the user's function, reported in the message
-                return "; " + uf.raised_message(f"forces[{k}]", f.accel, exc,
+                return "; " + uf.raised_message(labels[k], f.accel, exc,
                                                 f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
             if a.shape == (3,) and not np.all(np.isfinite(a)):
-                return (f"; forces[{k}] ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {tp:.9g} s, "
+                return (f"; {labels[k]} ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {tp:.9g} s, "
                         f"r = {r.tolist()}, v = {v.tolist()}")
     return ""
 
@@ -237,6 +237,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                                 f"not over the run's [0, {duration:g}] s")
     terms = [as_term(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
     forces = [f for f in terms if isinstance(f, Force)]
+    labels = [f"forces[{k}]" for k, f in enumerate(terms) if isinstance(f, Force)]  # as the user numbered them
     constraint = one_constraint(terms, r, v)
     events = sequence_of_callables(events, "events")
     for k, g in enumerate(events):
@@ -244,13 +245,13 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
     if method.startswith("rotation-splitting"):
-        check_splitting(method, forces, constraint)
+        check_splitting(method, forces, constraint, labels)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
-    _check_functions(forces, events, params, r[0], v[0], 0.0)
+    _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
-    roles = _roles(frame, origin, forces, events)
+    roles = _roles(frame, origin, forces, events, labels)
     for role, f in roles:
         uf.check_compilable(role, f, jit)
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
@@ -322,7 +323,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                 if isinstance(exc, numba.core.errors.NumbaError):
                     _compile_failure(exc, roles, params, r[0], v[0], frame)
                 _raised_later(exc, driver.module, y, saved, {"before": before, "after": after, "budget": budget}, forces,
-                              params, method, hfix, times, OUT, state, events)
+                              params, method, hfix, times, OUT, state, events, labels)
             if first:
                 compile_s = time.perf_counter() - t0
                 first = False
@@ -346,7 +347,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         t_bad = float(state["TC"][i])
         # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
         dt_failed = hfix if method != "dop853" else 10.0 * float(state["H"][i])
-        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i], dt_failed)
+        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i], dt_failed, labels)
         partial = _trajectory(times, OUT, state, events, method, good)
         raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
                                "samples up to there are kept", t_reached=t_bad, partial=partial)
@@ -409,7 +410,7 @@ def _restore(y, state, saved):
         state[key][...] = saved[key]
 
 
-def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events):
+def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
     """A user function raised inside a compiled call: find the step, name the function, give time and state.
 
     The call is replayed from the state saved before it, one step per call, particle by particle
@@ -427,7 +428,7 @@ def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, tim
                 module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
-                blame = _blame(forces, params, t, yi, dt)
+                blame = _blame(forces, params, t, yi, dt, labels)
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
                 state["TC"][i] = t

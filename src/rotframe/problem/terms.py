@@ -87,11 +87,14 @@ def as_term(f, k):
     return force
 
 
-def check_splitting(method, forces, constraint):
-    """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes."""
+def check_splitting(method, forces, constraint, labels):
+    """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes.
+
+    ``labels``: each force as the user's list names it (``forces[k]``, counted with the string).
+    """
     flows = [k for k, f in enumerate(forces) if f.flow]
     if len(flows) > 1:
-        raise ScenarioError(f"method={method!r} cannot take forces[{flows[1]}] ({forces[flows[1]].name}): one drag "
+        raise ScenarioError(f"method={method!r} cannot take {labels[flows[1]]} ({forces[flows[1]].name}): one drag "
                             "term a run: give linear and quadratic to one rotframe.forces.drag, or use dop853 or rk4")
     for k, f in enumerate(forces):
         why = ("" if f.flow else
@@ -99,7 +102,7 @@ def check_splitting(method, forces, constraint):
                "exact flow, runs under the splittings)" if uf.reads_argument(f.accel, 2)
                else "is given in inertial axes" if f.axes == "inertial" else "")
         if why:
-            raise ScenarioError(f"method={method!r} cannot take forces[{k}] ({f.name or uf.display_name(f.accel)}): "
+            raise ScenarioError(f"method={method!r} cannot take {labels[k]} ({f.name or uf.display_name(f.accel)}): "
                                 f"it {why}; use dop853 or rk4")
     if constraint is not None:
         raise ScenarioError(f"method={method!r} cannot take the pendulum's string in rotframe.simulate yet (the "
