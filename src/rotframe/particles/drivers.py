@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import math
 import numpy as np
+from numba import njit
 
 from rotframe.numerics.compiled import inlined
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
-from rotframe.particles.kernels import advance, make_plan, method_steps, one_step, rk4_step
-from rotframe.particles.packed import NFEV, as_state, is_finite, jit_kernel, store, store_particle, unpack
+from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
+from rotframe.particles.packed import NFEV, as_state, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
 __all__ = ["run_fixed", "run_dop853"]
@@ -30,6 +31,64 @@ __all__ = ["run_fixed", "run_dop853"]
 _store = inlined(store)
 _advance = inlined(advance)
 _is_finite = inlined(is_finite)
+#: a loop that takes its one-step map as an argument, inlined with it into its caller
+_inline_kernel = njit(inline="always", error_model="numpy", nogil=True)
+
+
+@_inline_kernel
+def _steady_loop(step, method, r, v, alive, n_samples, steps_per_sample, h, m, plan, out_r, out_v):
+    """`run_fixed` at a steady rate with no event to watch, with the inlined one-step map ``step``.
+
+    Every particle, ``steps_per_sample`` steps of ``step`` a sample. Inlined with
+    its ``step`` (numba resolves the argument to the global it is passed), so each
+    step family gets a loop holding its body alone. Returns ``(n_done, bad, steps)``:
+    ``steps`` is particle 0's (its force evaluations are ``steps`` times the method's).
+    """
+    n_done = n_samples
+    bad = -1
+    steps0 = 0
+    for p in range(r.shape[0]):
+        state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
+        if alive[p]:
+            for s in range(n_samples):
+                for _ in range(steps_per_sample):
+                    state = step(state, method, h, m, plan)
+                if p == 0:
+                    steps0 += steps_per_sample
+                if not _is_finite(state):
+                    if s < n_done:
+                        n_done = s
+                    if bad < 0:
+                        bad = p
+                    break
+                _store(out_r, out_v, s, p, state)
+        else:
+            for s in range(n_samples):
+                _store(out_r, out_v, s, p, state)
+        store_particle(r, v, p, state)
+    return n_done, bad, steps0
+
+
+@jit_internal
+def _steady_run(method, r, v, alive, n_samples, steps_per_sample, h, m, plan, rk4, sphere, out_r, out_v):
+    """`_steady_loop` with the step family's map (`run_fixed` at a steady rate, no event).
+
+    A function of its own, not inlined into `run_fixed`: its types do not depend on
+    the event table or the schedule, so every variant of the driver calls the one
+    compiled loop (a first run compiles it once, not once per variant). ``rk4`` and
+    ``sphere`` None are pruned here, before the steps are inlined, so a free
+    particle's loop compiles no RK4 and no sphere (numba inlines before it types,
+    and prunes only on arguments).
+    """
+    if rk4 is not None:
+        if rk4:
+            return _steady_loop(rk4_step_of, method, r, v, alive, n_samples, steps_per_sample, h, m, plan, out_r,
+                                out_v)
+    if sphere is not None:
+        if sphere:
+            return _steady_loop(sphere_step, method, r, v, alive, n_samples, steps_per_sample, h, m, plan, out_r,
+                                out_v)
+    return _steady_loop(free_step, method, r, v, alive, n_samples, steps_per_sample, h, m, plan, out_r, out_v)
 
 
 @jit_kernel
@@ -77,11 +136,15 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     plan = make_plan(method, t0, h, m, wt, wv, wint)
     nfev_step = NFEV[method]
     n = r.shape[0]
+    if events is None and (wt is None or m.steady):
+        # the throughput path: one loop compiled once for every variant of this driver
+        n_done, bad, steps0 = _steady_run(method, r, v, alive, n_samples, steps_per_sample, h, m, plan, rk4, sphere,
+                                          out_r, out_v)
+        return n_done, bad, nfev_step * steps0
     n_ev = 0 if events is None else events.shape[0]
     if events is not None:
         g_old = np.empty(n_ev)
         row = event_row(events, 0) if n_ev > 0 else (0.0, 0, 0.0, 0.0)  # the watch loop's event, read once
-    is_rk4 = False if rk4 is None else rk4
     nfev0 = 0
     n_done = n_samples
     bad = -1
@@ -96,16 +159,8 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         for s in range(n_samples):
             if is_alive:
                 if events is None:
-                    # no event to watch: the whole sample interval in one call
-                    if is_rk4 and (wt is None or m.steady):
-                        for _ in range(steps_per_sample):  # a loop of its own: RK4's body alone
-                            state = rk4_step(state, h, m, plan)
-                    elif wt is None or m.steady:
-                        for _ in range(steps_per_sample):  # one_step inlined: the scalars stay in registers
-                            state = one_step(method, state, h, m, plan, rk4, sphere)
-                    else:
-                        state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan,
-                                         rk4, sphere)
+                    # a varying rate, no event to watch: the whole sample interval in one call
+                    state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4, sphere)
                     k_step += steps_per_sample
                     if p == 0:
                         nfev0 += nfev_step * steps_per_sample
@@ -114,8 +169,18 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                     # step and the event test in registers; the same steps, tests and location as below
                     k = 0
                     while k < steps_per_sample:
-                        done, start, state, g_start, g_new, hit = watch_steps(
-                            method, state, steps_per_sample - k, h, m, plan, rk4, sphere, row, g_old[0])
+                        # the step family's map, chosen where numba prunes rk4 and sphere None before it
+                        # inlines the watch loop: a free particle's loop compiles no RK4 and no sphere
+                        if rk4 is not None and rk4:
+                            watched = watch_steps(rk4_step_of, method, state, steps_per_sample - k, h, m, plan, row,
+                                                  g_old[0])
+                        elif sphere is not None and sphere:
+                            watched = watch_steps(sphere_step, method, state, steps_per_sample - k, h, m, plan, row,
+                                                  g_old[0])
+                        else:
+                            watched = watch_steps(free_step, method, state, steps_per_sample - k, h, m, plan, row,
+                                                  g_old[0])
+                        done, start, state, g_start, g_new, hit = watched
                         k += done
                         k_step += done
                         g_old[0] = g_new

@@ -19,7 +19,7 @@ from numba import njit
 
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
-from rotframe.particles.kernels import make_plan, method_steps, one_step, rk4_step
+from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import as_state, jit_internal
 
 _inline = njit(inline="always", error_model="numpy", nogil=True)
@@ -66,32 +66,23 @@ def row_value(row, state, radius):
 
 
 @_inline
-def watch_steps(method, state, n, h, m, plan, rk4, sphere, row, g_old):
+def watch_steps(step, method, state, n, h, m, plan, row, g_old):
     """Up to ``n`` steps with one plan, watching one event (`event_row`); stops after its first crossing.
 
     The fixed-step drivers' loop for one event at a steady rate, inlined into the
-    driver (a call per sample interval would pass the packed model and the plan, some
-    40 scalars, every few steps): each step is
-    `rotframe.particles.kernels.one_step` (inlined, so the step's scalars stay
-    in registers), then the event function and `crossed`. Returns
+    driver's sample loop with ``step``, the inlined one-step map of its family
+    (`rotframe.particles.kernels.free_step`, ``sphere_step`` or ``rk4_step_of``),
+    so that the step's scalars stay in registers and each family's loop holds its
+    body alone (one loop holding RK4's and the splitting's ran RK4 at half speed).
+    Each step is followed by the event function and `crossed`. Returns
     ``(k, start, state, g_start, g_new, hit)``: the steps taken, the state before
     and after the last of them, the event function before and after it, and
     whether it crossed (then the crossing is in the last step).
     """
     direction = row[3]
-    if rk4 is not None and rk4:
-        # RK4 in a loop of its own (one loop holding both methods' bodies ran RK4 at half speed)
-        for k in range(n):
-            start = state
-            state = rk4_step(state, h, m, plan)
-            g_new = row_value(row, state, m.radius)
-            if _crossed(direction, g_old, g_new):
-                return k + 1, start, state, g_old, g_new, True
-            g_old = g_new
-        return n, state, state, g_old, g_old, False
     for k in range(n):
         start = state
-        state = one_step(method, state, h, m, plan, rk4, sphere)
+        state = step(state, method, h, m, plan)
         g_new = row_value(row, state, m.radius)
         if _crossed(direction, g_old, g_new):
             return k + 1, start, state, g_old, g_new, True

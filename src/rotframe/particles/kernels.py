@@ -45,7 +45,7 @@ def loop_code(name: str) -> int:
     """The code the compiled loops know the fixed-step method ``name`` by (-1: not one of theirs, dop853)."""
     return _LOOP_CODES.get(name, -1)
 
-__all__ = ["loop_code", "EVALS_PER_STEP", "make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
+__all__ = ["loop_code", "EVALS_PER_STEP", "make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "rk4_step_of", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
 
 # numba compiles a separate version of a function for every constant it is called with
@@ -323,6 +323,12 @@ def rk4_step(state, h, m, plan):
                            vy + h6 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y),
                            vz + h6 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z))
     return x, y, z, vx, vy, vz
+
+
+@_inline
+def rk4_step_of(state, method, h, m, plan):
+    """`rk4_step` with the splittings' arguments (``method`` unused), to be passed where they are."""
+    return rk4_step(state, h, m, plan)
 
 
 @jit_internal
