@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe.numerics.linefit import line_fit
+
 from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
@@ -121,18 +123,14 @@ def measured_rates(times, r, v, length, g, with_error=False):
     """
     w0 = math.sqrt(g / length)
     angle = swing_angle(r, v, w0)
-    slope = np.polyfit(times, angle, 1)[0]
-    if with_error:
-        resid = angle - np.polyval(np.polyfit(times, angle, 1), times)
-        spread = float(np.sum((times - times.mean()) ** 2))
-        slope_error = math.sqrt(float(np.sum(resid**2)) / max(len(times) - 2, 1) / spread) if spread > 0 else math.inf
+    slope, _, slope_error = line_fit(times, angle)
     # period from the maxima of the horizontal distance: x.v changes sign from + to -
     scale = max(float(np.max(np.abs(r[:, :2]))), float(np.max(np.abs(v[:, :2]))) / w0) or 1.0
     rho = (r[:, 0] / scale) * (v[:, 0] / scale) + (r[:, 1] / scale) * (v[:, 1] / scale)
     k = np.nonzero((rho[:-1] > 0) & (rho[1:] <= 0))[0]
     if len(k) >= 3:
         tc = times[k] + (times[k + 1] - times[k]) * rho[k] / (rho[k] - rho[k + 1])
-        half_period = np.polyfit(np.arange(len(tc)), tc, 1)[0]
+        half_period = line_fit(np.arange(len(tc), dtype=np.float64), tc)[0]
         period = 2 * half_period
     else:
         period = math.nan

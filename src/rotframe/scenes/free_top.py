@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe.numerics.linefit import line_fit
+
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
 from rotframe.scenes.rigid_base import (FREE_METHODS, adaptive_rel_error, free_body_state,
                                        invariant_drifts, record_body, simulate_free_body)
@@ -75,12 +77,16 @@ def simulate(p, terms, method, run, progress):
     return result
 
 
-def measured_rates(traj, inertia):
-    """(body precession rate of (w1, w2), space precession rate of e3 about L), rad/s, signed."""
+def measured_rates(traj, inertia, with_error=False):
+    """(body precession rate of (w1, w2), space precession rate of e3 about L), rad/s, signed.
+
+    With ``with_error`` two more values: the standard errors (rad/s) of the two
+    fitted rates, from the scatter of the angles about their lines.
+    """
     from rotframe.rigid import dynamics as rigid
     w = traj.L / inertia
     body_angle = np.unwrap(np.arctan2(w[:, 1], w[:, 0]))
-    body_rate = np.polyfit(traj.times, body_angle, 1)[0]
+    body_rate, _, body_error = line_fit(traj.times, body_angle)
     Ls = rigid.angular_momentum_space(traj.q[0], traj.L[0])
     n = Ls / np.linalg.norm(Ls)
     e3 = rigid.body_to_space(traj.q, np.array([0.0, 0.0, 1.0]))
@@ -89,8 +95,17 @@ def measured_rates(traj, inertia):
     a /= np.linalg.norm(a)
     b = np.cross(n, a)
     space_angle = np.unwrap(np.arctan2(e3 @ b, e3 @ a))
-    space_rate = np.polyfit(traj.times, space_angle, 1)[0]
-    return body_rate, space_rate
+    space_rate, _, space_error = line_fit(traj.times, space_angle)
+    return (body_rate, space_rate, body_error, space_error) if with_error else (body_rate, space_rate)
+
+
+def _unresolved(name, error, tol, duration):
+    """A note when a fitted rate's standard error ``error`` exceeds its tolerance ``tol`` (else None)."""
+    if error <= tol:
+        return None
+    return (f"{name} not measured: over {duration:.4g} s the angle it fits turns too little to tell its rate "
+            f"from round-off (standard error {error:.3g} rad/s, over the tolerance {tol:.3g} rad/s); "
+            "lengthen duration")
 
 
 def _tolerance(method, rate, traj):
@@ -125,12 +140,13 @@ def analyse(p, result):
     metrics = {"body_precession_period_s": math.nan, "space_precession_rate_rad_s": math.nan}
     diagnostics = {}
     body_rate = space_rate = math.nan
+    body_error = space_error = 0.0
     if omega3 == 0.0 and omega_perp == 0.0:
         notes.append("omega3 = omega_perp = 0: the body does not turn; nothing precesses")
     elif not result.extras.get("resolved", True):
         notes.append(unresolved_note("precession", "precession", result.extras["shortest_period"], duration))
     else:
-        body_rate, space_rate = measured_rates(traj, inertia)
+        body_rate, space_rate, body_error, space_error = measured_rates(traj, inertia, with_error=True)
     if omega_perp == 0.0 and omega3 != 0.0:
         notes.append("omega_perp = 0: the body spins about its symmetry axis, so omega, L and the axis stay "
                      "aligned and nothing precesses (both precession metrics are null)")
@@ -163,6 +179,14 @@ def analyse(p, result):
         notes.append(f"simulated {periods:.4g} body precession periods" if periods < 1e6 else
                      f"simulated {periods:.4g} body precession periods (the default duration is two Euler periods "
                      "of the Earth; set duration to suit another body)")
+    # a rate the samples cannot resolve from round-off is null with a note, never a number
+    errors = {"body_precession_period_s": body_error / abs(k) * theory.get("body_precession_period_s", 0.0)
+              if k else 0.0, "space_precession_rate_rad_s": space_error}
+    for name, tol in tolerance.items():
+        note = _unresolved(name, errors[name], tol, duration)
+        if note and math.isfinite(metrics.get(name, math.nan)):
+            metrics[name] = math.nan
+            notes.append(note)
     diagnostics.update(energy_rel_drift=e_drift, momentum_rel_drift=m_drift)
     return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
             "diagnostics": diagnostics, "notes": notes}

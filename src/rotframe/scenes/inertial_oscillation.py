@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe.numerics.linefit import line_fit
+
 from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
@@ -80,7 +82,7 @@ def measured(times, r, v):
     and the radius is the curvature radius |v| / |turning rate| instead.
     """
     heading = np.unwrap(np.arctan2(v[:, 1], v[:, 0]))
-    rate = np.polyfit(times, heading, 1)[0]
+    rate = line_fit(times, heading)[0]
     turned = abs(rate) * (times[-1] - times[0])
     if turned < TURN_FLOOR:
         return math.inf, math.inf, 0.0
