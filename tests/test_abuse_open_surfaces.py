@@ -278,6 +278,7 @@ CACHE_RUN = textwrap.dedent('''
 
 def _cache_run(tmp_path, cache, **env):
     environ = dict(os.environ, PYTHONPATH=str(REPO / "src"), ROTFRAME_CACHE_DIR=str(cache), **env)
+    environ.pop("NUMBA_CACHE_DIR", None)  # numba's files beside the driver's source, where the tests damage them
     return subprocess.run([sys.executable, "-c", CACHE_RUN], capture_output=True, text=True, timeout=300,
                           env=environ, cwd=tmp_path)
 
