@@ -111,3 +111,23 @@ def test_bench_help_names_every_benchmark_that_is_not_a_problem():
                          timeout=120).stdout
     words = " ".join(out.split())  # argparse wraps the help text (user- force)
     assert all(name in words.replace("- ", "-") for name in EXTRAS), words
+
+
+def test_bare_quick_is_a_smoke_test_of_each_problems_default_method(monkeypatch):
+    # `rotframe bench --quick` with no names: each problem's scene default only (a first run compiles
+    # little), plain scipy beside it, and no ensemble or user-force rows; named problems keep every method
+    import rotframe.app.bench as bench
+    from rotframe.app.bench.problems import problems
+
+    (tower,) = problems(["tower-drop"], quick=True)
+    assert {"exact", "rotation-splitting", "rk4", "dop853"} <= set(tower.runs)
+    assert bench.smoke_runs(tower) == {"exact": tower.runs["exact"]}
+    (foucault,) = problems(["foucault"], quick=True)
+    assert list(bench.smoke_runs(foucault)) == ["dop853"]  # "dop853 for the full pendulum; ..."
+    monkeypatch.setattr(bench, "problems", lambda names, quick: [tower])
+    monkeypatch.setattr(bench, "record_rows", lambda n: [])
+    rows = bench.run_bench(quick=True)
+    methods = {r["method"] for r in rows if r.get("kind") is None}
+    assert methods == {"exact", "scipy-RK45", "scipy-DOP853", "scipy-Radau", "scipy-LSODA"}
+    assert not any(r["scenario"] in ("ensemble", "user-force") for r in rows)
+    assert any("smoke test" in r.get("note", "") for r in rows)

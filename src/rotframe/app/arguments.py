@@ -140,7 +140,7 @@ def build_parser(commands):
                    help="scenario problems, or ensemble, sweep, startup, record, user-force, gpu (default: all; "
                         "gpu only where a CUDA GPU is)")
     q.add_argument("--json", action="store_true", help="print a JSON list of rows on stdout and nothing else")
-    q.add_argument("--quick", action="store_true", help="a short ladder, for a smoke test")
+    q.add_argument("--quick", action="store_true", help="the smoke test: each problem's default method, plain scipy at one tolerance; named problems run every method on short ladders")
     q.add_argument("--plots", metavar="DIR", default=None, help="write work-precision PNGs to DIR")
     add_threads(q, "the all-core ensemble rows")
     q.set_defaults(func=commands["bench"])

@@ -39,14 +39,16 @@ from rotframe.app.bench.gpu import gpu_rows
 from rotframe.app.bench.throughput import ensemble_rows, record_rows, startup_rows, sweep_rows
 from rotframe.app.bench.user_force import user_force_rows
 
-__all__ = ["Problem", "problems", "run_bench", "level_summary", "speedups", "main"]
+__all__ = ["Problem", "problems", "run_bench", "smoke_runs", "level_summary", "speedups", "main"]
 
 def run_bench(names=None, quick=False, progress=None, on_row=None):
     """All rows for the named benchmarks (default: every problem, ensemble, sweep, start-up, recording).
 
     ``quick``: short ladders, three repeats, plain scipy at one tolerance (no
-    numba or diffrax peers), no sweep or start-up (they start processes); every
-    problem still runs once. ``progress(done, total, label)`` is called after each
+    numba or diffrax peers), no sweep or start-up (they start processes). With
+    no names it is the smoke test: every problem with its scene's default method
+    only (`smoke_runs`) and the recording row, so that a first run compiles
+    little; named problems run every method. ``progress(done, total, label)`` is called after each
     timed unit; ``on_row(row)`` with each row. Summary rows (``kind``
     "summary", one per problem and error level) close the list.
     """
@@ -56,6 +58,10 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
     notes = []
     plan = Plan(quick, progress)
     probs = problems(scenario_names or None, quick=quick) if (scenario_names or not names) else []
+    smoke = quick and not names
+    if smoke:
+        for p in probs:
+            p.runs = smoke_runs(p)
     from rotframe.app.bench import peers
 
     peers_ok, why = peers.diffrax_available()
@@ -63,8 +69,10 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
         notes.append(why)
     if quick:
         notes.append("quick: plain scipy at rtol 1e-6 only (no numba or diffrax peers), short ladders, 3 repeats, "
-                     "no sweep or start-up")
-    extras = [n for n in EXTRAS if (not names and not (quick and n in ("sweep", "startup"))) or n in names]
+                     "no sweep or start-up" + ("; the smoke test: each problem's default method only, and no "
+                                               "ensemble or user-force rows (name them to run them)" if smoke else ""))
+    skipped = ("sweep", "startup") + (("ensemble", "user-force", "gpu") if smoke else ())
+    extras = [n for n in EXTRAS if (not names and not (quick and n in skipped)) or n in names]
     plan.total = sum(planned_units(p, quick, peers_ok) for p in probs) + len(extras)
     for p in probs:
         rows.extend(run_problem(p, on_row, plan))
@@ -86,6 +94,22 @@ def run_bench(names=None, quick=False, progress=None, on_row=None):
         rows.append({"scenario": "notes", "method": "note", "setting": None, "wall_s": 0.0, "error": math.nan,
                      "error_kind": "note", "nfev": 0, "kind": "note", "note": n})
     return rows
+
+
+def smoke_runs(p):
+    """The runs of problem ``p`` that `run_bench`'s smoke test keeps: its scene's default method.
+
+    The default method is the first word of the scene's ``DEFAULT_METHOD`` (which may
+    say more: "dop853 for the full pendulum; ..."), where the problem runs it, else
+    the problem's first method.
+    """
+    from rotframe import scenes
+    from rotframe.app import scenario
+
+    said = getattr(scenes.get(scenario.load(p.scenario).scene), "DEFAULT_METHOD", None) or ""
+    default = said.split()[0] if said.split() else None
+    method = default if default in p.runs else next(iter(p.runs))
+    return {method: p.runs[method]}
 
 
 def main(args) -> int:
