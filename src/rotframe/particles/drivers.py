@@ -36,6 +36,12 @@ _inline_kernel = njit(inline="always", error_model="numpy", nogil=True)
 
 
 @_inline_kernel
+def _failed(n_done, bad, s, p):
+    """The drivers' failure record once particle p is not finite at sample s: the first such sample and particle."""
+    return (s if s < n_done else n_done), (p if bad < 0 else bad)
+
+
+@_inline_kernel
 def _steady_loop(step, method, r, v, alive, n_samples, steps_per_sample, h, m, plan, out_r, out_v):
     """`run_fixed` at a steady rate with no event to watch, with the inlined one-step map ``step``.
 
@@ -56,10 +62,7 @@ def _steady_loop(step, method, r, v, alive, n_samples, steps_per_sample, h, m, p
                 if p == 0:
                     steps0 += steps_per_sample
                 if not _is_finite(state):
-                    if s < n_done:
-                        n_done = s
-                    if bad < 0:
-                        bad = p
+                    n_done, bad = _failed(n_done, bad, s, p)
                     break
                 _store(out_r, out_v, s, p, state)
         else:
@@ -219,10 +222,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
                             is_alive = False
                             break
                 if not _is_finite(state):
-                    if s < n_done:
-                        n_done = s
-                    if bad < 0:
-                        bad = p
+                    n_done, bad = _failed(n_done, bad, s, p)
                     break
             _store(out_r, out_v, s, p, state)  # inlined: a call passing two arrays costs their reference counts
         store_particle(r, v, p, state)
@@ -368,10 +368,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 failed = True
                 break
         if failed:
-            if bad < 0:
-                bad = p
-            if k_out < n_done:
-                n_done = k_out
+            n_done, bad = _failed(n_done, bad, k_out, p)
         # a stopped particle keeps its final state in the remaining samples
         while k_out < n_out:
             store(out_r, out_v, k_out, p, y)
