@@ -353,7 +353,11 @@ def method_steps(method, state, n, h, m, plan, rk4, sphere):
 
 @_inline
 def one_step(method, state, h, m, plan, rk4, sphere):
-    """One step of `method_steps` (inlined into its callers: the event watch's loop)."""
+    """One step of `method_steps`, the family chosen at run time (the GPU kernel's step, `rotframe.particles.gpu`).
+
+    The CPU drivers choose the family where numba prunes it and pass `free_step`,
+    `sphere_step` or `rk4_step_of` alone: inlined, this function brings all three.
+    """
     if rk4 is not None:
         if rk4:
             return rk4_step(state, h, m, plan)
