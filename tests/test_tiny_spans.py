@@ -60,3 +60,39 @@ def test_free_top_space_rate_over_a_nanosecond_is_null_with_a_note(capsys):
     # the body precession angle starts at 0, where round-off is tiny: its fit resolves the closed form
     assert math.isclose(summary["metrics"]["body_precession_period_s"],
                         summary["theory"]["body_precession_period_s"], rel_tol=1e-9)
+
+
+@pytest.mark.parametrize("speed", ["1e-160", "1e-300"])
+def test_a_shot_whose_apex_is_subnormal_measures_nothing_at_its_landing(capsys, speed):
+    # heights below 1e-290 m keep a few digits or none: speed 1e-160 m/s gave the flight time 0.5 % off,
+    # 1e-170 m/s a factor 667, unflagged; the closed form's flight time (2 v sin(el) / g) is still shown
+    code, out, err = call(capsys, "run", "projectile", "--set", f"speed={speed}", "--no-record", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert all(summary["metrics"][k] is None for k in ("range_m", "lateral_deflection_m", "flight_time_s"))
+    assert any("apex" in n and "normal range" in n for n in summary["notes"])
+    el = math.radians(summary["params"]["elevation"])
+    assert math.isclose(summary["theory"]["flight_time_s"], 2 * float(speed) * math.sin(el) / 9.80665, rel_tol=1e-2)
+
+
+def test_a_metric_its_own_tolerance_cannot_resolve_is_null_with_a_note(capsys):
+    # a shot at 1e-12 m/s: the lateral deflection is 1e-42 m in theory, the run resolves it to 1e-34 m
+    # (round-off of positions of 1e-25 m); it gave -1.2e-41 m, the wrong sign, inside that tolerance
+    code, out, err = call(capsys, "run", "projectile", "--set", "speed=1e-12", "--no-record", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["metrics"]["lateral_deflection_m"] is None
+    assert any(n.startswith("lateral_deflection_m not measured") for n in summary["notes"])
+    assert summary["metrics"]["range_m"] is not None  # resolved: kept
+
+
+def test_unresolved_metrics_keeps_error_metrics_and_resolved_ones():
+    from rotframe.app.runner import unresolved_metrics
+
+    analysis = {"metrics": {"err_m": 1e-16, "big": 2.0, "tiny": 3e-9, "bare": 5.0},
+                "theory": {"err_m": 0.0, "big": 2.0, "tiny": 1e-9, "bare": 5.0},
+                "tolerance": {"err_m": 1e-8, "big": 1e-8, "tiny": 1e-8}}
+    out = unresolved_metrics(analysis)
+    assert out["metrics"]["err_m"] == 1e-16 and out["metrics"]["big"] == 2.0 and out["metrics"]["bare"] == 5.0
+    assert math.isnan(out["metrics"]["tiny"]) and len(out["notes"]) == 1
+    assert analysis["metrics"]["tiny"] == 3e-9  # the scene's own analysis is not changed

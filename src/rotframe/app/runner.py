@@ -81,7 +81,7 @@ def summarize(scn, values, result, timing, given=()):
         return summarize_minimal(scn, values, result, timing)
     scene = scenes.get(scn.scene)
     params = {k: v for k, v in values.items() if k != "run"}
-    analysis = scene.analyse(params, result)
+    analysis = unresolved_metrics(scene.analyse(params, result))
     theory = analysis.get("theory", {})
     summary = {
         "scenario": scn.name,
@@ -141,6 +141,31 @@ def _gpu_unused(scn, result):
 def _plain(values: dict) -> dict:
     """Numbers as Python's own (a numpy scalar becomes a float, int or bool), as JSON will have them."""
     return {k: v.item() if hasattr(v, "item") and getattr(v, "ndim", 1) == 0 else v for k, v in values.items()}
+
+
+def unresolved_metrics(analysis):
+    """A scene's analysis with every metric that its own stated accuracy cannot resolve made null, with a note.
+
+    A metric is unresolved when its tolerance (the largest |simulated - theory|
+    the run allows) is at least the size of its nonzero theory value: whatever
+    the run gives is then within "accuracy" of zero as much as of the answer, a
+    number with no digit to trust (a projectile at 1e-12 m/s: lateral deflection
+    1e-42 m, tolerance 1e-34 m from the positions' round-off, simulated -1.2e-41 m).
+    A theory of exactly zero (an error metric, whose ideal is 0) is kept.
+    """
+    import math
+
+    metrics, theory = dict(analysis["metrics"]), analysis.get("theory", {})
+    notes = list(analysis.get("notes", []))
+    for key, tol in analysis.get("tolerance", {}).items():
+        ref, value = theory.get(key), metrics.get(key)
+        numbers = all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                      for x in (tol, ref, value))
+        if numbers and ref != 0 and abs(ref) <= tol:
+            metrics[key] = math.nan
+            notes.append(f"{key} not measured: the run resolves it only to +-{tol:.3g}, more than its size "
+                         f"({ref:.3g} in theory)")
+    return dict(analysis, metrics=metrics, notes=notes)
 
 
 def theory_warnings(metrics, theory, tolerance, notes=None):

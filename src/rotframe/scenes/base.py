@@ -17,7 +17,7 @@ from rotframe.scenes.run_settings import RUN_DEFAULTS, run_setting
 from rotframe.particles.integrators import RunInterrupted, integrate_particles
 
 
-__all__ = ["RUN_DEFAULTS", "run_setting", "SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
+__all__ = ["UNDERFLOW", "RUN_DEFAULTS", "run_setting", "SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
            "landing",
            "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
            "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
@@ -365,6 +365,11 @@ def method_rel_error(traj, time_scale):
     if order is None or not h or not time_scale > 0:
         return 1e-9
     return 1e-9 + 10.0 * (h / time_scale) ** order
+
+
+#: Magnitudes below this (m or s) have lost float64's relative precision (normal range ends at 2.2e-308):
+#: a scene's metric derived from them is null with a note.
+UNDERFLOW = 1e-290
 
 
 def reject_subnormal(values):

@@ -28,7 +28,7 @@ from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
-                                  samples_for, with_parameters)
+                                  samples_for, UNDERFLOW, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -198,6 +198,19 @@ def analyse(p, result):
         notes.append("the shell had not landed at the end of the simulated time")
         metrics.update(range_m=math.nan, lateral_deflection_m=math.nan)
         notes.append("range and lateral deflection are of a landing, so they are null")
+    # a shot whose apex is below float64's normal range computes its heights with a few digits or none:
+    # the landing it locates, and all that is measured at it, are null (found: speed 1e-160 m/s gave the
+    # flight time 0.5 % off, 1e-170 m/s a factor 667)
+    vz = p.speed * math.sin(math.radians(p.elevation))
+    log_apex = 2 * math.log10(vz) - math.log10(2 * g) if vz > 0 else -math.inf
+    if log_apex < math.log10(UNDERFLOW) and vz > 0:
+        for key in ("range_m", "lateral_deflection_m", "flight_time_s"):
+            metrics[key] = math.nan
+        for key in ("range_m", "lateral_deflection_m"):  # of the same size as the apex: subnormal too
+            theory[key] = math.nan
+        notes.append(f"the shot's apex (about 1e{log_apex:.0f} m) is below float64's normal range: heights "
+                     "that small keep too few digits to locate the landing; range, lateral deflection and flight "
+                     "time are not computed")
     method_rel = method_rel_error(traj, theory["flight_time_s"])
     size = max(abs(theory["range_m"]), float(np.max(np.abs(r))))
     tolerance = {k: acc + method_rel * (theory[k] if k == "flight_time_s" else size)

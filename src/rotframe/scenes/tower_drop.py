@@ -24,7 +24,7 @@ from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
                                   particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
-                                  scene_parameters, with_parameters)
+                                  scene_parameters, UNDERFLOW, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -85,8 +85,6 @@ def simulate(p, terms, method, run, progress):
     return run_particles(model, r0, v0, duration, method, run, progress, finish, events=[GROUND])
 
 
-#: Magnitudes below this (m or s) have lost float64's relative precision (normal range ends at 2.2e-308).
-UNDERFLOW = 1e-290
 
 
 @with_parameters(TowerDropParameters)
