@@ -120,7 +120,8 @@ def _inertial_speed(result):
     traj, omega = result.trajectory, result.extras["omega"]
     r, v = traj.r[:, 0], traj.v[:, 0]
     w = np.array([omega.vector(t) for t in traj.times])
-    return np.linalg.norm(v + np.cross(w, r), axis=1)
+    u = v + np.cross(w, r)
+    return np.hypot(np.hypot(u[:, 0], u[:, 1]), u[:, 2])  # no square to overflow at huge rates and radii
 
 
 @with_parameters(TurntableParameters)
