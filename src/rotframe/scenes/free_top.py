@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.numerics.linefit import line_fit
-
 from rotframe.scenes.base import reject_subnormal, samples_for, unresolved_note, with_parameters
 from rotframe.scenes.rigid_base import (FREE_METHODS, adaptive_rel_error, free_body_state,
                                        invariant_drifts, record_body, simulate_free_body)
@@ -100,11 +99,12 @@ def measured_rates(traj, inertia, with_error=False):
 
 
 def _unresolved(name, error, tol, duration):
-    """A note when a fitted rate's standard error ``error`` exceeds its tolerance ``tol`` (else None)."""
+    """A note when a fitted metric's standard error ``error`` exceeds its tolerance ``tol`` (else None)."""
     if error <= tol:
         return None
+    unit = "s" if name.endswith("_s") else "rad/s"
     return (f"{name} not measured: over {duration:.4g} s the angle it fits turns too little to tell its rate "
-            f"from round-off (standard error {error:.3g} rad/s, over the tolerance {tol:.3g} rad/s); "
+            f"from round-off (standard error {error:.3g} {unit}, over the tolerance {tol:.3g} {unit}); "
             "lengthen duration")
 
 

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.numerics.linefit import line_fit
-
 from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
