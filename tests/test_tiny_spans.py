@@ -96,3 +96,17 @@ def test_unresolved_metrics_keeps_error_metrics_and_resolved_ones():
     assert out["metrics"]["err_m"] == 1e-16 and out["metrics"]["big"] == 2.0 and out["metrics"]["bare"] == 5.0
     assert math.isnan(out["metrics"]["tiny"]) and len(out["notes"]) == 1
     assert analysis["metrics"]["tiny"] == 3e-9  # the scene's own analysis is not changed
+
+
+def test_norm3_neither_overflows_nor_underflows():
+    from rotframe.numerics.vectors import norm3
+
+    x = np.array([[3e200, 4e200, 0.0], [3e-200, 0.0, 4e-200], [1.0, 2.0, 2.0]])
+    assert np.allclose(norm3(x) / np.array([5e200, 5e-200, 3.0]), 1.0, rtol=1e-15, atol=0)
+
+
+@pytest.mark.parametrize("setting", ["speed=1.234207595334801e+170", "duration=1.1509925876644392e+85"])
+def test_a_turntable_at_huge_scales_is_not_called_diverged(capsys, setting):
+    # |r - oracle| by np.linalg.norm squared 1e170 m into inf: a "diverged: inf m" exit 3 for a finite run
+    code, out, err = call(capsys, "run", "turntable", "--set", setting, "--no-record", "--json")
+    assert code == 0, err

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.numerics.linefit import line_fit
+from rotframe.numerics.vectors import norm3
 from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
@@ -86,7 +87,7 @@ def measured(times, r, v):
     if turned < TURN_FLOOR:
         return math.inf, math.inf, 0.0
     if turned < 0.5 * math.pi:
-        radius = float(np.mean(np.linalg.norm(v, axis=1))) / abs(rate)
+        radius = float(np.mean(norm3(v))) / abs(rate)
     else:
         # algebraic circle fit x^2 + y^2 + D x + E y + F = 0, in units of the path's extent so that
         # squares neither underflow nor overflow whatever the speed
@@ -108,7 +109,7 @@ def analyse(p, result):
     metrics = {"period_s": math.nan, "radius_m": math.nan}
     sense = 0.0
     if p.speed == 0:
-        metrics["radius_m"] = float(np.max(np.linalg.norm(r, axis=1)))
+        metrics["radius_m"] = float(np.max(norm3(r)))
         notes.append("speed = 0: the puck stays at rest; nothing circles, so there is no period")
     elif not result.extras.get("resolved", True):
         notes.append(unresolved_note("period_s and radius_m", "inertial", result.extras["period"],
@@ -132,7 +133,7 @@ def analyse(p, result):
     tolerance = {k: method_rel * abs(t) for k, t in theory_vals.items()
                  if math.isfinite(t) and (k != "period_s" or p.speed > 0)}
     expected = -math.copysign(1.0, lat) if lat != 0 and p.speed > 0 else 0.0
-    diagnostics = {"speed_rel_drift": rel_drift(np.linalg.norm(v, axis=1)) if p.speed > 0 else 0.0,
+    diagnostics = {"speed_rel_drift": rel_drift(norm3(v)) if p.speed > 0 else 0.0,
                    "sense": "clockwise" if sense < 0 else "counter-clockwise" if sense > 0 else "none"}
     warnings = []
     if math.isfinite(metrics["period_s"]) and sense != expected:
@@ -150,7 +151,7 @@ def record(rec, p, result):
     omega = np.array([0.0, 0.0, f / 2])  # the f-plane: only the vertical part of Omega acts
     rec.frame_axes("world/frame", max(float(np.max(np.abs(traj.r[:, 0]))) / 1000.0, 1.0) / 2, omega=omega)
     rec.scalars("diagnostics/speed_rel_error", traj.times,
-                np.linalg.norm(traj.v[:, 0], axis=1) / p.speed - 1 if p.speed else 0 * traj.times)
+                norm3(traj.v[:, 0]) / p.speed - 1 if p.speed else 0 * traj.times)
     v = traj.v[:, 0]
     if p.speed:
         direction = np.degrees(np.unwrap(np.arctan2(v[:, 1], v[:, 0])))

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe import analytic
+from rotframe.numerics.vectors import norm3
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, method_rel_error, particle_methods, reject_subnormal, rel_drift,
                                   run_particles, run_setting, with_parameters)
@@ -81,7 +82,7 @@ def simulate(p, terms, method, run, progress):
     result = run_particles(model, r0, v0, T, method, run, progress, finish)
     # a numerical instability that stays finite is still a failure: stop where the path left the exact line
     traj = result.trajectory
-    err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
+    err = norm3(traj.r[:, 0] - result.extras["oracle"])
     size = motion_size(p, traj.times)
     bad = np.nonzero(~(err <= DIVERGED * size))[0]
     if len(bad):
@@ -120,14 +121,13 @@ def _inertial_speed(result):
     traj, omega = result.trajectory, result.extras["omega"]
     r, v = traj.r[:, 0], traj.v[:, 0]
     w = np.array([omega.vector(t) for t in traj.times])
-    u = v + np.cross(w, r)
-    return np.hypot(np.hypot(u[:, 0], u[:, 1]), u[:, 2])  # no square to overflow at huge rates and radii
+    return norm3(v + np.cross(w, r))
 
 
 @with_parameters(TurntableParameters)
 def analyse(p, result):
     traj = result.trajectory
-    err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
+    err = norm3(traj.r[:, 0] - result.extras["oracle"])
     turns = float(result.extras["omega"].angle(traj.times[-1])[0] / (2 * math.pi))
     T = float(traj.times[-1])
     w_max = max(abs(p.omega0), abs(p.omega0 + p.alpha * T))
@@ -170,7 +170,7 @@ def record(rec, p, result):
                radii=[0.008], labels=["the puck's straight path in inertial space"])
     size = max(R, float(np.nanmax(np.abs(traj.r[:, 0, :2]))))
     rec.view(eye=(0.8 * size, -1.2 * size, 1.5 * size), look_at=(0.0, 0.0, 0.0))  # from above and aside: the whole curl
-    err = np.linalg.norm(traj.r[:, 0] - result.extras["oracle"], axis=1)
+    err = norm3(traj.r[:, 0] - result.extras["oracle"])
     rec.scalars("diagnostics/position_error_m", traj.times, err)
     rec.scalars("diagnostics/inertial_speed_rel_error", traj.times, _inertial_speed(result) / _inertial_speed(result)[0] - 1)
 
