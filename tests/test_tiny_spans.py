@@ -110,3 +110,10 @@ def test_a_turntable_at_huge_scales_is_not_called_diverged(capsys, setting):
     # |r - oracle| by np.linalg.norm squared 1e170 m into inf: a "diverged: inf m" exit 3 for a finite run
     code, out, err = call(capsys, "run", "turntable", "--set", setting, "--no-record", "--json")
     assert code == 0, err
+
+
+@pytest.mark.parametrize("setting", ["omega3=1e300", "omega_perp=1e300"])
+def test_a_free_top_whose_momentum_overflows_is_refused_in_one_line(capsys, setting):
+    # L = I omega overflowed before the check that refuses it (an internal error where warnings are errors)
+    code, out, err = call(capsys, "run", "free-top", "--set", setting, "--no-record", "--json")
+    assert code == 2 and "overflows a float64" in err, err

@@ -282,9 +282,9 @@ def free_body_state(inertia, omega_body):
     inertia = np.asarray(inertia, dtype=float)
     mass_properties.check_moments(inertia)
     omega = np.asarray(omega_body, dtype=float)
-    L = inertia * omega
     with np.errstate(over="ignore", invalid="ignore"):
-        # what the numbers become: |L| and the energy L . omega / 2, from which every metric is measured
+        # what the numbers become: L, |L| and the energy L . omega / 2, from which every metric is measured
+        L = inertia * omega
         energy = 0.5 * float(np.sum(np.abs(L) * np.abs(omega)))
         size = float(np.sqrt(np.sum(L * L)))
     if not (math.isfinite(energy) and math.isfinite(size)):
