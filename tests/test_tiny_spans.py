@@ -117,3 +117,13 @@ def test_a_free_top_whose_momentum_overflows_is_refused_in_one_line(capsys, sett
     # L = I omega overflowed before the check that refuses it (an internal error where warnings are errors)
     code, out, err = call(capsys, "run", "free-top", "--set", setting, "--no-record", "--json")
     assert code == 2 and "overflows a float64" in err, err
+
+
+@pytest.mark.parametrize("setting, code", [("mass=1e300", 3), ("length=1e300", 3), ("psidot0=1e150", 0),
+                                           ("wobble=-1e150", 0)])
+def test_a_heavy_top_at_huge_scales_exits_cleanly(capsys, setting, code):
+    # the first step's failure carried the kernel's raw arrays where a trajectory was expected, and a
+    # fixed-step error bound (w h)^p overflowed a Python float: both were internal errors (exit 1)
+    got, out, err = call(capsys, "run", "heavy-top", "--set", setting, "--no-record", "--json")
+    assert_clean(got, out, err)
+    assert got == code, err

@@ -217,9 +217,10 @@ def analyse(p, result):
             # a sampled extreme misses the true one by up to amplitude (pi dt / T)^2 / 2
             T = float(tp[2]) if len(tp) > 2 and math.isfinite(tp[2]) and tp[2] > 0 else math.inf
             w_fast = max(abs(w3), abs(p.phidot0), 2 * math.pi / T)
+            with np.errstate(over="ignore"):  # a rate of 1e150 rad/s: an infinite bound, not an OverflowError
+                fixed_rel = 10 * float(np.float64(w_fast * h) ** ORDERS.get(traj.method, 2)) + 1e-9
             method_rel = (adaptive_rel_error(traj) if traj.method == "dop853"
-                          else 10 * (w_fast * h) ** ORDERS.get(traj.method, 2) + 1e-9 if traj.method != "exact"
-                          else 1e-9)
+                          else fixed_rel if traj.method != "exact" else 1e-9)
             amp_deg = math.degrees(tp[1] - tp[0])
             for key, i in (("theta_min_deg", int(np.argmin(theta))), ("theta_max_deg", int(np.argmax(theta)))):
                 # the true extreme lies within a sample of the sampled one, so it differs from it by at most

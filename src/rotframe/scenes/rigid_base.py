@@ -129,7 +129,10 @@ def integrate_body(method, inertia, L0, q0, duration, run, progress, top=None):
     h = dt_sample / sps
     checked, stepper = _stepper(method, inertia, top)
     t0 = time.perf_counter()
-    checked(L0, q0, h, 1, 1)  # check every input once; load or compile the kernel
+    try:
+        checked(L0, q0, h, 1, 1)  # check every input once; load or compile the kernel
+    except IntegrationError as exc:  # the first step already fails: nothing but the start to keep
+        raise IntegrationError(str(exc), t_reached=0.0, partial=None) from None
     compile_s = time.perf_counter() - t0
     out_L = np.empty((samples + 1, 3))
     out_q = np.empty((samples + 1, 4))
