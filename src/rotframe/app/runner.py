@@ -143,6 +143,13 @@ def _plain(values: dict) -> dict:
     return {k: v.item() if hasattr(v, "item") and getattr(v, "ndim", 1) == 0 else v for k, v in values.items()}
 
 
+def _finite_numbers(*values) -> bool:
+    """Whether every value is a finite int or float (not a bool, not None, not nan)."""
+    import math
+
+    return all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in values)
+
+
 def unresolved_metrics(analysis):
     """A scene's analysis with every metric that its own stated accuracy cannot resolve made null, with a note.
 
@@ -158,10 +165,8 @@ def unresolved_metrics(analysis):
     metrics, theory = dict(analysis["metrics"]), analysis.get("theory", {})
     notes = list(analysis.get("notes", []))
     for key, tol in analysis.get("tolerance", {}).items():
-        ref, value = theory.get(key), metrics.get(key)
-        numbers = all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                      for x in (tol, ref, value))
-        if numbers and ref != 0 and abs(ref) <= tol:
+        ref = theory.get(key)
+        if _finite_numbers(tol, ref, metrics.get(key)) and ref != 0 and abs(ref) <= tol:
             metrics[key] = math.nan
             notes.append(f"{key} not measured: the run resolves it only to +-{tol:.3g}, more than its size "
                          f"({ref:.3g} in theory)")
@@ -176,14 +181,11 @@ def theory_warnings(metrics, theory, tolerance, notes=None):
     together. A metric with no tolerance, or with a missing (null) value on either
     side, is not compared.
     """
-    import math
-
     notes = notes or {}
     out = []
     for key, tol in tolerance.items():
         value, ref = metrics.get(key), theory.get(key)
-        if tol is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                                  for x in (value, ref)):
+        if tol is None or not _finite_numbers(value, ref):
             continue
         diff = abs(value - ref)
         if diff > tol:

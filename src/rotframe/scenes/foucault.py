@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe.numerics.linefit import line_fit
 from rotframe import analytic
+from rotframe.numerics.linefit import line_fit
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,

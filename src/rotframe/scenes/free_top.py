@@ -76,11 +76,10 @@ def simulate(p, terms, method, run, progress):
     return result
 
 
-def measured_rates(traj, inertia, with_error=False):
-    """(body precession rate of (w1, w2), space precession rate of e3 about L), rad/s, signed.
+def measured_rates(traj, inertia):
+    """(body precession rate of (w1, w2), space precession rate of e3 about L, their standard errors), rad/s.
 
-    With ``with_error`` two more values: the standard errors (rad/s) of the two
-    fitted rates, from the scatter of the angles about their lines.
+    The rates are signed; the errors come from the scatter of the angles about their fitted lines.
     """
     from rotframe.rigid import dynamics as rigid
     w = traj.L / inertia
@@ -95,7 +94,7 @@ def measured_rates(traj, inertia, with_error=False):
     b = np.cross(n, a)
     space_angle = np.unwrap(np.arctan2(e3 @ b, e3 @ a))
     space_rate, _, space_error = line_fit(traj.times, space_angle)
-    return (body_rate, space_rate, body_error, space_error) if with_error else (body_rate, space_rate)
+    return body_rate, space_rate, body_error, space_error
 
 
 def _unresolved(name, error, tol, duration):
@@ -146,7 +145,7 @@ def analyse(p, result):
     elif not result.extras.get("resolved", True):
         notes.append(unresolved_note("precession", "precession", result.extras["shortest_period"], duration))
     else:
-        body_rate, space_rate, body_error, space_error = measured_rates(traj, inertia, with_error=True)
+        body_rate, space_rate, body_error, space_error = measured_rates(traj, inertia)
     if omega_perp == 0.0 and omega3 != 0.0:
         notes.append("omega_perp = 0: the body spins about its symmetry axis, so omega, L and the axis stay "
                      "aligned and nothing precesses (both precession metrics are null)")

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe import analytic
 from rotframe.numerics.linefit import line_fit
 from rotframe.numerics.vectors import norm3
-from rotframe import analytic
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, method_rel_error, particle_methods,

@@ -202,8 +202,8 @@ def analyse(p, result):
     # the landing it locates, and all that is measured at it, are null (found: speed 1e-160 m/s gave the
     # flight time 0.5 % off, 1e-170 m/s a factor 667)
     vz = p.speed * math.sin(math.radians(p.elevation))
-    log_apex = 2 * math.log10(vz) - math.log10(2 * g) if vz > 0 else -math.inf
-    if log_apex < math.log10(UNDERFLOW) and vz > 0:
+    log_apex = 2 * math.log10(vz) - math.log10(2 * g) if vz > 0 else math.inf  # no apex: nothing to check
+    if log_apex < math.log10(UNDERFLOW):
         for key in ("range_m", "lateral_deflection_m", "flight_time_s"):
             metrics[key] = math.nan
         for key in ("range_m", "lateral_deflection_m"):  # of the same size as the apex: subnormal too

@@ -85,8 +85,6 @@ def simulate(p, terms, method, run, progress):
     return run_particles(model, r0, v0, duration, method, run, progress, finish, events=[GROUND])
 
 
-
-
 @with_parameters(TowerDropParameters)
 def theory_and_accuracy(p, model, g, Omega):
     """Closed forms for the drop and the relative accuracy each one claims, for this model.

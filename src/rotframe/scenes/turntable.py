@@ -82,7 +82,7 @@ def simulate(p, terms, method, run, progress):
     result = run_particles(model, r0, v0, T, method, run, progress, finish)
     # a numerical instability that stays finite is still a failure: stop where the path left the exact line
     traj = result.trajectory
-    err = norm3(traj.r[:, 0] - result.extras["oracle"])
+    err = _oracle_error(result)
     size = motion_size(p, traj.times)
     bad = np.nonzero(~(err <= DIVERGED * size))[0]
     if len(bad):
@@ -117,6 +117,11 @@ def inertial_line(omega, r0, v0, times):
     return analytic.turntable_inertial_line(r0, v_in, omega.angle(times), times)
 
 
+def _oracle_error(result):
+    """|r - r_exact| (m) at every sample: the distance of the run from the exact inertial line."""
+    return norm3(result.trajectory.r[:, 0] - result.extras["oracle"])
+
+
 def _inertial_speed(result):
     traj, omega = result.trajectory, result.extras["omega"]
     r, v = traj.r[:, 0], traj.v[:, 0]
@@ -127,7 +132,7 @@ def _inertial_speed(result):
 @with_parameters(TurntableParameters)
 def analyse(p, result):
     traj = result.trajectory
-    err = norm3(traj.r[:, 0] - result.extras["oracle"])
+    err = _oracle_error(result)
     turns = float(result.extras["omega"].angle(traj.times[-1])[0] / (2 * math.pi))
     T = float(traj.times[-1])
     w_max = max(abs(p.omega0), abs(p.omega0 + p.alpha * T))
@@ -170,9 +175,10 @@ def record(rec, p, result):
                radii=[0.008], labels=["the puck's straight path in inertial space"])
     size = max(R, float(np.nanmax(np.abs(traj.r[:, 0, :2]))))
     rec.view(eye=(0.8 * size, -1.2 * size, 1.5 * size), look_at=(0.0, 0.0, 0.0))  # from above and aside: the whole curl
-    err = norm3(traj.r[:, 0] - result.extras["oracle"])
+    err = _oracle_error(result)
     rec.scalars("diagnostics/position_error_m", traj.times, err)
-    rec.scalars("diagnostics/inertial_speed_rel_error", traj.times, _inertial_speed(result) / _inertial_speed(result)[0] - 1)
+    speed = _inertial_speed(result)
+    rec.scalars("diagnostics/inertial_speed_rel_error", traj.times, speed / speed[0] - 1)
 
 
 def _turn_z(r, angle):
