@@ -85,15 +85,15 @@ def test_a_fixed_step_particle_method_has_the_order_the_registry_states(name):
     assert abs(measured - registry.get(name).order) < 0.3, (name, measured, errors)
 
 
-def test_the_generated_drivers_codes_are_the_ones_their_source_says():
-    """The integer codes stay inside the modules that build the drivers, and the driver source's comments
-    (``stepping.take_step``: 0 DOP853, 1 RK4, 2 and 3 a driver's own splittings) say what they are."""
-    from rotframe.problem import body, particles, stepping
+def test_the_engines_codes_are_named_once_and_map_every_method_it_steps():
+    """The method codes are named in `rotframe.problem.models` alone; each problem maps the registry's names to
+    them, and a splitting's code is the one the engine hands to the model's own step."""
+    from rotframe.problem import body, engine, models, particles
 
-    for codes in (particles._CODES, body._CODES):
-        assert codes["dop853"] == 0 and codes["rk4"] == 1
-        assert sorted(c for c in codes.values() if c >= 2) == [2, 3]
-        assert set(codes) <= {m.name for m in registry.methods()}
-    assert "methods 2 and 3" in stepping.__doc__
-    assert "if method == 0:\n        dop853_step" in stepping.SOURCE and "elif method == 1:\n        rk4_step" in stepping.SOURCE
-    assert "2 or 3 (the body's or the particle's splittings" in stepping.SOURCE
+    for codes, problem in ((particles._CODES, "particles"), (body._CODES, "bodies")):
+        assert codes["dop853"] == models.DOP853 and codes["rk4"] == models.RK4
+        assert sorted(c for c in codes.values() if c not in (models.DOP853, models.RK4)) == [models.SPLITTING,
+                                                                                             models.SPLITTING4]
+        assert set(codes) == {m.name for m in registry.methods() if problem in m.runs and m.step != "exact"}
+    assert {models.DOP853, models.RK4, models.SPLITTING, models.SPLITTING4} == {0, 1, 2, 3}
+    assert "take_step" in vars(engine) and "own_step" in vars(models)

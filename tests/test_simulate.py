@@ -530,9 +530,12 @@ _CACHE_SCRIPT = textwrap.dedent('''
                             forces=[drag], params=(0.1,), samples=8)
     mods = [m for name, m in sys.modules.items() if name.startswith("rotframe_particle_problem_")]
     assert len(mods) == 1, mods
-    stats = mods[0].advance.stats
-    print(json.dumps({"hits": sum(stats.cache_hits.values()), "misses": sum(stats.cache_misses.values()),
-                      "cache_path": stats.cache_path, "r": res.trajectory.r[-1, 0].tolist()}))
+    from rotframe.problem import engine
+    # the problem's own glue (with the user's force inside) and the engine that steps it
+    stats = [mods[0].terms.stats, engine.advance.stats]
+    print(json.dumps({"hits": [sum(s.cache_hits.values()) for s in stats],
+                      "misses": [sum(s.cache_misses.values()) for s in stats],
+                      "r": res.trajectory.r[-1, 0].tolist()}))
 ''')
 
 
@@ -546,8 +549,8 @@ def test_second_process_compiles_nothing(tmp_path):
         assert proc.returncode == 0, proc.stderr[-2000:]
         outs.append(json.loads(proc.stdout.strip().splitlines()[-1]))
     first, second = outs
-    assert first["misses"] >= 1 and first["hits"] == 0
-    assert second["misses"] == 0 and second["hits"] >= 1
+    assert min(first["misses"]) >= 1 and max(first["hits"]) == 0
+    assert max(second["misses"]) == 0 and min(second["hits"]) >= 1
     assert second["r"] == first["r"]
     assert list((tmp_path / "problems").glob("rotframe_particle_problem_*.py"))
 

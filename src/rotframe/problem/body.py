@@ -22,8 +22,10 @@ import numpy as np
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
-from rotframe.problem.body_driver import SOURCE as BODY_SOURCE
 from rotframe.problem.codegen import Driver, build_module
+from rotframe.problem.glue import body_source, flatten_params
+from rotframe.problem.models import DOP853, RK4, SPLITTING, SPLITTING4
+from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
 from rotframe import method_registry as registry
 from rotframe.problem.arguments import check_flag, check_params, run_grid
@@ -32,9 +34,9 @@ from rotframe.validation import refuse_units
 
 __all__ = ["simulate_rigid_body", "BodyRun", "Torque"]
 
-#: The integer the compiled body driver branches on, for each method it steps (the names are
-#: `rotframe.method_registry`'s; ``exact`` is the elliptic flow, not the driver)
-_CODES = {"dop853": 0, "rk4": 1, "lie-poisson": 2, "lie-poisson4": 3}
+#: The code the engine branches on, for each method it steps (the names are `rotframe.method_registry`'s;
+#: ``exact`` is the elliptic flow, not the engine)
+_CODES = {"dop853": DOP853, "rk4": RK4, "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4}
 #: Lie-Poisson splittings: the torque as a kick at fixed attitude (a torque of (t, q) alone)
 KICK_METHODS = ("lie-poisson", "lie-poisson4")
 
@@ -102,15 +104,6 @@ def _inertia(inertia):
     return np.ascontiguousarray(I)
 
 
-def _header(nparams):
-    args = "".join(f", P[{j}]" for j in range(nparams))
-    return (f"\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n"
-            + f"    a = torque_fn(t, readonly(y[0:3]), readonly(y[3:7]){args})\n    return a[0], a[1], a[2]\n")
-
-
-_FREE_HEADER = "\nD = 7\nNE = 0\n\n@jit\ndef user_torque(t, y, P):\n    return 0.0, 0.0, 0.0\n"
-
-
 def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
                         samples=None, jit=True, progress=None) -> BodyRun:
     """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
@@ -164,13 +157,22 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
 
         fn = numba.njit(uf.plain_function(torque), error_model="numpy") if jit else uf.plain_function(torque)
         functions = {"torque_fn": fn}
-        header = _header(len(params))
-        key, cache_note = uf.cache_key([("torque", torque)], f"|{len(params)}")
+        glue = body_source(params)
+        key, cache_note = uf.cache_key([("torque", torque)], "")
     else:
-        functions, header, key, cache_note = {}, _FREE_HEADER, "free", None
+        functions, glue, key, cache_note = {}, "", "free", None
     cache_notes = [cache_note] if cache_note and jit else []
-    driver = Driver(lambda: build_module("body", key, functions, header, BODY_SOURCE, compiled=jit, notes=cache_notes),
-                    cache_notes)
+    t0 = time.perf_counter()
+    try:
+        driver = Driver(lambda: build_module("body", key, functions, glue, compiled=jit, notes=cache_notes),
+                        cache_notes, compiled=jit)
+    except Exception as exc:
+        import numba
+
+        if isinstance(exc, numba.core.errors.NumbaError):
+            _compile_failed(exc, torque, L, q, params)
+        raise
+    fns = driver.functions()
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
     OUT = np.full((n, 1, 7), np.nan)
@@ -181,14 +183,15 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     TC, H = np.zeros(1), np.zeros(1)
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
     GPREV = np.zeros((1, 1))
-    EDIR, ETERM = np.zeros(1), np.zeros(1, dtype=bool)
+    EDIR, ETERM = np.zeros(0), np.zeros(0, dtype=bool)
     code = _CODES[method]
-    t0 = time.perf_counter()
     compile_s = None
+    prob = (BODY, np.ascontiguousarray(Iinv.ravel()), flatten_params(params), 0, np.zeros(1), np.zeros((1, 1, 3)), 0,
+            np.zeros(1), np.zeros((1, 1, 3)))
+
     def call(budget):
-        driver.module.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                       st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, params, (Iinv,),
-                       (np.zeros(3),), np.empty(0))
+        driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+                       st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns)
 
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:
@@ -198,15 +201,6 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             try:
                 call(budget)
             except Exception as exc:
-                import numba
-
-                if compile_s is None and driver.rebuild(exc):  # numba's cache of the driver was damaged: rebuilt
-                    _restore(saved, y, TC, H, st)
-                    continue
-                if isinstance(exc, numba.core.errors.NumbaError):
-                    reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
-                    raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to "
-                                               "run it in plain Python (slow)") from None
                 _torque_raised(exc, call, saved, y, TC, H, st, torque, budget)
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
@@ -242,6 +236,12 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
     run.notes.extend(cache_notes)
     return run
+
+
+def _compile_failed(exc, torque, L, q, params):
+    reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
+    raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to run it in plain "
+                               "Python (slow)") from None
 
 
 def _restore(saved, y, TC, H, st):

@@ -1,14 +1,14 @@
-"""Drivers generated for a user's problem, compiled once and cached on disk.
+"""A problem's own functions, compiled once and cached on disk: the module of its glue.
 
-numba caches a compiled function under its module's file, and a function that takes another
-compiled function as an argument is compiled anew in every process (the argument's type is
-the function object itself). So each problem gets a small module of its own: a generated
-header binds the user's functions to global names (read from `ENTRIES` when the module
-is imported) and defines the frame's evaluators, followed by a fixed driver source
-(`rotframe.problem.particle_driver`, `rotframe.problem.body_driver`). Its file name
-is a fingerprint of everything it is made of (`rotframe.problem.callables.fingerprint`),
-so the same functions find the same file, compiled, in the next process, and an edited
-function makes a new one.
+The engine that steps every problem is compiled once (`rotframe.problem.engine`); what a problem
+compiles is its glue (`rotframe.problem.glue`): the few small functions, of fixed signatures,
+that call the user's. numba caches a compiled function under its module's file, so each problem's
+glue is a small module of its own: a header binds the user's functions to global names (read
+from `ENTRIES` when the module is imported), and the glue follows. Its file name is a
+fingerprint of everything it is made of (`rotframe.problem.callables.fingerprint`), so the
+same functions find the same file, compiled, in the next process, and an edited function makes
+a new one. The glue's functions have explicit signatures, so they compile (or load from
+numba's cache) as the module is imported.
 
 Where the files go: ``$ROTFRAME_CACHE_DIR``, else ``$XDG_CACHE_HOME/rotframe/problems``, else
 ``~/.cache/rotframe/problems``; a folder that cannot be written falls back to a temporary one,
@@ -17,8 +17,8 @@ The files are written through `rotframe.files` (atomic). A damaged entry (a sour
 UTF-8, a folder in its place, numba's cache files truncated or garbage) is dropped and rebuilt,
 with a note (`is_cache_damage`, `drop_cached`); a cache never fails a run.
 
-With ``jit=False`` the same source runs as plain Python (no numba at all): slow, for a
-function numba cannot compile.
+With ``jit=False`` the same source runs as plain Python (no numba at all), with the engine's
+(`rotframe.problem.plain`): slow, for a function numba cannot compile.
 """
 
 from __future__ import annotations
@@ -116,17 +116,47 @@ def is_cache_damage(exc: BaseException) -> bool:
 
 
 class Driver:
-    """A problem's generated module, rebuilt once if numba's cache of it turns out damaged.
+    """A problem's glue module and the engine that runs it, the glue rebuilt once if numba's cache of it is damaged.
 
-    ``build()`` makes the module (`build_module`); `call` runs one of its functions, and on an
-    exception that `is_cache_damage` recognises drops the files, rebuilds, notes it and calls again.
+    ``build()`` makes the module (`build_module`). ``advance``, ``start_events`` and
+    ``energies`` are the engine's entry points (`rotframe.problem.engine`; their plain Python
+    remakes with ``compiled=False``, `rotframe.problem.plain`), which take `functions` as
+    their last argument.
     """
 
-    def __init__(self, build, notes):
+    def __init__(self, build, notes, compiled=True):
+        from rotframe.problem import engine
+
         self._build = build
         self.notes = notes
+        self.compiled = compiled
         self.module = build()
         self.rebuilt = False
+        if compiled:
+            self.advance, self.start_events, self.energies = engine.ready()
+        else:
+            from rotframe.problem.plain import plain
+
+            self.advance, self.start_events, self.energies = (plain(f) for f in (engine.advance, engine.start_events,
+                                                                                  engine.energies))
+
+    def _own(self, name, stub):
+        found = getattr(self.module, name, None)
+        if found is not None:
+            return found
+        return stub if self.compiled else stub.py_func
+
+    def functions(self):
+        """What the engine calls (`rotframe.problem.signatures.FUNCTIONS`): terms, event, omega, origin."""
+        from rotframe.problem import stubs
+
+        return (self._own("terms", stubs.no_terms), self._own("event", stubs.no_event),
+                self._own("omega", stubs.no_vector), self._own("origin", stubs.no_vector))
+
+    def potential(self):
+        from rotframe.problem import stubs
+
+        return self._own("potential", stubs.no_potential)
 
     def rebuild(self, exc) -> bool:
         """After ``exc``: drop and rebuild once if it is cache damage (True), else False."""
@@ -139,25 +169,13 @@ class Driver:
         self.rebuilt = True
         return True
 
-    def call(self, name, *args):
-        try:
-            return getattr(self.module, name)(*args)
-        except Exception as exc:
-            if not self.rebuild(exc):
-                raise
-            return getattr(self.module, name)(*args)
-
 
 def drop_cached(module) -> None:
     """Remove a driver's files (its source and numba's cache of it) and forget it in this process."""
     sys.modules.pop(module.__name__, None)
     path = getattr(module, "__file__", None)
-    if not path:
-        return
-    path = Path(path)
-    for cached in (path.parent / "__pycache__").glob(f"{module.__name__}.*"):
-        _remove(cached)
-    _remove(path)
+    if path:
+        _drop_files(module.__name__, Path(path))
 
 
 _HEADER_COMPILED = """\
@@ -165,37 +183,29 @@ import math
 import numpy as np
 from numba import njit
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
-from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as error_norm
 from rotframe.problem.readonly import readonly
-from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
-from rotframe.numerics.rotation import rodrigues_rotate
-from rotframe.particles.forces import drag_flow
+from rotframe.problem.signatures import TERMS_SIG, EVENT_SIG, POTENTIAL_SIG, VECTOR_SIG
 
-jit = njit(cache={cache}, error_model="numpy", nogil=True)
+
+def jit(signature):
+    return njit(signature, cache={cache}, error_model="numpy", nogil=True)
 """
 
 _HEADER_PLAIN = """\
 import math
 import numpy as np
 from rotframe.problem.codegen import ENTRIES as _ENTRIES
-from rotframe.numerics.dop853 import coefficients as _coefficients, dop853_error_norm as _norm
 from rotframe.problem.callables import readonly_view as readonly
-from rotframe.numerics.composition import YOSHIDA4_OUTER, YOSHIDA4_INNER
-from rotframe.numerics.rotation import rodrigues_rotate as _rodrigues
-from rotframe.particles.forces import drag_flow as _drag_flow
+from rotframe.problem.signatures import TERMS_SIG, EVENT_SIG, POTENTIAL_SIG, VECTOR_SIG
 
-error_norm = _norm.py_func
-rodrigues_rotate = _rodrigues.py_func
-drag_flow = _drag_flow.py_func
 
-def jit(f):
-    return f
+def jit(signature):
+    return lambda f: f
 
 """
 
 
-def build_module(kind: str, key_material, functions: dict, header: str, body: str, *, compiled: bool,
-                 notes=None):
+def build_module(kind: str, key_material, functions: dict, glue: str, *, compiled: bool, notes=None):
     """The generated module for one problem: imported from the cache (compiled) or built in memory.
 
     Parameters
@@ -209,8 +219,8 @@ def build_module(kind: str, key_material, functions: dict, header: str, body: st
         alone, in memory, never cached or reused.
     functions : dict
         Global name -> the user's function (a numba dispatcher when ``compiled``, else plain Python).
-    header, body : str
-        The problem's own definitions and the fixed driver source.
+    glue : str
+        The problem's own functions (`rotframe.problem.glue`), compiled as the module is imported.
     notes : list, optional
         Receives a line for what the cache could not do (a damaged entry rebuilt, no cache
         writable): never a failure, the driver is then compiled in memory.
@@ -219,40 +229,58 @@ def build_module(kind: str, key_material, functions: dict, header: str, body: st
     folder = cache_dir(notes) if compiled and key_material is not None else None
     cached = folder is not None
     head = _HEADER_COMPILED.format(cache=cached) if compiled else _HEADER_PLAIN
-    source = head + "\nA, B, C, E3, E5 = _coefficients()\n"
     if not cached:
         key_material = f"uncached {os.getpid()} {next(_UNCACHED)}"
-    digest = hashlib.sha256((key_material + header + body + source).encode()).hexdigest()[:24]
+    digest = hashlib.sha256((key_material + glue + head).encode()).hexdigest()[:24]
     name = f"rotframe_{kind}_problem_{digest}"
     ENTRIES[digest] = functions
     binding = "".join(f"{g} = _ENTRIES[{digest!r}][{g!r}]\n" for g in functions)
-    text = '"""Generated by rotframe.problem.codegen for one problem; safe to delete."""\n' + source + binding \
-        + header + body
+    text = '"""Generated by rotframe.problem.codegen for one problem; safe to delete."""\n' + head + binding + glue
     if name in sys.modules:
         return sys.modules[name]
     if cached:
+        from rotframe.files import OutputError, write_text_atomic
+
         path = folder / f"{name}.py"
         if _cached_text(path, notes) != text:
-            from rotframe.files import OutputError, write_text_atomic
-
             try:
                 write_text_atomic(path, text, what="compiled-driver cache entry")
             except OutputError as exc:
                 notes.append(f"the compiled-driver cache could not be written ({exc}): the driver was compiled in "
                              "memory, not cached")
-                return build_module(kind, None, functions, header, body, compiled=compiled, notes=notes)
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
+                return build_module(kind, None, functions, glue, compiled=compiled, notes=notes)
         try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            sys.modules.pop(name, None)
-            raise
-        return module
+            return _import(name, path)
+        except Exception as exc:
+            if not is_cache_damage(exc):
+                raise
+            _drop_files(name, path)  # numba's cache of it is damaged: dropped, written and compiled anew
+            notes.append(f"the compiled-driver cache of this problem was damaged ({type(exc).__name__}): dropped and "
+                         "rebuilt")
+            write_text_atomic(path, text, what="compiled-driver cache entry")
+            return _import(name, path)
     module = types.ModuleType(name)
     exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # nothing on disk
     return module
+
+
+def _import(name, path):
+    """Import the module at ``path`` as ``name`` (its functions compile, or load from numba's cache, as it runs)."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        sys.modules.pop(name, None)
+        raise
+    return module
+
+
+def _drop_files(name, path):
+    for cached in (path.parent / "__pycache__").glob(f"{name}.*"):
+        _remove(cached)
+    _remove(path)
 
 
 #: numbers the uncached drivers of this process (each its own module)

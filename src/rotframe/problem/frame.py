@@ -90,6 +90,30 @@ class FrameSpec:
         return FrameSpec("body", tuple(np.ascontiguousarray(a) for a in (tc, wc, wdc, wddc)), t_range=self.t_range,
                          order=self.order)
 
+    def packed(self, derivative=True):
+        """``(kind code, T, C)``: the spec as the engine reads it (`rotframe.problem.models.vector_of_time`).
+
+        ``derivative=False`` (an origin's acceleration, whose derivative nothing reads): a function
+        is not differenced.
+        """
+        from rotframe.problem import models
+
+        none = np.zeros(1)
+        if self.kind in ("zero", "constant"):
+            C = np.zeros((1, 1, 3))
+            if self.kind == "constant":
+                C[0, 0] = self.data[0]
+            return (models.CONSTANT if self.kind == "constant" else models.ZERO), none, C
+        if self.kind == "table":
+            return models.TABLE, self.data[0], self.data[1]
+        if self.kind == "body":
+            times, w, wd, wdd = self.data
+            return models.BODY_FRAME, times, np.ascontiguousarray(np.stack([w, wd, wdd], axis=1))
+        # a function: omega' given, or derived with the step of derivative_step
+        given = len(self.funcs) > 1 or not derivative
+        step = np.array([float(self.data[0][0])]) if self.data else none
+        return (models.FUNCTION_DOT if given else models.FUNCTION), step, np.zeros((1, 1, 3))
+
     def knots(self) -> np.ndarray:
         """Times where the vector's higher derivatives jump: a table's knots, a body's samples (else none)."""
         if self.kind in ("table", "body"):

@@ -17,8 +17,8 @@ from rotframe.problem.frame import stop_times
 __all__ = ["frame_interpolation"]
 
 
-def frame_interpolation(module, frame, origin, y0, times, after, OUT, duration, rtol, diagnostics, warnings,
-                        notes):
+def frame_interpolation(advance, frame, origin, y0, times, after, OUT, duration, rtol, diagnostics, warnings,
+                        notes, problem_in):
     """Estimate the error a body frame's interpolation between its samples makes, and warn where it exceeds rtol.
 
     The first particle is integrated again in the frame made of every other sample
@@ -26,7 +26,9 @@ def frame_interpolation(module, frame, origin, y0, times, after, OUT, duration, 
     step stops at the knots keep the integrator's own error far below the interpolant's, so the
     difference is the interpolation's, of order ``frame.order`` in the sample interval h:
     ``error(h) ~ |r(h) - r(2h)| / (2^p - 1)`` (Richardson). Reported relative to the largest |r|
-    as ``frame_interpolation_rel_error``.
+    as ``frame_interpolation_rel_error``. ``advance`` is the engine's (`rotframe.problem.engine`),
+    ``after`` the run's arguments after the budget, ``problem_in(spec)`` the run's problem tuple in
+    the frame ``spec``.
     """
     coarse = frame.coarsened()
     if coarse is None:
@@ -39,12 +41,12 @@ def frame_interpolation(module, frame, origin, y0, times, after, OUT, duration, 
     TC, H = np.zeros(1), np.zeros(1)
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, D)), np.zeros((1, 1), np.int64)
     GPREV = np.zeros((1, 1))
-    code, _, atol, hfix, _, _, params, _, G, _ = after
-    no_events = (np.zeros(1), np.zeros(1, dtype=bool))
-    coarse_after = (code, rtol, atol[:1], hfix, *no_events, params, coarse.data, G,
-                    stop_times((coarse, origin), duration))
+    code, _, atol, hfix, _, _, _, _, fns = after
+    no_events = (np.zeros(0), np.zeros(0, dtype=bool))
+    coarse_after = (code, rtol, np.ascontiguousarray(atol[:1]), hfix, *no_events, stop_times((coarse, origin), duration),
+                    problem_in(coarse), fns)
     while st["ST"][0] == 0:
-        module.advance(0, 1, times, Y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT2, EVT, EVY, EVK, st["EVN"], GPREV,
+        advance(0, 1, times, Y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT2, EVT, EVY, EVK, st["EVN"], GPREV,
                        st["NSTEP"], st["NFEV"], 20000, *coarse_after)
     fine, rough = OUT[:, 0, :3], OUT2[:, 0, :3]
     both = np.all(np.isfinite(fine), axis=1) & np.all(np.isfinite(rough), axis=1)

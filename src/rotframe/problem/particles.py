@@ -29,21 +29,20 @@ from rotframe import method_registry as registry
 from rotframe.problem.arguments import (array_of, check_event, check_flag, check_params, run_grid,
                                         sequence_of_callables)
 from rotframe.problem.codegen import Driver, build_module
-from rotframe.problem.evaluators import SEARCH_SOURCE, vector_source
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
+from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.terms import (Force, StringConstraint, as_term, check_splitting, constraint_source, drag_source,
-                                    one_constraint)
-from rotframe.problem.particle_driver import PLAIN_OWN_STEP, SPLITTING_OWN_STEP
-from rotframe.problem.particle_driver import SOURCE as PARTICLE_SOURCE
+from rotframe.problem.models import DOP853, RK4, SPLITTING, SPLITTING4
+from rotframe.problem.signatures import PARTICLE
+from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, model_constants, one_constraint
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
 
-#: The integer the generated driver branches on (`rotframe.problem.stepping.take_step`), for each method it
-#: steps; the names are `rotframe.method_registry`'s.
-_CODES = {"dop853": 0, "rk4": 1, "rotation-splitting": 2, "rotation-splitting4": 3}
+#: The code the engine branches on (`rotframe.problem.engine.take_step`), for each method it steps; the names
+#: are `rotframe.method_registry`'s.
+_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4}
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
 
 
@@ -72,49 +71,9 @@ def _states(r0, v0):
     return r, v
 
 
-def _call_args(nparams):
-    return "".join(f", P[{j}]" for j in range(nparams))
-
-
-def _header(frame, origin, forces, events, nparams, D, constraint=None, splitting=False):
-    """The problem's own definitions: frame evaluators, the forces' sum, the string, the events, the potential,
-    and the driver's own step (the rotation splittings where the run takes one, else a stub)."""
-    args = _call_args(nparams)
-    src = [f"\nD = {D}\nNE = {len(events)}\n", SEARCH_SOURCE,
-           vector_source("frame_rates", frame.kind, True, "omega_fn", "omega_dot_fn" if len(frame.funcs) > 1 else ""),
-           vector_source("origin_acceleration", origin.kind, False, "origin_fn")]
-    body = ["", "@jit", "def user_acceleration(t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])",
-            "    ax = 0.0", "    ay = 0.0", "    az = 0.0"]
-    for k, f in enumerate(forces):
-        if splitting and f.flow:  # a term with an exact flow is not a kick: drag_flow below
-            continue
-        body.append(f"    a = force_{k}(t, r, v{args})")
-        if f.axes == "inertial":  # R^T a with R = R(q): a - 2 s (u x a) + 2 u x (u x a)
-            body += ["    qx = y[6]", "    qy = y[7]", "    qz = y[8]", "    qs = y[9]",
-                     "    bx = a[0]", "    by = a[1]", "    bz = a[2]",
-                     "    cx = qy * bz - qz * by", "    cy = qz * bx - qx * bz", "    cz = qx * by - qy * bx",
-                     "    ax += bx - 2.0 * qs * cx + 2.0 * (qy * cz - qz * cy)",
-                     "    ay += by - 2.0 * qs * cy + 2.0 * (qz * cx - qx * cz)",
-                     "    az += bz - 2.0 * qs * cz + 2.0 * (qx * cy - qy * cx)"]
-        else:
-            body += ["    ax += a[0]", "    ay += a[1]", "    az += a[2]"]
-    body.append("    return ax, ay, az")
-    src.append("\n".join(body) + "\n")
-    src.append(constraint_source(constraint))
-    src.append(drag_source(next((f for f in forces if f.flow), None) if splitting else None))
-    src.append(SPLITTING_OWN_STEP if splitting else PLAIN_OWN_STEP)
-    ev = ["", "@jit", "def event_value(k, t, y, P):", "    r = readonly(y[0:3])", "    v = readonly(y[3:6])"]
-    for k in range(len(events)):
-        ev.append(f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))")
-    ev.append("    return 0.0")
-    src.append("\n".join(ev) + "\n")
-    pot = ["", "@jit", "def potential(t, y, P):", "    r = readonly(y[0:3])", "    u = 0.0"]
-    for k, f in enumerate(forces):
-        if f.potential is not None:
-            pot.append(f"    u += float(potential_{k}(t, r{args}))")
-    pot.append("    return u")
-    src.append("\n".join(pot) + "\n")
-    return "".join(src)
+def problem_tuple(M, p, frame, origin):
+    """The engine's `rotframe.problem.signatures.PROBLEM` tuple of a particle problem."""
+    return (PARTICLE, M, p, *frame.packed(), *origin.packed(derivative=False))
 
 
 def _bind(frame, origin, forces, events, compiled):
@@ -254,13 +213,26 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     roles = _roles(frame, origin, forces, events, labels)
     for role, f in roles:
         uf.check_compilable(role, f, jit)
-    key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}|{len(params)}")
-    header = _header(frame, origin, forces, events, len(params), D, constraint,
-                     splitting=method.startswith("rotation-splitting"))
+    splitting = method.startswith("rotation-splitting")
+    glue = particle_source(forces, events, params, splitting=splitting, origin=origin.kind == "function",
+                           omega=("function_dot" if len(frame.funcs) > 1 else "function") if frame.kind == "function"
+                           else "")
+    key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
     cache_notes = [cache_note] if cache_note and jit else []
+    t0 = time.perf_counter()
+    try:
+        driver = Driver(lambda: build_module("particle", key, _bind(frame, origin, forces, events, jit), glue,
+                                             compiled=jit, notes=cache_notes), cache_notes, compiled=jit)
+    except Exception as exc:
+        import numba
 
-    driver = Driver(lambda: build_module("particle", key, _bind(frame, origin, forces, events, jit), header,
-                                         PARTICLE_SOURCE, compiled=jit, notes=cache_notes), cache_notes)
+        if isinstance(exc, numba.core.errors.NumbaError):
+            _compile_failure(exc, roles, params, r[0], v[0], frame)
+        raise
+    compile_s = time.perf_counter() - t0
+    fns = driver.functions()
+    prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None),
+                         flatten_params(params), frame, origin)
     slots = max_events if events else 1  # event records: none are kept without events
     n = samples + 1
     check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
@@ -279,8 +251,6 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
     y0_first = y[:1].copy()
-    F = frame.data  # for a function: ([h, 0, 0],), the step of its derived omega'
-    G = origin.data if origin.kind != "function" else (np.zeros(3),)
     atol_arr = _scales(r, v, duration, rtol, atol, D)
     OUT = np.full((n, N, D), np.nan)
     state = dict(TC=np.zeros(N), H=np.zeros(N), IDX=np.zeros(N, np.int64), SUB=np.zeros(N, np.int64),
@@ -288,44 +258,28 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                  EVK=np.zeros((N, slots), np.int64), EVN=np.zeros(N, np.int64),
                  GPREV=np.zeros((N, max(len(events), 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
     settings = [check_event(g, k) for k, g in enumerate(events)]
-    EDIR = np.array([d for d, _ in settings] or [0.0])
-    ETERM = np.array([t for _, t in settings] or [False])
+    EDIR = np.array([float(d) for d, _ in settings], dtype=float)
+    ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     code = _CODES[method]
-    t0 = time.perf_counter()
-    compile_s = 0.0
     first = True
     try:
         if events:
-            try:
-                driver.call("start_events", 0.0, y, state["GPREV"], params)
-            except Exception as exc:
-                import numba
-
-                if isinstance(exc, numba.core.errors.NumbaError):
-                    _compile_failure(exc, roles, params, r[0], v[0], frame)
-                raise
+            driver.start_events(0.0, y, state["GPREV"], prob, fns)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
-        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, params, F, G, stops)
+        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, fns)
         while True:
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
             budget = pacer.start()
             try:
-                advance_blocks(driver.module.advance, N, before + (budget,) + after)
+                advance_blocks(driver.advance, N, before + (budget,) + after)
             except Exception as exc:
-                import numba
-
-                if first and driver.rebuild(exc):  # numba's cache of the driver was damaged: rebuilt, run again
-                    _restore(y, state, saved)
-                    continue
-                if isinstance(exc, numba.core.errors.NumbaError):
-                    _compile_failure(exc, roles, params, r[0], v[0], frame)
-                _raised_later(exc, driver.module, y, saved, {"before": before, "after": after, "budget": budget}, forces,
+                _raised_later(exc, driver.advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
                               params, method, hfix, times, OUT, state, events, labels)
             if first:
-                compile_s = time.perf_counter() - t0
+                compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
                 first = False
             pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
             ST = state["ST"]
@@ -355,10 +309,10 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
-    _energy_diagnostics(driver, traj, OUT, params, frame, origin, forces, diagnostics, notes)
+    _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes)
     try:
-        frame_interpolation(driver.module, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
-                            warnings, notes)
+        frame_interpolation(driver.advance, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
+                            warnings, notes, lambda spec: problem_tuple(prob[1], prob[2], spec, origin))
     except KeyboardInterrupt:
         raise RunInterrupted(traj) from None
     if D == 10:
@@ -410,7 +364,7 @@ def _restore(y, state, saved):
         state[key][...] = saved[key]
 
 
-def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
+def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
     """A user function raised inside a compiled call: find the step, name the function, give time and state.
 
     The call is replayed from the state saved before it, one step per call, particle by particle
@@ -425,7 +379,7 @@ def _raised_later(exc, module, y, saved, args, forces, params, method, hfix, tim
         for _ in range(int(args["budget"]) + 1):
             t, yi = float(state["TC"][i]), y[i].copy()
             try:
-                module.advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
+                advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
                 blame = _blame(forces, params, t, yi, dt, labels)
@@ -499,7 +453,7 @@ def _event_names(events):
     return names
 
 
-def _energy_diagnostics(driver, traj, OUT, params, frame, origin, forces, diagnostics, notes):
+def _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes):
     """Energy (inertial frame) or Jacobi integral (steadily rotating frame) and its relative drift."""
     if not forces or any(f.potential is None for f in forces):
         return
@@ -509,8 +463,8 @@ def _energy_diagnostics(driver, traj, OUT, params, frame, origin, forces, diagno
         return
     w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
     rotating = bool(np.any(w != 0.0))
-    F = frame.data
-    E = driver.call("energies", traj.times, np.ascontiguousarray(OUT[: traj.times.size]), params, F, rotating)
+    E = driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, fns, driver.potential(),
+                        rotating)
     traj.extras["energy"] = E
     name = "jacobi" if rotating else "energy"
     E0 = E[0]

@@ -3,8 +3,8 @@
 A `Force` is a function of ``(t, r, v, *params)`` giving an acceleration, with what rotframe
 should know about it (its potential, its axes); the built-in terms of `rotframe.forces` are
 Forces too. A `StringConstraint` is not a force but the condition ``|r - pivot| = length``,
-kept by removing the normal part of the total acceleration (`constraint_source` writes it into
-the generated driver). `as_term` checks one entry of ``forces=``; `check_splitting` says what a
+kept by removing the normal part of the total acceleration (`rotframe.problem.models.constrain`,
+its constants from `model_constants`). `as_term` checks one entry of ``forces=``; `check_splitting` says what a
 splitting method cannot take as a kick.
 """
 
@@ -17,8 +17,7 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "constraint_source",
-           "drag_source"]
+__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "model_constants"]
 
 
 @dataclass(frozen=True)
@@ -39,7 +38,7 @@ class Force:
         the scenes' names for them).
     flow : tuple, optional
         The term's exact flow, where it has one that the splittings use instead of a kick:
-        ``("drag", k1, k2, H)`` for `rotframe.forces.drag` (`drag_source`). Set by the built-in
+        ``("drag", k1, k2, H)`` for `rotframe.forces.drag` (`model_constants`). Set by the built-in
         terms; a force of your own leaves it empty.
     """
 
@@ -133,42 +132,20 @@ def one_constraint(terms, r, v):
     return c
 
 
-def drag_source(force):
-    """``drag_rates(y)``: a drag term's coefficients at the particle's height, for the splittings' exact flow.
+def model_constants(constraint, drag):
+    """The particle model's constants ``M`` for the engine (`rotframe.problem.models`): the string, a drag's flow.
 
-    ``force.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v`` with ``rho = exp(-z / H)``
-    (1 for ``H = 0``). The flow itself at fixed position is the scenes' own
-    `rotframe.particles.forces.drag_flow`, which every generated driver imports. Without a drag
-    term the rates are zero and the flow the identity.
+    ``M = (string, px, py, pz, length, drag, k1, k2, H)``: the `StringConstraint` (1 and its pivot
+    and length, or zeros) and, under a splitting, the drag term whose exact flow it applies
+    (``drag.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v``, ``rho = exp(-z / H)``,
+    1 for ``H = 0``; the flow itself is the scenes' `rotframe.particles.forces.drag_flow`), or zeros.
     """
-    if force is None:
-        return "\n@jit\ndef drag_rates(y):\n    return 0.0, 0.0\n"
-    _, k1, k2, H = force.flow
-    air = f"math.exp(-y[2] / {float(H)!r})" if H > 0 else "1.0"
-    return f"""
-@jit
-def drag_rates(y):
-    # the drag term's coefficients at the particle's height (rotframe.problem.terms.drag_source)
-    air = {air}
-    return {float(k1)!r} * air, {float(k2)!r} * air
-"""
-
-
-def constraint_source(constraint):
-    """``constrain(y, ax, ay, az)``: the total acceleration kept on the string's sphere (`StringConstraint`), or as it is."""
-    if constraint is None:
-        return "\n@jit\ndef constrain(y, ax, ay, az):\n    return ax, ay, az\n"
-    px, py, pz = (repr(float(c)) for c in constraint.pivot)
-    L = repr(float(constraint.length))
-    return f"""
-@jit
-def constrain(y, ax, ay, az):
-    # the string (rotframe.problem.terms.StringConstraint): a <- a - (a . n + |v_t|^2 / L) n
-    nx = (y[0] - {px}) / {L}
-    ny = (y[1] - {py}) / {L}
-    nz = (y[2] - {pz}) / {L}
-    an = ax * nx + ay * ny + az * nz
-    vn = y[3] * nx + y[4] * ny + y[5] * nz
-    c = an + (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] - vn * vn) / {L}
-    return ax - c * nx, ay - c * ny, az - c * nz
-"""
+    M = np.zeros(9)
+    if constraint is not None:
+        M[0] = 1.0
+        M[1:4] = np.asarray(constraint.pivot, dtype=float)
+        M[4] = float(constraint.length)
+    if drag is not None:
+        _, k1, k2, H = drag.flow
+        M[5:9] = 1.0, float(k1), float(k2), float(H)
+    return M

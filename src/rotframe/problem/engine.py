@@ -1,16 +1,17 @@
-"""Source of the stepping shared by the generated drivers: DOP853 and RK4 steps, events, the loop.
+"""The engine of a problem of your own: DOP853, RK4, the models' splittings and events, compiled once.
 
-Appended to a driver's ``rhs`` (`rotframe.problem.particle_driver`,
-`rotframe.problem.body_driver`) by `rotframe.problem.codegen`. It needs from the
-header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
-``event_value(k, t, y, P)``, the DOP853 tableau ``A, B, C, E3, E5`` and ``error_norm``.
+Every particle problem of ``rotframe.simulate`` and every body of ``rotframe.simulate_body``
+runs these functions, compiled once with numba and cached on disk (``cache=True``): a problem
+hands them its own functions as first-class functions and its data as the
+`rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
+functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
 
 * DOP853: Hairer's step control (dop853.f: safety 0.9, growth at most 1/0.333, shrink at
   most 6, no growth right after a rejection) and starting step (hinit); a step never passes
-  the next sample time, so every sample is a step's end.
-* RK4 (method 1), and a driver's own fixed-step methods (``own_step``, methods 2 and 3: the
-  rigid body's Lie-Poisson splittings, the particle's rotation splittings, each of order 2 and
-  its Yoshida triple jump): a fixed step that divides each sample interval.
+  the next sample time, so every sample is a step's end. Tableau and error norm:
+  `rotframe.numerics.dop853`.
+* RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
+  ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
   length, each trial a re-step from the step's start by the same method, to round-off in
   time on the method's own discrete trajectory (as the built-in ground event,
@@ -24,86 +25,95 @@ header ``D`` (state size), ``NE`` (events), ``rhs(t, y, dy, P, F, G)``,
 * ``atol`` is (N, D), one row per particle (its own scales).
 * Each particle is integrated alone, ``budget`` steps per call, so results do not depend on
   the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
-  particles ``lo:hi``; Python runs blocks of them on threads (the driver holds no GIL). numba's
+  particles ``lo:hi``; Python runs blocks of them on threads (the engine holds no GIL). numba's
   ``prange`` was measured at 15 ms a call on the 2-core reference machine (its OpenMP pool
   waking), more than a whole single-particle run.
+
+Status codes per particle: 0 running, 1 finished, 2 stopped by a terminal event,
+3 non-finite state, 4 step size collapsed.
 """
 
-SOURCE = r'''
+from __future__ import annotations
 
+import math
+
+import numpy as np
+from numba import njit, types
+
+from rotframe.numerics.compiled import jit_internal
+from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs
+from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM, quiet
+
+__all__ = ["advance", "start_events", "energies", "ready"]
+
+A, B, C, E3, E5 = coefficients()
 FACC1 = 1.0 / 0.333   # Hairer's dop853: the step may grow at most by 1/0.333 and shrink by 6
 FACC2 = 1.0 / 6.0
 SAFE = 0.9
 
 
-@jit
-def attitude_rate(y, dy, k, wx, wy, wz):
-    """q' = q (w, 0) / 2 for the scalar-last quaternion y[k:k + 4] (w in the rotating axes), into dy."""
-    qx = y[k]
-    qy = y[k + 1]
-    qz = y[k + 2]
-    qw = y[k + 3]
-    dy[k] = 0.5 * (qw * wx + qy * wz - qz * wy)
-    dy[k + 1] = 0.5 * (qw * wy + qz * wx - qx * wz)
-    dy[k + 2] = 0.5 * (qw * wz + qx * wy - qy * wx)
-    dy[k + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+_entry = njit(cache=True, error_model="numpy", nogil=True)
 
 
-@jit
-def dop853_step(t, y, h, t_end, K, yt, yn, P, F, G):
+@jit_internal
+def dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
+    D = y.shape[0]
     for s in range(1, 12):
         for j in range(D):
             acc = 0.0
             for m in range(s):
                 acc += A[s, m] * K[m, j]
             yt[j] = y[j] + h * acc
-        rhs(t + C[s] * h, yt, K[s], P, F, G)
+        rhs(t + C[s] * h, yt, K[s], prob, fns, W)
     for j in range(D):
         acc = 0.0
         for s in range(12):
             acc += B[s] * K[s, j]
         yn[j] = y[j] + h * acc
-    rhs(t_end, yn, K[12], P, F, G)  # at the time the step ends on (a sample time exactly where it lands)
+    rhs(t_end, yn, K[12], prob, fns, W)  # at the time the step ends on (a sample time exactly where it lands)
 
 
-@jit
-def rk4_step(t, y, h, K, yt, yn, P, F, G):
+@jit_internal
+def rk4_step(t, y, h, K, yt, yn, prob, fns, W):
     """One classical Runge-Kutta step from (t, y) with K[0] = f(t, y)."""
+    D = y.shape[0]
     for j in range(D):
         yt[j] = y[j] + 0.5 * h * K[0, j]
-    rhs(t + 0.5 * h, yt, K[1], P, F, G)
+    rhs(t + 0.5 * h, yt, K[1], prob, fns, W)
     for j in range(D):
         yt[j] = y[j] + 0.5 * h * K[1, j]
-    rhs(t + 0.5 * h, yt, K[2], P, F, G)
+    rhs(t + 0.5 * h, yt, K[2], prob, fns, W)
     for j in range(D):
         yt[j] = y[j] + h * K[2, j]
-    rhs(t + h, yt, K[3], P, F, G)
+    rhs(t + h, yt, K[3], prob, fns, W)
     for j in range(D):
         yn[j] = y[j] + h * (K[0, j] + 2.0 * K[1, j] + 2.0 * K[2, j] + K[3, j]) / 6.0
 
 
-@jit
-def take_step(method, t, y, h, t_end, K, yt, yn, P, F, G):
-    if method == 0:
-        dop853_step(t, y, h, t_end, K, yt, yn, P, F, G)
-    elif method == 1:
-        rk4_step(t, y, h, K, yt, yn, P, F, G)
-    else:  # a driver's own fixed-step method, 2 or 3 (the body's or the particle's splittings, orders 2 and 4)
-        own_step(method, t, y, h, yn, P, F, G)
+@jit_internal
+def take_step(method, t, y, h, t_end, K, yt, yn, prob, fns, W):
+    if method == DOP853:
+        dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W)
+    elif method == RK4:
+        rk4_step(t, y, h, K, yt, yn, prob, fns, W)
+    else:  # the model's own splitting, of order 2 or 4
+        own_step(method, t, y, h, yn, prob, fns, W)
 
 
-@jit
+@jit_internal
 def all_finite(y):
-    for j in range(D):
+    for j in range(y.shape[0]):
         if not math.isfinite(y[j]):
             return False
     return True
 
 
-@jit
-def first_step(t, y, K, yt, rtol, atol, P, F, G, span):
+@jit_internal
+def first_step(t, y, K, yt, rtol, atol, prob, fns, W, span):
     """Hairer's starting step (hinit of dop853.f, order 8), K[0] = f(t, y) given."""
+    D = y.shape[0]
     d0 = 0.0
     d1 = 0.0
     for j in range(D):
@@ -116,7 +126,7 @@ def first_step(t, y, K, yt, rtol, atol, P, F, G, span):
     h0 = min(h0, span)
     for j in range(D):
         yt[j] = y[j] + h0 * K[0, j]
-    rhs(t + h0, yt, K[1], P, F, G)
+    rhs(t + h0, yt, K[1], prob, fns, W)
     d2 = 0.0
     for j in range(D):
         sc = atol[j] + rtol * abs(y[j])
@@ -127,7 +137,7 @@ def first_step(t, y, K, yt, rtol, atol, P, F, G, span):
     return min(100.0 * h0, h1, span)
 
 
-@jit
+@jit_internal
 def next_stop(S, t):
     """The first stop time in the sorted S after t (inf if none): a knot where the right-hand side is not smooth."""
     n = S.shape[0]
@@ -144,38 +154,39 @@ def next_stop(S, t):
     return S[lo]
 
 
-@jit
-def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, P, F, G):
+@jit_internal
+def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
-    Returns tau in (0, h]; ``yhi`` holds the state there. The crossing is bracketed to round-off
-    in time on the method's own discrete trajectory.
+    Returns tau in (0, h]; ``yhi`` holds the state there (the full step's end on entry). The
+    crossing is bracketed to round-off in time on the method's own discrete trajectory.
     """
     lo = 0.0
     hi = h
-    rhs(t, y, Kb[0], P, F, G)
-    # yhi holds the full step's end on entry
+    rhs(t, y, Kb[0], prob, fns, W)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if not (lo < mid < hi):
             break
-        take_step(method, t, y, mid, t + mid, Kb, ytb, ybuf, P, F, G)
-        gm = event_value(k, t + mid, ybuf, P)
+        take_step(method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
+        gm = fns[1](k, t + mid, ybuf, prob[2])
         if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
             lo = mid
             g_lo = gm
         else:
             hi = mid
-            for j in range(D):
+            for j in range(y.shape[0]):
                 yhi[j] = ybuf[j]
     return hi
 
 
-@jit
+@jit_internal
 def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                rtol, atol, hfix, EDIR, ETERM, P, F, G, S, K, Kb, V):
-    # K, Kb (13, D) stages and V (7, D) state vectors: scratch of the calling block, made once for all its particles
+                rtol, atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, W):
+    # K, Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: of the calling block, made once
     n = T.shape[0]
+    D = Y.shape[1]
+    NE = EDIR.shape[0]
     y = V[0]
     yt = V[1]
     yn = V[2]
@@ -183,21 +194,22 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
     yhi = V[4]
     ybuf = V[5]
     yev = V[6]
+    p = prob[2]
     for j in range(D):
         y[j] = Y[i, j]
     t = TC[i]
     h = H[i]
     idx = IDX[i]
     sub = SUB[i]
-    rhs(t, y, K[0], P, F, G)
+    rhs(t, y, K[0], prob, fns, W)
     NFEV[i] += 1
-    if h <= 0.0 and method == 0:
-        h = first_step(t, y, K, yt, rtol, atol, P, F, G, T[n - 1] - T[0])
+    if h <= 0.0 and method == DOP853:
+        h = first_step(t, y, K, yt, rtol, atol, prob, fns, W, T[n - 1] - T[0])
         NFEV[i] += 1
     steps = 0
     # DOP853 keeps in SUB whether its last try was rejected (no growth right after a rejection), so that
     # the steps, and the numbers, do not depend on where the budget cut the calls
-    rejected = method == 0 and sub != 0
+    rejected = method == DOP853 and sub != 0
     status = 0
     while idx < n and steps < budget:
         if t >= T[idx]:
@@ -210,7 +222,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         stop = next_stop(S, t)
         at_knot = stop < T[idx]
         target = stop if at_knot else T[idx]
-        if method == 0:
+        if method == DOP853:
             span = target - t
             hh = h if h < span else span
             landing = hh == span
@@ -227,16 +239,16 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
                 hh = hfix if on_grid else grid_next - t
                 sub += 1
                 landing = last
-        take_step(method, t, y, hh, target if landing else t + hh, K, yt, yn, P, F, G)
+        take_step(method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
         steps += 1
         NSTEP[i] += 1
-        NFEV[i] += 12 if method == 0 else 3 if method == 1 else 2
+        NFEV[i] += 12 if method == DOP853 else 3 if method == RK4 else 2
         ok = all_finite(yn)
         err = 0.0
-        if method == 0:
-            err = error_norm(K, hh, y, yn, rtol, atol, E3, E5)
+        if method == DOP853:
+            err = dop853_error_norm(K, hh, y, yn, rtol, atol, E3, E5)
             ok = ok and math.isfinite(err)
-        if method == 0 and (not ok or err > 1.0):
+        if method == DOP853 and (not ok or err > 1.0):
             if ok:
                 fac11 = err ** 0.125
                 h = hh / min(FACC1, fac11 / SAFE)
@@ -251,20 +263,20 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             status = 3
             break
         t_new = target if landing else t + hh
-        if method != 0 and not landing:
+        if method != DOP853 and not landing:
             t_new = T[idx - 1] + sub * hfix
         # events over (t, t_new]: every crossing located; the earliest terminal one ends the particle
         stop_tau = -1.0
         stop_k = -1
         for k in range(NE):
-            g_new = event_value(k, t_new, yn, P)
+            g_new = fns[1](k, t_new, yn, p)
             g_old = GPREV[i, k]
             rising = g_old < 0.0 and g_new >= 0.0
             falling = g_old > 0.0 and g_new <= 0.0
             if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
                 for j in range(D):
                     yhi[j] = yn[j]
-                tau = locate(method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, P, F, G)
+                tau = locate(method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
                 m = EVN[i]
                 if m < EVT.shape[1]:
                     EVT[i, m] = t + tau
@@ -299,7 +311,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
                 idx += 1
             status = 2
             break
-        if method == 0:
+        if method == DOP853:
             fac11 = err ** 0.125
             fac = max(FACC2, min(FACC1, fac11 / SAFE))
             h_next = hh / fac
@@ -312,8 +324,8 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         t = t_new
         for j in range(D):
             y[j] = yn[j]
-        if method != 0:
-            rhs(t, y, K[0], P, F, G)
+        if method != DOP853:
+            rhs(t, y, K[0], prob, fns, W)
             NFEV[i] += 1
     if status == 0 and idx >= n:
         status = 1
@@ -322,27 +334,74 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
     TC[i] = t
     H[i] = h
     IDX[i] = idx
-    SUB[i] = sub if method != 0 else (1 if rejected else 0)
+    SUB[i] = sub if method != DOP853 else (1 if rejected else 0)
     ST[i] = status
 
 
-@jit
+@_entry
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
-            atol, hfix, EDIR, ETERM, P, F, G, S):
+            atol, hfix, EDIR, ETERM, S, prob, fns):
+    """Advance the particles ``lo:hi`` by at most ``budget`` steps each (module docstring); the state is in the arrays.
+
+    ``T`` the sample times; ``Y`` (N, D) the states to go on from, ``TC``, ``H``, ``IDX``, ``SUB``,
+    ``ST`` each particle's time, step, next sample, fixed-step count and status; ``OUT`` (n, N, D)
+    the samples; ``EVT``, ``EVY``, ``EVK``, ``EVN`` the event records; ``GPREV`` (N, NE) each
+    event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
+    """
+    D = Y.shape[1]
     K = np.empty((13, D))
     Kb = np.empty((13, D))
     V = np.empty((7, D))
+    W = np.zeros(SCRATCH)
     for i in range(lo, hi):
         if ST[i] == 0:
             advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol[i], hfix, EDIR, ETERM, P, F, G, S, K, Kb, V)
+                        rtol, atol[i], hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, W)
 
 
-@jit
-def start_events(t, Y, GPREV, P):
+@_entry
+def start_events(t, Y, GPREV, prob, fns):
+    """Each event's value at the start, per particle, into ``GPREV`` (N, NE)."""
     for i in range(Y.shape[0]):
-        for k in range(NE):
-            GPREV[i, k] = event_value(k, t, Y[i], P)
+        for k in range(GPREV.shape[1]):
+            GPREV[i, k] = fns[1](k, t, Y[i], prob[2])
 
 
-'''
+@_entry
+def energies(T, OUT, prob, fns, potential, rotating):
+    """Energy (rotating = False) or the Jacobi integral (rotating = True) per sample and particle, per unit mass."""
+    n = OUT.shape[0]
+    N = OUT.shape[1]
+    E = np.empty((n, N))
+    W = np.zeros(SCRATCH)
+    for a in range(n):
+        for i in range(N):
+            E[a, i] = particle_energy(T[a], OUT[a, i], prob, fns, potential, rotating, W)
+    return E
+
+
+#: the one signature of each entry point: compiled (or loaded from numba's cache) once, never for a problem
+SIGNATURES = {
+    advance: types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, I8, F8, A2, F8, A1,
+                        B1, A1, PROBLEM, FUNCTIONS),
+    start_events: types.void(F8, A2, A2, PROBLEM, FUNCTIONS),
+    energies: A2(A1, A3, PROBLEM, FUNCTIONS, POTENTIAL, types.boolean),
+}
+
+
+_READY = []
+
+
+def ready():
+    """The entry points compiled for their one signature each (loaded from numba's cache after the first time).
+
+    Each is then closed to new compiles: a problem's functions reach it as first-class functions
+    of the signatures' types, never as a new specialisation.
+    """
+    quiet()
+    if not _READY:
+        for kernel, signature in SIGNATURES.items():
+            kernel.compile(signature)
+            kernel.disable_compile()
+        _READY.append(True)
+    return advance, start_events, energies

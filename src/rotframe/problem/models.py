@@ -1,0 +1,401 @@
+"""The equations of motion the engine steps: a particle in any rotating frame, a rigid body under a torque.
+
+Compiled once (numba, cached on disk) for every problem: the user's functions arrive as
+first-class functions (`rotframe.problem.signatures`) and the problem's data in the
+`PROBLEM` tuple ``(model, M, p, FK, FT, FC, OK, OT, OC)``.
+
+**A particle** (``model = PARTICLE``), state ``(x, y, z, vx, vy, vz)`` in the frame's axes,
+followed, when a force is given in inertial axes, by the frame's attitude ``(qx, qy, qz, qw)``
+(scalar last, rotating frame components into inertial ones), ``q' = q (omega, 0) / 2``.
+Equation of motion (docs/physics/rotating-frames.md)::
+
+    r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)   [+ the string's tension]
+
+``M = (string, px, py, pz, length, drag, k1, k2, H)``: the pendulum's string (1 or 0, its
+pivot and length; `rotframe.problem.terms.StringConstraint`) and, for the splittings, a drag
+term's exact flow (1 or 0 and ``v' = -(k1 + k2 |v|) exp(-z / H) v``, ``H = 0``: uniform air).
+
+**A rigid body** (``model = BODY``), state ``(L1, L2, L3, qx, qy, qz, qw)``, the angular
+momentum in body axes and the attitude (body to space, scalar last)::
+
+    L' = L x omega + tau(t, L, q),   omega = I^-1 L,   q' = q (omega, 0) / 2
+
+``M`` = ``I^-1`` by rows (9 numbers).
+
+**Vectors of time** (`vector_of_time`): omega and omega' of the frame, a0 of its origin, by
+kind: ``ZERO``; ``CONSTANT`` (``C[0, 0]``); ``TABLE``, a C2 cubic spline (``T`` the knots,
+``C`` (n - 1, 4, 3) its coefficients); ``BODY``, the quintic Hermite interpolant through a
+body's omega, omega', omega'' (``T`` its sample times, ``C`` (n, 3, 3)); ``FUNCTION``, the
+user's ``omega(t)`` with omega' from the fourth-order central difference of step ``T[0]``
+(`rotframe.problem.frame.derivative_step`) or ``FUNCTION_DOT``, with the user's omega'.
+The numpy twins used for analysis are in `rotframe.problem.frame`.
+
+**Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING`` and ``SPLITTING4``):
+a particle's rotation splitting (docs/physics/splitting.md: drift, kick, the Coriolis rotation,
+a drag term's exact flow) and a body's Lie-Poisson splitting (McLachlan 1993; Dullweber,
+Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torque a kick at
+fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
+(`rotframe.numerics.composition`).
+
+Scratch ``W`` (24 numbers, one per calling block): ``W[0:6]`` omega and omega', ``W[6:12]`` a
+user vector function's output, ``W[12:18]`` the origin's acceleration, ``W[18:24]`` the terms.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rotframe.numerics.compiled import jit_internal
+from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
+from rotframe.numerics.rotation import rodrigues_rotate
+from rotframe.particles.forces import drag_flow
+
+__all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
+           "SPLITTING4", "SCRATCH", "vector_of_time", "rhs", "own_step", "particle_energy"]
+
+#: kinds of a vector of time
+ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
+#: method codes of the compiled loop (the names are `rotframe.method_registry`'s; no code leaves this package)
+DOP853, RK4, SPLITTING, SPLITTING4 = range(4)
+#: the length of the scratch ``W``
+SCRATCH = 24
+
+
+@jit_internal
+def interval(knots, t):
+    """The index i of the interval [knots[i], knots[i + 1]] holding t (clipped to the ends)."""
+    n = knots.shape[0]
+    if t <= knots[0]:
+        return 0
+    if t >= knots[n - 1]:
+        return n - 2
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if knots[mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@jit_internal
+def vector_of_time(kind, T, C, fn, t, out, W):
+    """The vector of the kind (module docstring) and its derivative at ``t`` into ``out[0:3]``, ``out[3:6]``."""
+    if kind == ZERO:
+        for k in range(6):
+            out[k] = 0.0
+    elif kind == CONSTANT:
+        for k in range(3):
+            out[k] = C[0, 0, k]
+            out[k + 3] = 0.0
+    elif kind == TABLE:
+        i = interval(T, t)
+        s = t - T[i]
+        for k in range(3):
+            out[k] = ((C[i, 0, k] * s + C[i, 1, k]) * s + C[i, 2, k]) * s + C[i, 3, k]
+            out[k + 3] = (3.0 * C[i, 0, k] * s + 2.0 * C[i, 1, k]) * s + C[i, 2, k]
+    elif kind == BODY_FRAME:
+        i = interval(T, t)
+        h = T[i + 1] - T[i]
+        s = (t - T[i]) / h
+        s2 = s * s
+        s3 = s2 * s
+        s4 = s3 * s
+        s5 = s4 * s
+        h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5
+        h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5
+        h2 = 0.5 * (s2 - 3.0 * s3 + 3.0 * s4 - s5)
+        h3 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5
+        h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5
+        h5 = 0.5 * (s3 - 2.0 * s4 + s5)
+        d0 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4
+        d1 = 1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4
+        d2 = 0.5 * (2.0 * s - 9.0 * s2 + 12.0 * s3 - 5.0 * s4)
+        d3 = 30.0 * s2 - 60.0 * s3 + 30.0 * s4
+        d4 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4
+        d5 = 0.5 * (3.0 * s2 - 8.0 * s3 + 5.0 * s4)
+        for k in range(3):  # C[i, 0] omega, C[i, 1] omega', C[i, 2] omega''
+            out[k] = (h0 * C[i, 0, k] + h1 * h * C[i, 1, k] + h2 * h * h * C[i, 2, k] + h3 * C[i + 1, 0, k]
+                      + h4 * h * C[i + 1, 1, k] + h5 * h * h * C[i + 1, 2, k])
+            out[k + 3] = (d0 * C[i, 0, k] + d1 * h * C[i, 1, k] + d2 * h * h * C[i, 2, k] + d3 * C[i + 1, 0, k]
+                          + d4 * h * C[i + 1, 1, k] + d5 * h * h * C[i + 1, 2, k]) / h
+    else:  # the user's function, its derivative given (FUNCTION_DOT) or a central difference (FUNCTION)
+        buf = W[6:12]
+        fn(t, buf)
+        for k in range(3):
+            out[k] = buf[k]
+        if kind == FUNCTION_DOT:
+            for k in range(3):
+                out[k + 3] = buf[k + 3]
+        else:
+            hh = (t + T[0]) - t  # the step of frame.derivative_step, exact in floats
+            for k in range(3):
+                out[k + 3] = 0.0
+            for j, c in ((-2.0, 1.0), (-1.0, -8.0), (1.0, 8.0), (2.0, -1.0)):
+                fn(t + j * hh, buf)
+                for k in range(3):
+                    out[k + 3] += c * buf[k]
+            for k in range(3):
+                out[k + 3] /= 12.0 * hh
+
+
+@jit_internal
+def attitude_rate(y, dy, k, wx, wy, wz):
+    """q' = q (w, 0) / 2 for the scalar-last quaternion y[k:k + 4] (w in the rotating axes), into dy."""
+    qx = y[k]
+    qy = y[k + 1]
+    qz = y[k + 2]
+    qw = y[k + 3]
+    dy[k] = 0.5 * (qw * wx + qy * wz - qz * wy)
+    dy[k + 1] = 0.5 * (qw * wy + qz * wx - qx * wz)
+    dy[k + 2] = 0.5 * (qw * wz + qx * wy - qy * wx)
+    dy[k + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+
+
+@jit_internal
+def constrain(M, y, ax, ay, az):
+    """The total acceleration kept on the string's sphere: a <- a - (a . n + |v_t|^2 / L) n (or as it is)."""
+    if M[0] == 0.0:
+        return ax, ay, az
+    L = M[4]
+    nx = (y[0] - M[1]) / L
+    ny = (y[1] - M[2]) / L
+    nz = (y[2] - M[3]) / L
+    an = ax * nx + ay * ny + az * nz
+    vn = y[3] * nx + y[4] * ny + y[5] * nz
+    c = an + (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] - vn * vn) / L
+    return ax - c * nx, ay - c * ny, az - c * nz
+
+
+@jit_internal
+def particle_rhs(t, y, dy, prob, fns, W):
+    model, M, p, FK, FT, FC, OK, OT, OC = prob
+    vector_of_time(FK, FT, FC, fns[2], t, W[0:6], W)
+    wx = W[0]
+    wy = W[1]
+    wz = W[2]
+    ex = W[3]
+    ey = W[4]
+    ez = W[5]
+    x = y[0]
+    yy = y[1]
+    z = y[2]
+    vx = y[3]
+    vy = y[4]
+    vz = y[5]
+    a = W[18:24]
+    fns[0](t, y, p, a)
+    ax = a[0]
+    ay = a[1]
+    az = a[2]
+    # Coriolis: -2 w x v
+    ax -= 2.0 * (wy * vz - wz * vy)
+    ay -= 2.0 * (wz * vx - wx * vz)
+    az -= 2.0 * (wx * vy - wy * vx)
+    # centrifugal: -w x (w x r) = |w|^2 r - (w . r) w
+    wr = wx * x + wy * yy + wz * z
+    w2 = wx * wx + wy * wy + wz * wz
+    ax += w2 * x - wr * wx
+    ay += w2 * yy - wr * wy
+    az += w2 * z - wr * wz
+    # Euler: -w' x r
+    ax -= ey * z - ez * yy
+    ay -= ez * x - ex * z
+    az -= ex * yy - ey * x
+    o = W[12:18]
+    vector_of_time(OK, OT, OC, fns[3], t, o, W)
+    ax, ay, az = constrain(M, y, ax - o[0], ay - o[1], az - o[2])
+    dy[0] = vx
+    dy[1] = vy
+    dy[2] = vz
+    dy[3] = ax
+    dy[4] = ay
+    dy[5] = az
+    if y.shape[0] == 10:
+        attitude_rate(y, dy, 6, wx, wy, wz)
+
+
+@jit_internal
+def body_rhs(t, y, dy, prob, fns, W):
+    M = prob[1]
+    L1 = y[0]
+    L2 = y[1]
+    L3 = y[2]
+    w1 = M[0] * L1 + M[1] * L2 + M[2] * L3
+    w2 = M[3] * L1 + M[4] * L2 + M[5] * L3
+    w3 = M[6] * L1 + M[7] * L2 + M[8] * L3
+    tau = W[18:24]
+    fns[0](t, y, prob[2], tau)
+    dy[0] = L2 * w3 - L3 * w2 + tau[0]
+    dy[1] = L3 * w1 - L1 * w3 + tau[1]
+    dy[2] = L1 * w2 - L2 * w1 + tau[2]
+    attitude_rate(y, dy, 3, w1, w2, w3)
+
+
+@jit_internal
+def rhs(t, y, dy, prob, fns, W):
+    """y' = f(t, y) of the problem's model into ``dy``."""
+    if prob[0] == 0:
+        particle_rhs(t, y, dy, prob, fns, W)
+    else:
+        body_rhs(t, y, dy, prob, fns, W)
+
+
+@jit_internal
+def kick_acceleration(t, y, prob, fns, W):
+    """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
+    centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
+    model, M, p, FK, FT, FC, OK, OT, OC = prob
+    vector_of_time(FK, FT, FC, fns[2], t, W[0:6], W)
+    wx = W[0]
+    wy = W[1]
+    wz = W[2]
+    ex = W[3]
+    ey = W[4]
+    ez = W[5]
+    x = y[0]
+    yy = y[1]
+    z = y[2]
+    a = W[18:24]
+    fns[0](t, y, p, a)
+    wr = wx * x + wy * yy + wz * z
+    w2 = wx * wx + wy * wy + wz * wz
+    o = W[12:18]
+    vector_of_time(OK, OT, OC, fns[3], t, o, W)
+    ax = a[0]
+    ay = a[1]
+    az = a[2]
+    ax += w2 * x - wr * wx - (ey * z - ez * yy) - o[0]
+    ay += w2 * yy - wr * wy - (ez * x - ex * z) - o[1]
+    az += w2 * z - wr * wz - (ex * yy - ey * x) - o[2]
+    return ax, ay, az, wx, wy, wz
+
+
+@jit_internal
+def drag_rates(M, y):
+    """The drag term's coefficients at the particle's height, for its exact flow (zero without one)."""
+    if M[5] == 0.0:
+        return 0.0, 0.0
+    air = math.exp(-y[2] / M[8]) if M[8] > 0.0 else 1.0
+    return M[6] * air, M[7] * air
+
+
+@jit_internal
+def rotation_strang(t, h, yn, prob, fns, W):
+    """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
+    drift h/2, kick h/2, a drag term's exact flow h/2, the Coriolis flow v' = -2 w x v (v turned by
+    -2 |w| h about w, with w at the step's middle: exact for a constant omega, symmetric always),
+    the drag flow h/2, kick h/2, drift h/2."""
+    hh = 0.5 * h
+    for j in range(3):
+        yn[j] += hh * yn[j + 3]
+    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yn, prob, fns, W)
+    vx = yn[3] + hh * ax
+    vy = yn[4] + hh * ay
+    vz = yn[5] + hh * az
+    k1, k2 = drag_rates(prob[1], yn)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+    w = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if w > 0.0:
+        angle = -2.0 * w * h
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, math.cos(angle), math.sin(angle))
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+    yn[3] = vx + hh * ax
+    yn[4] = vy + hh * ay
+    yn[5] = vz + hh * az
+    for j in range(3):
+        yn[j] += hh * yn[j + 3]
+
+
+@jit_internal
+def turn_about_axis(k, a, yn):
+    """The exact flow of H_k = L_k^2 / (2 I_k) for an angle a = h L_k / I_k: L turns by -a about body
+    axis k, the attitude by +a about it (q <- q (e_k sin(a/2), cos(a/2)))."""
+    c = math.cos(a)
+    s = math.sin(a)
+    i = (k + 1) % 3
+    j = (k + 2) % 3
+    li = yn[i]
+    lj = yn[j]
+    yn[i] = c * li + s * lj
+    yn[j] = -s * li + c * lj
+    hc = math.cos(0.5 * a)
+    hs = math.sin(0.5 * a)
+    qx = yn[3]
+    qy = yn[4]
+    qz = yn[5]
+    qw = yn[6]
+    ex = hs if k == 0 else 0.0
+    ey = hs if k == 1 else 0.0
+    ez = hs if k == 2 else 0.0
+    yn[3] = qw * ex + hc * qx + (qy * ez - qz * ey)
+    yn[4] = qw * ey + hc * qy + (qz * ex - qx * ez)
+    yn[5] = qw * ez + hc * qz + (qx * ey - qy * ex)
+    yn[6] = qw * hc - (qx * ex + qy * ey + qz * ez)
+
+
+@jit_internal
+def torque_kick(t, h, yn, prob, fns, W):
+    """L += h tau(t, L, q): exact for a torque of (t, q) alone (the only torques the splittings take)."""
+    tau = W[18:24]
+    fns[0](t, yn, prob[2], tau)
+    yn[0] += h * tau[0]
+    yn[1] += h * tau[1]
+    yn[2] += h * tau[2]
+
+
+@jit_internal
+def lie_poisson_strang(t, h, yn, prob, fns, W):
+    """Kick(h/2) . R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2) . kick(h/2): second order, symplectic on the
+    Lie-Poisson manifold (principal axes: ``M`` holds the diagonal I^-1)."""
+    M = prob[1]
+    torque_kick(t, 0.5 * h, yn, prob, fns, W)
+    turn_about_axis(0, 0.5 * h * yn[0] * M[0], yn)
+    turn_about_axis(1, 0.5 * h * yn[1] * M[4], yn)
+    turn_about_axis(2, h * yn[2] * M[8], yn)
+    turn_about_axis(1, 0.5 * h * yn[1] * M[4], yn)
+    turn_about_axis(0, 0.5 * h * yn[0] * M[0], yn)
+    torque_kick(t + h, 0.5 * h, yn, prob, fns, W)
+
+
+@jit_internal
+def strang(t, h, yn, prob, fns, W):
+    if prob[0] == 0:
+        rotation_strang(t, h, yn, prob, fns, W)
+    else:
+        lie_poisson_strang(t, h, yn, prob, fns, W)
+
+
+@jit_internal
+def own_step(method, t, y, h, yn, prob, fns, W):
+    """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4)."""
+    for j in range(y.shape[0]):
+        yn[j] = y[j]
+    if method == SPLITTING:
+        strang(t, h, yn, prob, fns, W)
+    else:
+        w1 = YOSHIDA4_OUTER
+        w0 = YOSHIDA4_INNER
+        strang(t, w1 * h, yn, prob, fns, W)
+        strang(t + w1 * h, w0 * h, yn, prob, fns, W)
+        strang(t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+
+
+@jit_internal
+def particle_energy(t, y, prob, fns, potential, rotating, W):
+    """Energy per unit mass (``rotating`` False) or the Jacobi integral (True) of one particle's state."""
+    vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W[0:6], W)
+    kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
+    e = kin + potential(t, y, prob[2])
+    if rotating:
+        wx = W[0]
+        wy = W[1]
+        wz = W[2]
+        cx = wy * y[2] - wz * y[1]
+        cy = wz * y[0] - wx * y[2]
+        cz = wx * y[1] - wy * y[0]
+        e -= 0.5 * (cx * cx + cy * cy + cz * cz)
+    return e
+

@@ -1,0 +1,44 @@
+"""The engine as plain Python (``jit=False``): the same functions, with every compiled callee its Python original.
+
+A numba dispatcher's ``py_func`` is the Python function it was made from, but that function
+still calls its module's compiled neighbours, which cannot take plain Python functions as
+arguments. `plain` remakes a function over a copy of its module's globals in which every
+numba dispatcher is itself remade this way, so a whole call tree runs as Python (slow: for a
+user function numba cannot compile). No source is copied: the code objects are the modules' own.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+
+from numba.core.dispatcher import Dispatcher
+
+__all__ = ["plain"]
+
+_SPACES: dict[str, dict] = {}
+_PLAIN: dict[int, types.FunctionType] = {}
+
+
+def _space(module_name: str) -> dict:
+    """The globals of ``module_name`` with each numba dispatcher replaced by its plain remake (made once)."""
+    space = _SPACES.get(module_name)
+    if space is None:
+        original = vars(sys.modules[module_name])
+        space = dict(original)
+        _SPACES[module_name] = space  # before the remakes: a module's functions call each other
+        for name, value in original.items():
+            if isinstance(value, Dispatcher):
+                space[name] = plain(value)
+    return space
+
+
+def plain(f):
+    """``f`` (a numba dispatcher or a function) as a Python function whose compiled callees are plain too."""
+    py = getattr(f, "py_func", f)
+    made = _PLAIN.get(id(py))
+    if made is None:
+        made = types.FunctionType(py.__code__, _space(py.__module__), py.__name__, py.__defaults__, py.__closure__)
+        made.__doc__ = py.__doc__
+        _PLAIN[id(py)] = made
+    return made
