@@ -22,7 +22,7 @@ from __future__ import annotations
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["jit_kernel", "jit_internal", "inlined", "CompiledOnlyDispatcher"]
+__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_inline", "inlined", "CompiledOnlyDispatcher"]
 
 #: The decorator of every compiled kernel that reports failures as non-finite numbers.
 jit_kernel = njit(cache=True, error_model="numpy", nogil=True)
@@ -44,6 +44,28 @@ def jit_internal(func):
     dispatcher = _jit_without_entry_point(func)
     dispatcher.__class__ = CompiledOnlyDispatcher
     return dispatcher
+
+
+_jit_without_reference_counts = njit(cache=True, error_model="numpy", nogil=True, no_cpython_wrapper=True,
+                                     no_cfunc_wrapper=True, _nrt=False)
+
+
+def jit_uncounted(func):
+    """`jit_internal` without numba's reference counting (NRT): for hot loops over arrays their caller owns.
+
+    numba counts the references to every array a function holds (an atomic add and a call at each
+    binding and at each exit); on a loop whose functions take many arrays, that was measured to
+    cost more than the arithmetic. Such a kernel may not allocate an array; it may index, slice
+    and pass the arrays it is given, which live in its caller for the whole call.
+    """
+    dispatcher = _jit_without_reference_counts(func)
+    dispatcher.__class__ = CompiledOnlyDispatcher
+    return dispatcher
+
+
+#: A kernel that numba inlines into each caller (its IR, before typing): for small functions on a hot path,
+#: and for those that take first-class functions (a call across which one is passed costs some 20 ns).
+jit_inline = njit(inline="always", error_model="numpy", nogil=True)
 
 
 def inlined(kernel):

@@ -30,7 +30,8 @@ functions, and nothing else, per problem). The equations are `rotframe.problem.m
   waking), more than a whole single-particle run.
 
 Status codes per particle: 0 running, 1 finished, 2 stopped by a terminal event,
-3 non-finite state, 4 step size collapsed.
+3 non-finite state, 4 step size collapsed, 5 an event function gave NaN (or raised), 6 a user
+function raised (`rotframe.problem.calls`: the engine stops the particle at the step where it did).
 """
 
 from __future__ import annotations
@@ -40,10 +41,12 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics.compiled import jit_internal
+from rotframe.numerics.compiled import jit_inline, jit_uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.problem.calls import call_event
+from rotframe.problem.calls import RAISED
 from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs
-from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM, quiet
+from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM
 
 __all__ = ["advance", "start_events", "energies", "ready"]
 
@@ -56,43 +59,47 @@ SAFE = 0.9
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 
 
-@jit_internal
+@jit_inline
+def stage_state(z, y, h, K, s, D):
+    """z = y + h sum_m a_m K[m] for stage s (12: the step's end, weights B), each sum over m in order."""
+    for j in range(D):
+        z[j] = 0.0
+    for m in range(s):
+        a = A[s, m] if s < 12 else B[m]
+        for j in range(D):
+            z[j] += a * K[m, j]
+    for j in range(D):
+        z[j] = y[j] + h * z[j]
+
+
+@jit_uncounted
 def dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
     D = y.shape[0]
-    for s in range(1, 12):
-        for j in range(D):
-            acc = 0.0
-            for m in range(s):
-                acc += A[s, m] * K[m, j]
-            yt[j] = y[j] + h * acc
-        rhs(t + C[s] * h, yt, K[s], prob, fns, W)
-    for j in range(D):
-        acc = 0.0
-        for s in range(12):
-            acc += B[s] * K[s, j]
-        yn[j] = y[j] + h * acc
-    rhs(t_end, yn, K[12], prob, fns, W)  # at the time the step ends on (a sample time exactly where it lands)
+    for s in range(1, 13):  # the stages, then f at the step's end (one call of the inlined rhs)
+        z = yt if s < 12 else yn
+        if D == 6:  # a particle: the loops of 6 known to the compiler (unrolled), the same arithmetic
+            stage_state(z, y, h, K, s, 6)
+        else:
+            stage_state(z, y, h, K, s, D)
+        ts = t + C[s] * h if s < 12 else t_end  # the last: the time the step ends on (a sample time where it lands)
+        rhs(ts, z, K[s], prob, fns, W)
 
 
-@jit_internal
+@jit_uncounted
 def rk4_step(t, y, h, K, yt, yn, prob, fns, W):
     """One classical Runge-Kutta step from (t, y) with K[0] = f(t, y)."""
     D = y.shape[0]
-    for j in range(D):
-        yt[j] = y[j] + 0.5 * h * K[0, j]
-    rhs(t + 0.5 * h, yt, K[1], prob, fns, W)
-    for j in range(D):
-        yt[j] = y[j] + 0.5 * h * K[1, j]
-    rhs(t + 0.5 * h, yt, K[2], prob, fns, W)
-    for j in range(D):
-        yt[j] = y[j] + h * K[2, j]
-    rhs(t + h, yt, K[3], prob, fns, W)
+    for s in range(1, 4):  # one call of the inlined rhs
+        c = 0.5 if s < 3 else 1.0
+        for j in range(D):
+            yt[j] = y[j] + c * h * K[s - 1, j]
+        rhs(t + c * h, yt, K[s], prob, fns, W)
     for j in range(D):
         yn[j] = y[j] + h * (K[0, j] + 2.0 * K[1, j] + 2.0 * K[2, j] + K[3, j]) / 6.0
 
 
-@jit_internal
+@jit_inline
 def take_step(method, t, y, h, t_end, K, yt, yn, prob, fns, W):
     if method == DOP853:
         dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W)
@@ -102,7 +109,7 @@ def take_step(method, t, y, h, t_end, K, yt, yn, prob, fns, W):
         own_step(method, t, y, h, yn, prob, fns, W)
 
 
-@jit_internal
+@jit_inline
 def all_finite(y):
     for j in range(y.shape[0]):
         if not math.isfinite(y[j]):
@@ -110,7 +117,7 @@ def all_finite(y):
     return True
 
 
-@jit_internal
+@jit_uncounted
 def first_step(t, y, K, yt, rtol, atol, prob, fns, W, span):
     """Hairer's starting step (hinit of dop853.f, order 8), K[0] = f(t, y) given."""
     D = y.shape[0]
@@ -137,7 +144,7 @@ def first_step(t, y, K, yt, rtol, atol, prob, fns, W, span):
     return min(100.0 * h0, h1, span)
 
 
-@jit_internal
+@jit_inline
 def next_stop(S, t):
     """The first stop time in the sorted S after t (inf if none): a knot where the right-hand side is not smooth."""
     n = S.shape[0]
@@ -154,7 +161,7 @@ def next_stop(S, t):
     return S[lo]
 
 
-@jit_internal
+@jit_uncounted
 def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
@@ -169,7 +176,7 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
         if not (lo < mid < hi):
             break
         take_step(method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
-        gm = fns[1](k, t + mid, ybuf, prob[2])
+        gm = call_event(fns[1], k, t + mid, ybuf, prob[2])
         if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
             lo = mid
             g_lo = gm
@@ -180,7 +187,7 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     return hi
 
 
-@jit_internal
+@jit_uncounted
 def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
                 rtol, atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, W):
     # K, Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: of the calling block, made once
@@ -201,6 +208,7 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
     h = H[i]
     idx = IDX[i]
     sub = SUB[i]
+    W[RAISED] = 0.0
     rhs(t, y, K[0], prob, fns, W)
     NFEV[i] += 1
     if h <= 0.0 and method == DOP853:
@@ -243,6 +251,9 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         steps += 1
         NSTEP[i] += 1
         NFEV[i] += 12 if method == DOP853 else 3 if method == RK4 else 2
+        if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
+            status = 6
+            break
         ok = all_finite(yn)
         err = 0.0
         if method == DOP853:
@@ -269,7 +280,10 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         stop_tau = -1.0
         stop_k = -1
         for k in range(NE):
-            g_new = fns[1](k, t_new, yn, p)
+            g_new = call_event(fns[1], k, t_new, yn, p)
+            if not math.isfinite(g_new):  # NaN, or the event function raised: stop here, Python names it
+                status = 5
+                break
             g_old = GPREV[i, k]
             rising = g_old < 0.0 and g_new >= 0.0
             falling = g_old > 0.0 and g_new <= 0.0
@@ -290,6 +304,8 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
                     for j in range(D):
                         yev[j] = yhi[j]
             GPREV[i, k] = g_new
+        if status == 5:
+            break
         if stop_k >= 0:
             # drop records of non-terminal crossings after the terminal one
             m = EVN[i]
@@ -364,7 +380,7 @@ def start_events(t, Y, GPREV, prob, fns):
     """Each event's value at the start, per particle, into ``GPREV`` (N, NE)."""
     for i in range(Y.shape[0]):
         for k in range(GPREV.shape[1]):
-            GPREV[i, k] = fns[1](k, t, Y[i], prob[2])
+            GPREV[i, k] = call_event(fns[1], k, t, Y[i], prob[2])
 
 
 @_entry
@@ -395,10 +411,9 @@ _READY = []
 def ready():
     """The entry points compiled for their one signature each (loaded from numba's cache after the first time).
 
-    Each is then closed to new compiles: a problem's functions reach it as first-class functions
-    of the signatures' types, never as a new specialisation.
+    Each is then closed to new compiles: a problem's functions reach it as addresses
+    (`rotframe.problem.calls`), never as a new specialisation.
     """
-    quiet()
     if not _READY:
         for kernel, signature in SIGNATURES.items():
             kernel.compile(signature)

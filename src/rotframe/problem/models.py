@@ -37,17 +37,24 @@ Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torqu
 fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 (`rotframe.numerics.composition`).
 
-Scratch ``W`` (24 numbers, one per calling block): ``W[0:6]`` omega and omega', ``W[6:12]`` a
-user vector function's output, ``W[12:18]`` the origin's acceleration, ``W[18:24]`` the terms.
+Where the problem's own functions are called: a first-class function that crosses a call of
+numba's costs some 20 ns there (measured; called in the function that holds it, a few ns), so
+the right-hand sides and what they call are inlined (`rotframe.numerics.compiled.jit_inline`)
+into the steps, which hold the functions and are called once a step.
+
+Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
+vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is taken: a view costs more than the
+arithmetic of a term).
 """
 
 from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import jit_internal
+from rotframe.numerics.compiled import jit_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
+from rotframe.problem.calls import call_potential, call_terms, call_vector
 from rotframe.particles.forces import drag_flow
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
@@ -57,11 +64,11 @@ __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT"
 ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
 #: method codes of the compiled loop (the names are `rotframe.method_registry`'s; no code leaves this package)
 DOP853, RK4, SPLITTING, SPLITTING4 = range(4)
-#: the length of the scratch ``W``
-SCRATCH = 24
+#: the length of the scratch ``W`` (its last slot: `rotframe.problem.calls.RAISED`)
+SCRATCH = 7
 
 
-@jit_internal
+@jit_inline
 def interval(knots, t):
     """The index i of the interval [knots[i], knots[i + 1]] holding t (clipped to the ends)."""
     n = knots.shape[0]
@@ -80,68 +87,89 @@ def interval(knots, t):
     return lo
 
 
-@jit_internal
-def vector_of_time(kind, T, C, fn, t, out, W):
-    """The vector of the kind (module docstring) and its derivative at ``t`` into ``out[0:3]``, ``out[3:6]``."""
+@jit_inline
+def vector_of_time(kind, T, C, fn, t, W):
+    """The vector of the kind (module docstring) and its derivative at ``t``: ``(x, y, z, dx, dy, dz)``.
+
+    ``W`` (6,) receives what a user's function writes (``FUNCTION``, ``FUNCTION_DOT``). The
+    constant kinds are answered here (small enough for the compiler to inline into the
+    right-hand side), the others by `varying_vector`.
+    """
+    if kind == CONSTANT:
+        return C[0, 0, 0], C[0, 0, 1], C[0, 0, 2], 0.0, 0.0, 0.0
     if kind == ZERO:
-        for k in range(6):
-            out[k] = 0.0
-    elif kind == CONSTANT:
-        for k in range(3):
-            out[k] = C[0, 0, k]
-            out[k + 3] = 0.0
-    elif kind == TABLE:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return varying_vector(kind, T, C, fn, t, W)
+
+
+@jit_uncounted
+def varying_vector(kind, T, C, fn, t, buf):
+    """`vector_of_time` of a table, a body's samples or a user's function."""
+    if kind == TABLE:
         i = interval(T, t)
         s = t - T[i]
-        for k in range(3):
-            out[k] = ((C[i, 0, k] * s + C[i, 1, k]) * s + C[i, 2, k]) * s + C[i, 3, k]
-            out[k + 3] = (3.0 * C[i, 0, k] * s + 2.0 * C[i, 1, k]) * s + C[i, 2, k]
-    elif kind == BODY_FRAME:
-        i = interval(T, t)
-        h = T[i + 1] - T[i]
-        s = (t - T[i]) / h
-        s2 = s * s
-        s3 = s2 * s
-        s4 = s3 * s
-        s5 = s4 * s
-        h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5
-        h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5
-        h2 = 0.5 * (s2 - 3.0 * s3 + 3.0 * s4 - s5)
-        h3 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5
-        h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5
-        h5 = 0.5 * (s3 - 2.0 * s4 + s5)
-        d0 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4
-        d1 = 1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4
-        d2 = 0.5 * (2.0 * s - 9.0 * s2 + 12.0 * s3 - 5.0 * s4)
-        d3 = 30.0 * s2 - 60.0 * s3 + 30.0 * s4
-        d4 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4
-        d5 = 0.5 * (3.0 * s2 - 8.0 * s3 + 5.0 * s4)
-        for k in range(3):  # C[i, 0] omega, C[i, 1] omega', C[i, 2] omega''
-            out[k] = (h0 * C[i, 0, k] + h1 * h * C[i, 1, k] + h2 * h * h * C[i, 2, k] + h3 * C[i + 1, 0, k]
-                      + h4 * h * C[i + 1, 1, k] + h5 * h * h * C[i + 1, 2, k])
-            out[k + 3] = (d0 * C[i, 0, k] + d1 * h * C[i, 1, k] + d2 * h * h * C[i, 2, k] + d3 * C[i + 1, 0, k]
-                          + d4 * h * C[i + 1, 1, k] + d5 * h * h * C[i + 1, 2, k]) / h
-    else:  # the user's function, its derivative given (FUNCTION_DOT) or a central difference (FUNCTION)
-        buf = W[6:12]
-        fn(t, buf)
-        for k in range(3):
-            out[k] = buf[k]
-        if kind == FUNCTION_DOT:
-            for k in range(3):
-                out[k + 3] = buf[k + 3]
-        else:
-            hh = (t + T[0]) - t  # the step of frame.derivative_step, exact in floats
-            for k in range(3):
-                out[k + 3] = 0.0
-            for j, c in ((-2.0, 1.0), (-1.0, -8.0), (1.0, 8.0), (2.0, -1.0)):
-                fn(t + j * hh, buf)
-                for k in range(3):
-                    out[k + 3] += c * buf[k]
-            for k in range(3):
-                out[k + 3] /= 12.0 * hh
+        x = ((C[i, 0, 0] * s + C[i, 1, 0]) * s + C[i, 2, 0]) * s + C[i, 3, 0]
+        y = ((C[i, 0, 1] * s + C[i, 1, 1]) * s + C[i, 2, 1]) * s + C[i, 3, 1]
+        z = ((C[i, 0, 2] * s + C[i, 1, 2]) * s + C[i, 2, 2]) * s + C[i, 3, 2]
+        dx = (3.0 * C[i, 0, 0] * s + 2.0 * C[i, 1, 0]) * s + C[i, 2, 0]
+        dy = (3.0 * C[i, 0, 1] * s + 2.0 * C[i, 1, 1]) * s + C[i, 2, 1]
+        dz = (3.0 * C[i, 0, 2] * s + 2.0 * C[i, 1, 2]) * s + C[i, 2, 2]
+        return x, y, z, dx, dy, dz
+    if kind == BODY_FRAME:
+        return hermite(T, C, t)
+    call_vector(fn, t, buf)  # the user's function: omega' given (FUNCTION_DOT) or a central difference (FUNCTION)
+    x = buf[0]
+    y = buf[1]
+    z = buf[2]
+    if kind == FUNCTION_DOT:
+        return x, y, z, buf[3], buf[4], buf[5]
+    hh = (t + T[0]) - t  # the step of frame.derivative_step, exact in floats
+    call_vector(fn, t - 2.0 * hh, buf)
+    ax, ay, az = buf[0], buf[1], buf[2]
+    call_vector(fn, t - hh, buf)
+    bx, by, bz = buf[0], buf[1], buf[2]
+    call_vector(fn, t + hh, buf)
+    cx, cy, cz = buf[0], buf[1], buf[2]
+    call_vector(fn, t + 2.0 * hh, buf)
+    return (x, y, z, (ax - 8.0 * bx + 8.0 * cx - buf[0]) / (12.0 * hh), (ay - 8.0 * by + 8.0 * cy - buf[1]) / (12.0 * hh),
+            (az - 8.0 * bz + 8.0 * cz - buf[2]) / (12.0 * hh))
 
 
-@jit_internal
+@jit_uncounted
+def hermite(T, C, t):
+    """The quintic Hermite interpolant through a body's omega, omega', omega'' (C[i, 0..2]) and its derivative."""
+    i = interval(T, t)
+    h = T[i + 1] - T[i]
+    s = (t - T[i]) / h
+    s2 = s * s
+    s3 = s2 * s
+    s4 = s3 * s
+    s5 = s4 * s
+    h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5
+    h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5
+    h2 = 0.5 * (s2 - 3.0 * s3 + 3.0 * s4 - s5)
+    h3 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5
+    h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5
+    h5 = 0.5 * (s3 - 2.0 * s4 + s5)
+    d0 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4
+    d1 = 1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4
+    d2 = 0.5 * (2.0 * s - 9.0 * s2 + 12.0 * s3 - 5.0 * s4)
+    d3 = 30.0 * s2 - 60.0 * s3 + 30.0 * s4
+    d4 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4
+    d5 = 0.5 * (3.0 * s2 - 8.0 * s3 + 5.0 * s4)
+    return (mix(C, i, 0, h, h0, h1, h2, h3, h4, h5), mix(C, i, 1, h, h0, h1, h2, h3, h4, h5),
+            mix(C, i, 2, h, h0, h1, h2, h3, h4, h5), mix(C, i, 0, h, d0, d1, d2, d3, d4, d5) / h,
+            mix(C, i, 1, h, d0, d1, d2, d3, d4, d5) / h, mix(C, i, 2, h, d0, d1, d2, d3, d4, d5) / h)
+
+
+@jit_uncounted
+def mix(C, i, k, h, a0, a1, a2, a3, a4, a5):
+    """Component k of the Hermite sum with the weights a0..a5 (values, h times first, h^2 times second derivatives)."""
+    return (a0 * C[i, 0, k] + a1 * h * C[i, 1, k] + a2 * h * h * C[i, 2, k] + a3 * C[i + 1, 0, k]
+            + a4 * h * C[i + 1, 1, k] + a5 * h * h * C[i + 1, 2, k])
+
+
+@jit_inline
 def attitude_rate(y, dy, k, wx, wy, wz):
     """q' = q (w, 0) / 2 for the scalar-last quaternion y[k:k + 4] (w in the rotating axes), into dy."""
     qx = y[k]
@@ -154,7 +182,7 @@ def attitude_rate(y, dy, k, wx, wy, wz):
     dy[k + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
 
 
-@jit_internal
+@jit_inline
 def constrain(M, y, ax, ay, az):
     """The total acceleration kept on the string's sphere: a <- a - (a . n + |v_t|^2 / L) n (or as it is)."""
     if M[0] == 0.0:
@@ -169,27 +197,19 @@ def constrain(M, y, ax, ay, az):
     return ax - c * nx, ay - c * ny, az - c * nz
 
 
-@jit_internal
+@jit_uncounted
 def particle_rhs(t, y, dy, prob, fns, W):
-    model, M, p, FK, FT, FC, OK, OT, OC = prob
-    vector_of_time(FK, FT, FC, fns[2], t, W[0:6], W)
-    wx = W[0]
-    wy = W[1]
-    wz = W[2]
-    ex = W[3]
-    ey = W[4]
-    ez = W[5]
+    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
     x = y[0]
     yy = y[1]
     z = y[2]
     vx = y[3]
     vy = y[4]
     vz = y[5]
-    a = W[18:24]
-    fns[0](t, y, p, a)
-    ax = a[0]
-    ay = a[1]
-    az = a[2]
+    call_terms(fns[0], t, y, prob[2], W)
+    ax = W[0]
+    ay = W[1]
+    az = W[2]
     # Coriolis: -2 w x v
     ax -= 2.0 * (wy * vz - wz * vy)
     ay -= 2.0 * (wz * vx - wx * vz)
@@ -204,9 +224,8 @@ def particle_rhs(t, y, dy, prob, fns, W):
     ax -= ey * z - ez * yy
     ay -= ez * x - ex * z
     az -= ex * yy - ey * x
-    o = W[12:18]
-    vector_of_time(OK, OT, OC, fns[3], t, o, W)
-    ax, ay, az = constrain(M, y, ax - o[0], ay - o[1], az - o[2])
+    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], t, W)
+    ax, ay, az = constrain(prob[1], y, ax - ox, ay - oy, az - oz)
     dy[0] = vx
     dy[1] = vy
     dy[2] = vz
@@ -217,7 +236,7 @@ def particle_rhs(t, y, dy, prob, fns, W):
         attitude_rate(y, dy, 6, wx, wy, wz)
 
 
-@jit_internal
+@jit_uncounted
 def body_rhs(t, y, dy, prob, fns, W):
     M = prob[1]
     L1 = y[0]
@@ -226,15 +245,14 @@ def body_rhs(t, y, dy, prob, fns, W):
     w1 = M[0] * L1 + M[1] * L2 + M[2] * L3
     w2 = M[3] * L1 + M[4] * L2 + M[5] * L3
     w3 = M[6] * L1 + M[7] * L2 + M[8] * L3
-    tau = W[18:24]
-    fns[0](t, y, prob[2], tau)
-    dy[0] = L2 * w3 - L3 * w2 + tau[0]
-    dy[1] = L3 * w1 - L1 * w3 + tau[1]
-    dy[2] = L1 * w2 - L2 * w1 + tau[2]
+    call_terms(fns[0], t, y, prob[2], W)
+    dy[0] = L2 * w3 - L3 * w2 + W[0]
+    dy[1] = L3 * w1 - L1 * w3 + W[1]
+    dy[2] = L1 * w2 - L2 * w1 + W[2]
     attitude_rate(y, dy, 3, w1, w2, w3)
 
 
-@jit_internal
+@jit_inline
 def rhs(t, y, dy, prob, fns, W):
     """y' = f(t, y) of the problem's model into ``dy``."""
     if prob[0] == 0:
@@ -243,37 +261,28 @@ def rhs(t, y, dy, prob, fns, W):
         body_rhs(t, y, dy, prob, fns, W)
 
 
-@jit_internal
+@jit_uncounted
 def kick_acceleration(t, y, prob, fns, W):
     """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
     centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
-    model, M, p, FK, FT, FC, OK, OT, OC = prob
-    vector_of_time(FK, FT, FC, fns[2], t, W[0:6], W)
-    wx = W[0]
-    wy = W[1]
-    wz = W[2]
-    ex = W[3]
-    ey = W[4]
-    ez = W[5]
+    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
     x = y[0]
     yy = y[1]
     z = y[2]
-    a = W[18:24]
-    fns[0](t, y, p, a)
+    call_terms(fns[0], t, y, prob[2], W)
+    ax = W[0]
+    ay = W[1]
+    az = W[2]
     wr = wx * x + wy * yy + wz * z
     w2 = wx * wx + wy * wy + wz * wz
-    o = W[12:18]
-    vector_of_time(OK, OT, OC, fns[3], t, o, W)
-    ax = a[0]
-    ay = a[1]
-    az = a[2]
-    ax += w2 * x - wr * wx - (ey * z - ez * yy) - o[0]
-    ay += w2 * yy - wr * wy - (ez * x - ex * z) - o[1]
-    az += w2 * z - wr * wz - (ex * yy - ey * x) - o[2]
+    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], t, W)
+    ax += w2 * x - wr * wx - (ey * z - ez * yy) - ox
+    ay += w2 * yy - wr * wy - (ez * x - ex * z) - oy
+    az += w2 * z - wr * wz - (ex * yy - ey * x) - oz
     return ax, ay, az, wx, wy, wz
 
 
-@jit_internal
+@jit_inline
 def drag_rates(M, y):
     """The drag term's coefficients at the particle's height, for its exact flow (zero without one)."""
     if M[5] == 0.0:
@@ -282,7 +291,7 @@ def drag_rates(M, y):
     return M[6] * air, M[7] * air
 
 
-@jit_internal
+@jit_uncounted
 def rotation_strang(t, h, yn, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
     drift h/2, kick h/2, a drag term's exact flow h/2, the Coriolis flow v' = -2 w x v (v turned by
@@ -309,7 +318,7 @@ def rotation_strang(t, h, yn, prob, fns, W):
         yn[j] += hh * yn[j + 3]
 
 
-@jit_internal
+@jit_uncounted
 def turn_about_axis(k, a, yn):
     """The exact flow of H_k = L_k^2 / (2 I_k) for an angle a = h L_k / I_k: L turns by -a about body
     axis k, the attitude by +a about it (q <- q (e_k sin(a/2), cos(a/2)))."""
@@ -336,17 +345,16 @@ def turn_about_axis(k, a, yn):
     yn[6] = qw * hc - (qx * ex + qy * ey + qz * ez)
 
 
-@jit_internal
+@jit_uncounted
 def torque_kick(t, h, yn, prob, fns, W):
     """L += h tau(t, L, q): exact for a torque of (t, q) alone (the only torques the splittings take)."""
-    tau = W[18:24]
-    fns[0](t, yn, prob[2], tau)
-    yn[0] += h * tau[0]
-    yn[1] += h * tau[1]
-    yn[2] += h * tau[2]
+    call_terms(fns[0], t, yn, prob[2], W)
+    yn[0] += h * W[0]
+    yn[1] += h * W[1]
+    yn[2] += h * W[2]
 
 
-@jit_internal
+@jit_uncounted
 def lie_poisson_strang(t, h, yn, prob, fns, W):
     """Kick(h/2) . R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2) . kick(h/2): second order, symplectic on the
     Lie-Poisson manifold (principal axes: ``M`` holds the diagonal I^-1)."""
@@ -360,7 +368,7 @@ def lie_poisson_strang(t, h, yn, prob, fns, W):
     torque_kick(t + h, 0.5 * h, yn, prob, fns, W)
 
 
-@jit_internal
+@jit_uncounted
 def strang(t, h, yn, prob, fns, W):
     if prob[0] == 0:
         rotation_strang(t, h, yn, prob, fns, W)
@@ -368,7 +376,7 @@ def strang(t, h, yn, prob, fns, W):
         lie_poisson_strang(t, h, yn, prob, fns, W)
 
 
-@jit_internal
+@jit_uncounted
 def own_step(method, t, y, h, yn, prob, fns, W):
     """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4)."""
     for j in range(y.shape[0]):
@@ -383,16 +391,13 @@ def own_step(method, t, y, h, yn, prob, fns, W):
         strang(t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
 
 
-@jit_internal
+@jit_uncounted
 def particle_energy(t, y, prob, fns, potential, rotating, W):
     """Energy per unit mass (``rotating`` False) or the Jacobi integral (True) of one particle's state."""
-    vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W[0:6], W)
+    wx, wy, wz, _, _, _ = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
     kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
-    e = kin + potential(t, y, prob[2])
+    e = kin + call_potential(potential, t, y, prob[2])
     if rotating:
-        wx = W[0]
-        wy = W[1]
-        wz = W[2]
         cx = wy * y[2] - wz * y[1]
         cy = wz * y[0] - wx * y[2]
         cz = wx * y[1] - wy * y[0]

@@ -43,7 +43,9 @@ __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "adv
 #: The code the engine branches on (`rotframe.problem.engine.take_step`), for each method it steps; the names
 #: are `rotframe.method_registry`'s.
 _CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4}
-STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t"}
+#: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
+STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
+          5: "an event function gave a non-finite value", 6: "a user function raised"}
 
 
 @dataclass
@@ -146,6 +148,21 @@ def _blame(forces, params, t, y, dt, labels):
     return ""
 
 
+def _blame_events(events, params, t, y, dt):
+    """After an event gave NaN (status 5): which event, probed as plain Python at the last state, raises or gives it."""
+    r, v = y[:3].copy(), y[3:6].copy()
+    for k, g in enumerate(events):
+        for tp in [t] + [t + f * dt for f in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]:
+            try:
+                value = float(uf.plain_function(g)(tp, *uf.read_only_args((r, v)), *params))
+            except Exception as exc:  # the user's function, reported in the message
+                return "; " + uf.raised_message(f"events[{k}]", g, exc,
+                                                f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
+            if not np.isfinite(value):
+                return f"; events[{k}] ({uf.display_name(g)}) returned {value} at t = {tp:.9g} s"
+    return ""
+
+
 def _scales(r, v, duration, rtol, atol, D):
     """Absolute tolerances, one row per particle ((N, D)): each particle's from its own scales, so that its
     steps, and its numbers, do not depend on the other particles of the ensemble."""
@@ -221,7 +238,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
     try:
-        driver = Driver(lambda: build_module("particle", key, _bind(frame, origin, forces, events, jit), glue,
+        driver = Driver(lambda: build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
                                              compiled=jit, notes=cache_notes), cache_notes, compiled=jit)
     except Exception as exc:
         import numba
@@ -300,11 +317,21 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         good = int(state["IDX"][i])
         t_bad = float(state["TC"][i])
         # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
-        dt_failed = hfix if method != "dop853" else 10.0 * float(state["H"][i])
-        why = STATUS[int(state["ST"][i])] + _blame(forces, params, t_bad, y[i], dt_failed, labels)
+        code = int(state["ST"][i])
+        dt_failed = hfix if method != "dop853" else (10.0 if code in (3, 4) else 1.0) * float(state["H"][i])
+        if code == 5:
+            blame = _blame_events(events, params, t_bad, y[i], dt_failed)
+        else:
+            blame = _blame(forces, params, t_bad, y[i], dt_failed, labels)
         partial = _trajectory(times, OUT, state, events, method, good)
-        raise IntegrationError(f"simulate: particle {i}: {why} after t = {t_bad:.9g} s (method {method}); "
-                               "samples up to there are kept", t_reached=t_bad, partial=partial)
+        state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
+        if code == 6 or " raised " in blame:  # a user function raised (compiled: the engine stopped at once)
+            err = uf.UserFunctionError(f"simulate: particle {i}: a user function raised in the step from "
+                                       f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept")
+            err.t_reached, err.partial = t_bad, partial
+            raise err
+        raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
+                               f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
     warnings, notes, diagnostics = [], list(frame.notes) + cache_notes, {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "

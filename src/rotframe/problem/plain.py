@@ -35,6 +35,9 @@ def _space(module_name: str) -> dict:
 
 def plain(f):
     """``f`` (a numba dispatcher or a function) as a Python function whose compiled callees are plain too."""
+    override = getattr(f, "plain", None)  # a helper that has no Python form of its own (rotframe.problem.calls)
+    if override is not None:
+        return override
     py = getattr(f, "py_func", f)
     made = _PLAIN.get(id(py))
     if made is None:

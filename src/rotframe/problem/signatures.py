@@ -1,21 +1,21 @@
-"""The types through which the compiled engine calls a problem's own functions (numba first-class functions).
+"""The signatures through which the compiled engine calls a problem's own functions, by address.
 
 The engine (`rotframe.problem.engine`, `rotframe.problem.models`) is compiled once, with
 these types in its signatures, and cached on disk like every other kernel: it never sees the
-user's functions, only their addresses. What a problem compiles is the few small functions of
-`rotframe.problem.glue` that call the user's own, each with one of the fixed signatures below
-(so that numba can pass it as a first-class function), as numbalsoda hands a solver the address
-of a right-hand side compiled alone. Every array is float64 and C-contiguous.
+user's functions, only their addresses (`rotframe.problem.calls`). What a problem compiles is
+the few small functions of `rotframe.problem.glue` that call the user's own, each with one of
+the fixed signatures below, as numbalsoda hands a solver the address of a right-hand side
+compiled alone. Every array is float64 and C-contiguous.
 
 ==============  ==========================================  ==========================================
 name            signature                                   what it computes
 ==============  ==========================================  ==========================================
-`TERMS`         ``f(t, y, p, out) -> None``                 a particle: the sum of the user's forces
+`TERMS_SIG`     ``f(t, y, p, out) -> None``                 a particle: the sum of the user's forces
                                                             (m/s^2, frame axes) into ``out[0:3]``; a
                                                             body: the user's torque (N m, body axes)
-`EVENT`         ``g(k, t, y, p) -> float``                  event ``k``'s function
-`POTENTIAL`     ``U(t, y, p) -> float``                     the sum of the forces' potentials, J/kg
-`VECTOR`        ``w(t, out) -> None``                       a user's vector of time: omega (and
+`EVENT_SIG`     ``g(k, t, y, p) -> float``                  event ``k``'s function
+`POTENTIAL_SIG` ``U(t, y, p) -> float``                     the sum of the forces' potentials, J/kg
+`VECTOR_SIG`    ``w(t, out) -> None``                       a user's vector of time: omega (and
                                                             omega' in ``out[3:6]`` where given), or the
                                                             origin's acceleration
 ==============  ==========================================  ==========================================
@@ -32,30 +32,10 @@ the parameters, and the frame's and the origin's evaluators (a kind code and two
 
 from __future__ import annotations
 
-import warnings
-
 from numba import types
 
-
-def quiet():
-    """Hide numba's notice that first-class functions are "experimental", for this notice alone.
-
-    The engine's signatures use them on purpose; numba tells it when such a type is made, at
-    every compile and at every call that passes one, which would reach every user and fail a
-    suite that turns warnings into errors. A filter, not a context: the calls run on threads.
-    Set again at every run (`rotframe.problem.engine.ready`: test runners restore the filters
-    between tests).
-    """
-    from numba.core.errors import NumbaExperimentalFeatureWarning
-
-    warnings.filterwarnings("ignore", message=".*First-class function type feature is experimental",
-                            category=NumbaExperimentalFeatureWarning)
-
-
-quiet()
-
-__all__ = ["TERMS", "EVENT", "POTENTIAL", "VECTOR", "FUNCTIONS", "PROBLEM", "TERMS_SIG", "EVENT_SIG",
-           "POTENTIAL_SIG", "VECTOR_SIG", "PARTICLE", "BODY", "quiet", "F8", "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
+__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "TERMS_SIG", "EVENT_SIG", "POTENTIAL_SIG", "VECTOR_SIG", "PARTICLE",
+           "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
 
 F8 = types.float64
 I8 = types.int64
@@ -71,13 +51,11 @@ EVENT_SIG = F8(I8, F8, A1, A1)
 POTENTIAL_SIG = F8(F8, A1, A1)
 VECTOR_SIG = types.void(F8, A1)
 
-TERMS = types.FunctionType(TERMS_SIG)
-EVENT = types.FunctionType(EVENT_SIG)
-POTENTIAL = types.FunctionType(POTENTIAL_SIG)
-VECTOR = types.FunctionType(VECTOR_SIG)
-
-#: what the stepping calls: the terms, the events, omega(t), the origin's acceleration
-FUNCTIONS = types.Tuple((TERMS, EVENT, VECTOR, VECTOR))
+#: what the stepping calls, by address (`rotframe.problem.calls`): the terms, the events, omega(t), the
+#: origin's acceleration
+FUNCTIONS = types.UniTuple(types.int64, 4)
+#: the potential, by address
+POTENTIAL = types.int64
 
 #: (model, M, p, FK, FT, FC, OK, OT, OC)
 PROBLEM = types.Tuple((I8, A1, A1, I8, A1, A3, I8, A1, A3))

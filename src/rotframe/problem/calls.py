@@ -1,0 +1,131 @@
+"""Calls from the compiled engine to a problem's own functions, by address.
+
+A problem's functions (`rotframe.problem.glue`) are compiled with one fixed signature each
+(`rotframe.problem.signatures`); the engine receives the address of each compiled function
+as an integer (`address`) and calls it through numba's own calling convention (`call_terms`,
+`call_event`, `call_potential`, `call_vector`), as numba does for a first-class function. An
+exception raised in the user's function becomes NaN and a flag (`_codegen`, `RAISED`), which ends
+the particle at that step; Python then names the function, calling it again in plain Python. An integer costs
+nothing to hand from function to function, where numba's first-class function values were
+measured at some 20 ns a call they crossed, more than a term's arithmetic; and it is a
+run-time value, so the engine compiled once serves every problem from numba's cache.
+
+In plain Python (``jit=False``, `rotframe.problem.plain`) the "address" is the Python function
+itself and each call helper is a plain call (``.plain`` of the helper).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import types
+from numba.extending import intrinsic
+
+from rotframe.numerics.compiled import jit_inline
+from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VECTOR_SIG
+
+__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "RAISED"]
+
+
+def address(dispatcher, signature) -> int:
+    """The address of ``dispatcher`` compiled for ``signature`` (numba's calling convention, not C's)."""
+    compiled = dispatcher.get_compile_result(signature)
+    return int(compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name))
+
+
+def _codegen(signature):
+    """A call of the function at ``args[0]`` of ``signature`` (numba's calling convention), and what it returns.
+
+    An exception raised there is not passed on: the call gives True (a function without a result)
+    or NaN (a function with one) instead, and the engine ends the particle with a non-finite state,
+    which Python then names (`rotframe.problem.particles`). A call that could raise would make numba
+    keep a reference count of every array alive around it, on the hot path: it cost more than the
+    arithmetic of the steps (measured, 4 times the old generated drivers' time a step).
+    """
+    returns = signature.return_type
+
+    def codegen(context, builder, sig, args):
+        fnty = context.call_conv.get_function_type(returns, signature.args)
+        fnptr = builder.inttoptr(args[0], fnty.as_pointer())
+        status, result = context.call_conv.call_function(builder, fnptr, returns, signature.args, args[1:])
+        if returns == types.void:
+            return status.is_error
+        return builder.select(status.is_error, context.get_constant(returns, math.nan), result)
+
+    return (types.boolean if returns == types.void else returns)(types.int64, *signature.args), codegen
+
+
+@intrinsic
+def _terms(typingctx, addr, t, y, p, out):
+    return _codegen(TERMS_SIG)
+
+
+@intrinsic
+def _event(typingctx, addr, k, t, y, p):
+    return _codegen(EVENT_SIG)
+
+
+@intrinsic
+def _potential(typingctx, addr, t, y, p):
+    return _codegen(POTENTIAL_SIG)
+
+
+@intrinsic
+def _vector(typingctx, addr, t, out):
+    return _codegen(VECTOR_SIG)
+
+
+#: the slot of the engine's scratch ``W`` (the ``out`` of the terms and the vectors) set to 1 when a user
+#: function raised
+RAISED = 6
+
+
+@jit_inline
+def call_terms(addr, t, y, p, out):
+    """The terms at ``addr``: ``f(t, y, p, out)``; where it raised, NaN in ``out[0:3]`` and 1 in ``out[RAISED]``."""
+    if _terms(addr, t, y, p, out):
+        for k in range(3):
+            out[k] = math.nan
+        out[RAISED] = 1.0
+
+
+@jit_inline
+def call_event(addr, k, t, y, p):
+    """Event ``k`` of the function at ``addr``: ``g(k, t, y, p)``; NaN where it raised."""
+    return _event(addr, k, t, y, p)
+
+
+@jit_inline
+def call_potential(addr, t, y, p):
+    """The potential at ``addr``: ``U(t, y, p)``; NaN where it raised."""
+    return _potential(addr, t, y, p)
+
+
+@jit_inline
+def call_vector(addr, t, out):
+    """The vector of time at ``addr``: ``w(t, out)``; where it raised, NaN in ``out[0:6]``, 1 in ``out[RAISED]``."""
+    if _vector(addr, t, out):
+        for k in range(6):
+            out[k] = math.nan
+        out[RAISED] = 1.0
+
+
+def _plain_terms(f, t, y, p, out):
+    f(t, y, p, out)
+
+
+def _plain_event(f, k, t, y, p):
+    return f(k, t, y, p)
+
+
+def _plain_potential(f, t, y, p):
+    return f(t, y, p)
+
+
+def _plain_vector(f, t, out):
+    f(t, out)
+
+
+for _helper, _python in ((call_terms, _plain_terms), (call_event, _plain_event), (call_potential, _plain_potential),
+                         (call_vector, _plain_vector)):
+    _helper.plain = _python  # what rotframe.problem.plain calls instead
