@@ -10,9 +10,14 @@ Modules, one concept each:
 * ``frame``: a frame that rotates any way (omega as a constant, a table, a function, or a
   rigid body's axes) and an accelerating origin;
 * ``callables``: the user's functions: fingerprints, numba compilation, one-line errors;
-* ``codegen``: the generated, disk-cached driver module of a problem;
-* ``evaluators``: source of the frame's compiled evaluators;
-* ``particle_driver``, ``body_driver``: source of the compiled drivers;
+* ``engine``: the one compiled engine (DOP853, RK4, the models' splittings, events), compiled
+  once and cached, for every problem; ``models``: the equations it steps (a particle in any
+  rotating frame, a rigid body) and their splittings; ``signatures``: the fixed signatures of a
+  problem's own functions; ``calls``: the engine's calls to them, by address;
+* ``glue``: the source of a problem's own small functions (its forces summed, its events...);
+  ``codegen``: that glue compiled and cached on disk as a module of its own; ``stubs``: the
+  functions a problem does not have; ``plain``: the engine as plain Python (``jit=False``);
+* ``terms``: a force, the pendulum's string, what a splitting takes;
 * ``particles``: `simulate_particles`, `Force`;
 * ``body``: `simulate_rigid_body`;
 * ``forces``: the built-in forces as ordinary members of the same system.

@@ -2,8 +2,8 @@
 
 Every particle problem of ``rotframe.simulate`` and every body of ``rotframe.simulate_body``
 runs these functions, compiled once with numba and cached on disk (``cache=True``): a problem
-hands them its own functions as first-class functions and its data as the
-`rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
+hands them the addresses of its own compiled functions (`rotframe.problem.calls`) and its data
+as the `rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
 functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
 
 * DOP853: Hairer's step control (dop853.f: safety 0.9, growth at most 1/0.333, shrink at
@@ -28,6 +28,9 @@ functions, and nothing else, per problem). The equations are `rotframe.problem.m
   particles ``lo:hi``; Python runs blocks of them on threads (the engine holds no GIL). numba's
   ``prange`` was measured at 15 ms a call on the 2-core reference machine (its OpenMP pool
   waking), more than a whole single-particle run.
+* The kernels compile without reference counting (`rotframe.numerics.compiled.jit_uncounted`:
+  the counts, at every call that could raise, cost more than the arithmetic; measured 2 to 3
+  times a step's time) and take every array from ``advance``, which owns them for the call.
 
 Status codes per particle: 0 running, 1 finished, 2 stopped by a terminal event,
 3 non-finite state, 4 step size collapsed, 5 an event function gave NaN (or raised), 6 a user

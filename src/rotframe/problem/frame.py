@@ -154,7 +154,7 @@ def stop_times(specs, duration: float) -> np.ndarray:
 
     A spline or Hermite interpolant is smooth between its knots only; a step across a knot
     integrates a function whose higher derivatives jump, and loses its order (a finer table then
-    gives a larger error). The drivers end a step on each (``S`` of `rotframe.problem.stepping`).
+    gives a larger error). The drivers end a step on each (``S`` of `rotframe.problem.engine`).
     """
     knots = np.concatenate([spec.knots() for spec in specs] + [np.empty(0)])
     knots = np.unique(knots[(knots > 0.0) & (knots < duration)])

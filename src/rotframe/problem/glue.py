@@ -1,7 +1,7 @@
 """What a problem compiles of its own: the few small functions that call the user's, behind fixed signatures.
 
 The engine (`rotframe.problem.engine`) is compiled once for every problem; it calls a
-problem's functions as first-class functions of the signatures of
+problem's functions by address (`rotframe.problem.calls`), each of one of the signatures of
 `rotframe.problem.signatures`. This module writes their source for one problem: it sums the
 forces (turning a force given in inertial axes into the frame's by the integrated attitude),
 names each event, sums the potentials, calls the user's omega(t) and a0(t), or calls the torque

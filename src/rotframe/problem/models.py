@@ -1,7 +1,7 @@
 """The equations of motion the engine steps: a particle in any rotating frame, a rigid body under a torque.
 
-Compiled once (numba, cached on disk) for every problem: the user's functions arrive as
-first-class functions (`rotframe.problem.signatures`) and the problem's data in the
+Compiled once (numba, cached on disk) for every problem: the user's functions arrive as the
+addresses of their compiled glue (`rotframe.problem.calls`) and the problem's data in the
 `PROBLEM` tuple ``(model, M, p, FK, FT, FC, OK, OT, OC)``.
 
 **A particle** (``model = PARTICLE``), state ``(x, y, z, vx, vy, vz)`` in the frame's axes,
@@ -37,14 +37,15 @@ Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torqu
 fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 (`rotframe.numerics.composition`).
 
-Where the problem's own functions are called: a first-class function that crosses a call of
-numba's costs some 20 ns there (measured; called in the function that holds it, a few ns), so
-the right-hand sides and what they call are inlined (`rotframe.numerics.compiled.jit_inline`)
-into the steps, which hold the functions and are called once a step.
+The small functions on the hot path (`vector_of_time`'s constant kinds, `constrain`,
+`attitude_rate`, `rhs`) are inlined into their callers (`rotframe.numerics.compiled.jit_inline`);
+the others are compiled without reference counting (`rotframe.numerics.compiled.jit_uncounted`,
+see `rotframe.problem.engine`). Inlining the large ones too made the engine's first compile take
+two minutes, for no measured gain.
 
 Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
-vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is taken: a view costs more than the
-arithmetic of a term).
+vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is
+taken: a view costs more than the arithmetic of a term).
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ SIGTERM) and reports progress only between calls. Calls sized in steps made a sl
 function (0.2 ms an evaluation) hold a signal for minutes. `Pacer` sizes them in time instead:
 the first call takes a few steps (it compiles, too), each later one as many steps as about
 `CALL_SECONDS` of work took before. The numbers do not depend on where a call ends: the drivers
-keep everything a step needs in their arrays (`rotframe.problem.stepping`).
+keep everything a step needs in their arrays (`rotframe.problem.engine`).
 
 The work is estimated against `rotframe.limits`:
 

@@ -148,6 +148,24 @@ def _blame(forces, params, t, y, dt, labels):
     return ""
 
 
+def _blame_frame(frame, origin, t, dt):
+    """After a failure no force explains: which of omega(t), omega'(t), a0(t) raises or gives non-finite values."""
+    roles = []
+    if frame.kind == "function":
+        roles += list(zip(("omega", "omega_dot"), frame.funcs))
+    if origin.kind == "function":
+        roles.append(("origin_acceleration", origin.funcs[0]))
+    for role, f in roles:
+        for tp in [t] + [t + f_ * dt for f_ in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]:
+            try:
+                value = np.asarray(uf.plain_function(f)(tp), dtype=float)
+            except Exception as exc:  # the user's function, reported in the message
+                return "; " + uf.raised_message(role, f, exc, f"at t = {tp:.9g} s")
+            if not np.all(np.isfinite(value)):
+                return f"; {role} ({uf.display_name(f)}) returned {value.tolist()} at t = {tp:.9g} s"
+    return ""
+
+
 def _blame_events(events, params, t, y, dt):
     """After an event gave NaN (status 5): which event, probed as plain Python at the last state, raises or gives it."""
     r, v = y[:3].copy(), y[3:6].copy()
@@ -322,7 +340,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if code == 5:
             blame = _blame_events(events, params, t_bad, y[i], dt_failed)
         else:
-            blame = _blame(forces, params, t_bad, y[i], dt_failed, labels)
+            blame = _blame(forces, params, t_bad, y[i], dt_failed, labels) or _blame_frame(frame, origin, t_bad,
+                                                                                           dt_failed)
         partial = _trajectory(times, OUT, state, events, method, good)
         state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
         if code == 6 or " raised " in blame:  # a user function raised (compiled: the engine stopped at once)
