@@ -22,7 +22,8 @@ from __future__ import annotations
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_inline", "inlined", "CompiledOnlyDispatcher"]
+__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_inline", "inlined", "uncounted",
+           "CompiledOnlyDispatcher"]
 
 #: The decorator of every compiled kernel that reports failures as non-finite numbers.
 jit_kernel = njit(cache=True, error_model="numpy", nogil=True)
@@ -66,6 +67,15 @@ def jit_uncounted(func):
 #: A kernel that numba inlines into each caller (its IR, before typing): for small functions on a hot path,
 #: and for those that take first-class functions (a call across which one is passed costs some 20 ns).
 jit_inline = njit(inline="always", error_model="numpy", nogil=True)
+
+
+def uncounted(kernel):
+    """A copy of compiled ``kernel`` without reference counting (`jit_uncounted`), for callers that are so too.
+
+    The same Python function, compiled again: a counted kernel called from an uncounted loop
+    still counts the references to its array arguments, atomically, at every call.
+    """
+    return jit_uncounted(kernel.py_func)
 
 
 def inlined(kernel):

@@ -52,7 +52,7 @@ from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import jit_inline, jit_uncounted
+from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.problem.calls import call_potential, call_terms, call_vector
@@ -258,6 +258,19 @@ def rhs(t, y, dy, prob, fns, W):
     """y' = f(t, y) of the problem's model into ``dy``."""
     if prob[0] == 0:
         particle_rhs(t, y, dy, prob, fns, W)
+    else:
+        body_rhs(t, y, dy, prob, fns, W)
+
+
+#: `particle_rhs` inlined where DOP853 calls it 12 times a step (a call of it cost about 10 ns)
+particle_rhs_inlined = inlined(particle_rhs)
+
+
+@jit_inline
+def rhs_inlined(t, y, dy, prob, fns, W):
+    """`rhs`, the particle's right-hand side inlined into the caller (DOP853's stages)."""
+    if prob[0] == 0:
+        particle_rhs_inlined(t, y, dy, prob, fns, W)
     else:
         body_rhs(t, y, dy, prob, fns, W)
 
