@@ -164,8 +164,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
     try:
-        driver = Driver(lambda: build_module("body", key, functions, glue, compiled=jit, notes=cache_notes),
-                        cache_notes, compiled=jit)
+        driver = Driver(build_module("body", key, functions, glue, compiled=jit, notes=cache_notes), compiled=jit)
     except Exception as exc:
         import numba
 
@@ -232,10 +231,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                     blame = f"; torque ({uf.display_name(torque)}) returned {a.tolist()} at t = {tp:.9g} s"
                     break
         if int(st["ST"][0]) == 6:  # the torque raised (compiled: the engine stopped at that step)
-            err = uf.UserFunctionError(f"simulate_body: {blame[2:] or 'the torque raised'} in the step from "
-                                       f"t = {t_bad:.9g} s, L = {y[0, :3].tolist()}, q = {y[0, 3:].tolist()}")
-            err.t_reached, err.partial = t_bad, partial
-            raise err
+            raise uf.raised_during_run(f"simulate_body: {blame[2:] or 'the torque raised'} in the step from "
+                                       f"t = {t_bad:.9g} s, L = {y[0, :3].tolist()}, q = {y[0, 3:].tolist()}",
+                                       t_bad, partial)
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)

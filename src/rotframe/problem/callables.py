@@ -26,13 +26,24 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call",
+__all__ = ["raised_during_run", "fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call",
            "check_compilable", "UserFunctionError", "read_only_args", "raised_message", "readonly_view",
            "readonly_array"]
 
 
 class UserFunctionError(ScenarioError):
-    """A user's function is unusable: wrong shape, non-finite, raises, or numba cannot compile it."""
+    """A user's function is unusable: wrong shape, non-finite, raises, or numba cannot compile it.
+
+    Raised during a run, it carries ``t_reached`` and ``partial`` (the samples up to there), as an
+    `rotframe.errors.IntegrationError` does (`raised_during_run`).
+    """
+
+
+def raised_during_run(message: str, t_reached: float, partial) -> UserFunctionError:
+    """A `UserFunctionError` for a user function that raised during a run, with the time and the samples kept."""
+    err = UserFunctionError(message)
+    err.t_reached, err.partial = t_reached, partial
+    return err
 
 
 def plain_function(f):

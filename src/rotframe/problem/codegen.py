@@ -15,7 +15,7 @@ Where the files go: ``$ROTFRAME_CACHE_DIR``, else ``$XDG_CACHE_HOME/rotframe/pro
 and where neither can be written the driver compiles in memory (once per process), with a note.
 The files are written through `rotframe.files` (atomic). A damaged entry (a source that is not
 UTF-8, a folder in its place, numba's cache files truncated or garbage) is dropped and rebuilt,
-with a note (`is_cache_damage`, `drop_cached`); a cache never fails a run.
+with a note (`is_cache_damage`); a cache never fails a run.
 
 With ``jit=False`` the same source runs as plain Python (no numba at all), with the engine's
 (`rotframe.problem.plain`): slow, for a function numba cannot compile.
@@ -34,7 +34,7 @@ import tempfile
 import types
 from pathlib import Path
 
-__all__ = ["ENTRIES", "cache_dir", "build_module", "is_cache_damage", "drop_cached", "Driver"]
+__all__ = ["ENTRIES", "cache_dir", "build_module", "is_cache_damage", "Driver"]
 
 #: fingerprint -> {global name: function} for the generated modules of this process
 ENTRIES: dict[str, dict] = {}
@@ -116,22 +116,18 @@ def is_cache_damage(exc: BaseException) -> bool:
 
 
 class Driver:
-    """A problem's glue module and the engine that runs it, the glue rebuilt once if numba's cache of it is damaged.
+    """A problem's glue module and the engine that runs it.
 
-    ``build()`` makes the module (`build_module`). ``advance``, ``start_events`` and
-    ``energies`` are the engine's entry points (`rotframe.problem.engine`; their plain Python
-    remakes with ``compiled=False``, `rotframe.problem.plain`), which take `functions` as
-    their last argument.
+    ``advance``, ``start_events`` and ``energies`` are the engine's entry points
+    (`rotframe.problem.engine`; their plain Python remakes with ``compiled=False``,
+    `rotframe.problem.plain`), which take `functions` as their last argument.
     """
 
-    def __init__(self, build, notes, compiled=True):
+    def __init__(self, module, compiled=True):
         from rotframe.problem import engine
 
-        self._build = build
-        self.notes = notes
+        self.module = module
         self.compiled = compiled
-        self.module = build()
-        self.rebuilt = False
         if compiled:
             self.advance, self.start_events, self.energies = engine.ready()
         else:
@@ -164,25 +160,6 @@ class Driver:
         from rotframe.problem import signatures as sg, stubs
 
         return self._own("potential", stubs.no_potential, sg.POTENTIAL_SIG)
-
-    def rebuild(self, exc) -> bool:
-        """After ``exc``: drop and rebuild once if it is cache damage (True), else False."""
-        if self.rebuilt or not is_cache_damage(exc):
-            return False
-        drop_cached(self.module)
-        self.notes.append(f"the compiled-driver cache of this problem was damaged ({type(exc).__name__}): dropped and "
-                          "rebuilt")
-        self.module = self._build()
-        self.rebuilt = True
-        return True
-
-
-def drop_cached(module) -> None:
-    """Remove a driver's files (its source and numba's cache of it) and forget it in this process."""
-    sys.modules.pop(module.__name__, None)
-    path = getattr(module, "__file__", None)
-    if path:
-        _drop_files(module.__name__, Path(path))
 
 
 _HEADER_COMPILED = """\

@@ -256,8 +256,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
     try:
-        driver = Driver(lambda: build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
-                                             compiled=jit, notes=cache_notes), cache_notes, compiled=jit)
+        driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
+                                     compiled=jit, notes=cache_notes), compiled=jit)
     except Exception as exc:
         import numba
 
@@ -345,10 +345,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         partial = _trajectory(times, OUT, state, events, method, good)
         state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
         if code == 6 or " raised " in blame:  # a user function raised (compiled: the engine stopped at once)
-            err = uf.UserFunctionError(f"simulate: particle {i}: a user function raised in the step from "
-                                       f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept")
-            err.t_reached, err.partial = t_bad, partial
-            raise err
+            raise uf.raised_during_run(f"simulate: particle {i}: a user function raised in the step from "
+                                       f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept",
+                                       t_bad, partial)
         raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
                                f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
     warnings, notes, diagnostics = [], list(frame.notes) + cache_notes, {}
@@ -441,10 +440,8 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
         t = float(np.min(state["TC"]))
         where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
     good = int(np.min(state["IDX"]))
-    err = uf.UserFunctionError(f"simulate: {where}; samples up to there are kept")
-    err.t_reached = float(times[max(good, 1) - 1])
-    err.partial = _trajectory(times, OUT, state, events, method, good)
-    raise err from None
+    raise uf.raised_during_run(f"simulate: {where}; samples up to there are kept", float(times[max(good, 1) - 1]),
+                               _trajectory(times, OUT, state, events, method, good)) from None
 
 
 def _compile_failure(exc, roles, params, r, v, frame):
