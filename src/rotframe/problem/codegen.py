@@ -124,17 +124,28 @@ class Driver:
     """
 
     def __init__(self, module, compiled=True):
-        from rotframe.problem import engine
-
         self.module = module
         self.compiled = compiled
-        if compiled:
-            self.advance, self.start_events, self.energies = engine.ready()
-        else:
+        self.advance = self._entry("advance")
+
+    def _entry(self, name):
+        """The engine's entry point ``name``, compiled when first needed (or its plain Python remake)."""
+        from rotframe.problem import engine
+
+        kernel = getattr(engine, name)
+        if not self.compiled:
             from rotframe.problem.plain import plain
 
-            self.advance, self.start_events, self.energies = (plain(f) for f in (engine.advance, engine.start_events,
-                                                                                  engine.energies))
+            return plain(kernel)
+        return engine.ready(kernel)
+
+    @property
+    def start_events(self):
+        return self._entry("start_events")
+
+    @property
+    def energies(self):
+        return self._entry("energies")
 
     def _own(self, name, stub, signature):
         """The module's function ``name`` (else ``stub``): its address (`rotframe.problem.calls`), or itself in plain Python."""

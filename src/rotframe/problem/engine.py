@@ -410,18 +410,14 @@ SIGNATURES = {
 }
 
 
-_READY = []
+def ready(kernel):
+    """The entry point ``kernel`` compiled for its one signature (loaded from numba's cache after the first time).
 
-
-def ready():
-    """The entry points compiled for their one signature each (loaded from numba's cache after the first time).
-
-    Each is then closed to new compiles: a problem's functions reach it as addresses
-    (`rotframe.problem.calls`), never as a new specialisation.
+    Each is compiled when a run first needs it (a problem without events or potentials never
+    compiles `start_events` or `energies`), then closed to new compiles: a problem's functions
+    reach it as addresses (`rotframe.problem.calls`), never as a new specialisation.
     """
-    if not _READY:
-        for kernel, signature in SIGNATURES.items():
-            kernel.compile(signature)
-            kernel.disable_compile()
-        _READY.append(True)
-    return advance, start_events, energies
+    if not kernel.signatures:
+        kernel.compile(SIGNATURES[kernel])
+        kernel.disable_compile()
+    return kernel
