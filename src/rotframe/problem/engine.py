@@ -47,8 +47,7 @@ from numba import njit, types
 from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients
 from rotframe.numerics.dop853 import dop853_error_norm as _counted_error_norm
-from rotframe.problem.calls import call_event
-from rotframe.problem.calls import RAISED
+from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs, rhs_inlined
 from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM
 
@@ -56,10 +55,9 @@ __all__ = ["advance", "start_events", "energies", "ready"]
 
 A, B, C, E3, E5 = coefficients()
 dop853_error_norm = uncounted(_counted_error_norm)  # Hairer's error norm, as the engine's other kernels compiled
-FACC1 = 1.0 / 0.333   # Hairer's dop853: the step may grow at most by 1/0.333 and shrink by 6
+FACC1 = 1.0 / 0.333  # Hairer's dop853: the step may grow at most by 1/0.333 and shrink by 6
 FACC2 = 1.0 / 6.0
 SAFE = 0.9
-
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 
