@@ -220,16 +220,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         blame = ""
         if torque is not None:  # a torque that turns non-finite at a time: probe it inside the failed step
             dt = hfix if method != "dop853" else (1.0 if int(st["ST"][0]) == 6 else 10.0) * float(H[0])
-            for tp in (t_bad, t_bad + 1e-3 * dt, t_bad + 0.5 * dt, t_bad + dt):
-                try:  # as plain Python the torque may raise where compiled it gave NaN (math.sqrt(-1))
-                    a = np.asarray(uf.plain_function(torque)(tp, *uf.read_only_args((y[0, :3], y[0, 3:])),
-                                                             *params), float)
-                except Exception as exc:  # the user's function, reported in the message
-                    blame = "; " + uf.raised_message("torque", torque, exc, f"at t = {tp:.9g} s")
-                    break
-                if a.shape == (3,) and not np.all(np.isfinite(a)):
-                    blame = f"; torque ({uf.display_name(torque)}) returned {a.tolist()} at t = {tp:.9g} s"
-                    break
+            L_last, q_last = y[0, :3].copy(), y[0, 3:].copy()
+            blame, _ = uf.blame_in_step([("torque", torque, lambda tp: (tp, *uf.read_only_args((L_last, q_last)),
+                                                                         *params), "")], t_bad, dt)
         if int(st["ST"][0]) == 6:  # the torque raised (compiled: the engine stopped at that step)
             raise uf.raised_during_run(f"simulate_body: {blame[2:] or 'the torque raised'} in the step from "
                                        f"t = {t_bad:.9g} s, L = {y[0, :3].tolist()}, q = {y[0, 3:].tolist()}",

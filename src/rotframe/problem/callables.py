@@ -26,7 +26,7 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["raised_during_run", "fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call",
+__all__ = ["blame_in_step", "raised_during_run", "fingerprint", "Unfingerprintable", "cache_key", "plain_function", "display_name", "check_call",
            "check_compilable", "UserFunctionError", "read_only_args", "raised_message", "readonly_view",
            "readonly_array"]
 
@@ -37,6 +37,28 @@ class UserFunctionError(ScenarioError):
     Raised during a run, it carries ``t_reached`` and ``partial`` (the samples up to there), as an
     `rotframe.errors.IntegrationError` does (`raised_during_run`).
     """
+
+
+def blame_in_step(candidates, t: float, dt: float):
+    """Which user function raises or gives a non-finite value near a failed step, called again in plain Python.
+
+    ``candidates``: ``(role, f, args_of, where)``, ``args_of(tp)`` the arguments of ``f`` at time
+    ``tp`` (the last finite state's), ``where`` the state for the message. Each is probed at
+    ``t`` and inside the failed step ``(t, t + dt]`` (a function that fails at a time, not a
+    state, fails only there). Returns ``("; <one line>", raised)``, or ``("", False)`` when none
+    fails.
+    """
+    probes = [t] + [t + s * dt for s in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]
+    for role, f, args_of, where in candidates:
+        for tp in probes:
+            when = f"at t = {tp:.9g} s{where}"
+            try:  # as plain Python a function may raise where compiled it gave NaN (math.sqrt(-1))
+                value = np.asarray(plain_function(f)(*args_of(tp)), dtype=float)
+            except Exception as exc:  # the user's function, reported in the message
+                return "; " + raised_message(role, f, exc, when), True
+            if not np.all(np.isfinite(value)):
+                return f"; {role} ({display_name(f)}) returned {value.tolist()} {when}", False
+    return "", False
 
 
 def raised_during_run(message: str, t_reached: float, partial) -> UserFunctionError:

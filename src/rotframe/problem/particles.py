@@ -126,59 +126,21 @@ def _check_functions(forces, events, params, r, v, t0, labels):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
 
-def _blame(forces, params, t, y, dt, labels):
-    """After a non-finite state: which force gives a non-finite value (or raises) near the last finite state.
+def _blame(functions, params, t, y, dt, labels, frame_roles=()):
+    """After a failed step: which of ``functions`` (forces' accelerations or events, named by ``labels``), called
+    at the last finite state ``y``, or of ``frame_roles`` (omega(t), a0(t)), raises or gives non-finite values.
 
-    The force is probed at the last finite state, at ``t`` and at times inside the failed step
-    ``(t, t + dt]`` (a force that turns NaN at a time, not a state, fails only there). Returns
-    '' when none does.
+    Returns ``(text, raised)`` (`rotframe.problem.callables.blame_in_step`).
     """
     r, v = y[:3].copy(), y[3:6].copy()
-    probes = [t] + [t + f * dt for f in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]
-    for k, f in enumerate(forces):
-        for tp in probes:
-            try:
-                a = np.asarray(uf.plain_function(f.accel)(tp, *uf.read_only_args((r, v)), *params), dtype=float)
-            except Exception as exc:  # the user's function, reported in the message
-                return "; " + uf.raised_message(labels[k], f.accel, exc,
-                                                f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
-            if a.shape == (3,) and not np.all(np.isfinite(a)):
-                return (f"; {labels[k]} ({uf.display_name(f.accel)}) returned {a.tolist()} at t = {tp:.9g} s, "
-                        f"r = {r.tolist()}, v = {v.tolist()}")
-    return ""
+    where = f", r = {r.tolist()}, v = {v.tolist()}"
 
+    def at_state(tp):
+        return (tp, *uf.read_only_args((r, v)), *params)
 
-def _blame_frame(frame, origin, t, dt):
-    """After a failure no force explains: which of omega(t), omega'(t), a0(t) raises or gives non-finite values."""
-    roles = []
-    if frame.kind == "function":
-        roles += list(zip(("omega", "omega_dot"), frame.funcs))
-    if origin.kind == "function":
-        roles.append(("origin_acceleration", origin.funcs[0]))
-    for role, f in roles:
-        for tp in [t] + [t + f_ * dt for f_ in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]:
-            try:
-                value = np.asarray(uf.plain_function(f)(tp), dtype=float)
-            except Exception as exc:  # the user's function, reported in the message
-                return "; " + uf.raised_message(role, f, exc, f"at t = {tp:.9g} s")
-            if not np.all(np.isfinite(value)):
-                return f"; {role} ({uf.display_name(f)}) returned {value.tolist()} at t = {tp:.9g} s"
-    return ""
-
-
-def _blame_events(events, params, t, y, dt):
-    """After an event gave NaN (status 5): which event, probed as plain Python at the last state, raises or gives it."""
-    r, v = y[:3].copy(), y[3:6].copy()
-    for k, g in enumerate(events):
-        for tp in [t] + [t + f * dt for f in (1e-3, 0.1, 0.5, 1.0) if dt > 0.0]:
-            try:
-                value = float(uf.plain_function(g)(tp, *uf.read_only_args((r, v)), *params))
-            except Exception as exc:  # the user's function, reported in the message
-                return "; " + uf.raised_message(f"events[{k}]", g, exc,
-                                                f"at t = {tp:.9g} s, r = {r.tolist()}, v = {v.tolist()}")
-            if not np.isfinite(value):
-                return f"; events[{k}] ({uf.display_name(g)}) returned {value} at t = {tp:.9g} s"
-    return ""
+    candidates = [(labels[k], f, at_state, where) for k, f in enumerate(functions)]
+    candidates += [(role, f, lambda tp: (tp,), "") for role, f in frame_roles]
+    return uf.blame_in_step(candidates, t, dt)
 
 
 def _scales(r, v, duration, rtol, atol, D):
@@ -264,7 +226,6 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if isinstance(exc, numba.core.errors.NumbaError):
             _compile_failure(exc, roles, params, r[0], v[0], frame)
         raise
-    compile_s = time.perf_counter() - t0
     fns = driver.functions()
     prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None),
                          flatten_params(params), frame, origin)
@@ -338,13 +299,13 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         code = int(state["ST"][i])
         dt_failed = hfix if method != "dop853" else (10.0 if code in (3, 4) else 1.0) * float(state["H"][i])
         if code == 5:
-            blame = _blame_events(events, params, t_bad, y[i], dt_failed)
+            blame, raised = _blame(events, params, t_bad, y[i], dt_failed, [f"events[{k}]" for k in range(len(events))])
         else:
-            blame = _blame(forces, params, t_bad, y[i], dt_failed, labels) or _blame_frame(frame, origin, t_bad,
-                                                                                           dt_failed)
+            blame, raised = _blame([f.accel for f in forces], params, t_bad, y[i], dt_failed, labels,
+                                   _roles(frame, origin, [], [], []))
         partial = _trajectory(times, OUT, state, events, method, good)
         state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
-        if code == 6 or " raised " in blame:  # a user function raised (compiled: the engine stopped at once)
+        if code == 6 or raised:  # a user function raised (compiled: the engine stopped at once)
             raise uf.raised_during_run(f"simulate: particle {i}: a user function raised in the step from "
                                        f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept",
                                        t_bad, partial)
@@ -427,7 +388,7 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
                 advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
-                blame = _blame(forces, params, t, yi, dt, labels)
+                blame = _blame([f.accel for f in forces], params, t, yi, dt, labels)[0]
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
                 state["TC"][i] = t
