@@ -128,7 +128,6 @@ class KernelSetup:
             self.sps = 0
             self.h = 0.0
             self.tableau = coefficients()
-            self.h0 = dt / 10.0
             # a steady model without events runs the specialised driver (bitwise the same results,
             # three compiled functions instead of fourteen): rotframe.particles.dop853_steady
             if is_steady_model(model, self.events, self.P):
@@ -174,12 +173,12 @@ class KernelSetup:
             return None, None, None, None, None, evb.max_events
         return evb.args()
 
-    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, h0=None, t0=None,
+    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, t0=None,
              sps=None, times=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
-        the events; ``atol``, ``h_state`` (N,) and ``h0`` are DOP853's. Returns
+        the events; ``atol`` and ``h_state`` (N,) are DOP853's. Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
         of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
@@ -215,7 +214,7 @@ class KernelSetup:
 
             n_done, bad, nfev, steps = run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
             return n_done, bad, nfev, k * n_done
-        h0 = self.h0 if h0 is None else h0
+        span = self.duration  # the starting step's bound: the whole run, however it is cut into calls
         end = first + 1 + max(count, 1)
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
         steady = self.steady_args is not None
@@ -230,13 +229,13 @@ class KernelSetup:
             q, tab = self.steady_args
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, start, times, q, self.rtol, atol, h0, tab, np.empty((31, 6)), out_r, out_v,
+                return kernel(r, v, start, times, q, self.rtol, atol, span, tab, np.empty((32, 6)), out_r, out_v,
                               h_state)
         else:
             A, B, C, E3, E5 = self.tableau
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, h0, A, B, C,
+                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span, A, B, C,
                               E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
                               h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
         return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))

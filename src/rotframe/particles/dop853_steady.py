@@ -31,11 +31,13 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_internal, jit_kernel
 from rotframe.numerics.dop853 import coefficients
+from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
 
 __all__ = ["is_steady_model", "steady_parameters", "steady_tableau", "run_dop853_steady", "STEADY_TERMS"]
 
-# The force (rotframe.particles.forces.state_acceleration, its string constraint included), the error norm
-# (rotframe.numerics.dop853.dop853_error_norm), the step-size control and the sample steps of the general
+# The step-size control and the starting step are the shared ones (rotframe.numerics.step_control). The force
+# (rotframe.particles.forces.state_acceleration, its string constraint included), the error norm
+# (rotframe.numerics.dop853.dop853_error_norm) and the sample steps of the general
 # driver (rotframe.particles.drivers.run_dop853) are written in place below, in the same order, rather than
 # shared: calling the general force compiles the packed model and its helpers (what this driver exists to
 # avoid), and sharing the others by numba's IR inlining (numerics.compiled.inlined) made a first run's
@@ -166,12 +168,12 @@ def _step(y, h, q, tab, K, y_new, tmp):
 
 
 @jit_kernel
-def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_r, out_v, h_state):
+def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, tab, work, out_r, out_v, h_state):
     """Adaptive DOP853 for an ensemble under a steady model (see the module docstring).
 
     Parameters and results as `rotframe.particles.drivers.run_dop853`, with
     ``q`` from `steady_parameters`, ``tab`` from `steady_tableau` and
-    ``work`` (31, 6) scratch from the caller. There are no events, so every
+    ``work`` (32, 6) scratch from the caller. There are no events, so every
     particle stays alive. Returns ``(n_done, bad, nfev, steps)`` (cost of particle 0).
     """
     n = r.shape[0]
@@ -183,6 +185,9 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_
     yt = work[28]
     tmp = work[29]
     f0 = work[30]
+    atol_vec = work[31]
+    for j in range(6):
+        atol_vec[j] = atol
     nfev0 = 0
     steps0 = 0
     n_done = n_out
@@ -194,11 +199,18 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_
             y[3 + i] = v[p, i]
         t = t0
         h = h_state[p]
-        if h <= 0.0:
-            h = h0
         ax, ay, az = _acceleration(y[0], y[1], y[2], y[3], y[4], y[5], q)
         f0[0], f0[1], f0[2], f0[3], f0[4], f0[5] = y[3], y[4], y[5], ax, ay, az
         nf = 1
+        if h <= 0.0:  # Hairer's starting step (numerics.step_control), one more evaluation at its trial step
+            h0 = first_step_trial(y, f0, rtol, atol_vec, span)
+            for j in range(6):
+                tmp[j] = y[j] + h0 * f0[j]
+            ax, ay, az = _acceleration(tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5], q)
+            K[1, 0], K[1, 1], K[1, 2], K[1, 3], K[1, 4], K[1, 5] = tmp[3], tmp[4], tmp[5], ax, ay, az
+            h = first_step(y, f0, K[1], h0, rtol, atol_vec, span)
+            nf += 1
+        rejected = False
         k_out = 0
         while k_out < n_out and sample_times[k_out] <= t:
             for i in range(3):
@@ -216,9 +228,8 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_
                 truncated = t + h > t_end
                 if truncated:
                     h = t_end - t
-                min_h = 10.0 * (np.nextafter(t, np.inf) - t)
-                if h < min_h:
-                    if t_end - t < min_h:
+                if step_collapsed(h, t):
+                    if step_collapsed(t_end - t, t):
                         at_end = True  # within a few ulp of the end (see run_dop853)
                         h = h_ctrl
                     else:
@@ -248,20 +259,10 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, h0, tab, work, out_
                     err = 0.0
                 else:
                     err = (h if h >= 0.0 else -h) * e5 / math.sqrt((e5 + 0.01 * e3) * 6)
-                if not math.isfinite(err):
-                    h *= 0.2
-                    continue
-                if err < 1.0:
-                    fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
-                    if fac > 10.0:
-                        fac = 10.0
-                    accepted = True
-                else:
-                    fac = 0.9 * err ** (-1.0 / 8.0)
-                    if fac < 0.2:
-                        fac = 0.2
+                accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
+                rejected = not accepted
                 h_used = h
-                h = h * fac
+                h = h_next
             if failed:
                 break
             if at_end:

@@ -17,6 +17,7 @@ from numba import njit
 
 from rotframe.numerics.compiled import inlined
 from rotframe.numerics.dop853 import dop853_error_norm
+from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
 from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
@@ -231,7 +232,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 
 @jit_kernel
-def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C, E3, E5,
+def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, B, C, E3, E5,
                events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state, K, Kt, rows):
     """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
 
@@ -240,7 +241,9 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
     step is computed by one extra DOP853 step of the right length from the
     step's start (an interpolant of the same order as the method). Events are
     located the same way, by bisection on the length of that extra step.
-    ``h_state`` (N,) carries each particle's step size between calls.
+    ``h_state`` (N,) carries each particle's step size between calls; where it is 0, the
+    particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the
+    same in every call, so that the steps do not depend on how the run is cut into calls).
     ``events`` None (no event table) prunes the event code at compile time,
     as in `run_fixed`; so does ``wt`` None (a steady rotation rate).
     ``K``, ``Kt`` (13, 6) and ``rows`` (5, 6) are work arrays from the caller (a
@@ -268,13 +271,23 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
             y[3 + i] = v[p, i]
         t = t0
         h = h_state[p]
-        if h <= 0.0:
-            h = h0
         is_alive = alive[p]
         w, wd = rates(t, m.steady, m.w, wt, wv)
         ax, ay, az = state_acceleration(as_state(y), m, w, wd)
         f0 = (y[3], y[4], y[5], ax, ay, az)
         nf = 1
+        if h <= 0.0:  # Hairer's starting step (numerics.step_control), one more evaluation at its trial step
+            for j in range(6):
+                K[0, j] = f0[j]
+            h0 = first_step_trial(y, K[0], rtol, atol_vec, span)
+            for j in range(6):
+                yt[j] = y[j] + h0 * f0[j]
+            w1, wd1 = rates(t + h0, m.steady, m.w, wt, wv)
+            ax, ay, az = state_acceleration(as_state(yt), m, w1, wd1)
+            K[1, 0], K[1, 1], K[1, 2], K[1, 3], K[1, 4], K[1, 5] = yt[3], yt[4], yt[5], ax, ay, az
+            h = first_step(y, K[0], K[1], h0, rtol, atol_vec, span)
+            nf += 1
+        rejected = False
         if events is not None:
             for e in range(n_ev):
                 g_old[e] = start_value(events, e, as_state(y), m, w, wd)
@@ -293,9 +306,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 truncated = t + h > t_end
                 if truncated:
                     h = t_end - t
-                min_h = 10.0 * (np.nextafter(t, np.inf) - t)  # > 0 for a finite t
-                if h < min_h:
-                    if t_end - t < min_h:
+                if step_collapsed(h, t):
+                    if step_collapsed(t_end - t, t):
                         # the steps summed to within a few ulp of the end: it is reached (the state
                         # is off by |f| * 10 ulp(t), far below any tolerance); not a collapsed step
                         at_end = True
@@ -306,20 +318,10 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, h0, A, B, C
                 dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
                 nf += 12
                 err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
-                if not math.isfinite(err):
-                    h *= 0.2
-                    continue
-                if err < 1.0:
-                    fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
-                    if fac > 10.0:  # min(10, ...) as a comparison: no overload to compile
-                        fac = 10.0
-                    accepted = True
-                else:
-                    fac = 0.9 * err ** (-1.0 / 8.0)
-                    if fac < 0.2:
-                        fac = 0.2
+                accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
+                rejected = not accepted
                 h_used = h
-                h = h * fac
+                h = h_next
             if failed:
                 break
             if at_end:

@@ -6,10 +6,9 @@ hands them the addresses of its own compiled functions (`rotframe.problem.calls`
 as the `rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
 functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
 
-* DOP853: Hairer's step control (dop853.f: safety 0.9, growth at most 1/0.333, shrink at
-  most 6, no growth right after a rejection) and starting step (hinit); a step never passes
-  the next sample time, so every sample is a step's end. Tableau and error norm:
-  `rotframe.numerics.dop853`.
+* DOP853: Hairer's step control and starting step (hinit), written once for every DOP853 loop in
+  `rotframe.numerics.step_control`; a step never passes the next sample time, so every sample is
+  a step's end. Tableau and error norm: `rotframe.numerics.dop853`.
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
   ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
@@ -47,6 +46,8 @@ from numba import njit, types
 from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients
 from rotframe.numerics.dop853 import dop853_error_norm as _counted_error_norm
+from rotframe.numerics import step_control
+from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs, rhs_inlined
 from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM
@@ -54,10 +55,10 @@ from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I
 __all__ = ["advance", "start_events", "energies", "ready"]
 
 A, B, C, E3, E5 = coefficients()
-dop853_error_norm = uncounted(_counted_error_norm)  # Hairer's error norm, as the engine's other kernels compiled
-FACC1 = 1.0 / 0.333  # Hairer's dop853: the step may grow at most by 1/0.333 and shrink by 6
-FACC2 = 1.0 / 6.0
-SAFE = 0.9
+# the shared kernels that take arrays, compiled as the engine's own (without reference counts)
+dop853_error_norm = uncounted(_counted_error_norm)
+first_step_trial = uncounted(step_control.first_step_trial)
+first_step_final = uncounted(step_control.first_step)
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 
@@ -122,29 +123,12 @@ def all_finite(y):
 
 @jit_uncounted
 def first_step(t, y, K, yt, rtol, atol, prob, fns, W, span):
-    """Hairer's starting step (hinit of dop853.f, order 8), K[0] = f(t, y) given."""
-    D = y.shape[0]
-    d0 = 0.0
-    d1 = 0.0
-    for j in range(D):
-        sc = atol[j] + rtol * abs(y[j])
-        d0 += (y[j] / sc) ** 2
-        d1 += (K[0, j] / sc) ** 2
-    d0 = math.sqrt(d0 / D)
-    d1 = math.sqrt(d1 / D)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, span)
-    for j in range(D):
+    """Hairer's starting step (`rotframe.numerics.step_control`), K[0] = f(t, y) given; K[1] = f at the trial step."""
+    h0 = first_step_trial(y, K[0], rtol, atol, span)
+    for j in range(y.shape[0]):
         yt[j] = y[j] + h0 * K[0, j]
     rhs(t + h0, yt, K[1], prob, fns, W)
-    d2 = 0.0
-    for j in range(D):
-        sc = atol[j] + rtol * abs(y[j])
-        d2 += ((K[1, j] - K[0, j]) / sc) ** 2
-    d2 = math.sqrt(d2 / D) / h0
-    big = max(d1, d2)
-    h1 = max(1e-6, h0 * 1e-3) if big <= 1e-15 else (0.01 / big) ** 0.125
-    return min(100.0 * h0, h1, span)
+    return first_step_final(y, K[0], K[1], h0, rtol, atol, span)
 
 
 @jit_inline
@@ -258,21 +242,18 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             status = 6
             break
         ok = all_finite(yn)
-        err = 0.0
+        h_next = h
         if method == DOP853:
-            err = dop853_error_norm(K, hh, y, yn, rtol, atol, E3, E5)
-            ok = ok and math.isfinite(err)
-        if method == DOP853 and (not ok or err > 1.0):
-            if ok:
-                fac11 = err ** 0.125
-                h = hh / min(FACC1, fac11 / SAFE)
-            else:
-                h = hh * 0.1
-            rejected = True
-            if h < 1e-14 * abs(t) or h < 1e-290:  # below round-off of t (the run's span has no say in that)
-                status = 4 if ok else 3
-                break
-            continue
+            err = dop853_error_norm(K, hh, y, yn, rtol, atol, E3, E5) if ok else math.nan
+            ok = math.isfinite(err)
+            accepted, h_next = next_step(hh, h, err, rejected)
+            if not accepted:
+                h = h_next
+                rejected = True
+                if step_collapsed(h, t):
+                    status = 4 if ok else 3
+                    break
+                continue
         if not ok:
             status = 3
             break
@@ -331,13 +312,8 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             status = 2
             break
         if method == DOP853:
-            fac11 = err ** 0.125
-            fac = max(FACC2, min(FACC1, fac11 / SAFE))
-            h_next = hh / fac
-            if rejected:
-                h_next = min(h_next, hh)
+            h = h_next
             rejected = False
-            h = h_next if not (landing and hh < h) else max(h, h_next)
             for j in range(D):
                 K[0, j] = K[12, j]
         t = t_new

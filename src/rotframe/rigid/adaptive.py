@@ -9,9 +9,9 @@ torque of a heavy symmetric top ``mgl (z_b[1], -z_b[0], 0)``, a constant body
 torque and a constant space torque turned into body axes with ``q/|q|``.
 
 The method is Hairer's DOP853 (Hairer, Norsett & Wanner, Solving ODEs I,
-II.10): 12 stages, the combined 5th/3rd-order error estimate, step-size
-control ``0.9 err^(-1/8)`` within ``[0.2, 10]``, the first step chosen as in
-Hairer's code (II.4), and the 7th-order dense output (3 extra stages, only in
+II.10): 12 stages, the combined 5th/3rd-order error estimate, Hairer's step-size
+control and first step (II.4), shared by every DOP853 loop of rotframe
+(`rotframe.numerics.step_control`), and the 7th-order dense output (3 extra stages, only in
 steps that hold an output time) for samples between steps. Tolerances are
 relative: component ``j`` is scaled by ``atol_j + rtol max(|y_j|, |y_new_j|)``
 with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
@@ -33,7 +33,9 @@ import functools
 import math
 
 import numpy as np
+from rotframe.numerics import step_control
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.numerics.dop853_dense import dense_tables
 from rotframe.rigid.kernels import euler_rates
 
@@ -92,12 +94,14 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
     nb0, nb1, nb2, ns0, ns1, ns2 = p[4], p[5], p[6], p[7], p[8], p[9]
     nfev = 0
     steps = 0
+    rejected = False
     while t < t_end:
         # a step cut to end at t_end lands on it exactly (t + (t_end - t) can round to an ulp short)
+        h_ctrl = h
         clipped = t + h >= t_end
         if clipped:
             h = t_end - t
-        if h < 10.0 * abs(math.nextafter(t, math.inf) - t):
+        if step_collapsed(h, t):
             return k_out, nfev, steps
         t_new = t_end if clipped else t + h
         dense = False
@@ -108,7 +112,7 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
                     y_new[j] = tmp[j]
                 err = _error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
                 # the 7th-order dense output needs stages 13..15, when the step holds a sample
-                if not (err < 1.0 and k_out < n_out and times[k_out] < t_new):
+                if not (err <= 1.0 and k_out < n_out and times[k_out] < t_new):
                     break
                 nfev += 3
                 dense = True
@@ -120,12 +124,10 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
             K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
                 tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5], tmp[6], i0, i1, i2, mgl, nb0, nb1, nb2,
                 ns0, ns1, ns2)
-        if not math.isfinite(err):
-            h *= 0.2
-            continue
-        if err >= 1.0:
-            fac = 0.9 * err ** (-1.0 / 8.0)
-            h *= fac if fac > 0.2 else 0.2  # max(0.2, fac)
+        accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
+        rejected = not accepted
+        if not accepted:
+            h = h_next
             continue
         steps += 1
         if dense:  # the interpolant's coefficients (Hairer's dense output)
@@ -166,45 +168,23 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
         t = t_new
         if not finite:
             return k_out - 1, nfev, steps
-        fac = 10.0 if err == 0.0 else 0.9 * err ** (-1.0 / 8.0)
-        h *= fac if fac < 10.0 else 10.0  # min(10, fac)
-        h = h_max if h_max < h else h  # min(h, h_max)
+        h = h_max if h_max < h_next else h_next  # min(h_next, h_max)
     return k_out, nfev, steps
 
 
-def _first_step(y, K, p, t_span, atol_L, atol_q, rtol, h_max):
-    """``K[0] = f(y)`` and the first step (Hairer, II.4), with one more evaluation into ``K[1]``.
+def _first_step(y, K, p, h_max, atol_vec, rtol):
+    """``K[0] = f(y)`` and Hairer's starting step (`rotframe.numerics.step_control`), ``K[1]`` f at its trial step.
 
-    Scalar arithmetic in the order of Hairer's code (float64 throughout, as in a
-    compiled kernel). Returns the step ``h``.
+    The shared functions run as Python here (a few microseconds; numpy float64 scalars, the
+    same IEEE double operations as compiled, x / 0 giving inf or nan). Returns the step ``h``.
     """
     args = p.tolist()
-    f0 = euler_rates(*y, *args)
-    K[0] = f0
-    d0 = d1 = 0.0
-    sc = [(atol_L if j < 3 else atol_q) + rtol * abs(y[j]) for j in range(7)]
-    for j in range(7):
-        a, b = y[j] / sc[j], f0[j] / sc[j]
-        d0 += a * a
-        d1 += b * b
-    d0 = math.sqrt(d0 / 7)
-    d1 = math.sqrt(d1 / 7)
-    h = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h = min(h, abs(t_span))
-    f1 = euler_rates(*(y[j] + h * f0[j] for j in range(7)), *args)
-    K[1] = f1
-    if h == 0.0:  # a run of one sample: no step (min(100 h, h1, h_max) below is 0 whatever h1 is)
-        return 0.0
-    d2 = 0.0
-    for j in range(7):
-        c = (f1[j] - f0[j]) / sc[j]
-        d2 += c * c
-    d2 = math.sqrt(d2 / 7) / h
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100 * h, h1, h_max)
+    with np.errstate(all="ignore"):
+        y = np.asarray(y, dtype=np.float64)
+        K[0] = euler_rates(*y.tolist(), *args)
+        h0 = step_control.first_step_trial.py_func(y, K[0], rtol, atol_vec, h_max)
+        K[1] = euler_rates(*(y + h0 * K[0]).tolist(), *args)
+        return step_control.first_step.py_func(y, K[0], K[1], h0, rtol, atol_vec, h_max)
 
 
 def steps_estimate(inertia, L0, duration, rtol, mgl=0.0):
@@ -264,11 +244,7 @@ def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
     out_q[0] = [v / n for v in y[3:]]
     K = np.empty((16, 7))
     t_span = float(times[n_out - 1] - times[0])
-    try:
-        h = _first_step(y, K, p, t_span, atol_L, atol, rtol, h_max)
-    except ZeroDivisionError:  # atol = 0 or a non-finite rate: float64 scalars, whose x / 0 is inf or nan
-        with np.errstate(all="ignore"):
-            h = _first_step([np.float64(v) for v in y], K, p, t_span, np.float64(atol_L), atol, rtol, h_max)
+    h = _first_step(y, K, p, min(abs(t_span), h_max), atol_vec, rtol)
     A, E3, E5, D = _tableau()
     done, nfev, steps = _steps(np.array(y), K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D,
                                out_L, out_q, np.empty(7), np.empty(7), np.empty((7, 7)))

@@ -28,6 +28,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from rotframe.numerics.step_control import first_step, first_step_trial, next_step
+
 __all__ = ["serial", "parallel", "dop853_serial", "dop853_parallel", "rotation_cos_sin", "KINDS"]
 
 _inl = njit(inline="always", error_model="numpy")
@@ -179,20 +181,31 @@ def _dop_stage_f(y, g, w, K, s):
 
 
 @_inl
-def _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground):
-    """One particle by DOP853 from 0 to T (or its ground crossing); its accepted steps."""
+def _dop_particle(r, v, p, g, w, tab, rtol, atol, T, ground):
+    """One particle by DOP853 from 0 to T (or its ground crossing); its accepted steps.
+
+    rotframe's step control and starting step (`rotframe.numerics.step_control`, a few scalar
+    operations each), so that it takes the same steps as the drivers it bounds.
+    """
     K = np.empty((13, 6))
     y = np.empty(6)
     y_new = np.empty(6)
     tmp = np.empty(6)
+    atol_vec = np.full(6, atol)
     for i in range(3):
         y[i] = r[p, i]
         y[3 + i] = v[p, i]
     _dop_stage_f(y, g, w, K, 0)
+    h0 = first_step_trial(y, K[0], rtol, atol_vec, T)
+    for j in range(6):
+        tmp[j] = y[j] + h0 * K[0, j]
+    _dop_stage_f(tmp, g, w, K, 1)
+    h = first_step(y, K[0], K[1], h0, rtol, atol_vec, T)
     t = 0.0
-    h = h0
     steps = 0
+    rejected = False
     while t < T:
+        h_ctrl = h
         truncated = t + h > T
         if truncated:
             h = T - t
@@ -220,8 +233,9 @@ def _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground):
             e5 += (s5 / sc) ** 2
             e3 += (s3 / sc) ** 2
         err = 0.0 if e5 == 0.0 and e3 == 0.0 else abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 6)
-        if err < 1.0:
-            fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
+        accepted, h_next = next_step(h, h_ctrl, err, rejected)
+        rejected = not accepted
+        if accepted:
             z_old = y[2]
             t = T if truncated else t + h
             steps += 1
@@ -230,9 +244,7 @@ def _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground):
                 K[0, j] = K[12, j]
             if ground and z_old > 0.0 and y[2] <= 0.0:
                 break
-        else:
-            fac = max(0.2, 0.9 * err ** (-1.0 / 8.0))
-        h *= fac
+        h = h_next
     for i in range(3):
         r[p, i] = y[i]
         v[p, i] = y[3 + i]
@@ -240,14 +252,14 @@ def _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground):
 
 
 @njit(cache=True, error_model="numpy")
-def dop853_serial(r, v, g, w, tab, rtol, atol, h0, T, ground, steps):
+def dop853_serial(r, v, g, w, tab, rtol, atol, T, ground, steps):
     """All particles by DOP853 on one core; ``steps`` (N,) receives each one's accepted steps."""
     for p in range(r.shape[0]):
-        steps[p] = _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground)
+        steps[p] = _dop_particle(r, v, p, g, w, tab, rtol, atol, T, ground)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def dop853_parallel(r, v, g, w, tab, rtol, atol, h0, T, ground, steps):
+def dop853_parallel(r, v, g, w, tab, rtol, atol, T, ground, steps):
     """`dop853_serial` with ``prange`` over particles."""
     for p in prange(r.shape[0]):
-        steps[p] = _dop_particle(r, v, p, g, w, tab, rtol, atol, h0, T, ground)
+        steps[p] = _dop_particle(r, v, p, g, w, tab, rtol, atol, T, ground)

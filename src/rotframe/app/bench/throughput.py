@@ -160,7 +160,7 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
 
         with threads_scope(threads if threads is not None else threads_in_force()):
             # DOP853 with the event: the ensemble's own call with one sample (an ensemble this small asks
-            # for 16, and DOP853's first step is a tenth of the sample interval: other steps than the ceiling's)
+            # for 16, and each sample is landed on: other steps than the ceiling's)
             traj = integrate_particles(model, r0, v0, duration, method=method, step=h or None, rtol=rtol,
                                        atol=atol, samples=1, events=[ground] if event else (), max_events=1,
                                        records=True)
@@ -175,7 +175,7 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
         def hand(fn):
             def go(k=n):
                 r, v = r0[:k].copy(), v0[:k].copy()
-                fn(r, v, g, w, tab, rtol, atol, duration / 10.0, duration, event, hand_steps[:k])
+                fn(r, v, g, w, tab, rtol, atol, duration, event, hand_steps[:k])
                 return r, v
             return go
         serial, parallel = hand(ceiling.dop853_serial), hand(ceiling.dop853_parallel)

@@ -1,0 +1,136 @@
+"""DOP853's step-size control and starting step, written once for every DOP853 loop of rotframe.
+
+Hairer's rules, as in ``dop853.f`` (Hairer, Norsett & Wanner, *Solving Ordinary Differential
+Equations I*, 2nd ed., II.4 and II.10; docs/physics/dop853.md), with the code's defaults
+(``safe = 0.9``, ``fac1 = 0.333``, ``fac2 = 6``, ``beta = 0``):
+
+* a step whose error norm ``err`` (`rotframe.numerics.dop853.dop853_error_norm`) is at most 1
+  is accepted, and the next one is ``h / fac`` with ``fac = err^(1/8) / 0.9`` held within
+  ``[1/6, 1/0.333]``: it grows at most 6 times and shrinks at most 3.003 times;
+* right after a rejection the step does not grow;
+* a rejected step is tried again with ``h / min(1/0.333, err^(1/8) / 0.9)``;
+* a step that gave a non-finite state (an overflow: far too long a step) is tried again 10 times
+  shorter (``dop853.f`` leaves this case undefined);
+* a step cut short to land on a sample or a knot (``h < h_ctrl``, the controller's own) hands the
+  controller's step on, not one made from the short step's error (``dop853.f`` lands only on the
+  end of the run; here the loops land on every sample, so this keeps the steps those of the
+  controller);
+* the starting step is Hairer's ``hinit`` of order 8: an explicit Euler trial step from the
+  sizes of ``y`` and ``f(y)``, then the step at which the second derivative, estimated from
+  one more evaluation, keeps the local error at the tolerance.
+
+The particle scenes (`rotframe.particles.drivers`, `rotframe.particles.dop853_steady`), the
+rigid bodies (`rotframe.rigid.adaptive`) and the engine of your own problems
+(`rotframe.problem.engine`) all call these functions: one controller, so a method named
+``dop853`` takes the same steps whatever runs it. ``tests/test_step_control.py`` checks them
+against the rules above written out independently.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rotframe.numerics.compiled import jit_internal
+
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "SAFE", "FACC1", "FACC2",
+           "NONFINITE_SHRINK"]
+
+SAFE = 0.9  # dop853.f's safety factor
+FACC1 = 1.0 / 0.333  # the most a step shrinks after an error estimate (1 / fac1)
+FACC2 = 1.0 / 6.0  # 1 / fac2: the most a step grows is 6 times
+NONFINITE_SHRINK = 0.1  # a step that gave a non-finite state is tried again this much shorter
+
+
+@jit_internal
+def next_step(h, h_ctrl, err, rejected):
+    """Whether a step of length ``h`` with error norm ``err`` is accepted, and the next step to try.
+
+    Parameters
+    ----------
+    h : float
+        The step just taken (s).
+    h_ctrl : float
+        The controller's step before it was cut to land on a target (``h <= h_ctrl``; ``h`` where
+        it was not cut).
+    err : float
+        Hairer's error norm of the step (1 is the tolerance); non-finite for a non-finite state.
+    rejected : bool
+        Whether the try before this one was rejected (then the step does not grow).
+
+    Returns
+    -------
+    (accepted, h_next) : (bool, float)
+    """
+    if not math.isfinite(err):
+        return False, h * NONFINITE_SHRINK
+    fac = err ** 0.125 / SAFE
+    if fac > FACC1:  # comparisons, not min/max: no overloads to compile
+        fac = FACC1
+    if err > 1.0:
+        return False, h / fac
+    if fac < FACC2:
+        fac = FACC2
+    h_next = h / fac
+    if rejected and h_next > h:
+        h_next = h
+    if h < h_ctrl and h_next < h_ctrl:  # a step cut to land: go on with the controller's
+        h_next = h_ctrl
+    return True, h_next
+
+
+@jit_internal
+def step_collapsed(h, t):
+    """Whether a step ``h`` from time ``t`` is below round-off: under 10 units in the last place of ``t``."""
+    return h < 10.0 * (math.nextafter(abs(t), math.inf) - abs(t))
+
+
+@jit_internal
+def first_step_trial(y, f0, rtol, atol, h_max):
+    """Hairer's starting step, first part: the explicit Euler trial step ``h0`` (at most ``h_max``).
+
+    ``y``, ``f0 = f(t, y)`` and ``atol`` (one per component) of length n; the scale of component
+    j is ``atol[j] + rtol |y[j]|``. The caller evaluates ``f1 = f(t + h0, y + h0 f0)`` and
+    passes it to `first_step`.
+    """
+    n = y.shape[0]
+    d0 = 0.0
+    d1 = 0.0
+    for j in range(n):
+        sc = atol[j] + rtol * abs(y[j])
+        a = y[j] / sc
+        b = f0[j] / sc
+        d0 += a * a
+        d1 += b * b
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    return h0 if h0 < h_max else h_max
+
+
+@jit_internal
+def first_step(y, f0, f1, h0, rtol, atol, h_max):
+    """Hairer's starting step of order 8 from the trial step ``h0`` of `first_step_trial` and ``f1`` there.
+
+    Returns ``min(100 h0, h1, h_max)`` with ``h1 = (0.01 / max(|f0|, |f1 - f0| / h0))^(1/8)`` in
+    the scaled norm (``max(1e-6, 1e-3 h0)`` where both are below 1e-15); 0 when ``h0`` is 0 (a
+    run of no length).
+    """
+    if h0 == 0.0:
+        return 0.0
+    n = y.shape[0]
+    d1 = 0.0
+    d2 = 0.0
+    for j in range(n):
+        sc = atol[j] + rtol * abs(y[j])
+        b = f0[j] / sc
+        c = (f1[j] - f0[j]) / sc
+        d1 += b * b
+        d2 += c * c
+    d1 = math.sqrt(d1 / n)
+    d2 = math.sqrt(d2 / n) / h0
+    big = d1 if d1 > d2 else d2
+    h1 = (1e-6 if 1e-6 > h0 * 1e-3 else h0 * 1e-3) if big <= 1e-15 else (0.01 / big) ** 0.125
+    h = 100.0 * h0
+    if h1 < h:
+        h = h1
+    return h if h < h_max else h_max

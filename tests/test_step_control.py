@@ -1,0 +1,254 @@
+"""One DOP853 step controller and starting step for every loop (rotframe.numerics.step_control).
+
+The oracles are written here, apart from the code they check: Hairer's rules (dop853.f's defaults,
+docs/physics/dop853.md) as formulas, his starting step (II.4) in numpy with RMS norms (and scipy's
+own ``select_initial_step`` where it is importable), and a plain-Python DOP853 loop over the
+tableau with that control. The loops of rotframe (the particle scenes, the engine of your own
+problems, the rigid body, the bench's hand-written ceiling) must take exactly the steps of that
+loop on the same problem.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from rotframe.numerics import step_control as sc
+from rotframe.numerics.dop853 import coefficients
+
+next_step = sc.next_step.py_func
+first_step_trial = sc.first_step_trial.py_func
+first_step = sc.first_step.py_func
+
+errs = st.floats(min_value=0.0, max_value=1e12, allow_nan=False)
+steps = st.floats(min_value=1e-6, max_value=1e6)
+
+
+# ---------------------------------------------------------------- the rules
+
+
+@given(h=steps, err=errs)
+def test_an_error_at_most_one_is_accepted_and_the_step_scaled_within_a_sixth_and_three(h, err):
+    accepted, h_next = next_step(h, h, err, False)
+    assert accepted == (err <= 1.0)
+    ratio = 0.9 * err ** (-1.0 / 8.0) if err > 0.0 else math.inf
+    if accepted:
+        expected = min(6.0, max(0.333, ratio))
+    else:
+        expected = max(0.333, ratio)
+    assert h_next == pytest.approx(h * expected, rel=1e-12)
+
+
+def test_the_bounds_themselves():
+    assert next_step(1.0, 1.0, 0.0, False) == (True, pytest.approx(6.0, rel=1e-15))  # growth at most 6
+    assert next_step(1.0, 1.0, 1e30, False) == (False, pytest.approx(0.333, rel=1e-15))  # shrink at most 3.003
+    assert next_step(1.0, 1.0, 1.0, False) == (True, pytest.approx(0.9, rel=1e-15))  # the safety factor
+    assert next_step(2.0, 2.0, 2.0 ** 8, False) == (False, pytest.approx(2.0 * 0.9 / 2.0, rel=1e-14))
+
+
+@given(h=steps, err=st.floats(min_value=0.0, max_value=1.0))
+def test_no_growth_right_after_a_rejection(h, err):
+    accepted, h_next = next_step(h, h, err, True)
+    assert accepted
+    assert h_next <= h
+    assert h_next == pytest.approx(h * min(1.0, 0.9 * err ** (-1.0 / 8.0)) if err > 0 else h, rel=1e-12)
+
+
+@given(h=steps, cut=st.floats(min_value=1e-6, max_value=0.999), err=st.floats(min_value=0.0, max_value=1.0))
+def test_a_step_cut_to_land_hands_on_the_controllers_step(h, cut, err):
+    accepted, h_next = next_step(h * cut, h, err, False)
+    assert accepted
+    own = h * cut * min(6.0, max(0.333, 0.9 * err ** (-1.0 / 8.0) if err > 0 else 6.0))
+    assert h_next == pytest.approx(max(h, own), rel=1e-12)
+
+
+@pytest.mark.parametrize("err", [math.nan, math.inf, -math.inf])
+def test_a_non_finite_error_is_a_rejection_ten_times_shorter(err):
+    assert next_step(0.5, 0.5, err, False) == (False, pytest.approx(0.05, rel=1e-15))
+
+
+def test_a_collapsed_step_is_under_ten_ulp_of_t():
+    t = 1e6
+    ulp = math.ulp(t)
+    assert sc.step_collapsed.py_func(9.0 * ulp, t)
+    assert not sc.step_collapsed.py_func(11.0 * ulp, t)
+    assert sc.step_collapsed.py_func(9.0 * ulp, -t)  # the same below zero
+
+
+# ---------------------------------------------------------------- the starting step
+
+
+def hinit(f, t, y, rtol, atol, bound):
+    """Hairer's starting step of order 8 (II.4), in numpy with RMS norms: the test's own."""
+    scale = atol + rtol * np.abs(y)
+    rms = lambda x: float(np.sqrt(np.mean(np.square(x))))  # noqa: E731
+    f0 = f(t, y)
+    d0, d1 = rms(y / scale), rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, bound)
+    f1 = f(t + h0, y + h0 * f0)
+    d2 = rms((f1 - f0) / scale) / h0
+    h1 = max(1e-6, 1e-3 * h0) if max(d1, d2) <= 1e-15 else (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, bound)
+
+
+def ours(f, t, y, rtol, atol, bound):
+    f0 = f(t, y)
+    h0 = first_step_trial(y, f0, rtol, atol, bound)
+    return first_step(y, f0, f(t + h0, y + h0 * f0), h0, rtol, atol, bound)
+
+
+def _problems():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        M = rng.normal(size=(5, 5)) * 10.0 ** rng.uniform(-3, 3)
+        y = rng.normal(size=5) * 10.0 ** rng.uniform(-2, 4)
+        yield (lambda t, y, M=M: M @ y + np.sin(t) * y ** 2 * 1e-3), y
+    yield (lambda t, y: np.zeros_like(y)), np.ones(5)  # no motion: the 1e-6 branches
+    yield (lambda t, y: np.full_like(y, 1e-20)), np.zeros(5)
+
+
+@pytest.mark.parametrize("k", range(22))
+def test_the_starting_step_is_hairers(k):
+    f, y = list(_problems())[k]
+    for rtol, bound in ((1e-6, 1e3), (1e-10, 1e3), (1e-8, 1e-4)):
+        atol = np.full(5, rtol * 1e-2)
+        assert ours(f, 0.3, y, rtol, atol, bound) == pytest.approx(hinit(f, 0.3, y, rtol, atol, bound), rel=1e-12)
+
+
+def test_the_starting_step_agrees_with_scipys():
+    common = pytest.importorskip("scipy.integrate._ivp.common")
+    select = getattr(common, "select_initial_step", None)
+    if select is None:
+        pytest.skip("scipy has no select_initial_step here")
+    for f, y in list(_problems())[:20]:
+        try:  # scipy >= 1.12: (fun, t0, y0, t_bound, max_step, f0, direction, order, rtol, atol)
+            theirs = select(f, 0.3, y, 0.3 + 50.0, np.inf, f(0.3, y), 1.0, 7, 1e-8, 1e-10)
+        except TypeError:
+            pytest.skip("scipy's select_initial_step has another signature")
+        assert ours(f, 0.3, y, 1e-8, np.full(5, 1e-10), 50.0) == pytest.approx(theirs, rel=1e-12)
+
+
+def test_a_run_of_no_length_starts_with_no_step():
+    y = np.ones(3)
+    assert first_step(y, y, y, 0.0, 1e-8, np.ones(3), 0.0) == 0.0
+
+
+# ---------------------------------------------------------------- the loops take the oracle's steps
+
+
+def reference_dop853(f, t0, y0, T, rtol, atol):
+    """A plain-Python DOP853 to T with Hairer's control, its own code: (accepted steps, final state)."""
+    A, B, C, E3, E5 = coefficients()
+    atol = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape)
+    h = hinit(f, t0, y0, rtol, atol, T - t0)
+    t, y, k0 = t0, y0.copy(), f(t0, y0)
+    accepted_steps, last_rejected = 0, False
+    while t < T:
+        cut = t + h > T
+        hh = T - t if cut else h
+        K = np.zeros((13, y.size))
+        K[0] = k0
+        for s in range(1, 12):
+            K[s] = f(t + C[s] * hh, y + hh * (A[s, :s] @ K[:s]))
+        y_new = y + hh * (B @ K[:12])
+        K[12] = f(t + hh, y_new)
+        scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
+        e5 = np.sum(((E5 @ K) / scale) ** 2)
+        e3 = np.sum(((E3 @ K) / scale) ** 2)
+        err = 0.0 if e5 == 0.0 and e3 == 0.0 else hh * e5 / math.sqrt((e5 + 0.01 * e3) * y.size)
+        fac11 = err ** 0.125
+        if err <= 1.0:
+            h_new = hh / max(1.0 / 6.0, min(1.0 / 0.333, fac11 / 0.9))
+            if last_rejected:
+                h_new = min(h_new, hh)
+            if hh < h:
+                h_new = max(h_new, h)
+            t, y, k0 = (T if cut else t + hh), y_new, K[12]
+            accepted_steps += 1
+            last_rejected = False
+        else:
+            h_new = hh / min(1.0 / 0.333, fac11 / 0.9)
+            last_rejected = True
+        h = h_new
+    return accepted_steps, y
+
+
+W = np.array([0.0, 0.3, 0.4])
+G = np.array([0.0, 0.0, -9.81])
+R0 = np.array([1.0, 2.0, 1e4])
+V0 = np.array([0.5, 0.1, 0.2])
+
+
+def particle_rhs(t, y):
+    """Gravity, Coriolis and the centrifugal term in a frame turning at W (the test's own)."""
+    r, v = y[:3], y[3:]
+    a = G - 2.0 * np.cross(W, v) - np.cross(W, np.cross(W, r))
+    return np.concatenate([v, a])
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return reference_dop853(particle_rhs, 0.0, np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6)
+
+
+def test_the_particle_scenes_take_the_oracles_steps(reference):
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    model = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=OmegaSchedule.constant(W), g=G)
+    traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6, samples=1)
+    n, y = reference
+    assert traj.steps == n
+    np.testing.assert_allclose(np.concatenate([traj.r[-1, 0], traj.v[-1, 0]]), y, rtol=1e-11)
+
+
+def test_a_problem_of_your_own_takes_the_oracles_steps(reference):
+    from rotframe import forces
+    from rotframe.problem.particles import simulate_particles
+
+    run = simulate_particles(omega=W, r0=R0, v0=V0, duration=20.0, forces=[forces.gravity(G)], method="dop853",
+                             rtol=1e-10, atol=1e-6, samples=1)
+    n, y = reference
+    assert run.trajectory.steps == n
+    np.testing.assert_allclose(np.concatenate([run.trajectory.r[-1, 0], run.trajectory.v[-1, 0]]), y, rtol=1e-11)
+
+
+def test_the_bench_ceiling_takes_the_oracles_steps(reference):
+    from rotframe.app.bench import ceiling
+
+    A, B, C, E3, E5 = coefficients()
+    tab = np.zeros((16, 13))
+    tab[:12, :12], tab[12, :12], tab[13, :12], tab[14], tab[15] = A, B, C, E3, E5
+    r, v, counted = R0[None].copy(), V0[None].copy(), np.zeros(1, dtype=np.int64)
+    # the ceiling's loop has no centrifugal term: its own oracle run
+    n, y = reference_dop853(lambda t, y: np.concatenate([y[3:], G - 2.0 * np.cross(W, y[3:])]), 0.0,
+                            np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6)
+    ceiling.dop853_serial(r, v, G, W, tab, 1e-10, 1e-6, 20.0, False, counted)
+    assert counted[0] == n
+    np.testing.assert_allclose(np.concatenate([r[0], v[0]]), y, rtol=1e-11)
+
+
+def test_the_rigid_body_takes_the_oracles_steps():
+    from rotframe.rigid.adaptive import rigid_dop853
+
+    inertia = np.array([1.0, 2.0, 3.0])
+    L0 = np.array([0.1, 2.0, 0.05])
+    q0 = np.array([0.0, 0.0, 0.0, 1.0])
+
+    def rhs(t, y):  # Euler's equations and dq/dt = q (omega, 0) / 2, scalar-last (the test's own)
+        L, q = y[:3], y[3:]
+        w = L / inertia
+        x, yy, z, s = q
+        dq = 0.5 * np.array([s * w[0] + yy * w[2] - z * w[1], s * w[1] + z * w[0] - x * w[2],
+                             s * w[2] + x * w[1] - yy * w[0], -(x * w[0] + yy * w[1] + z * w[2])])
+        return np.concatenate([np.cross(L, w), dq])
+
+    atol = np.array([1e-9 * np.linalg.norm(L0)] * 3 + [1e-9] * 4)
+    n, y = reference_dop853(rhs, 0.0, np.concatenate([L0, q0]), 30.0, 1e-9, atol)
+    run = rigid_dop853(inertia, L0, q0, np.array([0.0, 30.0]), rtol=1e-9)
+    assert run.steps == n
+    np.testing.assert_allclose(run.L[-1], y[:3], rtol=1e-9)
