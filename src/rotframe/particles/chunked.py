@@ -174,7 +174,7 @@ class KernelSetup:
         return evb.args()
 
     def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, t0=None,
-             sps=None, times=None):
+             sps=None, times=None, kernel_for=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
@@ -185,7 +185,9 @@ class KernelSetup:
         `sps`) let a fixed-step call start inside a sample interval and take part
         of it (`one_sample_in_pieces`). ``times`` (adaptive only) replaces the sample times
         the call lands on: the probe's short spans, or the pieces of a long sample interval
-        (`run_chunked`).
+        (`run_chunked`). ``kernel_for`` (default N) is the number of particles whose driver runs
+        the call: the probe's one-particle tries take the driver of the run they measure, so that
+        they compile no other.
 
         More particles than one block (`rotframe.particles.threads.BLOCK`) run in
         blocks on every core (`rotframe.particles.blocks.run_blocks`),
@@ -218,7 +220,7 @@ class KernelSetup:
         end = first + 1 + max(count, 1)
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
         steady = self.steady_args is not None
-        if steady and r.shape[0] > threads.BLOCK:
+        if steady and (r.shape[0] if kernel_for is None else kernel_for) > threads.BLOCK:
             # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py):
             # its force is inlined into the stages, the specialised one keeps calls (a smaller first compile)
             from rotframe.particles import drivers
@@ -314,7 +316,9 @@ def _probe(setup, r, v, alive, evb, atol, h_state, out_r, out_v, whole):
     """
     t0, t1 = float(setup.times[0]), float(setup.times[1])
     dt = t1 - t0
-    scratch = np.empty((1, r.shape[0], 3))
+    # the count is particle 0's (the drivers report its cost), so the tries integrate particle 0 alone:
+    # a try over the whole ensemble cost its every particle a first step and more, 25 times
+    scratch = np.empty((1, 1, 3))
     for k in range(PROBE_DEPTH, -1, -1):
         end = t1 if k == 0 else t0 + dt / 4.0 ** k
         if k > 0 and not end > t0:
@@ -322,8 +326,9 @@ def _probe(setup, r, v, alive, evb, atol, h_state, out_r, out_v, whole):
         if k == 0 and whole:
             result = setup.call(r, v, alive, 0, 1, out_r, out_v, evb, atol, h_state)
             return float(result[3]), result
-        steps = setup.call(r.copy(), v.copy(), alive.copy(), 0, 1, scratch, scratch.copy(),
-                           EventBuffers(r.shape[0], evb.max_events), atol, h_state.copy(), times=np.array([end]))[3]
+        steps = setup.call(r[:1].copy(), v[:1].copy(), alive[:1].copy(), 0, 1, scratch, scratch.copy(),
+                           EventBuffers(1, evb.max_events), atol, h_state[:1].copy(), times=np.array([end]),
+                           kernel_for=r.shape[0])[3]
         if k == 0 or steps >= PROBE_STEPS:
             return float(steps) * dt / (end - t0), None
     return 1.0, None
