@@ -1,11 +1,12 @@
-"""One DOP853 step controller and starting step for every loop (rotframe.numerics.step_control).
+"""One DOP853 step controller, starting step and dense output for every loop (rotframe.numerics).
 
 The oracles are written here, apart from the code they check: Hairer's rules (dop853.f's defaults,
 docs/physics/dop853.md) as formulas, his starting step (II.4) in numpy with RMS norms (and scipy's
 own ``select_initial_step`` where it is importable), and a plain-Python DOP853 loop over the
 tableau with that control. The loops of rotframe (the particle scenes, the engine of your own
 problems, the rigid body, the bench's hand-written ceiling) must take exactly the steps of that
-loop on the same problem.
+loop on the same problem, and give its samples, which are Hairer's dense output (``contd8``
+written here in dop853.f's own form).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from hypothesis import given, settings, strategies as st
 
 from rotframe.numerics import step_control as sc
 from rotframe.numerics.dop853 import coefficients
+from rotframe.numerics.dop853_dense import dense_tables
 
 next_step = sc.next_step.py_func
 first_step_trial = sc.first_step_trial.py_func
@@ -140,25 +142,48 @@ def test_a_run_of_no_length_starts_with_no_step():
 # ---------------------------------------------------------------- the loops take the oracle's steps
 
 
-def reference_dop853(f, t0, y0, T, rtol, atol):
-    """A plain-Python DOP853 to T with Hairer's control, its own code: (accepted steps, final state)."""
+def contd8(y, y_new, K, h, s):
+    """Hairer's dense output at t + s h in dop853.f's own form (contd8): K (16, n) the step's and dense stages."""
+    _, D = dense_tables()
+    ydiff = y_new - y
+    bspl = h * K[0] - ydiff
+    c3 = ydiff - h * K[12] - bspl
+    d = [h * (D[r] @ K) for r in range(4)]
+    s1 = 1.0 - s
+    conpar = d[0] + s * (d[1] + s1 * (d[2] + s * d[3]))
+    return y + s * (ydiff + s1 * (bspl + s * (c3 + s1 * conpar)))
+
+
+def dense_stages_of(f, t, y, h, K):
+    """The three dense-output stages of a step, K[13..15] (the test's own stage loop)."""
+    A_extra, _ = dense_tables()
+    for i, c in enumerate((0.1, 0.2, 7.0 / 9.0)):
+        K[13 + i] = f(t + c * h, y + h * (A_extra[i, :13 + i] @ K[:13 + i]))
+
+
+def reference_dop853(f, t0, y0, T, rtol, atol, samples=()):
+    """A plain-Python DOP853 to T with Hairer's control, its own code.
+
+    Returns (accepted steps, final state, the states at ``samples`` by the dense output).
+    """
     A, B, C, E3, E5 = coefficients()
     atol = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape)
     h = hinit(f, t0, y0, rtol, atol, T - t0)
     t, y, k0 = t0, y0.copy(), f(t0, y0)
     accepted_steps, last_rejected = 0, False
+    out, pending = [], list(samples)
     while t < T:
         cut = t + h > T
         hh = T - t if cut else h
-        K = np.zeros((13, y.size))
+        K = np.zeros((16, y.size))
         K[0] = k0
         for s in range(1, 12):
             K[s] = f(t + C[s] * hh, y + hh * (A[s, :s] @ K[:s]))
         y_new = y + hh * (B @ K[:12])
         K[12] = f(t + hh, y_new)
         scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
-        e5 = np.sum(((E5 @ K) / scale) ** 2)
-        e3 = np.sum(((E3 @ K) / scale) ** 2)
+        e5 = np.sum(((E5 @ K[:13]) / scale) ** 2)
+        e3 = np.sum(((E3 @ K[:13]) / scale) ** 2)
         err = 0.0 if e5 == 0.0 and e3 == 0.0 else hh * e5 / math.sqrt((e5 + 0.01 * e3) * y.size)
         fac11 = err ** 0.125
         if err <= 1.0:
@@ -167,14 +192,20 @@ def reference_dop853(f, t0, y0, T, rtol, atol):
                 h_new = min(h_new, hh)
             if hh < h:
                 h_new = max(h_new, h)
-            t, y, k0 = (T if cut else t + hh), y_new, K[12]
+            t_new = T if cut else t + hh
+            if pending and pending[0] < t_new:
+                dense_stages_of(f, t, y, hh, K)
+            while pending and pending[0] <= t_new:
+                ts = pending.pop(0)
+                out.append(y_new.copy() if ts == t_new else contd8(y, y_new, K, hh, (ts - t) / hh))
+            t, y, k0 = t_new, y_new, K[12]
             accepted_steps += 1
             last_rejected = False
         else:
             h_new = hh / min(1.0 / 0.333, fac11 / 0.9)
             last_rejected = True
         h = h_new
-    return accepted_steps, y
+    return accepted_steps, y, np.array(out)
 
 
 W = np.array([0.0, 0.3, 0.4])
@@ -190,31 +221,42 @@ def particle_rhs(t, y):
     return np.concatenate([v, a])
 
 
+SAMPLES = 7  # samples of the run: all but the last inside steps, from the dense output
+
+
 @pytest.fixture(scope="module")
 def reference():
-    return reference_dop853(particle_rhs, 0.0, np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6)
+    times = np.linspace(0.0, 20.0, SAMPLES + 1)[1:]
+    return reference_dop853(particle_rhs, 0.0, np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6, samples=times)
 
 
-def test_the_particle_scenes_take_the_oracles_steps(reference):
+def test_the_particle_scenes_take_the_oracles_steps_and_samples(reference, monkeypatch):
+    from rotframe.particles import dop853_steady
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     model = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=OmegaSchedule.constant(W), g=G)
-    traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6, samples=1)
-    n, y = reference
-    assert traj.steps == n
-    np.testing.assert_allclose(np.concatenate([traj.r[-1, 0], traj.v[-1, 0]]), y, rtol=1e-11)
+    n, y, samples = reference
+    for driver in ("steady", "general"):
+        if driver == "general":  # the general driver, for a model the steady one would take
+            monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(), packed=None: False)
+        traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6,
+                                   samples=SAMPLES)
+        assert traj.steps == n
+        got = np.concatenate([traj.r[1:, 0], traj.v[1:, 0]], axis=1)
+        np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
 
 
-def test_a_problem_of_your_own_takes_the_oracles_steps(reference):
+def test_a_problem_of_your_own_takes_the_oracles_steps_and_samples(reference):
     from rotframe import forces
     from rotframe.problem.particles import simulate_particles
 
     run = simulate_particles(omega=W, r0=R0, v0=V0, duration=20.0, forces=[forces.gravity(G)], method="dop853",
-                             rtol=1e-10, atol=1e-6, samples=1)
-    n, y = reference
+                             rtol=1e-10, atol=1e-6, samples=SAMPLES)
+    n, y, samples = reference
     assert run.trajectory.steps == n
-    np.testing.assert_allclose(np.concatenate([run.trajectory.r[-1, 0], run.trajectory.v[-1, 0]]), y, rtol=1e-11)
+    got = np.concatenate([run.trajectory.r[1:, 0], run.trajectory.v[1:, 0]], axis=1)
+    np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
 
 
 def test_the_bench_ceiling_takes_the_oracles_steps(reference):
@@ -225,14 +267,14 @@ def test_the_bench_ceiling_takes_the_oracles_steps(reference):
     tab[:12, :12], tab[12, :12], tab[13, :12], tab[14], tab[15] = A, B, C, E3, E5
     r, v, counted = R0[None].copy(), V0[None].copy(), np.zeros(1, dtype=np.int64)
     # the ceiling's loop has no centrifugal term: its own oracle run
-    n, y = reference_dop853(lambda t, y: np.concatenate([y[3:], G - 2.0 * np.cross(W, y[3:])]), 0.0,
+    n, y, _ = reference_dop853(lambda t, y: np.concatenate([y[3:], G - 2.0 * np.cross(W, y[3:])]), 0.0,
                             np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6)
     ceiling.dop853_serial(r, v, G, W, tab, 1e-10, 1e-6, 20.0, False, counted)
     assert counted[0] == n
     np.testing.assert_allclose(np.concatenate([r[0], v[0]]), y, rtol=1e-11)
 
 
-def test_the_rigid_body_takes_the_oracles_steps():
+def test_the_rigid_body_takes_the_oracles_steps_and_samples():
     from rotframe.rigid.adaptive import rigid_dop853
 
     inertia = np.array([1.0, 2.0, 3.0])
@@ -248,7 +290,61 @@ def test_the_rigid_body_takes_the_oracles_steps():
         return np.concatenate([np.cross(L, w), dq])
 
     atol = np.array([1e-9 * np.linalg.norm(L0)] * 3 + [1e-9] * 4)
-    n, y = reference_dop853(rhs, 0.0, np.concatenate([L0, q0]), 30.0, 1e-9, atol)
-    run = rigid_dop853(inertia, L0, q0, np.array([0.0, 30.0]), rtol=1e-9)
+    times = np.linspace(0.0, 30.0, 8)
+    n, y, samples = reference_dop853(rhs, 0.0, np.concatenate([L0, q0]), 30.0, 1e-9, atol, samples=times[1:])
+    run = rigid_dop853(inertia, L0, q0, times, rtol=1e-9)
     assert run.steps == n
-    np.testing.assert_allclose(run.L[-1], y[:3], rtol=1e-9)
+    np.testing.assert_allclose(run.L[1:], samples[:, :3], rtol=1e-9, atol=1e-12)
+    q = samples[:, 3:] / np.linalg.norm(samples[:, 3:], axis=1, keepdims=True)  # rigid_dop853 normalises q
+    np.testing.assert_allclose(run.q[1:], q, rtol=1e-9, atol=1e-12)
+
+
+# ---------------------------------------------------------------- the dense output itself
+
+
+def test_the_dense_stages_nodes_are_their_row_sums():
+    from rotframe.numerics.dop853_dense import C_EXTRA
+
+    A_extra, _ = dense_tables()
+    np.testing.assert_allclose(A_extra.sum(axis=1), C_EXTRA, rtol=0, atol=1e-14)
+
+
+def _one_step_interpolant(h, x):
+    """y'' = -y from (1, 0): one DOP853 step of length h and its dense output at x h (rotframe's F and value)."""
+    from rotframe.numerics.dop853_dense import dense_coefficients, dense_value
+
+    A, B, C, _, _ = coefficients()
+    f = lambda t, y: np.array([y[1], -y[0]])  # noqa: E731
+    y = np.array([1.0, 0.0])
+    K = np.zeros((16, 2))
+    K[0] = f(0.0, y)
+    for s in range(1, 12):
+        K[s] = f(C[s] * h, y + h * (A[s, :s] @ K[:s]))
+    y_new = y + h * (B @ K[:12])
+    K[12] = f(h, y_new)
+    dense_stages_of(f, 0.0, y, h, K)
+    F = np.empty((7, 2))
+    _, D = dense_tables()
+    dense_coefficients.py_func(y, y_new, K, h, D, F)
+    got = np.array([dense_value.py_func(F, y, x, j) for j in range(2)])
+    return got, y, y_new, K
+
+
+def test_the_dense_output_is_of_order_seven():
+    x = 0.37
+    errors = []
+    for h in (0.4, 0.2, 0.1):
+        got, *_ = _one_step_interpolant(h, x)
+        errors.append(abs(got[0] - math.cos(x * h)))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all((orders > 7.5) & (orders < 8.6))  # local error O(h^8) of an order-7 interpolant
+
+
+@pytest.mark.parametrize("x", [0.0, 0.2, 0.5, 0.9, 1.0])
+def test_the_dense_output_is_hairers_contd8(x):
+    got, y, y_new, K = _one_step_interpolant(0.3, x)
+    np.testing.assert_allclose(got, contd8(y, y_new, K, 0.3, x), rtol=1e-14, atol=1e-15)
+    if x == 0.0:
+        np.testing.assert_array_equal(got, y)
+    if x == 1.0:
+        np.testing.assert_allclose(got, y_new, rtol=1e-15)

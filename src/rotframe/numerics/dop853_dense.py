@@ -8,7 +8,7 @@ three more stages
     k_i = f(t + C[i] h, y + h sum_j A[i, j] k_j)     i = 14, 15, 16
 
 and four rows of weights ``D`` give the coefficients of the interpolant (docs/physics/dop853.md;
-`rotframe.rigid.adaptive` evaluates it). The constants are the decimal strings published
+`dense_coefficients` and `dense_value` evaluate it, for every DOP853 loop of rotframe). The constants are the decimal strings published
 with ``dop853.f`` (as scipy's ``solve_ivp`` ships them), rounded to float64 once; the 12-stage
 tableau itself is `rotframe.numerics.dop853`. Kept here rather than read from scipy so that
 a first run does not import ``scipy.integrate`` (0.2 s).
@@ -20,7 +20,9 @@ import functools
 
 import numpy as np
 
-__all__ = ["dense_tables"]
+from rotframe.numerics.compiled import jit_inline, jit_internal
+
+__all__ = ["dense_tables", "extended_tableau", "dense_coefficients", "dense_value", "C_EXTRA"]
 
 # rows 14..16 of A: {stage (1-based): {column (1-based): a}}
 _A_EXTRA = {
@@ -79,3 +81,66 @@ def dense_tables():
         for j, d in row.items():
             D[i - 1, j - 1] = float(d)
     return A, D
+
+
+#: the nodes of the three dense-output stages (dop853.f's c14, c15, c16)
+C_EXTRA = (0.1, 0.2, 0.777777777777777777777777777778)
+
+
+@functools.cache
+def extended_tableau():
+    """(A (16, 16), C (16,), D (4, 16)): the step's stages and the dense output's, in one stage loop.
+
+    Rows 0..11 of ``A`` are the stages of `rotframe.numerics.dop853.coefficients`, row 12 its
+    order-8 weights ``B`` (so that "stage 12" forms ``y_new = y + h sum B_q k_q``, and ``k_12`` is
+    ``f(t + h, y_new)``), rows 13..15 the dense output's stages. ``C`` their nodes (``C[12] = 1``).
+    Read-only arrays, made once.
+    """
+    from rotframe.numerics.dop853 import coefficients
+
+    A12, B, C12, _, _ = coefficients()
+    A_extra, D = dense_tables()
+    A = np.zeros((16, 16))
+    A[:12, :12] = A12
+    A[12, :12] = B
+    A[13:] = A_extra
+    C = np.zeros(16)
+    C[:12] = C12
+    C[12] = 1.0
+    C[13:] = C_EXTRA
+    for x in (A, C, D):
+        x.flags.writeable = False
+    return A, C, D
+
+
+@jit_internal
+def dense_coefficients(y, y_new, K, h, D, F):
+    """The interpolant's coefficients ``F`` (7, n) of an accepted step, Hairer's ``contd8`` form.
+
+    ``K`` (16, n) holds the step's stages, ``K[12] = f(t + h, y_new)`` and the dense output's
+    three stages ``K[13..15]`` (rows 13..15 of `extended_tableau`); ``D`` as `extended_tableau`.
+    """
+    for j in range(y.shape[0]):
+        dy = y_new[j] - y[j]
+        F[0, j] = dy
+        F[1, j] = h * K[0, j] - dy
+        F[2, j] = 2 * dy - h * (K[12, j] + K[0, j])
+        for r in range(4):
+            acc = 0.0
+            for q in range(16):
+                acc += D[r, q] * K[q, j]
+            F[3 + r, j] = h * acc
+
+
+@jit_inline
+def dense_value(F, y, x, j):
+    """Component ``j`` of the interpolant at ``t + x h`` (``0 <= x <= 1``): order 7 in the step.
+
+    ``y + x (F0 + (1-x) (F1 + x (F2 + (1-x) (F3 + x (F4 + (1-x) (F5 + x F6))))))``, from the
+    innermost term out (``contd8`` of dop853.f).
+    """
+    v = 0.0
+    for i in range(7):
+        v += F[6 - i, j]
+        v *= x if i % 2 == 0 else 1.0 - x
+    return y[j] + v

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import jit_internal
+from rotframe.numerics.compiled import jit_inline, jit_internal
 
 __all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
@@ -41,7 +41,7 @@ FACC2 = 1.0 / 6.0  # 1 / fac2: the most a step grows is 6 times
 NONFINITE_SHRINK = 0.1  # a step that gave a non-finite state is tried again this much shorter
 
 
-@jit_internal
+@jit_inline
 def next_step(h, h_ctrl, err, rejected):
     """Whether a step of length ``h`` with error norm ``err`` is accepted, and the next step to try.
 
@@ -78,7 +78,7 @@ def next_step(h, h_ctrl, err, rejected):
     return True, h_next
 
 
-@jit_internal
+@jit_inline
 def step_collapsed(h, t):
     """Whether a step ``h`` from time ``t`` is below round-off: under 10 units in the last place of ``t``."""
     return h < 10.0 * (math.nextafter(abs(t), math.inf) - abs(t))

@@ -123,11 +123,13 @@ class KernelSetup:
             self.evals_per_step = EVALS_PER_STEP[info.name]
         else:
             from rotframe.numerics.dop853 import coefficients
+            from rotframe.numerics.dop853_dense import extended_tableau
             from rotframe.particles.dop853_steady import is_steady_model, steady_parameters, steady_tableau
 
             self.sps = 0
             self.h = 0.0
-            self.tableau = coefficients()
+            A, C, D = extended_tableau()
+            self.tableau = (A, C, D) + coefficients()[3:]  # A, C, D, E3, E5
             # a steady model without events runs the specialised driver (bitwise the same results,
             # three compiled functions instead of fourteen): rotframe.particles.dop853_steady
             if is_steady_model(model, self.events, self.P):
@@ -231,15 +233,15 @@ class KernelSetup:
             q, tab = self.steady_args
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, start, times, q, self.rtol, atol, span, tab, np.empty((32, 6)), out_r, out_v,
+                return kernel(r, v, start, times, q, self.rtol, atol, span, tab, np.empty((28, 6)), out_r, out_v,
                               h_state)
         else:
-            A, B, C, E3, E5 = self.tableau
+            A, C, D, E3, E5 = self.tableau
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span, A, B, C,
-                              E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
-                              h_state, np.empty((13, 6)), np.empty((13, 6)), np.empty((5, 6)))
+                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span, A, C,
+                              D, E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
+                              h_state, np.empty((16, 6)), np.empty((13, 6)), np.empty((12, 6)))
         return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
 
     def warm_up(self):

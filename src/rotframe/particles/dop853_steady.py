@@ -1,4 +1,4 @@
-"""DOP853 specialised to the steady models: three compiled functions instead of fourteen.
+"""DOP853 specialised to the steady models: a few small compiled functions instead of about fourteen.
 
 The general driver `rotframe.particles.drivers.run_dop853` handles every
 term, rotation schedule and event, and a first run compiles it with its force,
@@ -11,12 +11,14 @@ about fourteen functions). Most scenes that run DOP853 need much less:
 - no drag, no spring, no events.
 
 For such a model `run_dop853_steady` is the same algorithm with the force
-written in place: the same stages, error norm, step control, sample steps and
-failure checks, in the same floating-point order, so that its results are
+written in place: the same stages, error norm, step control and starting step
+(`rotframe.numerics.step_control`), dense output (`rotframe.numerics.dop853_dense`)
+and failure checks, in the same floating-point order, so that its results are
 bitwise those of the general driver (``tests/test_dop853_steady.py`` checks
-this on random models). It is three compiled functions instead of about
-fourteen, and a first ``rotframe run foucault`` compiles for about 2.5 s instead of 3.3 to 4 s
-on the 2-core machine (numba's own start, about 0.5 s, included).
+this on random models). Its kernel, the force, one stage loop and the shared
+pieces compile in about 1.9 s on a first ``rotframe run foucault`` on the 2-core
+machine (numba's own start, about 0.5 s, included), where the general driver
+takes 3.3 to 4 s.
 
 `steady_parameters` packs the model for it; `is_steady_model` says
 whether a model qualifies.
@@ -30,18 +32,17 @@ import math
 import numpy as np
 
 from rotframe.numerics.compiled import jit_internal, jit_kernel
-from rotframe.numerics.dop853 import coefficients
+from rotframe.numerics.dop853 import coefficients, dop853_error_norm
+from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
 
 __all__ = ["is_steady_model", "steady_parameters", "steady_tableau", "run_dop853_steady", "STEADY_TERMS"]
 
-# The step-size control and the starting step are the shared ones (rotframe.numerics.step_control). The force
-# (rotframe.particles.forces.state_acceleration, its string constraint included), the error norm
-# (rotframe.numerics.dop853.dop853_error_norm) and the sample steps of the general
-# driver (rotframe.particles.drivers.run_dop853) are written in place below, in the same order, rather than
-# shared: calling the general force compiles the packed model and its helpers (what this driver exists to
-# avoid), and sharing the others by numba's IR inlining (numerics.compiled.inlined) made a first run's
-# compile 5 to 8 % more work, measured. tests/test_dop853_steady.py keeps the copies bitwise the same.
+# The error norm, the step-size control, the starting step and the dense output are the shared ones
+# (rotframe.numerics). The force (rotframe.particles.forces.state_acceleration, its string constraint
+# included) is written in place below, in the same order, rather than shared: calling the general force
+# compiles the packed model and its helpers (what this driver exists to avoid). tests/test_dop853_steady.py
+# keeps the two bitwise the same.
 
 #: The terms that the steady driver evaluates (a model with any other term runs the general driver).
 STEADY_TERMS = frozenset({"gravity", "coriolis", "centrifugal", "pendulum"})
@@ -91,17 +92,20 @@ def steady_parameters(model, packed=None):
 
 @functools.cache
 def steady_tableau():
-    """The DOP853 tableau as one (16, 13) array: rows 0-11 ``A``, 12 ``B``, 13 ``C``, 14 ``E3``, 15 ``E5``.
+    """The DOP853 tableau with its dense output as one (22, 16) array.
 
-    The same floats as `rotframe.numerics.dop853.coefficients` (made once; read-only).
+    Rows 0-15 ``A`` of `rotframe.numerics.dop853_dense.extended_tableau` (row 12 the order-8
+    weights ``B``, rows 13-15 the dense output's stages), 16 ``E3``, 17 ``E5``, 18-21 the dense
+    output's weights ``D``: the same floats (made once; read-only). The model is steady, so the
+    nodes ``C`` are not needed.
     """
-    A, B, C, E3, E5 = coefficients()
-    tab = np.zeros((16, 13))
-    tab[:12, :12] = A
-    tab[12, :12] = B
-    tab[13, :12] = C
-    tab[14] = E3
-    tab[15] = E5
+    A, _, D = extended_tableau()
+    _, _, _, E3, E5 = coefficients()
+    tab = np.zeros((22, 16))
+    tab[:16] = A
+    tab[16, :13] = E3
+    tab[17, :13] = E5
+    tab[18:22] = D
     tab.flags.writeable = False
     return tab
 
@@ -146,25 +150,18 @@ def _acceleration(x, y, z, vx, vy, vz, q):
 
 
 @jit_internal
-def _step(y, h, q, tab, K, y_new, tmp):
-    """One DOP853 step of length h from y; ``K[0]`` holds f(y) on entry, ``K`` (13, 6) all stages on return."""
-    for s in range(1, 13):
-        last = s == 12
+def _stages(first, last, y, h, q, tab, K, z):
+    """Stages ``first .. last - 1``: ``z = y + h sum_p tab[s, p] K[p]``, ``K[s] = f(z)`` (the model is steady)."""
+    for s in range(first, last):
         for j in range(6):
             acc = 0.0
-            if last:
-                for p in range(12):
-                    acc += tab[12, p] * K[p, j]
-                y_new[j] = y[j] + h * acc
-                tmp[j] = y_new[j]
-            else:
-                for p in range(s):
-                    acc += tab[s, p] * K[p, j]
-                tmp[j] = y[j] + h * acc
-        K[s, 3], K[s, 4], K[s, 5] = _acceleration(tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5], q)
-        K[s, 0] = tmp[3]
-        K[s, 1] = tmp[4]
-        K[s, 2] = tmp[5]
+            for p in range(s):
+                acc += tab[s, p] * K[p, j]
+            z[j] = y[j] + h * acc
+        K[s, 3], K[s, 4], K[s, 5] = _acceleration(z[0], z[1], z[2], z[3], z[4], z[5], q)
+        K[s, 0] = z[3]
+        K[s, 1] = z[4]
+        K[s, 2] = z[5]
 
 
 @jit_kernel
@@ -173,19 +170,20 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, tab, work, ou
 
     Parameters and results as `rotframe.particles.drivers.run_dop853`, with
     ``q`` from `steady_parameters`, ``tab`` from `steady_tableau` and
-    ``work`` (32, 6) scratch from the caller. There are no events, so every
+    ``work`` (28, 6) scratch from the caller. There are no events, so every
     particle stays alive. Returns ``(n_done, bad, nfev, steps)`` (cost of particle 0).
     """
     n = r.shape[0]
     n_out = sample_times.shape[0]
-    K = work[0:13]
-    Kt = work[13:26]
-    y = work[26]
-    y_new = work[27]
-    yt = work[28]
-    tmp = work[29]
-    f0 = work[30]
-    atol_vec = work[31]
+    K = work[0:16]
+    y = work[16]
+    y_new = work[17]
+    tmp = work[18]
+    f0 = work[19]
+    atol_vec = work[20]
+    F = work[21:28]  # the interpolant's coefficients of the current step
+    E3 = tab[16, :13]
+    E5 = tab[17, :13]
     for j in range(6):
         atol_vec[j] = atol
     nfev0 = 0
@@ -237,28 +235,12 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, tab, work, ou
                     break
                 for j in range(6):
                     K[0, j] = f0[j]
-                _step(y, h, q, tab, K, y_new, tmp)
+                # the step: stages 1-11, then row 12 (the order-8 weights) into y_new and f(y_new); int(): one
+                # compiled _stages for every range (a literal would compile one for each)
+                _stages(int(1), int(12), y, h, q, tab, K, tmp)
+                _stages(int(12), int(13), y, h, q, tab, K, y_new)
                 nf += 12
-                # Hairer's error norm, as rotframe.numerics.dop853.dop853_error_norm (one atol for all six)
-                e5 = 0.0
-                e3 = 0.0
-                for j in range(6):
-                    a = y[j] if y[j] >= 0.0 else -y[j]
-                    b = y_new[j] if y_new[j] >= 0.0 else -y_new[j]
-                    sc = atol + rtol * (a if a >= b else b)
-                    s5 = 0.0
-                    s3 = 0.0
-                    for i in range(13):
-                        s5 += tab[15, i] * K[i, j]
-                        s3 += tab[14, i] * K[i, j]
-                    r5 = s5 / sc
-                    r3 = s3 / sc
-                    e5 += r5 * r5
-                    e3 += r3 * r3
-                if e5 == 0.0 and e3 == 0.0:
-                    err = 0.0
-                else:
-                    err = (h if h >= 0.0 else -h) * e5 / math.sqrt((e5 + 0.01 * e3) * 6)
+                err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
                 accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
                 rejected = not accepted
                 h_used = h
@@ -271,6 +253,7 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, tab, work, ou
             t_new = t_end if truncated else t + h_used
             if p == 0:
                 steps0 += 1
+            dense = False
             while k_out < n_out and sample_times[k_out] <= t_new:
                 ts = sample_times[k_out]
                 if ts == t_new:
@@ -278,13 +261,15 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, tab, work, ou
                         out_r[k_out, p, i] = y_new[i]
                         out_v[k_out, p, i] = y_new[3 + i]
                 else:
-                    for j in range(6):
-                        Kt[0, j] = f0[j]
-                    _step(y, ts - t, q, tab, Kt, yt, tmp)
-                    nf += 12
+                    if not dense:  # the dense output's stages and coefficients, once a step (as run_dop853)
+                        _stages(int(13), int(16), y, h_used, q, tab, K, tmp)
+                        dense_coefficients(y, y_new, K, h_used, tab[18:22], F)
+                        nf += 3
+                        dense = True
+                    x = (ts - t) / h_used
                     for i in range(3):
-                        out_r[k_out, p, i] = yt[i]
-                        out_v[k_out, p, i] = yt[3 + i]
+                        out_r[k_out, p, i] = dense_value(F, y, x, i)
+                        out_v[k_out, p, i] = dense_value(F, y, x, 3 + i)
                 k_out += 1
             finite = True
             for j in range(6):

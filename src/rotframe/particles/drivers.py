@@ -18,7 +18,8 @@ from numba import njit
 from rotframe.numerics.compiled import inlined
 from rotframe.numerics.dop853 import dop853_error_norm
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
-from rotframe.particles.dop853_steps import dop853_step
+from rotframe.numerics.dop853_dense import dense_coefficients, dense_value
+from rotframe.particles.dop853_steps import dense_stages, dop853_step
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
@@ -232,21 +233,22 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 
 @jit_kernel
-def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, B, C, E3, E5,
+def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, C, D, E3, E5,
                events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state, K, Kt, rows):
     """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
 
     Error control as in Hairer's DOP853 (5th- and 3rd-order estimates combined).
     Output at ``sample_times``: the state at a sample time inside an accepted
-    step is computed by one extra DOP853 step of the right length from the
-    step's start (an interpolant of the same order as the method). Events are
-    located the same way, by bisection on the length of that extra step.
+    step is Hairer's dense output of order 7 (three more stages in a step that
+    holds a sample; `rotframe.numerics.dop853_dense`). Events are located on the
+    method's own steps: bisection on the length of one extra DOP853 step from the
+    step's start. ``A``, ``C``, ``D``: `rotframe.numerics.dop853_dense.extended_tableau`.
     ``h_state`` (N,) carries each particle's step size between calls; where it is 0, the
     particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the
     same in every call, so that the steps do not depend on how the run is cut into calls).
     ``events`` None (no event table) prunes the event code at compile time,
     as in `run_fixed`; so does ``wt`` None (a steady rotation rate).
-    ``K``, ``Kt`` (13, 6) and ``rows`` (5, 6) are work arrays from the caller (a
+    ``K`` (16, 6), ``Kt`` (13, 6) and ``rows`` (12, 6) are work arrays from the caller (a
     kernel that allocates compiles numpy's allocators on a first run).
 
     Returns (n_done, bad, nfev, steps) like `run_fixed` (cost of particle 0).
@@ -256,6 +258,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, B,
     n_out = sample_times.shape[0]
     n_ev = 0 if events is None else events.shape[0]
     y, y_new, yt, tmp, atol_vec = rows[0], rows[1], rows[2], rows[3], rows[4]
+    F = rows[5:12]  # the interpolant's coefficients of the current step
     for j in range(6):
         atol_vec[j] = atol
     if events is not None:
@@ -315,7 +318,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, B,
                     else:
                         failed = True
                     break
-                dop853_step(t, y, f0, h, m, wt, wv, A, B, C, K, y_new, tmp)
+                dop853_step(t, y, f0, h, m, wt, wv, A, C, K, y_new, tmp)
                 nf += 12
                 err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
                 accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
@@ -338,25 +341,32 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, B,
                 for e in range(n_ev):
                     g_new = event_value(events, e, as_state(y_new), m.radius)
                     if crossed(events[e, 3], g_old[e], g_new):
-                        hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, B, C, f0, Kt, y, tmp,
+                        hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, C, f0, Kt, y, tmp,
                                                       yt)
                         record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
                         if events[e, 4] != 0.0 and t + hi <= t_stop:
                             stop = True
                             t_stop = t + hi
                     g_old[e] = g_new
-            # samples inside (t, t_stop]
+            # samples inside (t, t_stop]: the dense output inside the step, the new state at its end
+            dense = False
             while k_out < n_out and sample_times[k_out] <= t_stop:
                 ts = sample_times[k_out]
                 if ts == t_new:
                     store(out_r, out_v, k_out, p, y_new)
                 else:
-                    dop853_step(t, y, f0, ts - t, m, wt, wv, A, B, C, Kt, yt, tmp)
-                    nf += 12
+                    if not dense:
+                        dense_stages(t, y, h_used, m, wt, wv, A, C, K, tmp)
+                        dense_coefficients(y, y_new, K, h_used, D, F)
+                        nf += 3
+                        dense = True
+                    x = (ts - t) / h_used
+                    for j in range(6):
+                        yt[j] = dense_value(F, y, x, j)
                     store(out_r, out_v, k_out, p, yt)
                 k_out += 1
             if stop:
-                dop853_step(t, y, f0, t_stop - t, m, wt, wv, A, B, C, Kt, yt, tmp)
+                dop853_step(t, y, f0, t_stop - t, m, wt, wv, A, C, Kt, yt, tmp)
                 for j in range(6):
                     y[j] = yt[j]
                 t = t_stop

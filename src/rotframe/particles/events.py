@@ -201,11 +201,11 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, 
 
 
 @jit_internal
-def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, tmp, y_out):
+def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, C, f0, K, y, tmp, y_out):
     """`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
 
-    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, B, C`` are the
-    tableau, ``K`` (13, 6) and ``tmp`` (6,) scratch, and ``y_out`` (6,) receives the
+    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, C`` are the
+    tableau (`rotframe.numerics.dop853_dense.extended_tableau`), ``K`` (13, 6) and ``tmp`` (6,) scratch, and ``y_out`` (6,) receives the
     state (`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
     the state at the event (a 6-tuple).
     """
@@ -216,9 +216,9 @@ def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, B, C, f0, K, y, 
         mid = bisection_midpoint(lo, hi)
         if mid < 0.0:
             break
-        dop853_step(t, y, f0, mid, m, wt, wv, A, B, C, K, y_out, tmp)
+        dop853_step(t, y, f0, mid, m, wt, wv, A, C, K, y_out, tmp)
         lo, hi, g_lo = narrow(lo, hi, g_lo, mid, event_value(events, e, as_state(y_out), m.radius))
-    dop853_step(t, y, f0, hi, m, wt, wv, A, B, C, K, y_out, tmp)
+    dop853_step(t, y, f0, hi, m, wt, wv, A, C, K, y_out, tmp)
     return hi, as_state(y_out)
 
 

@@ -7,8 +7,10 @@ as the `rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` comp
 functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
 
 * DOP853: Hairer's step control and starting step (hinit), written once for every DOP853 loop in
-  `rotframe.numerics.step_control`; a step never passes the next sample time, so every sample is
-  a step's end. Tableau and error norm: `rotframe.numerics.dop853`.
+  `rotframe.numerics.step_control`; a step lands on the run's end and on the stops, and the
+  samples inside a step are Hairer's dense output of order 7 (three more stages in a step that
+  holds one; `rotframe.numerics.dop853_dense`), as in every DOP853 loop of rotframe. Tableau
+  and error norm: `rotframe.numerics.dop853`.
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
   ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
@@ -46,7 +48,8 @@ from numba import njit, types
 from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients
 from rotframe.numerics.dop853 import dop853_error_norm as _counted_error_norm
-from rotframe.numerics import step_control
+from rotframe.numerics import dop853_dense, step_control
+from rotframe.numerics.dop853_dense import extended_tableau
 from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs, rhs_inlined
@@ -54,22 +57,25 @@ from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I
 
 __all__ = ["advance", "start_events", "energies", "ready"]
 
-A, B, C, E3, E5 = coefficients()
+A, C, DW = extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
+E3, E5 = coefficients()[3:]
 # the shared kernels that take arrays, compiled as the engine's own (without reference counts)
 dop853_error_norm = uncounted(_counted_error_norm)
 first_step_trial = uncounted(step_control.first_step_trial)
 first_step_final = uncounted(step_control.first_step)
+dense_coefficients = uncounted(dop853_dense.dense_coefficients)
+dense_value = dop853_dense.dense_value  # inlined into its callers
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 
 
 @jit_inline
 def stage_state(z, y, h, K, s, D):
-    """z = y + h sum_m a_m K[m] for stage s (12: the step's end, weights B), each sum over m in order."""
+    """z = y + h sum_m a_m K[m] for stage s (12: the step's end, weights B; 13-15 the dense output's), in order."""
     for j in range(D):
         z[j] = 0.0
     for m in range(s):
-        a = A[s, m] if s < 12 else B[m]
+        a = A[s, m]
         for j in range(D):
             z[j] += a * K[m, j]
     for j in range(D):
@@ -88,6 +94,20 @@ def dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W):
             stage_state(z, y, h, K, s, D)
         ts = t + C[s] * h if s < 12 else t_end  # the last: the time the step ends on (a sample time where it lands)
         rhs_inlined(ts, z, K[s], prob, fns, W)
+
+
+@jit_uncounted
+def dense_output(t, y, yn, h, K, z, F, prob, fns, W):
+    """The interpolant's coefficients ``F`` (7, D) of an accepted DOP853 step (t, y) -> (t + h, yn).
+
+    Its three more stages into ``K[13..15]`` (`rotframe.numerics.dop853_dense`), then Hairer's
+    coefficients; `dense_value` evaluates them.
+    """
+    D = y.shape[0]
+    for s in range(13, 16):
+        stage_state(z, y, h, K, s, D)
+        rhs(t + C[s] * h, z, K[s], prob, fns, W)
+    dense_coefficients(y, yn, K, h, DW, F)
 
 
 @jit_uncounted
@@ -176,8 +196,9 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
 
 @jit_uncounted
 def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                rtol, atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, W):
-    # K, Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: of the calling block, made once
+                rtol, atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+    # K (16, D), Kb (13, D) stages, V (7, D) state vectors, F (7, D) the dense output's coefficients, W the
+    # models' scratch: of the calling block, made once
     n = T.shape[0]
     D = Y.shape[1]
     NE = EDIR.shape[0]
@@ -213,15 +234,18 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             idx += 1
             sub = 0
             continue
-        # a step ends on the next sample or the next stop (a knot of a table or a body frame), whichever is first
         stop = next_stop(S, t)
-        at_knot = stop < T[idx]
-        target = stop if at_knot else T[idx]
         if method == DOP853:
+            # a step ends on the next stop (a knot of a table or a body frame) or the run's end, whichever is
+            # first; the samples inside a step are its dense output
+            target = stop if stop < T[n - 1] else T[n - 1]
             span = target - t
             hh = h if h < span else span
             landing = hh == span
         else:
+            # a step ends on the next sample or the next stop, whichever is first
+            at_knot = stop < T[idx]
+            target = stop if at_knot else T[idx]
             interval = T[idx] - T[idx - 1]
             on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
             last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
@@ -290,6 +314,18 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
             GPREV[i, k] = g_new
         if status == 5:
             break
+        # DOP853's samples inside the step (up to a terminal event's time): its dense output, of order 7
+        if method == DOP853 and idx < n and T[idx] < t_new and (stop_k < 0 or T[idx] <= t + stop_tau):
+            dense_output(t, y, yn, hh, K, yt, F, prob, fns, W)
+            NFEV[i] += 3
+            if W[RAISED] != 0.0:
+                status = 6
+                break
+            while idx < n and T[idx] < t_new and (stop_k < 0 or T[idx] <= t + stop_tau):
+                x = (T[idx] - t) / hh
+                for j in range(D):
+                    OUT[idx, i, j] = dense_value(F, y, x, j)
+                idx += 1
         if stop_k >= 0:
             # drop records of non-terminal crossings after the terminal one
             m = EVN[i]
@@ -344,14 +380,15 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
     """
     D = Y.shape[1]
-    K = np.empty((13, D))
+    K = np.empty((16, D))
     Kb = np.empty((13, D))
     V = np.empty((7, D))
+    F = np.empty((7, D))
     W = np.zeros(SCRATCH)
     for i in range(lo, hi):
         if ST[i] == 0:
             advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol[i], hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, W)
+                        rtol, atol[i], hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W)
 
 
 @_entry

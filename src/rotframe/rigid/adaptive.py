@@ -36,7 +36,7 @@ import numpy as np
 from rotframe.numerics import step_control
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
-from rotframe.numerics.dop853_dense import dense_tables
+from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun", "dop853_kernel", "dop853_from", "steps_estimate"]
@@ -56,19 +56,13 @@ class RigidRun:
 
 @functools.cache
 def _tableau():
-    """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)) of DOP853 with its dense output.
+    """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)): DOP853 with its dense output in one stage loop.
 
-    Rows 0..11 of ``A`` are the stages of `rotframe.numerics.dop853.coefficients`,
-    row 12 its order-8 weights ``B`` (so that "stage 12" of the stage loop forms
-    ``y_new = y + h sum B_q k_q`` and ``f(y_new)``), rows 13..15 the dense-output
-    stages of `rotframe.numerics.dop853_dense.dense_tables`.
+    ``A`` and ``D`` as `rotframe.numerics.dop853_dense.extended_tableau` gives them (row 12 of
+    ``A`` the order-8 weights, rows 13..15 the dense-output stages).
     """
-    A12, B, _, E3, E5 = coefficients()
-    A_extra, D = dense_tables()
-    A = np.zeros((16, 16))
-    A[:12, :12] = A12
-    A[12, :12] = B
-    A[13:] = A_extra
+    A, _, D = extended_tableau()
+    _, _, _, E3, E5 = coefficients()
     return A, E3, E5, D
 
 
@@ -131,28 +125,12 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
             continue
         steps += 1
         if dense:  # the interpolant's coefficients (Hairer's dense output)
-            for j in range(7):
-                dy = y_new[j] - y[j]
-                F[0, j] = dy
-                F[1, j] = h * K[0, j] - dy
-                F[2, j] = 2 * dy - h * (K[12, j] + K[0, j])
-                for r in range(4):
-                    acc = 0.0
-                    for q in range(16):
-                        acc += D[r, q] * K[q, j]
-                    F[3 + r, j] = h * acc
+            dense_coefficients(y, y_new, K, h, D, F)
         # the samples in (t, t_new]: interpolated inside, the new state at t_new
         while k_out < n_out and times[k_out] <= t_new:
             x = (times[k_out] - t) / h
             for j in range(7):
-                if times[k_out] < t_new:
-                    v = 0.0
-                    for i in range(7):
-                        v += F[6 - i, j]
-                        v *= x if i % 2 == 0 else 1.0 - x
-                    tmp[j] = y[j] + v
-                else:
-                    tmp[j] = y_new[j]
+                tmp[j] = dense_value(F, y, x, j) if times[k_out] < t_new else y_new[j]
             n = math.sqrt(tmp[3] * tmp[3] + tmp[4] * tmp[4] + tmp[5] * tmp[5] + tmp[6] * tmp[6])
             for i in range(7):
                 if i < 3:
