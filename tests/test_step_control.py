@@ -21,9 +21,11 @@ from rotframe.numerics import step_control as sc
 from rotframe.numerics.dop853 import coefficients
 from rotframe.numerics.dop853_dense import dense_tables
 
-next_step = sc.next_step.py_func
-first_step_trial = sc.first_step_trial.py_func
-first_step = sc.first_step.py_func
+from rotframe.numerics.plain import plain  # noqa: E402
+
+next_step = plain(sc.next_step)
+first_step_trial = plain(sc.first_step_trial)
+first_step = plain(sc.first_step)
 
 errs = st.floats(min_value=0.0, max_value=1e12, allow_nan=False)
 steps = st.floats(min_value=1e-6, max_value=1e6)
@@ -75,9 +77,9 @@ def test_a_non_finite_error_is_a_rejection_ten_times_shorter(err):
 def test_a_collapsed_step_is_under_ten_ulp_of_t():
     t = 1e6
     ulp = math.ulp(t)
-    assert sc.step_collapsed.py_func(9.0 * ulp, t)
-    assert not sc.step_collapsed.py_func(11.0 * ulp, t)
-    assert sc.step_collapsed.py_func(9.0 * ulp, -t)  # the same below zero
+    assert plain(sc.step_collapsed)(9.0 * ulp, t)
+    assert not plain(sc.step_collapsed)(11.0 * ulp, t)
+    assert plain(sc.step_collapsed)(9.0 * ulp, -t)  # the same below zero
 
 
 # ---------------------------------------------------------------- the starting step
@@ -325,8 +327,8 @@ def _one_step_interpolant(h, x):
     dense_stages_of(f, 0.0, y, h, K)
     F = np.empty((7, 2))
     _, D = dense_tables()
-    dense_coefficients.py_func(y, y_new, K, h, D, F)
-    got = np.array([dense_value.py_func(F, y, x, j) for j in range(2)])
+    plain(dense_coefficients)(y, y_new, K, h, D, F)
+    got = np.array([plain(dense_value)(F, y, x, j) for j in range(2)])
     return got, y, y_new, K
 
 

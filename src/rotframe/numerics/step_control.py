@@ -84,6 +84,17 @@ def step_collapsed(h, t):
     return h < 10.0 * (math.nextafter(abs(t), math.inf) - abs(t))
 
 
+@jit_inline
+def scaled_rms(x, y, rtol, atol):
+    """The RMS norm of ``x`` scaled componentwise by ``atol[j] + rtol |y[j]|`` (Hairer's hinit)."""
+    n = y.shape[0]
+    acc = 0.0
+    for j in range(n):
+        c = x[j] / (atol[j] + rtol * abs(y[j]))
+        acc += c * c
+    return math.sqrt(acc / n)
+
+
 @jit_internal
 def first_step_trial(y, f0, rtol, atol, h_max):
     """Hairer's starting step, first part: the explicit Euler trial step ``h0`` (at most ``h_max``).
@@ -92,17 +103,8 @@ def first_step_trial(y, f0, rtol, atol, h_max):
     j is ``atol[j] + rtol |y[j]|``. The caller evaluates ``f1 = f(t + h0, y + h0 f0)`` and
     passes it to `first_step`.
     """
-    n = y.shape[0]
-    d0 = 0.0
-    d1 = 0.0
-    for j in range(n):
-        sc = atol[j] + rtol * abs(y[j])
-        a = y[j] / sc
-        b = f0[j] / sc
-        d0 += a * a
-        d1 += b * b
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
+    d0 = scaled_rms(y, y, rtol, atol)
+    d1 = scaled_rms(f0, y, rtol, atol)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     return h0 if h0 < h_max else h_max
 
@@ -118,15 +120,11 @@ def first_step(y, f0, f1, h0, rtol, atol, h_max):
     if h0 == 0.0:
         return 0.0
     n = y.shape[0]
-    d1 = 0.0
+    d1 = scaled_rms(f0, y, rtol, atol)
     d2 = 0.0
     for j in range(n):
-        sc = atol[j] + rtol * abs(y[j])
-        b = f0[j] / sc
-        c = (f1[j] - f0[j]) / sc
-        d1 += b * b
+        c = (f1[j] - f0[j]) / (atol[j] + rtol * abs(y[j]))
         d2 += c * c
-    d1 = math.sqrt(d1 / n)
     d2 = math.sqrt(d2 / n) / h0
     big = d1 if d1 > d2 else d2
     h1 = (1e-6 if 1e-6 > h0 * 1e-3 else h0 * 1e-3) if big <= 1e-15 else (0.01 / big) ** 0.125

@@ -16,7 +16,7 @@ Modules, one concept each:
   problem's own functions; ``calls``: the engine's calls to them, by address;
 * ``glue``: the source of a problem's own small functions (its forces summed, its events...);
   ``codegen``: that glue compiled and cached on disk as a module of its own; ``stubs``: the
-  functions a problem does not have; ``plain``: the engine as plain Python (``jit=False``);
+  functions a problem does not have; and the engine as plain Python (``jit=False``) is `rotframe.numerics.plain`;
 * ``terms``: a force, the pendulum's string, what a splitting takes;
 * ``particles``: `simulate_particles`, `Force`;
 * ``body``: `simulate_rigid_body`;

@@ -10,7 +10,7 @@ nothing to hand from function to function, where numba's first-class function va
 measured at some 20 ns a call they crossed, more than a term's arithmetic; and it is a
 run-time value, so the engine compiled once serves every problem from numba's cache.
 
-In plain Python (``jit=False``, `rotframe.problem.plain`) the "address" is the Python function
+In plain Python (``jit=False``, `rotframe.numerics.plain`) the "address" is the Python function
 itself and each call helper is a plain call (``.plain`` of the helper).
 """
 
@@ -128,4 +128,4 @@ def _plain_vector(f, t, out):
 
 for _helper, _python in ((call_terms, _plain_terms), (call_event, _plain_event), (call_potential, _plain_potential),
                          (call_vector, _plain_vector)):
-    _helper.plain = _python  # what rotframe.problem.plain calls instead
+    _helper.plain = _python  # what rotframe.numerics.plain calls instead

@@ -18,7 +18,7 @@ UTF-8, a folder in its place, numba's cache files truncated or garbage) is dropp
 with a note (`is_cache_damage`); a cache never fails a run.
 
 With ``jit=False`` the same source runs as plain Python (no numba at all), with the engine's
-(`rotframe.problem.plain`): slow, for a function numba cannot compile.
+(`rotframe.numerics.plain`): slow, for a function numba cannot compile.
 """
 
 from __future__ import annotations
@@ -120,7 +120,7 @@ class Driver:
 
     ``advance``, ``start_events`` and ``energies`` are the engine's entry points
     (`rotframe.problem.engine`; their plain Python remakes with ``compiled=False``,
-    `rotframe.problem.plain`), which take `functions` as their last argument.
+    `rotframe.numerics.plain`), which take `functions` as their last argument.
     """
 
     def __init__(self, module, compiled=True):
@@ -134,7 +134,7 @@ class Driver:
 
         kernel = getattr(engine, name)
         if not self.compiled:
-            from rotframe.problem.plain import plain
+            from rotframe.numerics.plain import plain
 
             return plain(kernel)
         return engine.ready(kernel)

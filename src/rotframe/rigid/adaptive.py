@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 from rotframe.numerics import step_control
+from rotframe.numerics.plain import plain
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
@@ -153,16 +154,17 @@ def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out
 def _first_step(y, K, p, h_max, atol_vec, rtol):
     """``K[0] = f(y)`` and Hairer's starting step (`rotframe.numerics.step_control`), ``K[1]`` f at its trial step.
 
-    The shared functions run as Python here (a few microseconds; numpy float64 scalars, the
-    same IEEE double operations as compiled, x / 0 giving inf or nan). Returns the step ``h``.
+    The shared functions run as plain Python here (`rotframe.numerics.plain`: a few microseconds,
+    nothing to compile; numpy float64 scalars, the same IEEE double operations as compiled, x / 0
+    giving inf or nan). Returns the step ``h``.
     """
     args = p.tolist()
     with np.errstate(all="ignore"):
         y = np.asarray(y, dtype=np.float64)
         K[0] = euler_rates(*y.tolist(), *args)
-        h0 = step_control.first_step_trial.py_func(y, K[0], rtol, atol_vec, h_max)
+        h0 = plain(step_control.first_step_trial)(y, K[0], rtol, atol_vec, h_max)
         K[1] = euler_rates(*(y + h0 * K[0]).tolist(), *args)
-        return step_control.first_step.py_func(y, K[0], K[1], h0, rtol, atol_vec, h_max)
+        return plain(step_control.first_step)(y, K[0], K[1], h0, rtol, atol_vec, h_max)
 
 
 def steps_estimate(inertia, L0, duration, rtol, mgl=0.0):

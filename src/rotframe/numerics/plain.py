@@ -1,4 +1,8 @@
-"""The engine as plain Python (``jit=False``): the same functions, with every compiled callee its Python original.
+"""Compiled functions as plain Python: the same functions, with every compiled callee its Python original.
+
+The engine of your own problems runs this way with ``jit=False``; the rigid body's starting step
+runs the shared `rotframe.numerics.step_control` functions this way (a few microseconds, nothing
+to compile).
 
 A numba dispatcher's ``py_func`` is the Python function it was made from, but that function
 still calls its module's compiled neighbours, which cannot take plain Python functions as
