@@ -136,6 +136,21 @@ def test_the_starting_step_agrees_with_scipys():
         assert ours(f, 0.3, y, 1e-8, np.full(5, 1e-10), 50.0) == pytest.approx(theirs, rel=1e-12)
 
 
+@pytest.mark.parametrize("f, y", [
+    (lambda t, y: np.full(4, 1.0), np.full(4, 1.5e-5)),  # |y| just above the 1e-5 of the trial step's rule
+    (lambda t, y: np.full(4, 1.0), np.full(4, 1e-7)),  # |y| below it, |f| above
+    (lambda t, y: np.full(4, 1.5e-5), np.ones(4)),  # |f| just above it
+    (lambda t, y: np.full(4, 1.5e-15 * t), np.ones(4)),  # f = 0 at the start, |f'| just above 1e-15
+])
+def test_the_starting_steps_thresholds(f, y):
+    """The branches of hinit at their edges, with unit scales (atol 1, rtol 0): the norms are the values.
+
+    (Where ``max(d1, d2) <= 1e-15``, ``h0`` is at most 1e-6, so ``max(1e-6, 1e-3 h0)`` is always
+    1e-6: its second term cannot be reached, in Hairer's code as here.)"""
+    atol = np.ones(4)
+    assert ours(f, 0.0, y, 0.0, atol, 1e9) == pytest.approx(hinit(f, 0.0, y, 0.0, atol, 1e9), rel=1e-12)
+
+
 def test_a_run_of_no_length_starts_with_no_step():
     y = np.ones(3)
     assert first_step(y, y, y, 0.0, 1e-8, np.ones(3), 0.0) == 0.0
