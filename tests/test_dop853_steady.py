@@ -21,8 +21,15 @@ from rotframe.particles.trajectory import Event
 
 
 def general_driver(monkeypatch):
-    """Make every run in this test take the general DOP853 driver."""
+    """Make every run in this test take the general DOP853 driver.
+
+    The set-ups that earlier runs kept (`rotframe.particles.integrators._SETUPS`, each holding its
+    driver) are set aside too: a repeated run would reuse the steady one.
+    """
+    from rotframe.particles import integrators
+
     monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(), packed=None: False)
+    monkeypatch.setattr(integrators, "_SETUPS", {})
 
 
 def random_case(seed):

@@ -255,8 +255,11 @@ def test_the_particle_scenes_take_the_oracles_steps_and_samples(reference, monke
     model = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=OmegaSchedule.constant(W), g=G)
     n, y, samples = reference
     for driver in ("steady", "general"):
-        if driver == "general":  # the general driver, for a model the steady one would take
+        if driver == "general":  # the general driver, for a model the steady one would take (a new set-up)
+            from rotframe.particles import integrators
+
             monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(), packed=None: False)
+            monkeypatch.setattr(integrators, "_SETUPS", {})
         traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6,
                                    samples=SAMPLES)
         assert traj.steps == n
