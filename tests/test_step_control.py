@@ -368,3 +368,25 @@ def test_the_dense_output_is_hairers_contd8(x):
         np.testing.assert_array_equal(got, y)
     if x == 1.0:
         np.testing.assert_allclose(got, y_new, rtol=1e-15)
+
+
+def test_samples_inside_steps_cut_to_a_knot_are_the_solution():
+    """rotframe.simulate's steps end on the knots of an omega table; samples inside such a cut step are
+    interpolated on the step actually taken (a spring in a frame whose table holds zero rotation:
+    the closed form x = x0 cos(w t) + v0 / w sin(w t))."""
+    from rotframe.problem.particles import simulate_particles
+
+    k = 4.0
+
+    def spring(t, r, v):
+        return -k * r[0], -k * r[1], -k * r[2]
+
+    knots = np.linspace(0.0, 10.0, 14)  # steps of about 0.3 s are cut at every 0.77 s
+    table = (knots, np.zeros((knots.size, 3)))
+    r0, v0 = np.array([1.0, -0.5, 0.2]), np.array([0.3, 0.7, -0.1])
+    run = simulate_particles(omega=table, r0=r0, v0=v0, duration=10.0, forces=[spring], method="dop853",
+                             rtol=1e-12, samples=400)
+    t = run.trajectory.times[:, None]
+    w = math.sqrt(k)
+    exact = r0 * np.cos(w * t) + v0 / w * np.sin(w * t)
+    np.testing.assert_allclose(run.trajectory.r[:, 0], exact, rtol=0, atol=1e-9)
