@@ -16,7 +16,7 @@ written in place: the same stages, error norm, step control and starting step
 and failure checks, in the same floating-point order, so that its results are
 bitwise those of the general driver (``tests/test_dop853_steady.py`` checks
 this on random models). Its kernel, the force, one stage loop and the shared
-pieces compile in about 1.9 s on a first ``rotframe run foucault`` on the 2-core
+pieces compile in about 2.5 s on a first ``rotframe run foucault`` on the 2-core
 machine (numba's own start, about 0.5 s, included), where the general driver
 takes 3.3 to 4 s.
 
