@@ -390,3 +390,22 @@ def test_samples_inside_steps_cut_to_a_knot_are_the_solution():
     w = math.sqrt(k)
     exact = r0 * np.cos(w * t) + v0 / w * np.sin(w * t)
     np.testing.assert_allclose(run.trajectory.r[:, 0], exact, rtol=0, atol=1e-9)
+
+
+def test_every_kernel_is_cached_under_the_whole_packages_sources():
+    """numba stamps a disk cache with the kernel's own file; rotframe's kernels carry the package's
+    fingerprint, so that a change to a callee in another file (models.py under engine.py) recompiles."""
+    from numba import njit
+
+    from rotframe.numerics.compiled import source_fingerprint
+    from rotframe.problem import engine
+    from rotframe.rigid import adaptive
+
+    for kernel in (engine.advance, adaptive._steps):
+        assert kernel._cache._impl._locator.get_source_stamp() == source_fingerprint()
+
+    def outside(x):  # a kernel of another package (this test file): numba's own stamp, its file alone
+        return x + 1.0
+
+    stamp = njit(cache=True)(outside)._cache._impl._locator.get_source_stamp()
+    assert stamp != source_fingerprint()

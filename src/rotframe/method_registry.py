@@ -95,9 +95,9 @@ _REGISTRY = (
            "a torque-free body", ("particle scenes", "bodies", "free body")),
     Method("rotation-splitting", 2, "fixed", _ROTATION,
            "the frame's Coriolis term as an exact rotation of v (exact for omega of fixed direction over a "
-           "step), forces of (t, r) alone as kicks, drag (rotframe.forces.drag) as its exact flow; in the "
-           "scenes also the pendulum on its sphere; refuses a force of your own that reads v or is given in "
-           "inertial axes", ("particle scenes", "particles"),
+           "step), forces of (t, r) alone as kicks, drag (rotframe.forces.drag) as its exact flow, the "
+           "pendulum's string (rotframe.forces.pendulum) on its sphere; refuses a force of your own that "
+           "reads v or is given in inertial axes", ("particle scenes", "particles"),
            gpu=True, aliases=("splitting",)),
     Method("rotation-splitting4", 4, "fixed", _ROTATION + " (Yoshida's triple jump of rotation-splitting)",
            "as rotation-splitting", ("particle scenes", "particles"), gpu=True, aliases=("splitting4",)),

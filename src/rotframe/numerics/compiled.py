@@ -19,11 +19,81 @@ plain Python function.
 
 from __future__ import annotations
 
+import functools
+import hashlib
+import os
+
 from numba import njit
+from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_inline", "inlined", "uncounted",
-           "CompiledOnlyDispatcher"]
+           "CompiledOnlyDispatcher", "source_fingerprint"]
+
+#: The package's folder: a kernel defined in a file below it is cached with `source_fingerprint` as its stamp.
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@functools.cache
+def source_fingerprint() -> bytes:
+    """SHA-256 of every Python source file of the package (their paths and contents), made once a process.
+
+    numba stamps a kernel's disk cache with its own file's contents alone, so a kernel whose callee
+    lives in another file (the engine's entry in ``engine.py``, its equations in ``models.py``) would
+    load stale machine code after that file changed: in a checkout being edited, or in an install
+    upgraded over an old cache. Every rotframe kernel is stamped with this fingerprint instead
+    (`_StampedByPackage`): any change to the package's sources makes each kernel compile once again.
+    Reading the sources (about 1.4 MB) takes a few milliseconds.
+    """
+    digest = hashlib.sha256()
+    for folder, subfolders, files in os.walk(PACKAGE_DIR):
+        subfolders[:] = sorted(d for d in subfolders if d != "__pycache__")
+        for name in sorted(files):
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                digest.update(os.path.relpath(path, PACKAGE_DIR).encode())
+                with open(path, "rb") as f:
+                    digest.update(f.read())
+    return digest.digest()
+
+
+def _in_package(py_file) -> bool:
+    return os.path.abspath(py_file).startswith(PACKAGE_DIR + os.sep)
+
+
+class _StampedByPackage:
+    """A numba cache locator for rotframe's own kernels: numba's, with `source_fingerprint` as the stamp."""
+
+    def get_source_stamp(self):
+        return source_fingerprint()
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if not _in_package(py_file):
+            return None  # a kernel of another package (a user's): numba's own locators
+        return super().from_function(py_func, py_file)
+
+
+class _UserProvided(_StampedByPackage, caching.UserProvidedCacheLocator):
+    """``NUMBA_CACHE_DIR``, where it is set."""
+
+
+class _InTree(_StampedByPackage, caching.InTreeCacheLocator):
+    """``__pycache__`` beside the source, where it is writable."""
+
+
+class _UserWide(_StampedByPackage, caching.UserWideCacheLocator):
+    """numba's user-wide cache folder otherwise."""
+
+
+def _install_locators():
+    """Put rotframe's locators first in numba's list (once); kernels of other packages pass through them."""
+    classes = caching.CacheImpl._locator_classes
+    if _UserProvided not in classes:
+        classes[:0] = [_UserProvided, _InTree, _UserWide]
+
+
+_install_locators()
 
 #: The decorator of every compiled kernel that reports failures as non-finite numbers.
 jit_kernel = njit(cache=True, error_model="numpy", nogil=True)

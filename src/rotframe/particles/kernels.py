@@ -22,6 +22,7 @@ from numba import njit
 
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
+from rotframe.numerics.sphere import great_circle
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
 from rotframe.particles.packed import NFEV, jit_internal, jit_kernel, unpack
@@ -217,7 +218,8 @@ def _sphere_step(state, h, m, sub):
     """One sub-step of `_sphere_steps` with the rotation data ``sub``."""
     x, y, z, vx, vy, vz = state
     hh = 0.5 * h
-    x, y, z, vx, vy, vz = _great_circle(x, y, z, vx, vy, vz, hh, m)
+    px, py, pz = m.pivot
+    x, y, z, vx, vy, vz = great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, m.length)  # numerics.sphere
     ax, ay, az = position_acceleration(x, y, z, m, sub[0], sub[1])
     nx, ny, nz = string_normal(x, y, z, m)
     an = ax * nx + ay * ny + az * nz
@@ -241,40 +243,7 @@ def _sphere_step(state, h, m, sub):
     vx += hh * ax
     vy += hh * ay
     vz += hh * az
-    return _great_circle(x, y, z, vx, vy, vz, hh, m)
-
-
-@jit_internal
-def _great_circle(x, y, z, vx, vy, vz, tau, m):
-    """Exact geodesic flow on the sphere of radius L about the pivot, for time tau."""
-    L = m.length
-    px, py, pz = m.pivot
-    nx, ny, nz = string_normal(x, y, z, m)
-    vn = vx * nx + vy * ny + vz * nz
-    vx = vx - vn * nx
-    vy = vy - vn * ny
-    vz = vz - vn * nz
-    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-    if speed > 0.0:
-        ux = vx / speed
-        uy = vy / speed
-        uz = vz / speed
-        phi = speed * tau / L
-        c = math.cos(phi)
-        s = math.sin(phi)
-        mx = nx * c + ux * s
-        my = ny * c + uy * s
-        mz = nz * c + uz * s
-        vx = speed * (ux * c - nx * s)
-        vy = speed * (uy * c - ny * s)
-        vz = speed * (uz * c - nz * s)
-        nx, ny, nz = mx, my, mz
-    norm = math.sqrt(nx * nx + ny * ny + nz * nz)
-    nx /= norm
-    ny /= norm
-    nz /= norm
-    vn = vx * nx + vy * ny + vz * nz
-    return px + L * nx, py + L * ny, pz + L * nz, vx - vn * nx, vy - vn * ny, vz - vn * nz
+    return great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, m.length)
 
 
 @jit_internal

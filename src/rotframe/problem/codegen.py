@@ -227,7 +227,11 @@ def build_module(kind: str, key_material, functions: dict, glue: str, *, compile
     head = _HEADER_COMPILED.format(cache=cached) if compiled else _HEADER_PLAIN
     if not cached:
         key_material = f"uncached {os.getpid()} {next(_UNCACHED)}"
-    digest = hashlib.sha256((key_material + glue + head).encode()).hexdigest()[:24]
+    from rotframe.numerics.compiled import source_fingerprint
+
+    # the package's sources in the name too: the glue's machine code holds rotframe's helpers, which numba's
+    # own stamp (the glue file's text) does not see
+    digest = hashlib.sha256((key_material + glue + head).encode() + source_fingerprint()).hexdigest()[:24]
     name = f"rotframe_{kind}_problem_{digest}"
     if name in sys.modules:  # built in this process already: the user's functions are not compiled again
         return sys.modules[name]

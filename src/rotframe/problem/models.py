@@ -32,7 +32,8 @@ The numpy twins used for analysis are in `rotframe.problem.frame`.
 
 **Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING`` and ``SPLITTING4``):
 a particle's rotation splitting (docs/physics/splitting.md: drift, kick, the Coriolis rotation,
-a drag term's exact flow) and a body's Lie-Poisson splitting (McLachlan 1993; Dullweber,
+a drag term's exact flow; with a pendulum's string, the same on the string's sphere, `sphere_strang`:
+the great-circle flow for the drift, the Coriolis rotation about the string) and a body's Lie-Poisson splitting (McLachlan 1993; Dullweber,
 Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torque a kick at
 fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 (`rotframe.numerics.composition`).
@@ -55,6 +56,7 @@ import math
 from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
+from rotframe.numerics.sphere import great_circle
 from rotframe.problem.calls import call_potential, call_terms, call_vector
 from rotframe.particles.forces import drag_flow
 
@@ -333,6 +335,52 @@ def rotation_strang(t, h, yn, prob, fns, W):
 
 
 @jit_uncounted
+def sphere_strang(t, h, yn, prob, fns, W):
+    """One step of the rotation splitting on the string's sphere, as the scenes' pendulum splitting
+    (`rotframe.particles.kernels`; docs/physics/splitting.md): the great-circle flow h/2
+    (`rotframe.numerics.sphere`), the kick's part across the string h/2, a drag term's exact flow h/2,
+    the Coriolis flow across the string (v turned about the string's direction n by -2 (w . n) h, w at
+    the step's middle), the drag flow h/2, the kick h/2, the great-circle flow h/2. The string's
+    tension is the part of every force along n, which the flows on the sphere take exactly."""
+    M = prob[1]
+    px = M[1]
+    py = M[2]
+    pz = M[3]
+    L = M[4]
+    hh = 0.5 * h
+    x, y, z, vx, vy, vz = great_circle(yn[0], yn[1], yn[2], yn[3], yn[4], yn[5], hh, px, py, pz, L)
+    yn[0] = x
+    yn[1] = y
+    yn[2] = z
+    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yn, prob, fns, W)
+    nx = (x - px) / L
+    ny = (y - py) / L
+    nz = (z - pz) / L
+    an = ax * nx + ay * ny + az * nz
+    ax -= an * nx
+    ay -= an * ny
+    az -= an * nz
+    vx += hh * ax
+    vy += hh * ay
+    vz += hh * az
+    k1, k2 = drag_rates(M, yn)
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+    angle = -2.0 * (wx * nx + wy * ny + wz * nz) * h
+    vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, math.cos(angle), math.sin(angle))
+    vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
+    vx += hh * ax
+    vy += hh * ay
+    vz += hh * az
+    x, y, z, vx, vy, vz = great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, L)
+    yn[0] = x
+    yn[1] = y
+    yn[2] = z
+    yn[3] = vx
+    yn[4] = vy
+    yn[5] = vz
+
+
+@jit_uncounted
 def turn_about_axis(k, a, yn):
     """The exact flow of H_k = L_k^2 / (2 I_k) for an angle a = h L_k / I_k: L turns by -a about body
     axis k, the attitude by +a about it (q <- q (e_k sin(a/2), cos(a/2)))."""
@@ -385,7 +433,10 @@ def lie_poisson_strang(t, h, yn, prob, fns, W):
 @jit_uncounted
 def strang(t, h, yn, prob, fns, W):
     if prob[0] == 0:
-        rotation_strang(t, h, yn, prob, fns, W)
+        if prob[1][0] != 0.0:  # a pendulum's string: the splitting on its sphere
+            sphere_strang(t, h, yn, prob, fns, W)
+        else:
+            rotation_strang(t, h, yn, prob, fns, W)
     else:
         lie_poisson_strang(t, h, yn, prob, fns, W)
 

@@ -201,7 +201,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
     params = check_params(params)
     if method.startswith("rotation-splitting"):
-        check_splitting(method, forces, constraint, labels)
+        check_splitting(method, forces, labels)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)

@@ -86,8 +86,10 @@ def as_term(f, k):
     return force
 
 
-def check_splitting(method, forces, constraint, labels):
+def check_splitting(method, forces, labels):
     """A splitting kicks with the forces: each must be a force of ``(t, r)`` alone, in the frame's axes.
+
+    A pendulum's string needs no check: the splittings run it on its sphere (`rotframe.problem.models`).
 
     ``labels``: each force as the user's list names it (``forces[k]``, counted with the string).
     """
@@ -103,9 +105,6 @@ def check_splitting(method, forces, constraint, labels):
         if why:
             raise ScenarioError(f"method={method!r} cannot take {labels[k]} ({f.name or uf.display_name(f.accel)}): "
                                 f"it {why}; use dop853 or rk4")
-    if constraint is not None:
-        raise ScenarioError(f"method={method!r} cannot take the pendulum's string in rotframe.simulate yet (the "
-                            "scenes' foucault runs it on the sphere); use dop853 or rk4")
 
 
 def one_constraint(terms, r, v):
