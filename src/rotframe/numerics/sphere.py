@@ -18,7 +18,7 @@ import math
 
 from rotframe.numerics.compiled import jit_inline
 
-__all__ = ["great_circle"]
+__all__ = ["great_circle", "kick_across"]
 
 
 @jit_inline
@@ -57,3 +57,16 @@ def great_circle(x, y, z, vx, vy, vz, tau, px, py, pz, L):
     nz /= norm
     vn = vx * nx + vy * ny + vz * nz
     return px + L * nx, py + L * ny, pz + L * nz, vx - vn * nx, vy - vn * ny, vz - vn * nz
+
+
+@jit_inline
+def kick_across(vx, vy, vz, ax, ay, az, nx, ny, nz, tau):
+    """A kick for ``tau`` by the acceleration's part across the string (its part along ``n`` is the tension's).
+
+    Returns that part and the kicked velocity, ``(ax, ay, az, vx, vy, vz)``.
+    """
+    an = ax * nx + ay * ny + az * nz
+    ax -= an * nx
+    ay -= an * ny
+    az -= an * nz
+    return ax, ay, az, vx + tau * ax, vy + tau * ay, vz + tau * az

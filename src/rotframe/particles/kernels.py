@@ -22,7 +22,7 @@ from numba import njit
 
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
-from rotframe.numerics.sphere import great_circle
+from rotframe.numerics.sphere import great_circle, kick_across
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
 from rotframe.particles.packed import NFEV, jit_internal, jit_kernel, unpack
@@ -222,13 +222,7 @@ def _sphere_step(state, h, m, sub):
     x, y, z, vx, vy, vz = great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, m.length)  # numerics.sphere
     ax, ay, az = position_acceleration(x, y, z, m, sub[0], sub[1])
     nx, ny, nz = string_normal(x, y, z, m)
-    an = ax * nx + ay * ny + az * nz
-    ax -= an * nx
-    ay -= an * ny
-    az -= an * nz
-    vx += hh * ax
-    vy += hh * ay
-    vz += hh * az
+    ax, ay, az, vx, vy, vz = kick_across(vx, vy, vz, ax, ay, az, nx, ny, nz, hh)
     k1 = 0.0
     k2 = 0.0
     if m.drag:

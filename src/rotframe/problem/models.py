@@ -56,7 +56,7 @@ import math
 from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
-from rotframe.numerics.sphere import great_circle
+from rotframe.numerics.sphere import great_circle, kick_across
 from rotframe.problem.calls import call_potential, call_terms, call_vector
 from rotframe.particles.forces import drag_flow
 
@@ -356,13 +356,7 @@ def sphere_strang(t, h, yn, prob, fns, W):
     nx = (x - px) / L
     ny = (y - py) / L
     nz = (z - pz) / L
-    an = ax * nx + ay * ny + az * nz
-    ax -= an * nx
-    ay -= an * ny
-    az -= an * nz
-    vx += hh * ax
-    vy += hh * ay
-    vz += hh * az
+    ax, ay, az, vx, vy, vz = kick_across(vx, vy, vz, ax, ay, az, nx, ny, nz, hh)
     k1, k2 = drag_rates(M, yn)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     angle = -2.0 * (wx * nx + wy * ny + wz * nz) * h
