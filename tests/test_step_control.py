@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 
 from rotframe.numerics import step_control as sc
 from rotframe.numerics.dop853 import coefficients

@@ -131,7 +131,7 @@ class KernelSetup:
             A, C, D = extended_tableau()
             self.tableau = (A, C, D) + coefficients()[3:]  # A, C, D, E3, E5
             # a steady model without events runs the specialised driver (bitwise the same results,
-            # three compiled functions instead of fourteen): rotframe.particles.dop853_steady
+            # a smaller first compile): rotframe.particles.dop853_steady
             if is_steady_model(model, self.events, self.P):
                 self.steady_args = (steady_parameters(model, self.P), steady_tableau())
 

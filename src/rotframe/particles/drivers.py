@@ -11,7 +11,6 @@ handled between chunks without losing data.
 
 from __future__ import annotations
 
-import math
 import numpy as np
 from numba import njit
 

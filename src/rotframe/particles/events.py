@@ -204,9 +204,9 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, 
 def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, C, f0, K, y, tmp, y_out):
     """`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
 
-    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, C`` are the
-    tableau (`rotframe.numerics.dop853_dense.extended_tableau`), ``K`` (13, 6) and ``tmp`` (6,) scratch, and ``y_out`` (6,) receives the
-    state (`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
+    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, C`` are the tableau
+    (`rotframe.numerics.dop853_dense.extended_tableau`), ``K`` (13, 6) and ``tmp`` (6,) scratch, and
+    ``y_out`` (6,) receives the state (`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
     the state at the event (a 6-tuple).
     """
     lo = 0.0

@@ -45,11 +45,9 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
-from rotframe.numerics.dop853 import coefficients
-from rotframe.numerics.dop853 import dop853_error_norm as _counted_error_norm
 from rotframe.numerics import dop853_dense, step_control
-from rotframe.numerics.dop853_dense import extended_tableau
+from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
+from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs, rhs_inlined
@@ -57,7 +55,7 @@ from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I
 
 __all__ = ["advance", "start_events", "energies", "ready"]
 
-A, C, DW = extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
+A, C, DW = dop853_dense.extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
 E3, E5 = coefficients()[3:]
 # the shared kernels that take arrays, compiled as the engine's own (without reference counts)
 dop853_error_norm = uncounted(_counted_error_norm)
@@ -315,13 +313,14 @@ def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         if status == 5:
             break
         # DOP853's samples inside the step (up to a terminal event's time): its dense output, of order 7
-        if method == DOP853 and idx < n and T[idx] < t_new and (stop_k < 0 or T[idx] <= t + stop_tau):
+        t_last = t + stop_tau if stop_k >= 0 else t_new
+        if method == DOP853 and idx < n and T[idx] < t_new and T[idx] <= t_last:
             dense_output(t, y, yn, hh, K, yt, F, prob, fns, W)
             NFEV[i] += 3
             if W[RAISED] != 0.0:
                 status = 6
                 break
-            while idx < n and T[idx] < t_new and (stop_k < 0 or T[idx] <= t + stop_tau):
+            while idx < n and T[idx] < t_new and T[idx] <= t_last:
                 x = (T[idx] - t) / hh
                 for j in range(D):
                     OUT[idx, i, j] = dense_value(F, y, x, j)

@@ -33,8 +33,8 @@ The numpy twins used for analysis are in `rotframe.problem.frame`.
 **Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING`` and ``SPLITTING4``):
 a particle's rotation splitting (docs/physics/splitting.md: drift, kick, the Coriolis rotation,
 a drag term's exact flow; with a pendulum's string, the same on the string's sphere, `sphere_strang`:
-the great-circle flow for the drift, the Coriolis rotation about the string) and a body's Lie-Poisson splitting (McLachlan 1993; Dullweber,
-Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torque a kick at
+the great-circle flow for the drift, the Coriolis rotation about the string) and a body's
+Lie-Poisson splitting (McLachlan 1993; Dullweber, Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torque a kick at
 fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 (`rotframe.numerics.composition`).
 
