@@ -15,6 +15,9 @@ from __future__ import annotations
 import ast
 import builtins
 
+import os
+import subprocess
+import sys
 import numpy as np
 import pytest
 
@@ -103,8 +106,52 @@ def test_the_engine_compiles_once_for_every_problem():
                       forces=[Force(lambda t, r, v: (0.0, 0.0, -1.0), axes="inertial")], method="rk4", step=0.01,
                       samples=4)
     rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.1], q0=[0, 0, 0, 1], duration=1.0, samples=4)
-    for kernel in (engine.advance, engine.start_events):
+    from rotframe.problem.models import DOP853, RK4
+    from rotframe.problem.signatures import BODY, PARTICLE
+
+    # each variant of the loop (model, method, events) compiled once, for its one signature, whatever the problem
+    used = [engine.variant(PARTICLE, DOP853, False), engine.variant(PARTICLE, RK4, True),
+            engine.variant(BODY, DOP853, False)]
+    for kernel in used + [engine.start_events]:
         assert len(kernel.signatures) == 1, kernel.signatures
+    assert len({id(k) for k in used}) == 3
+    with pytest.raises(TypeError):  # closed to new compiles: a problem's functions arrive as addresses
+        used[0](*[None] * 31)
+
+
+def test_a_variant_compiles_only_its_own_model_method_and_events(tmp_path):
+    """A first DOP853 particle problem without events compiles no body, no splitting, no RK4, no event locator."""
+    script = tmp_path / "first.py"
+    script.write_text(_FIRST_PROBLEM)
+    env = dict(os.environ, ROTFRAME_CACHE_DIR=str(tmp_path / "problems"), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    compiled = set(proc.stdout.split())
+    assert {"advance_particle_dop853", "particle_rhs", "dop853_step", "dense_output"} <= compiled, compiled
+    assert not compiled & {"body_rhs", "own_step", "strang", "rk4_step", "kick_acceleration", "lie_poisson_strang",
+                           "sphere_strang"}, compiled
+
+
+_FIRST_PROBLEM = """
+from numba.core import event
+import rotframe
+
+names = []
+
+
+class Listener(event.Listener):
+    def on_start(self, ev):
+        names.append(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listener())
+rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=1.0,
+                  forces=[lambda t, r, v: (-r[0], -r[1], -r[2])], samples=4)
+print(" ".join(names))
+"""
 
 
 def force_raises_after(t, r, v):

@@ -119,14 +119,17 @@ class Driver:
     """A problem's glue module and the engine that runs it.
 
     ``advance``, ``start_events`` and ``energies`` are the engine's entry points
-    (`rotframe.problem.engine`; their plain Python remakes with ``compiled=False``,
+    (`rotframe.problem.engine`: ``advance`` runs the problem's variant of the loop; their plain Python remakes with ``compiled=False``,
     `rotframe.numerics.plain`), which take `functions` as their last argument.
     """
 
     def __init__(self, module, compiled=True):
+        from rotframe.problem import engine
+
         self.module = module
         self.compiled = compiled
-        self.advance = self._entry("advance")
+        # the variant of the engine's loop that a problem needs is chosen (and compiled, once) at its first call
+        self.advance = engine.advance if compiled else functools.partial(engine.advance, compiled=False)
 
     def _entry(self, name):
         """The engine's entry point ``name``, compiled when first needed (or its plain Python remake)."""

@@ -1,10 +1,16 @@
 """The engine of a problem of your own: DOP853, RK4, the models' splittings and events, compiled once.
 
 Every particle problem of ``rotframe.simulate`` and every body of ``rotframe.simulate_body``
-runs these functions, compiled once with numba and cached on disk (``cache=True``): a problem
+runs these functions, compiled with numba and cached on disk (``cache=True``): a problem
 hands them the addresses of its own compiled functions (`rotframe.problem.calls`) and its data
 as the `rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
 functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
+
+The loop is one function, written once, compiled as a *variant* per model (particle or body),
+method and whether there are events (`variant`): those three are constants of a variant's code,
+so numba prunes everything else before it compiles (a first DOP853 particle problem compiles no
+body, no splitting, no RK4 and no event locator). Each variant compiles the first time any
+problem needs it, then loads from numba's cache; no problem ever compiles the loop again.
 
 * DOP853: Hairer's step control and starting step (hinit), written once for every DOP853 loop in
   `rotframe.numerics.step_control`; a step lands on the run's end and on the stops, and the
@@ -31,7 +37,8 @@ functions, and nothing else, per problem). The equations are `rotframe.problem.m
   waking), more than a whole single-particle run.
 * The kernels compile without reference counting (`rotframe.numerics.compiled.jit_uncounted`:
   the counts, at every call that could raise, cost more than the arithmetic; measured 2 to 3
-  times a step's time) and take every array from ``advance``, which owns them for the call.
+  times a step's time), the variants' loops too: ``advance`` (Python) makes their work arrays
+  (`scratch`) and owns every array for the call.
 
 Status codes per particle: 0 running, 1 finished, 2 stopped by a terminal event,
 3 non-finite state, 4 step size collapsed, 5 an event function gave NaN (or raised), 6 a user
@@ -50,10 +57,10 @@ from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.problem.calls import RAISED, call_event
-from rotframe.problem.models import DOP853, RK4, SCRATCH, own_step, particle_energy, rhs, rhs_inlined
-from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, POTENTIAL, PROBLEM
+from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs, rhs_inlined
+from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
-__all__ = ["advance", "start_events", "energies", "ready"]
+__all__ = ["advance", "variant", "scratch", "start_events", "energies", "ready"]
 
 A, C, DW = dop853_dense.extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
 E3, E5 = coefficients()[3:]
@@ -65,6 +72,9 @@ dense_coefficients = uncounted(dop853_dense.dense_coefficients)
 dense_value = dop853_dense.dense_value  # inlined into its callers
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
+#: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
+#: arrays made by the caller (`scratch`)
+_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
 
 
 @jit_inline
@@ -81,7 +91,7 @@ def stage_state(z, y, h, K, s, D):
 
 
 @jit_uncounted
-def dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W):
+def dop853_step(body, t, y, h, t_end, K, yt, yn, prob, fns, W):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
     D = y.shape[0]
     for s in range(1, 13):  # the stages, then f at the step's end (one call of the inlined rhs)
@@ -91,11 +101,11 @@ def dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W):
         else:
             stage_state(z, y, h, K, s, D)
         ts = t + C[s] * h if s < 12 else t_end  # the last: the time the step ends on (a sample time where it lands)
-        rhs_inlined(ts, z, K[s], prob, fns, W)
+        rhs_inlined(body, ts, z, K[s], prob, fns, W)
 
 
 @jit_uncounted
-def dense_output(t, y, yn, h, K, z, F, prob, fns, W):
+def dense_output(body, t, y, yn, h, K, z, F, prob, fns, W):
     """The interpolant's coefficients ``F`` (7, D) of an accepted DOP853 step (t, y) -> (t + h, yn).
 
     Its three more stages into ``K[13..15]`` (`rotframe.numerics.dop853_dense`), then Hairer's
@@ -104,31 +114,31 @@ def dense_output(t, y, yn, h, K, z, F, prob, fns, W):
     D = y.shape[0]
     for s in range(13, 16):
         stage_state(z, y, h, K, s, D)
-        rhs(t + C[s] * h, z, K[s], prob, fns, W)
+        rhs(body, t + C[s] * h, z, K[s], prob, fns, W)
     dense_coefficients(y, yn, K, h, DW, F)
 
 
 @jit_uncounted
-def rk4_step(t, y, h, K, yt, yn, prob, fns, W):
+def rk4_step(body, t, y, h, K, yt, yn, prob, fns, W):
     """One classical Runge-Kutta step from (t, y) with K[0] = f(t, y)."""
     D = y.shape[0]
     for s in range(1, 4):  # one call of the inlined rhs
         c = 0.5 if s < 3 else 1.0
         for j in range(D):
             yt[j] = y[j] + c * h * K[s - 1, j]
-        rhs(t + c * h, yt, K[s], prob, fns, W)
+        rhs(body, t + c * h, yt, K[s], prob, fns, W)
     for j in range(D):
         yn[j] = y[j] + h * (K[0, j] + 2.0 * K[1, j] + 2.0 * K[2, j] + K[3, j]) / 6.0
 
 
 @jit_inline
-def take_step(method, t, y, h, t_end, K, yt, yn, prob, fns, W):
+def take_step(body, method, t, y, h, t_end, K, yt, yn, prob, fns, W):
     if method == DOP853:
-        dop853_step(t, y, h, t_end, K, yt, yn, prob, fns, W)
+        dop853_step(body, t, y, h, t_end, K, yt, yn, prob, fns, W)
     elif method == RK4:
-        rk4_step(t, y, h, K, yt, yn, prob, fns, W)
+        rk4_step(body, t, y, h, K, yt, yn, prob, fns, W)
     else:  # the model's own splitting, of order 2 or 4
-        own_step(method, t, y, h, yn, prob, fns, W)
+        own_step(body, method, t, y, h, yn, prob, fns, W)
 
 
 @jit_inline
@@ -140,12 +150,12 @@ def all_finite(y):
 
 
 @jit_uncounted
-def first_step(t, y, K, yt, rtol, atol, prob, fns, W, span):
+def first_step(body, t, y, K, yt, rtol, atol, prob, fns, W, span):
     """Hairer's starting step (`rotframe.numerics.step_control`), K[0] = f(t, y) given; K[1] = f at the trial step."""
     h0 = first_step_trial(y, K[0], rtol, atol, span)
     for j in range(y.shape[0]):
         yt[j] = y[j] + h0 * K[0, j]
-    rhs(t + h0, yt, K[1], prob, fns, W)
+    rhs(body, t + h0, yt, K[1], prob, fns, W)
     return first_step_final(y, K[0], K[1], h0, rtol, atol, span)
 
 
@@ -166,8 +176,8 @@ def next_stop(S, t):
     return S[lo]
 
 
-@jit_uncounted
-def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
+@jit_inline
+def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
     Returns tau in (0, h]; ``yhi`` holds the state there (the full step's end on entry). The
@@ -175,12 +185,12 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """
     lo = 0.0
     hi = h
-    rhs(t, y, Kb[0], prob, fns, W)
+    rhs(body, t, y, Kb[0], prob, fns, W)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if not (lo < mid < hi):
             break
-        take_step(method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
+        take_step(body, method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
         gm = call_event(fns[1], k, t + mid, ybuf, prob[2])
         if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
             lo = mid
@@ -192,202 +202,246 @@ def locate(method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     return hi
 
 
-@jit_uncounted
-def advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                rtol, atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
-    # K (16, D), Kb (13, D) stages, V (7, D) state vectors, F (7, D) the dense output's coefficients, W the
-    # models' scratch: of the calling block, made once
-    n = T.shape[0]
-    D = Y.shape[1]
-    NE = EDIR.shape[0]
-    y = V[0]
-    yt = V[1]
-    yn = V[2]
-    ytb = V[3]
-    yhi = V[4]
-    ybuf = V[5]
-    yev = V[6]
-    p = prob[2]
-    for j in range(D):
-        y[j] = Y[i, j]
-    t = TC[i]
-    h = H[i]
-    idx = IDX[i]
-    sub = SUB[i]
-    W[RAISED] = 0.0
-    rhs(t, y, K[0], prob, fns, W)
-    NFEV[i] += 1
-    if h <= 0.0 and method == DOP853:
-        h = first_step(t, y, K, yt, rtol, atol, prob, fns, W, T[n - 1] - T[0])
-        NFEV[i] += 1
-    steps = 0
-    # DOP853 keeps in SUB whether its last try was rejected (no growth right after a rejection), so that
-    # the steps, and the numbers, do not depend on where the budget cut the calls
-    rejected = method == DOP853 and sub != 0
-    status = 0
-    while idx < n and steps < budget:
-        if t >= T[idx]:
-            for j in range(D):
-                OUT[idx, i, j] = y[j]
-            idx += 1
-            sub = 0
-            continue
-        stop = next_stop(S, t)
-        if method == DOP853:
-            # a step ends on the next stop (a knot of a table or a body frame) or the run's end, whichever is
-            # first; the samples inside a step are its dense output
-            target = stop if stop < T[n - 1] else T[n - 1]
-            span = target - t
-            hh = h if h < span else span
-            landing = hh == span
-        else:
-            # a step ends on the next sample or the next stop, whichever is first
-            at_knot = stop < T[idx]
-            target = stop if at_knot else T[idx]
-            interval = T[idx] - T[idx - 1]
-            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-            last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
-            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
-            if at_knot and stop < grid_next:
-                hh = stop - t  # to the knot; the grid goes on from there
-                landing = True
-            else:
-                target = T[idx]
-                hh = hfix if on_grid else grid_next - t
-                sub += 1
-                landing = last
-        take_step(method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
-        steps += 1
-        NSTEP[i] += 1
-        NFEV[i] += 12 if method == DOP853 else 3 if method == RK4 else 2
-        if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
-            status = 6
-            break
-        ok = all_finite(yn)
-        h_next = h
-        if method == DOP853:
-            err = dop853_error_norm(K, hh, y, yn, rtol, atol, E3, E5) if ok else math.nan
-            ok = math.isfinite(err)
-            accepted, h_next = next_step(hh, h, err, rejected)
-            if not accepted:
-                h = h_next
-                rejected = True
-                if step_collapsed(h, t):
-                    status = 4 if ok else 3
-                    break
+def _variant_kernel(model, method, events):
+    """The compiled loop of one variant: the model, ``method`` and ``events`` are constants of its code.
+
+    numba prunes the branches of the other model, the other methods and the events before it types
+    the function (a closure's variables are constants to it; the model reaches the steps as
+    ``body``, None for a particle, True for a rigid body: `rotframe.problem.models.rhs`), so a
+    variant compiles only its own right-hand side, step and dense output: a first DOP853 particle
+    problem compiles no body, no splitting and no event locator. Each variant is cached on disk
+    apart (its name, and its constants in numba's cache key).
+    """
+    body = None if model == PARTICLE else True
+
+    def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
+                atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+        # K (16, D), Kb (13, D) stages, V (7, D) state vectors, F (7, D) the dense output's coefficients, W the
+        # models' scratch: the caller's (`scratch`), one set for the block
+        n = T.shape[0]
+        D = Y.shape[1]
+        NE = EDIR.shape[0]
+        y = V[0]
+        yt = V[1]
+        yn = V[2]
+        ytb = V[3]
+        yhi = V[4]
+        ybuf = V[5]
+        yev = V[6]
+        p = prob[2]
+        for i in range(lo, hi):
+            if ST[i] != 0:
                 continue
-        if not ok:
-            status = 3
-            break
-        t_new = target if landing else t + hh
-        if method != DOP853 and not landing:
-            t_new = T[idx - 1] + sub * hfix
-        # events over (t, t_new]: every crossing located; the earliest terminal one ends the particle
-        stop_tau = -1.0
-        stop_k = -1
-        for k in range(NE):
-            g_new = call_event(fns[1], k, t_new, yn, p)
-            if not math.isfinite(g_new):  # NaN, or the event function raised: stop here, Python names it
-                status = 5
-                break
-            g_old = GPREV[i, k]
-            rising = g_old < 0.0 and g_new >= 0.0
-            falling = g_old > 0.0 and g_new <= 0.0
-            if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
-                for j in range(D):
-                    yhi[j] = yn[j]
-                tau = locate(method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
-                m = EVN[i]
-                if m < EVT.shape[1]:
-                    EVT[i, m] = t + tau
-                    EVK[i, m] = k
-                    for j in range(D):
-                        EVY[i, m, j] = yhi[j]
-                EVN[i] = m + 1
-                if ETERM[k] and (stop_tau < 0.0 or tau < stop_tau):
-                    stop_tau = tau
-                    stop_k = k
-                    for j in range(D):
-                        yev[j] = yhi[j]
-            GPREV[i, k] = g_new
-        if status == 5:
-            break
-        # DOP853's samples inside the step (up to a terminal event's time): its dense output, of order 7
-        t_last = t + stop_tau if stop_k >= 0 else t_new
-        if method == DOP853 and idx < n and T[idx] < t_new and T[idx] <= t_last:
-            dense_output(t, y, yn, hh, K, yt, F, prob, fns, W)
-            NFEV[i] += 3
-            if W[RAISED] != 0.0:
-                status = 6
-                break
-            while idx < n and T[idx] < t_new and T[idx] <= t_last:
-                x = (T[idx] - t) / hh
-                for j in range(D):
-                    OUT[idx, i, j] = dense_value(F, y, x, j)
-                idx += 1
-        if stop_k >= 0:
-            # drop records of non-terminal crossings after the terminal one
-            m = EVN[i]
-            keep = 0
-            for r in range(min(m, EVT.shape[1])):
-                if EVT[i, r] <= t + stop_tau:
-                    EVT[i, keep] = EVT[i, r]
-                    EVK[i, keep] = EVK[i, r]
-                    for j in range(D):
-                        EVY[i, keep, j] = EVY[i, r, j]
-                    keep += 1
-            EVN[i] = keep
-            t = t + stop_tau
+            atol_i = atol[i]
             for j in range(D):
-                y[j] = yev[j]
-            while idx < n:
-                for j in range(D):
-                    OUT[idx, i, j] = y[j]
-                idx += 1
-            status = 2
-            break
-        if method == DOP853:
-            h = h_next
-            rejected = False
-            for j in range(D):
-                K[0, j] = K[12, j]
-        t = t_new
-        for j in range(D):
-            y[j] = yn[j]
-        if method != DOP853:
-            rhs(t, y, K[0], prob, fns, W)
+                y[j] = Y[i, j]
+            t = TC[i]
+            h = H[i]
+            idx = IDX[i]
+            sub = SUB[i]
+            W[RAISED] = 0.0
+            rhs(body, t, y, K[0], prob, fns, W)
             NFEV[i] += 1
-    if status == 0 and idx >= n:
-        status = 1
-    for j in range(D):
-        Y[i, j] = y[j]
-    TC[i] = t
-    H[i] = h
-    IDX[i] = idx
-    SUB[i] = sub if method != DOP853 else (1 if rejected else 0)
-    ST[i] = status
+            if method == DOP853 and h <= 0.0:
+                h = first_step(body, t, y, K, yt, rtol, atol_i, prob, fns, W, T[n - 1] - T[0])
+                NFEV[i] += 1
+            steps = 0
+            # DOP853 keeps in SUB whether its last try was rejected (no growth right after a rejection), so that
+            # the steps, and the numbers, do not depend on where the budget cut the calls
+            rejected = method == DOP853 and sub != 0
+            status = 0
+            while idx < n and steps < budget:
+                if t >= T[idx]:
+                    for j in range(D):
+                        OUT[idx, i, j] = y[j]
+                    idx += 1
+                    sub = 0
+                    continue
+                stop = next_stop(S, t)
+                if method == DOP853:
+                    # a step ends on the next stop (a knot of a table or a body frame) or the run's end, whichever is
+                    # first; the samples inside a step are its dense output
+                    target = stop if stop < T[n - 1] else T[n - 1]
+                    span = target - t
+                    hh = h if h < span else span
+                    landing = hh == span
+                else:
+                    # a step ends on the next sample or the next stop, whichever is first
+                    at_knot = stop < T[idx]
+                    target = stop if at_knot else T[idx]
+                    interval = T[idx] - T[idx - 1]
+                    on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
+                    last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
+                    grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
+                    if at_knot and stop < grid_next:
+                        hh = stop - t  # to the knot; the grid goes on from there
+                        landing = True
+                    else:
+                        target = T[idx]
+                        hh = hfix if on_grid else grid_next - t
+                        sub += 1
+                        landing = last
+                take_step(body, method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
+                steps += 1
+                NSTEP[i] += 1
+                NFEV[i] += 12 if method == DOP853 else 3 if method == RK4 else 2
+                if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
+                    status = 6
+                    break
+                ok = all_finite(yn)
+                h_next = h
+                if method == DOP853:
+                    err = dop853_error_norm(K, hh, y, yn, rtol, atol_i, E3, E5) if ok else math.nan
+                    ok = math.isfinite(err)
+                    accepted, h_next = next_step(hh, h, err, rejected)
+                    if not accepted:
+                        h = h_next
+                        rejected = True
+                        if step_collapsed(h, t):
+                            status = 4 if ok else 3
+                            break
+                        continue
+                if not ok:
+                    status = 3
+                    break
+                t_new = target if landing else t + hh
+                if method != DOP853 and not landing:
+                    t_new = T[idx - 1] + sub * hfix
+                # events over (t, t_new]: every crossing located; the earliest terminal one ends the particle
+                stop_tau = -1.0
+                stop_k = -1
+                if events:  # a constant of the variant: without events, none of this is compiled
+                    for k in range(NE):
+                        g_new = call_event(fns[1], k, t_new, yn, p)
+                        if not math.isfinite(g_new):  # NaN, or the event function raised: stop here, Python names it
+                            status = 5
+                            break
+                        g_old = GPREV[i, k]
+                        rising = g_old < 0.0 and g_new >= 0.0
+                        falling = g_old > 0.0 and g_new <= 0.0
+                        if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
+                            for j in range(D):
+                                yhi[j] = yn[j]
+                            tau = locate(body, method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
+                            m = EVN[i]
+                            if m < EVT.shape[1]:
+                                EVT[i, m] = t + tau
+                                EVK[i, m] = k
+                                for j in range(D):
+                                    EVY[i, m, j] = yhi[j]
+                            EVN[i] = m + 1
+                            if ETERM[k] and (stop_tau < 0.0 or tau < stop_tau):
+                                stop_tau = tau
+                                stop_k = k
+                                for j in range(D):
+                                    yev[j] = yhi[j]
+                        GPREV[i, k] = g_new
+                if status == 5:
+                    break
+                # DOP853's samples inside the step (up to a terminal event's time): its dense output, of order 7
+                t_last = t + stop_tau if stop_k >= 0 else t_new
+                if method == DOP853 and idx < n and T[idx] < t_new and T[idx] <= t_last:
+                    dense_output(body, t, y, yn, hh, K, yt, F, prob, fns, W)
+                    NFEV[i] += 3
+                    if W[RAISED] != 0.0:
+                        status = 6
+                        break
+                    while idx < n and T[idx] < t_new and T[idx] <= t_last:
+                        x = (T[idx] - t) / hh
+                        for j in range(D):
+                            OUT[idx, i, j] = dense_value(F, y, x, j)
+                        idx += 1
+                if stop_k >= 0:
+                    # drop records of non-terminal crossings after the terminal one
+                    m = EVN[i]
+                    keep = 0
+                    for r in range(min(m, EVT.shape[1])):
+                        if EVT[i, r] <= t + stop_tau:
+                            EVT[i, keep] = EVT[i, r]
+                            EVK[i, keep] = EVK[i, r]
+                            for j in range(D):
+                                EVY[i, keep, j] = EVY[i, r, j]
+                            keep += 1
+                    EVN[i] = keep
+                    t = t + stop_tau
+                    for j in range(D):
+                        y[j] = yev[j]
+                    while idx < n:
+                        for j in range(D):
+                            OUT[idx, i, j] = y[j]
+                        idx += 1
+                    status = 2
+                    break
+                if method == DOP853:
+                    h = h_next
+                    rejected = False
+                    for j in range(D):
+                        K[0, j] = K[12, j]
+                t = t_new
+                for j in range(D):
+                    y[j] = yn[j]
+                if method != DOP853:
+                    rhs(body, t, y, K[0], prob, fns, W)
+                    NFEV[i] += 1
+            if status == 0 and idx >= n:
+                status = 1
+            for j in range(D):
+                Y[i, j] = y[j]
+            TC[i] = t
+            H[i] = h
+            IDX[i] = idx
+            SUB[i] = sub if method != DOP853 else (1 if rejected else 0)
+            ST[i] = status
+
+    name = f"advance_{'particle' if body is None else 'body'}_{METHOD_NAMES[method]}{'_events' if events else ''}"
+    advance.__name__ = name
+    advance.__qualname__ = name
+    return _uncounted_entry(advance)
 
 
-@_entry
+#: the engine's method codes by name, for the variants' names (the codes never leave this package)
+METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4"}
+_VARIANTS: dict = {}
+
+
+def variant(model, method, events, compiled=True):
+    """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a code of `rotframe.problem.models`) and
+    ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
+    when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`)."""
+    key = (int(model), int(method), bool(events), bool(compiled))
+    kernel = _VARIANTS.get(key)
+    if kernel is None:
+        kernel = _variant_kernel(*key[:3])
+        if compiled:
+            kernel.compile(VARIANT_SIGNATURE)
+            kernel.disable_compile()
+        else:
+            from rotframe.numerics.plain import plain
+
+            kernel = plain(kernel)
+        _VARIANTS[key] = kernel
+    return kernel
+
+
+def scratch(D):
+    """The loop's work arrays for states of D numbers: stages ``K`` (16, D) and ``Kb`` (13, D), state vectors
+    ``V`` (7, D), the dense output's coefficients ``F`` (7, D) and the models' scratch ``W``."""
+    return np.empty((16, D)), np.empty((13, D)), np.empty((7, D)), np.empty((7, D)), np.zeros(SCRATCH)
+
+
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
-            atol, hfix, EDIR, ETERM, S, prob, fns):
+            atol, hfix, EDIR, ETERM, S, prob, fns, compiled=True):
     """Advance the particles ``lo:hi`` by at most ``budget`` steps each (module docstring); the state is in the arrays.
 
     ``T`` the sample times; ``Y`` (N, D) the states to go on from, ``TC``, ``H``, ``IDX``, ``SUB``,
     ``ST`` each particle's time, step, next sample, fixed-step count and status; ``OUT`` (n, N, D)
     the samples; ``EVT``, ``EVY``, ``EVK``, ``EVN`` the event records; ``GPREV`` (N, NE) each
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
+    Runs the problem's `variant` of the loop (``compiled=False``: as plain Python) with work arrays of its own.
     """
-    D = Y.shape[1]
-    K = np.empty((16, D))
-    Kb = np.empty((13, D))
-    V = np.empty((7, D))
-    F = np.empty((7, D))
-    W = np.zeros(SCRATCH)
-    for i in range(lo, hi):
-        if ST[i] == 0:
-            advance_one(i, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
-                        rtol, atol[i], hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W)
+    kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled)
+    kernel(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
+           EDIR, ETERM, S, prob, fns, *scratch(Y.shape[1]))
 
 
 @_entry
@@ -411,10 +465,12 @@ def energies(T, OUT, prob, fns, potential, rotating):
     return E
 
 
-#: the one signature of each entry point: compiled (or loaded from numba's cache) once, never for a problem
+#: the one signature of every variant's loop (`variant`): compiled (or loaded from numba's cache) once, never for a
+#: problem
+VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
+                               B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
+#: the one signature of each other entry point
 SIGNATURES = {
-    advance: types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, I8, F8, A2, F8, A1,
-                        B1, A1, PROBLEM, FUNCTIONS),
     start_events: types.void(F8, A2, A2, PROBLEM, FUNCTIONS),
     energies: A2(A1, A3, PROBLEM, FUNCTIONS, POTENTIAL, types.boolean),
 }

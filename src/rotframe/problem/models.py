@@ -256,9 +256,14 @@ def body_rhs(t, y, dy, prob, fns, W):
 
 
 @jit_inline
-def rhs(t, y, dy, prob, fns, W):
-    """y' = f(t, y) of the problem's model into ``dy``."""
-    if prob[0] == 0:
+def rhs(body, t, y, dy, prob, fns, W):
+    """y' = f(t, y) into ``dy``: a particle's where ``body`` is None, else a rigid body's.
+
+    ``body`` is a constant of the compiled caller (None, or the literal True): numba prunes the
+    other model's branch before typing, so a particle's loop never compiles a body, nor a body's
+    a particle (`rotframe.problem.engine.variant`).
+    """
+    if body is None:
         particle_rhs(t, y, dy, prob, fns, W)
     else:
         body_rhs(t, y, dy, prob, fns, W)
@@ -269,9 +274,9 @@ particle_rhs_inlined = inlined(particle_rhs)
 
 
 @jit_inline
-def rhs_inlined(t, y, dy, prob, fns, W):
+def rhs_inlined(body, t, y, dy, prob, fns, W):
     """`rhs`, the particle's right-hand side inlined into the caller (DOP853's stages)."""
-    if prob[0] == 0:
+    if body is None:
         particle_rhs_inlined(t, y, dy, prob, fns, W)
     else:
         body_rhs(t, y, dy, prob, fns, W)
@@ -425,8 +430,8 @@ def lie_poisson_strang(t, h, yn, prob, fns, W):
 
 
 @jit_uncounted
-def strang(t, h, yn, prob, fns, W):
-    if prob[0] == 0:
+def strang(body, t, h, yn, prob, fns, W):
+    if body is None:  # a constant (`rhs`)
         if prob[1][0] != 0.0:  # a pendulum's string: the splitting on its sphere
             sphere_strang(t, h, yn, prob, fns, W)
         else:
@@ -436,18 +441,18 @@ def strang(t, h, yn, prob, fns, W):
 
 
 @jit_uncounted
-def own_step(method, t, y, h, yn, prob, fns, W):
+def own_step(body, method, t, y, h, yn, prob, fns, W):
     """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4)."""
     for j in range(y.shape[0]):
         yn[j] = y[j]
     if method == SPLITTING:
-        strang(t, h, yn, prob, fns, W)
+        strang(body, t, h, yn, prob, fns, W)
     else:
         w1 = YOSHIDA4_OUTER
         w0 = YOSHIDA4_INNER
-        strang(t, w1 * h, yn, prob, fns, W)
-        strang(t + w1 * h, w0 * h, yn, prob, fns, W)
-        strang(t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+        strang(body, t, w1 * h, yn, prob, fns, W)
+        strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
+        strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
 
 
 @jit_uncounted
