@@ -171,7 +171,6 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         if isinstance(exc, numba.core.errors.NumbaError):
             _compile_failed(exc, torque, L, q, params)
         raise
-    fns = driver.functions()
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
     OUT = np.full((n, 1, 7), np.nan)
@@ -187,6 +186,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     compile_s = None
     prob = (BODY, np.ascontiguousarray(Iinv.ravel()), flatten_params(params), 0, np.zeros(1), np.zeros((1, 1, 3)), 0,
             np.zeros(1), np.zeros((1, 1, 3)))
+    fns = driver.functions(prob)
 
     def call(budget):
         driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,

@@ -22,9 +22,9 @@ from numba import types
 from numba.extending import intrinsic
 
 from rotframe.numerics.compiled import jit_inline
-from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VECTOR_SIG
+from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VARYING_SIG, VECTOR_SIG
 
-__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "RAISED"]
+__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "RAISED"]
 
 
 def address(dispatcher, signature) -> int:
@@ -75,6 +75,11 @@ def _vector(typingctx, addr, t, out):
     return _codegen(VECTOR_SIG)
 
 
+@intrinsic
+def _varying(typingctx, addr, kind, T, C, fn, t, out):
+    return _codegen(VARYING_SIG)
+
+
 #: the slot of the engine's scratch ``W`` (the ``out`` of the terms and the vectors) set to 1 when a user
 #: function raised
 RAISED = 6
@@ -110,6 +115,15 @@ def call_vector(addr, t, out):
         out[RAISED] = 1.0
 
 
+@jit_inline
+def call_varying(addr, kind, T, C, fn, t, out):
+    """The engine's evaluator of a varying vector at ``addr`` into ``out[0:6]``; where it raised, NaN and ``out[RAISED]``."""
+    if _varying(addr, kind, T, C, fn, t, out):
+        for k in range(6):
+            out[k] = math.nan
+        out[RAISED] = 1.0
+
+
 def _plain_terms(f, t, y, p, out):
     f(t, y, p, out)
 
@@ -126,6 +140,10 @@ def _plain_vector(f, t, out):
     f(t, out)
 
 
+def _plain_varying(f, kind, T, C, fn, t, out):
+    f(kind, T, C, fn, t, out)
+
+
 for _helper, _python in ((call_terms, _plain_terms), (call_event, _plain_event), (call_potential, _plain_potential),
-                         (call_vector, _plain_vector)):
+                         (call_vector, _plain_vector), (call_varying, _plain_varying)):
     _helper.plain = _python  # what rotframe.numerics.plain calls instead

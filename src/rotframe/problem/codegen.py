@@ -152,23 +152,41 @@ class Driver:
 
     def _own(self, name, stub, signature):
         """The module's function ``name`` (else ``stub``): its address (`rotframe.problem.calls`), or itself in plain Python."""
-        from rotframe.problem.calls import address
-
         found = getattr(self.module, name, None)
         function = stub if found is None else found
         if not self.compiled:
             return getattr(function, "py_func", function)
+        return self._address(function, signature)
+
+    @staticmethod
+    def _address(function, signature):
+        """``function``'s address (`rotframe.problem.calls.address`), compiled for ``signature`` if it is not yet."""
+        from rotframe.problem.calls import address
+
         known = _ADDRESSES.get(id(function))
         if known is None or known[0] is not function:  # each function's address looked up once a process
+            if not function.signatures:
+                function.compile(signature)
             known = _ADDRESSES[id(function)] = (function, address(function, signature))
         return known[1]
 
-    def functions(self):
-        """What the engine calls (`rotframe.problem.signatures.FUNCTIONS`): terms, event, omega, origin."""
-        from rotframe.problem import signatures as sg, stubs
+    def functions(self, prob):
+        """What the engine calls for the problem ``prob`` (`rotframe.problem.signatures.FUNCTIONS`): terms, event,
+        omega, origin, and the engine's evaluator of a varying frame or origin, compiled only where ``prob`` has one
+        (else 0: a problem in a steady frame never compiles it)."""
+        from rotframe.problem import models, signatures as sg, stubs
 
+        if not models.needs_varying((prob[3], prob[6])):
+            varying = 0
+        elif self.compiled:
+            varying = self._address(models.varying_into, sg.VARYING_SIG)
+        else:
+            from rotframe.numerics.plain import plain
+
+            varying = plain(models.varying_into)
         return (self._own("terms", stubs.no_terms, sg.TERMS_SIG), self._own("event", stubs.no_event, sg.EVENT_SIG),
-                self._own("omega", stubs.no_vector, sg.VECTOR_SIG), self._own("origin", stubs.no_vector, sg.VECTOR_SIG))
+                self._own("omega", stubs.no_vector, sg.VECTOR_SIG), self._own("origin", stubs.no_vector, sg.VECTOR_SIG),
+                varying)
 
     def potential(self):
         from rotframe.problem import signatures as sg, stubs

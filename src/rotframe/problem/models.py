@@ -57,11 +57,11 @@ from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
-from rotframe.problem.calls import call_potential, call_terms, call_vector
+from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
 from rotframe.particles.forces import drag_flow
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
-           "SPLITTING4", "SCRATCH", "vector_of_time", "rhs", "own_step", "particle_energy"]
+           "SPLITTING4", "SCRATCH", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
 
 #: kinds of a vector of time
 ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
@@ -91,18 +91,38 @@ def interval(knots, t):
 
 
 @jit_inline
-def vector_of_time(kind, T, C, fn, t, W):
+def vector_of_time(kind, T, C, fn, varying, t, W):
     """The vector of the kind (module docstring) and its derivative at ``t``: ``(x, y, z, dx, dy, dz)``.
 
     ``W`` (6,) receives what a user's function writes (``FUNCTION``, ``FUNCTION_DOT``). The
     constant kinds are answered here (small enough for the compiler to inline into the
-    right-hand side), the others by `varying_vector`.
+    right-hand side), the others by `varying_into`, called at its address ``varying``
+    (`rotframe.problem.calls`): it is compiled only for a problem whose frame or origin varies,
+    not with the engine (`needs_varying`).
     """
     if kind == CONSTANT:
         return C[0, 0, 0], C[0, 0, 1], C[0, 0, 2], 0.0, 0.0, 0.0
     if kind == ZERO:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    return varying_vector(kind, T, C, fn, t, W)
+    call_varying(varying, kind, T, C, fn, t, W)
+    return W[0], W[1], W[2], W[3], W[4], W[5]
+
+
+def needs_varying(kinds) -> bool:
+    """Whether a frame's or origin's kinds need `varying_into` (a table, a body's samples, a user's function)."""
+    return any(kind not in (CONSTANT, ZERO) for kind in kinds)
+
+
+@jit_uncounted
+def varying_into(kind, T, C, fn, t, out):
+    """`varying_vector` into ``out[0:6]``: what the engine calls by address (`rotframe.problem.signatures.VARYING_SIG`)."""
+    x, y, z, dx, dy, dz = varying_vector(kind, T, C, fn, t, out)
+    out[0] = x
+    out[1] = y
+    out[2] = z
+    out[3] = dx
+    out[4] = dy
+    out[5] = dz
 
 
 @jit_uncounted
@@ -202,7 +222,7 @@ def constrain(M, y, ax, ay, az):
 
 @jit_uncounted
 def particle_rhs(t, y, dy, prob, fns, W):
-    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
+    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
     x = y[0]
     yy = y[1]
     z = y[2]
@@ -227,7 +247,7 @@ def particle_rhs(t, y, dy, prob, fns, W):
     ax -= ey * z - ez * yy
     ay -= ez * x - ex * z
     az -= ex * yy - ey * x
-    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], t, W)
+    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
     ax, ay, az = constrain(prob[1], y, ax - ox, ay - oy, az - oz)
     dy[0] = vx
     dy[1] = vy
@@ -286,7 +306,7 @@ def rhs_inlined(body, t, y, dy, prob, fns, W):
 def kick_acceleration(t, y, prob, fns, W):
     """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
     centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
-    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
+    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
     x = y[0]
     yy = y[1]
     z = y[2]
@@ -296,7 +316,7 @@ def kick_acceleration(t, y, prob, fns, W):
     az = W[2]
     wr = wx * x + wy * yy + wz * z
     w2 = wx * wx + wy * wy + wz * wz
-    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], t, W)
+    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
     ax += w2 * x - wr * wx - (ey * z - ez * yy) - ox
     ay += w2 * yy - wr * wy - (ez * x - ex * z) - oy
     az += w2 * z - wr * wz - (ex * yy - ey * x) - oz
@@ -458,7 +478,7 @@ def own_step(body, method, t, y, h, yn, prob, fns, W):
 @jit_uncounted
 def particle_energy(t, y, prob, fns, potential, rotating, W):
     """Energy per unit mass (``rotating`` False) or the Jacobi integral (True) of one particle's state."""
-    wx, wy, wz, _, _, _ = vector_of_time(prob[3], prob[4], prob[5], fns[2], t, W)
+    wx, wy, wz, _, _, _ = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
     kin = 0.5 * (y[3] * y[3] + y[4] * y[4] + y[5] * y[5])
     e = kin + call_potential(potential, t, y, prob[2])
     if rotating:

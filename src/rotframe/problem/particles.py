@@ -226,9 +226,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if isinstance(exc, numba.core.errors.NumbaError):
             _compile_failure(exc, roles, params, r[0], v[0], frame)
         raise
-    fns = driver.functions()
     prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None),
                          flatten_params(params), frame, origin)
+    fns = driver.functions(prob)
     slots = max_events if events else 1  # event records: none are kept without events
     n = samples + 1
     check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 from numba import types
 
-__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "TERMS_SIG", "EVENT_SIG", "POTENTIAL_SIG", "VECTOR_SIG", "PARTICLE",
+__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "TERMS_SIG", "EVENT_SIG", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE",
            "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
 
 F8 = types.float64
@@ -50,10 +50,13 @@ TERMS_SIG = types.void(F8, A1, A1, A1)
 EVENT_SIG = F8(I8, F8, A1, A1)
 POTENTIAL_SIG = F8(F8, A1, A1)
 VECTOR_SIG = types.void(F8, A1)
+#: the engine's own evaluator of a varying frame or origin (`rotframe.problem.models.varying_into`): kind, knots,
+#: coefficients, the user's function's address, t, out
+VARYING_SIG = types.void(I8, A1, A3, I8, F8, A1)
 
 #: what the stepping calls, by address (`rotframe.problem.calls`): the terms, the events, omega(t), the
-#: origin's acceleration
-FUNCTIONS = types.UniTuple(types.int64, 4)
+#: origin's acceleration, and the engine's evaluator of a varying frame or origin (0 where none varies)
+FUNCTIONS = types.UniTuple(types.int64, 5)
 #: the potential, by address
 POTENTIAL = types.int64
 
