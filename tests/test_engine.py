@@ -121,16 +121,18 @@ def test_the_engine_compiles_once_for_every_problem():
 
 def test_a_variant_compiles_only_its_own_model_method_and_events(tmp_path):
     """A first DOP853 particle problem without events, in a steady frame, compiles no body, no splitting, no RK4, no
-    event locator and no evaluator of a varying frame."""
+    event locator and no evaluator of a varying frame; a body then compiles its own variant and no particle's."""
     script = tmp_path / "first.py"
     script.write_text(_FIRST_PROBLEM)
     env = dict(os.environ, ROTFRAME_CACHE_DIR=str(tmp_path / "problems"), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    compiled = set(proc.stdout.split())
-    assert {"advance_particle_dop853", "particle_rhs", "dop853_step", "dense_output"} <= compiled, compiled
-    assert not compiled & {"body_rhs", "own_step", "strang", "rk4_step", "kick_acceleration", "lie_poisson_strang",
-                           "sphere_strang", "varying_into", "varying_vector", "hermite"}, compiled
+    particle, body = (set(line.split()) for line in proc.stdout.strip().splitlines()[-2:])
+    assert {"advance_particle_dop853", "particle_rhs", "dop853_step", "dense_output"} <= particle, particle
+    assert not particle & {"body_rhs", "own_step", "strang", "rk4_step", "kick_acceleration", "lie_poisson_strang",
+                           "sphere_strang", "varying_into", "varying_vector", "hermite"}, particle
+    # then a body: its own variant and right-hand side, no particle's
+    assert {"advance_body_dop853", "body_rhs", "dop853_step"} <= body and "particle_rhs" not in body, body
 
 
 _FIRST_PROBLEM = """
@@ -151,6 +153,9 @@ class Listener(event.Listener):
 event.register("numba:compile", Listener())
 rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=1.0,
                   forces=[lambda t, r, v: (-r[0], -r[1], -r[2])], samples=4)
+print(" ".join(names))
+names.clear()
+rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.1], q0=[0, 0, 0, 1], duration=1.0, samples=4)
 print(" ".join(names))
 """
 
