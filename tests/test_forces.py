@@ -155,6 +155,23 @@ def test_a_built_in_term_and_the_same_user_force_give_the_same_trajectory_to_the
     assert np.array_equal(single.trajectory.v, users.trajectory.v)
 
 
+def test_a_built_in_term_beside_a_force_with_params_ignores_them():
+    """The run's params go to every force: a built-in term takes them and ignores them (its constants are its own)."""
+
+    def users_gravity(t, r, v, gz, shear):
+        return 0.0, shear[0] * r[2], gz
+
+    def wind(t, r, v, gz, shear):
+        return 0.0, shear[0] * r[2], 0.0
+
+    common = dict(omega=[0.0, 4.6e-5, 5.7e-5], r0=[0.0, 0.0, 100.0], v0=[6.0, 1.0, 8.0], duration=3.0, samples=6,
+                  method="rk4", step=1e-3, params=(-9.81, np.array([0.02, 0.0])))
+    mixed = simulate_particles(forces=[forces.gravity([0.0, 0.0, -9.81]), wind], **common)
+    own = simulate_particles(forces=[users_gravity], **common)
+    assert np.max(np.abs(mixed.trajectory.r - own.trajectory.r)) <= 1e-12 * np.max(np.abs(own.trajectory.r))
+    assert np.max(np.abs(own.trajectory.r[-1, 0, 1])) > 1.0  # the wind's params reached it
+
+
 # ---- the pendulum's string ---------------------------------------------------------------------
 
 def test_the_pendulum_swings_with_the_large_amplitude_period():

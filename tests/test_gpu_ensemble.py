@@ -197,8 +197,11 @@ def test_bench_gpu_on_the_simulator_does_the_same_work_as_the_hand_written_kerne
     rows = [r for r in json.loads(res.stdout) if r.get("scenario") == "gpu-ensemble"]
     assert {(r["integrator"], r["event"]) for r in rows} == {(m, e) for m in ("rotation-splitting", "rk4")
                                                              for e in (True, False)}
-    doors = [r for r in rows if r["method"].startswith("rotframe integrate_ensemble")]
+    doors = [r for r in rows if r["method"].startswith("rotframe integrate_ensemble(device='gpu'):")]
     assert len(doors) == 4 and all(r["simulator"] for r in rows)
+    # the user's own problem (rotframe.simulate(device="gpu")) beside the scenes' ensemble of the same terms
+    users = [r for r in rows if "of_scene_gpu" in r]
+    assert len(users) == 4 and all(r["same_work"] and r["of_scene_gpu"] > 0 for r in users)
     for r in doors:
         assert r["of_ceiling"] > 0 and r["kernel_of_ceiling"] > 0 and r["ceiling_goal"] == 0.5
     timed_from_host = [r for r in rows if "same_work" in r]

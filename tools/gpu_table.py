@@ -41,6 +41,19 @@ def table(rows) -> str:
     lines.append("")
     lines.append(f"Particle-steps per second; {body[0]['setting'].split(', ', 2)[-1]}. The ceiling is the faster "
                  "hand-written kernel. Kernels alone: launched on arrays already on the GPU (no transfers).")
+    users = [r for r in body if "of_scene_gpu" in r]
+    if users:
+        lines += ["", "Your own problem on the GPU: `rotframe.simulate(device='gpu')` with gravity as a force of your own "
+                  "(and the ground as an event of your own), beside the scenes' ensemble of the same terms (gravity, "
+                  "Coriolis, centrifugal: simulate always models the frame's centrifugal term).", "",
+                  "| case | rotframe.simulate, user force | integrate_ensemble, same terms | ratio | same work |",
+                  "|---|---|---|---|---|"]
+        for u in users:
+            twin = next(r for r in body if r["integrator"] == u["integrator"] and r["event"] == u["event"]
+                        and r["method"].startswith("rotframe integrate_ensemble(device='gpu'), +"))
+            lines.append(f"| {u['integrator']}{' + ground event' if u['event'] else ''} | "
+                         f"{u['particle_steps_per_s']:.3g} | {twin['particle_steps_per_s']:.3g} | "
+                         f"{u['of_scene_gpu']:.2f} | {u['same_work']} ({u['same_work_max_rel']:.1e}) |")
     notes = sorted({r["notes"] for r in body if r.get("notes")})
     lines.extend(f"Note: {n}." for n in notes)
     return "\n".join(lines) + "\n"

@@ -88,7 +88,7 @@ def _result(scn, scene, scene_result, summary):
 
 def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(), method=None,
              rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None, jit=True,
-             progress=None, threads=None):
+             progress=None, threads=None, device=None, max_events=256):
     """Particles under your forces in any rotating frame; returns a [`rotframe.Result`][rotframe.app.api.Result].
 
     Solves ``r'' = sum f(t, r, v) - 2 w x v - w x (w x r) - w' x r - a0(t)`` in the frame's
@@ -118,10 +118,14 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     events : sequence of callables
         ``g(t, r, v, *params) -> float`` with optional ``terminal`` and ``direction``
         attributes, as in ``scipy.integrate.solve_ivp``; times in ``trajectory.event_times``.
-    method : {"dop853", "rk4"}, optional
+    method : {"dop853", "rk4", "rotation-splitting", "rotation-splitting4"}, optional
         Any case; default DOP853 at ``rtol`` (default 1e-10).
     rtol, step, samples : optional
         DOP853's tolerance; RK4's step (s); samples kept (default 1000 intervals).
+    max_events : int
+        Event crossings kept per particle (default 256; more are located, counted and dropped,
+        with a warning). Each slot holds a time and a state for every particle: a large ensemble
+        with a terminal event needs one.
     jit : bool
         False runs the forces and the integrator in plain Python (slow; for what numba cannot compile).
     progress : bool or callable, optional
@@ -129,6 +133,12 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     threads : int, optional
         Threads for many particles during this call (default every core); the numbers do not
         depend on it.
+    device : {"cpu", "gpu"}, optional
+        ``"gpu"`` runs every particle at once on a CUDA GPU: the same loop, equations and forces
+        compiled for it (`rotframe.problem.gpu`), the fixed-step methods (``rk4``,
+        ``rotation-splitting``, ``rotation-splitting4``; name one), numbers that agree with the
+        CPU's to round-off. Your functions must compile for the GPU too: arithmetic returning a
+        tuple, no array made.
 
     Raises
     ------
@@ -166,7 +176,8 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
             run = simulate_particles(omega=omega, r0=r0, v0=v0, duration=duration, forces=forces, params=params,
                                      origin_acceleration=origin_acceleration, events=events, method=method,
                                      rtol=rtol, step=step, samples=samples, omega_dot=omega_dot, atol=atol,
-                                     frame_attitude=frame_attitude, jit=jit, progress=bar)
+                                     frame_attitude=frame_attitude, jit=jit, progress=bar, device=device,
+                                     max_events=max_events)
     except (IntegrationError, RunInterrupted, ScenarioError) as exc:  # what was computed, as rotframe.run's Result
         partial = getattr(exc, "partial", None)
         if partial is not None and hasattr(partial, "r"):

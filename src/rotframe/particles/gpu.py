@@ -31,7 +31,7 @@ import numpy as np
 
 from rotframe import method_registry as registry
 
-__all__ = ["available", "require", "check_method", "launches", "launch_shape", "device_function",
+__all__ = ["available", "require", "check_method", "launches", "launch_shape", "device_function", "inline_options",
            "integrate_ensemble_gpu", "GpuLaunch", "GPU_METHODS"]
 
 #: the particle methods the GPU runs (the fixed-step ones)
@@ -76,35 +76,49 @@ def require(what="device"):
     require_gpu(what)
 
 
-def device_function(kernel):
+def device_function(kernel, made=None):
     """The GPU version of a compiled CPU function: its Python source compiled by ``cuda.jit(device=True)``.
 
     Every numba-compiled function that ``kernel``'s source calls (a global name bound
     to a dispatcher) is rebound to its own GPU version, made the same way, so the whole
     call tree is compiled from the one source for the GPU. Constants and modules (math)
     are kept. Made once per function.
+
+    ``made`` (optional) maps CPU functions (or other global values, such as an intrinsic)
+    to the GPU versions to use instead, and receives what is made: a tree of its own, for
+    a caller that replaces some functions of it (`rotframe.problem.gpu`: the calls by address
+    become direct calls of a problem's functions). Default: the process-wide tree.
     """
     from numba import cuda
     from numba.core.dispatcher import Dispatcher
 
-    done = _DEVICE.get(kernel)
+    made = _DEVICE if made is None else made
+    done = made.get(kernel)
     if done is not None:
         return done
     fn = kernel.py_func if isinstance(kernel, Dispatcher) else kernel
     names = dict(fn.__globals__)
     for name in _global_names(fn.__code__):
         value = names.get(name)
-        if isinstance(value, Dispatcher):
-            names[name] = device_function(value)
+        if isinstance(value, Dispatcher) or _replaced(made, value):
+            names[name] = device_function(value, made)
     clone = types.FunctionType(fn.__code__, names, fn.__name__, fn.__defaults__, fn.__closure__)
     clone.__qualname__ = fn.__qualname__
     clone.__module__ = fn.__module__
-    done = _DEVICE[kernel] = cuda.jit(device=True, **_inline_options())(clone)
+    done = made[kernel] = cuda.jit(device=True, **inline_options())(clone)
     return done
 
 
+def _replaced(made, value) -> bool:
+    """Whether ``made`` holds a replacement for the global ``value`` (unhashable values have none)."""
+    try:
+        return value in made
+    except TypeError:
+        return False
+
+
 @functools.cache
-def _inline_options():
+def inline_options():
     """Every device function inlined into its caller (``forceinline``, where numba's CUDA target has it).
 
     Not inlined, each call passes the packed model (some 30 scalars) through the call
@@ -223,7 +237,7 @@ def _kernel(method, rk4, sphere, watch, steady, structure):
     exec(compile(structure, "<rotframe.particles.gpu structured>", "exec"), made)  # noqa: S102 -- our own text
     names = dict(_ensemble_kernel_source.__globals__)
     names.update(cuda=cuda, METHOD=method, RK4=rk4, SPHERE=sphere, WATCH=watch, STEADY=steady,
-                 structured=cuda.jit(device=True, **_inline_options())(made["structured"]),
+                 structured=cuda.jit(device=True, **inline_options())(made["structured"]),
                  unpack=device_function(packed.unpack), make_plan=device_function(kernels.make_plan),
                  rates=device_function(schedule.rates), one_step=device_function(kernels.one_step),
                  crossed=device_function(events.crossed), event_value=device_function(events.event_value),

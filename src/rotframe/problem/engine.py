@@ -60,7 +60,7 @@ from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs, rhs_inlined
 from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
-__all__ = ["advance", "variant", "scratch", "start_events", "energies", "ready"]
+__all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
 A, C, DW = dop853_dense.extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
 E3, E5 = coefficients()[3:]
@@ -203,14 +203,20 @@ def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
 
 
 def _variant_kernel(model, method, events):
-    """The compiled loop of one variant: the model, ``method`` and ``events`` are constants of its code.
+    """The compiled loop of one variant (`variant_loop`), for the CPU: an entry point without reference counts."""
+    return _uncounted_entry(variant_loop(model, method, events))
+
+
+def variant_loop(model, method, events):
+    """The loop of one variant, as Python: the model, ``method`` and ``events`` are constants of its code.
 
     numba prunes the branches of the other model, the other methods and the events before it types
     the function (a closure's variables are constants to it; the model reaches the steps as
     ``body``, None for a particle, True for a rigid body: `rotframe.problem.models.rhs`), so a
     variant compiles only its own right-hand side, step and dense output: a first DOP853 particle
     problem compiles no body, no splitting and no event locator. Each variant is cached on disk
-    apart (its name, and its constants in numba's cache key).
+    apart (its name, and its constants in numba's cache key). The GPU compiles the same function
+    (`rotframe.problem.gpu`).
     """
     body = None if model == PARTICLE else True
 
@@ -396,7 +402,7 @@ def _variant_kernel(model, method, events):
     name = f"advance_{'particle' if body is None else 'body'}_{METHOD_NAMES[method]}{'_events' if events else ''}"
     advance.__name__ = name
     advance.__qualname__ = name
-    return _uncounted_entry(advance)
+    return advance
 
 
 #: the engine's method codes by name, for the variants' names (the codes never leave this package)

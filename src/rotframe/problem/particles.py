@@ -166,7 +166,7 @@ def _scales(r, v, duration, rtol, atol, D):
 
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
-                       frame_attitude=None, jit=True, progress=None, max_events=256) -> ProblemRun:
+                       frame_attitude=None, jit=True, progress=None, max_events=256, device=None) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -179,8 +179,11 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     """
     import time
 
-    method = registry.check(method, "particles", default="dop853")
     check_flag(jit, "jit")
+    on_gpu = _check_device(device, method, jit)
+    method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
+    if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
+        raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
     r, v = _states(r0, v0)
     N = r.shape[0]
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method != "dop853",
@@ -259,6 +262,12 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     code = _CODES[method]
     first = True
+    if on_gpu:  # the same loop on the GPU: every particle at once, the arrays kept there between calls
+        from rotframe.problem.gpu import gpu_advance
+
+        gpu = gpu_advance(driver.module, code, bool(events), D)
+    else:
+        gpu = None
     try:
         if events:
             driver.start_events(0.0, y, state["GPREV"], prob, fns)
@@ -270,8 +279,18 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             saved["Y"] = y.copy()
             budget = pacer.start()
             try:
-                advance_blocks(driver.advance, N, before + (budget,) + after)
+                if gpu is not None:
+                    gpu(0, N, *before, budget, *after)
+                    if gpu.ended.size:  # a user function raised on the GPU: the CPU runs the call again, to the step
+                        gpu.fetch()
+                        _again_on_the_cpu(gpu.ended, driver.advance, y, state, saved, before + (budget,) + after)
+                        if np.all(state["ST"][gpu.ended] == 0):  # it did not raise there: the GPU goes on from it
+                            gpu.resume()
+                else:
+                    advance_blocks(driver.advance, N, before + (budget,) + after)
             except Exception as exc:
+                if gpu is not None:
+                    gpu.fetch()
                 _raised_later(exc, driver.advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
                               params, method, hfix, times, OUT, state, events, labels)
             if first:
@@ -288,8 +307,12 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             running = ST == 0
             pacer.check(state["NSTEP"][running], state["TC"][running])
     except KeyboardInterrupt:
+        if gpu is not None:
+            gpu.fetch()
         traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])))
         raise RunInterrupted(traj) from None
+    if gpu is not None:
+        gpu.fetch()
     traj = _trajectory(times, OUT, state, events, method, n)
     if np.any(state["ST"] >= 3):
         i = int(np.flatnonzero(state["ST"] >= 3)[0])
@@ -330,6 +353,20 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
 
 
+def _check_device(device, method, jit) -> bool:
+    """Whether the run is on the GPU (``device="gpu"``, `rotframe.problem.gpu`): checked, in one line each."""
+    from rotframe.particles.threads import check_device
+
+    if check_device(device, "device") != "gpu":
+        return False
+    if method is None:
+        raise ScenarioError(f"method: none given; device='gpu' runs {', '.join(registry.names('particles', gpu=True))} "
+                            "(the default, dop853, runs on the CPU)")
+    if not jit:
+        raise ScenarioError("jit=False: plain Python runs on the CPU; device='gpu' compiles the forces for the GPU")
+    return True
+
+
 def advance_blocks(advance, N, args):
     """``advance(lo, hi, *args)`` over the blocks of the N particles, on the ensemble's threads.
 
@@ -368,6 +405,16 @@ def _restore(y, state, saved):
     y[...] = saved["Y"]
     for key in _REPLAYED:
         state[key][...] = saved[key]
+
+
+def _again_on_the_cpu(particles, advance, y, state, saved, args):
+    """Run the last call again on the CPU for ``particles``, from the state saved before it (the engine's CPU loop
+    stops at the step where a user function raised, status 6, which names it as a CPU run does)."""
+    for i in particles:
+        y[i] = saved["Y"][i]
+        for key in _REPLAYED:
+            state[key][i] = saved[key][i]
+        advance(int(i), int(i) + 1, *args)
 
 
 def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
@@ -427,17 +474,16 @@ def _trajectory(times, OUT, state, events, method, n_kept):
     complete = n_kept == times.size
     traj = Trajectory(times[:n_kept].copy(), r, v, method, steps, nfev, complete,
                       float(times[n_kept - 1]))
-    names = _event_names(events)
     N = OUT.shape[1]
-    for k, name in enumerate(names):
-        traj.event_times[name] = []
-        traj.event_states[name] = []
-        for i in range(N):
-            m = min(int(state["EVN"][i]), state["EVT"].shape[1])
-            sel = np.flatnonzero(state["EVK"][i, :m] == k)
-            order = sel[np.argsort(state["EVT"][i, sel], kind="stable")]
-            traj.event_times[name].append(state["EVT"][i, order].copy())
-            traj.event_states[name].append(state["EVY"][i, order, :6].copy())
+    kept = np.arange(state["EVT"].shape[1])[None, :] < np.minimum(state["EVN"], state["EVT"].shape[1])[:, None]
+    for k, name in enumerate(_event_names(events)):
+        # each particle's crossings of event k in time order (ties in the order located), split per particle
+        i, j = np.nonzero(kept & (state["EVK"] == k))
+        order = np.lexsort((state["EVT"][i, j], i))
+        i, j = i[order], j[order]
+        cuts = np.cumsum(np.bincount(i, minlength=N))[:-1]
+        traj.event_times[name] = np.split(state["EVT"][i, j], cuts)
+        traj.event_states[name] = np.split(state["EVY"][i, j, :6], cuts)
     traj.extras["status"] = state["ST"].copy()
     return traj
 

@@ -40,7 +40,7 @@ import numpy as np
 
 from rotframe.app.bench.throughput import best_interleaved
 
-__all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL"]
+__all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL", "USER_ROW"]
 
 #: issue 26's goals: rotframe's GPU rate over the hand-written kernel's, and over JAX vmap's on the same GPU
 CEILING_GOAL = 0.5
@@ -116,7 +116,12 @@ def _case(method, rk4, event, n, steps, quick):
     # (name, the timed call from host arrays to host arrays, its result as ((N, 6) states, particles landed))
     cases = [("rotframe integrate_ensemble(device='gpu')", ours, ours_state),
              ("hand-written numba CUDA kernel", lambda: _host_to_host(numba_kernel, r0, v0, g, w, c, s, h, steps),
-              hand_state)]
+              hand_state),
+             (USER_ROW, _user_problem(method, event, r0, v0, g, w, h, duration), _user_state)]
+    # rotframe.simulate always models the frame's centrifugal term: its scene twin, for the user row's ratio and check
+    spun = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=model.omega, g=np.array(g))
+    cases.append((SCENE_TWIN_ROW, lambda: integrate_ensemble(spun, r0, v0, duration, ground, method=method, run=run,
+                                                             device="gpu"), ours_state))
     notes = []
     cuda_c = _cuda_c_ceiling(rk4, event, notes)
     if cuda_c is not None:
@@ -172,8 +177,60 @@ def _case(method, rk4, event, n, steps, quick):
         mine["vs_jax_vmap"] = None
         if jax_rows:
             notes.append(f"JAX ran on {jax_device}, not this GPU: no ratio")
+    user = next(r for r in rows if r["method"].startswith(USER_ROW))
+    twin = next(r for r in rows if r["method"].startswith(SCENE_TWIN_ROW))
+    twin_state = results[[name for name, _, _ in cases].index(SCENE_TWIN_ROW)][0]
+    twin["same_work"], twin["same_work_max_rel"], twin["same_work_note"] = True, 0.0, "the user row's reference"
+    user_state, user_landed = results[[name for name, _, _ in cases].index(USER_ROW)]
+    user["same_work"], user["same_work_max_rel"], user["same_work_note"] = same_state(user_state, user_landed,
+                                                                                       twin_state)
+    user["same_work_note"] = "against the scene twin (+ centrifugal): " + user["same_work_note"]
+    user["of_scene_gpu"] = user["particle_steps_per_s"] / twin["particle_steps_per_s"]
     mine["notes"] = "; ".join(notes)
     return rows
+
+
+#: the row of a user's problem: the same work through ``rotframe.simulate(device="gpu")`` (the frame's centrifugal
+#: term included, as simulate always models it)
+USER_ROW = "rotframe.simulate(device='gpu'), user force and event"
+#: the scenes' ensemble of the same terms as the user row (gravity, Coriolis, centrifugal): its reference
+SCENE_TWIN_ROW = "rotframe integrate_ensemble(device='gpu'), + centrifugal"
+
+
+def _user_problem(method, event, r0, v0, g, w, h, duration):
+    """The same work as a user's problem: gravity as a force of the user's, the ground as an event of the user's.
+
+    Through the public door, ``rotframe.simulate`` (`rotframe.problem.gpu`): the frame's Coriolis
+    term is rotframe's, from ``omega``; one sample at the end (the ensemble's calls keep no path).
+    """
+    import rotframe
+    from rotframe import limits
+
+    gx, gy, gz = g
+
+    def gravity(t, r, v):
+        return gx, gy, gz
+
+    def ground(t, r, v):
+        return r[2]
+
+    ground.terminal = True
+    ground.direction = -1
+    events = [ground] if event else []
+    work = limits.current().with_overrides(max_steps=math.inf)
+
+    def call():
+        with limits.applied(work):
+            return rotframe.simulate(omega=list(w), r0=r0, v0=v0, duration=duration, forces=[gravity], events=events,
+                                     method=method, step=h, samples=1, device="gpu", max_events=1)
+
+    return call
+
+
+def _user_state(res):
+    traj = res.trajectory
+    landed = sum(len(t) for t in traj.event_times.get("ground", []))
+    return np.concatenate([traj.r[-1], traj.v[-1]], axis=1), int(landed)
 
 
 def _kernels_alone(model, duration, event, method, run, hand, r0, v0, hand_args, budget, rounds):

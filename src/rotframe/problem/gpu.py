@@ -1,0 +1,253 @@
+"""Your own problem's particles on a CUDA GPU: the engine's own loop and your forces, compiled for the GPU.
+
+``rotframe.simulate(..., device="gpu")`` runs one GPU thread per particle through the very
+loop that the CPU runs (`rotframe.problem.engine.variant_loop`: the same steps, sample grid,
+event location and status codes), with the same equations (`rotframe.problem.models`) and the
+same glue (`rotframe.problem.glue`: the problem's forces, built-in and user's alike). It is one
+Python source compiled for two targets, as the scenes' GPU ensembles are
+(`rotframe.particles.gpu.device_function`): nothing of the physics or the integrators is
+written for the GPU.
+
+The one difference is how the loop reaches the problem's functions. On the CPU it calls
+them at their addresses (`rotframe.problem.calls`), so that the engine compiles once for
+every problem; a GPU has no such calls, so each call by address is replaced by a direct
+call of the problem's function (`_overrides`) and the loop is compiled with the problem's
+functions inlined into it, once per problem and method (kept for the process, `_KERNELS`).
+The user's functions must then compile for the GPU too: plain arithmetic on numbers and
+arrays, returning a tuple, allocating no array (one line names the failure otherwise).
+
+What stays on the CPU: the checks, the events' start values, the energy diagnostics and the
+frame's interpolation check (`rotframe.problem.particles`). The GPU runs the fixed-step
+methods (`rotframe.method_registry`, ``gpu=True``). The arrays stay on the GPU for the whole
+run: after each call (a budget of steps, as on the CPU) only the per-particle state comes back,
+for the progress and the pacing; the samples and the events come back once, at the end
+(`GpuAdvance.fetch`).
+
+Results agree with the CPU's to round-off, not to the bit: the GPU's compiler fuses
+multiplies and adds, and its ``sin``, ``cos`` and ``exp`` are its own.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["GpuAdvance", "gpu_advance"]
+
+#: threads per block of the kernel
+_THREADS_PER_BLOCK = 128
+#: the tags that stand for the addresses of the frame's and the origin's functions (`_overrides`)
+_OMEGA, _ORIGIN = 1, 2
+#: (driver module, method code, events, D) -> the compiled kernel
+_KERNELS: dict = {}
+#: the per-particle arrays of the loop that come back after every call (the pacing and the progress read them)
+_STATE = ("Y", "TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
+#: the arrays that come back at the end (`GpuAdvance.fetch`)
+_RESULTS = ("OUT", "EVT", "EVY", "EVK")
+#: the loop's arguments, in order, up to the budget (`rotframe.problem.engine.advance`)
+_ARRAYS = ("T", "Y", "TC", "H", "IDX", "SUB", "ST", "OUT", "EVT", "EVY", "EVK", "EVN", "GPREV", "NSTEP", "NFEV")
+
+
+def _overrides(module):
+    """The GPU versions of the calls by address (`rotframe.problem.calls`): direct calls of ``module``'s functions.
+
+    ``module`` is the problem's compiled glue (`rotframe.problem.codegen.build_module`); a role it
+    lacks is the stub the CPU would call (`rotframe.problem.stubs`). The frame's and the origin's
+    functions are told apart by the tags `_OMEGA` and `_ORIGIN` where the CPU has their addresses.
+    Returns the dict that `rotframe.particles.gpu.device_function` takes: the replacements, and
+    the tree it makes.
+    """
+    from numba import cuda
+
+    from rotframe.particles.gpu import inline_options, device_function
+    from rotframe.problem import calls, models, readonly, stubs
+
+    made: dict = {}
+
+    def device(template, **names):
+        """``template`` compiled for the GPU with its capitalised global names bound to ``names``."""
+        import types
+
+        clone = types.FunctionType(template.__code__, dict(template.__globals__, **names), template.__name__)
+        return cuda.jit(device=True, **inline_options())(clone)
+
+    def own(name, stub):
+        return device_function(getattr(module, name, None) or stub, made)
+
+    made[readonly.readonly] = device(_same_array)  # the read-only check is the CPU compile's (the glue is built there)
+    made[calls.call_terms] = device(_call_terms, TERMS=own("terms", stubs.no_terms))
+    made[calls.call_event] = device(_call_event, EVENT=own("event", stubs.no_event))
+    made[calls.call_vector] = device(_call_vector, OMEGA=own("omega", stubs.no_vector),
+                                     ORIGIN=own("origin", stubs.no_vector))
+    made[calls.call_varying] = device(_call_varying, VARYING=device_function(models.varying_into, made))
+    return made
+
+
+# the templates of `_overrides`: the names in capitals are bound per problem
+def _same_array(a):
+    return a
+
+
+def _call_terms(addr, t, y, p, out):
+    TERMS(t, y, p, out)  # noqa: F821
+
+
+def _call_event(addr, k, t, y, p):
+    return EVENT(k, t, y, p)  # noqa: F821
+
+
+def _call_vector(addr, t, out):
+    if addr == _OMEGA:
+        OMEGA(t, out)  # noqa: F821
+    else:
+        ORIGIN(t, out)  # noqa: F821
+
+
+def _call_varying(addr, kind, T, C, fn, t, out):
+    VARYING(kind, T, C, fn, t, out)  # noqa: F821
+
+
+def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
+                   EDIR, ETERM, S, M, p, FK, FT, FC, OK, OT, OC, LIVE):
+    """One thread per particle: the engine's loop (``loop``, `rotframe.problem.engine.variant_loop`) over particle i.
+
+    The work arrays are the thread's own (``DIM``, the state's length, and ``SCRATCH`` are constants
+    of each compiled copy). ``LIVE[i]`` is 1 while the loop runs: a thread that a raised
+    exception ended (CUDA ends the thread, and says nothing) leaves it at 1.
+    """
+    i = cuda.grid(1)  # noqa: F821 -- the names in capitals, cuda and loop are bound per compiled copy
+    if i >= Y.shape[0]:
+        return
+    K = cuda.local.array((16, DIM), float64)  # noqa: F821
+    Kb = cuda.local.array((13, DIM), float64)  # noqa: F821
+    V = cuda.local.array((7, DIM), float64)  # noqa: F821
+    F = cuda.local.array((7, DIM), float64)  # noqa: F821
+    W = cuda.local.array(SCRATCH, float64)  # noqa: F821
+    for j in range(SCRATCH):  # noqa: F821
+        W[j] = 0.0
+    LIVE[i] = 1
+    loop(i, i + 1, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,  # noqa: F821
+         atol, hfix, EDIR, ETERM, S, (0, M, p, FK, FT, FC, OK, OT, OC), (0, 0, _OMEGA, _ORIGIN, 0), K, Kb, V, F, W)
+    LIVE[i] = 0
+
+
+def _kernel(module, method, events, D):
+    """The compiled kernel of one problem (its glue ``module``), method code and events, for states of D numbers."""
+    import types
+
+    key = (module.__name__, int(method), bool(events), int(D))
+    done = _KERNELS.get(key)
+    if done is not None:
+        return done
+    from numba import cuda, float64
+
+    from rotframe.particles.gpu import device_function
+    from rotframe.problem import engine, models
+    from rotframe.problem.signatures import PARTICLE
+
+    made = _overrides(module)
+    loop = device_function(engine.variant_loop(PARTICLE, method, events), made)
+    names = dict(_kernel_source.__globals__)
+    names.update(cuda=cuda, float64=float64, loop=loop, DIM=int(D), SCRATCH=models.SCRATCH)
+    fn = _kernel_source
+    clone = types.FunctionType(fn.__code__, names, "rotframe_problem_kernel", fn.__defaults__, fn.__closure__)
+    done = _KERNELS[key] = cuda.jit(clone)
+    return done
+
+
+class GpuAdvance:
+    """`rotframe.problem.engine.advance` on the GPU, for one run: the same arguments, the arrays kept on the GPU.
+
+    The first call uploads every array; each call launches one thread per particle (``lo``,
+    ``hi`` are the whole ensemble: the GPU takes every particle at once) and brings back the
+    per-particle state (`_STATE`) into the caller's arrays. `fetch` brings back the samples
+    and the events. A thread that a user function's exception ended is given status 6
+    (a user function raised) by the caller, which runs its call again on the CPU.
+    """
+
+    def __init__(self, module, method, events, D):
+        self.module = module
+        self.key = (method, events, D)
+        self.device = None  # name -> device array
+        self.host = None  # name -> the caller's array
+        self.live = None
+        #: the particles whose thread a user function's exception ended in the last call (`rotframe.problem.particles`
+        #: runs that call again for them on the CPU, which stops at the step and names the function)
+        self.ended = np.zeros(0, np.int64)
+        self.fetched = False
+
+    def __call__(self, lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method,
+                 rtol, atol, hfix, EDIR, ETERM, S, prob, fns):
+        from numba import cuda
+
+        host = dict(zip(_ARRAYS, (T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV)))
+        if self.device is None:
+            kernel = self._compiled()
+            self.host = host
+            self.device = {name: cuda.to_device(np.ascontiguousarray(a)) for name, a in host.items()}
+            self.settings = [cuda.to_device(np.ascontiguousarray(a)) for a in (atol, EDIR, ETERM, S, prob[1], prob[2],
+                                                                                 prob[4], prob[5], prob[7], prob[8])]
+            self.kinds = (int(prob[3]), int(prob[6]))
+            self.live = cuda.to_device(np.zeros(Y.shape[0], np.int64))
+            self.kernel = kernel
+        n = Y.shape[0]
+        blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
+        atol_d, edir, eterm, stops, M, p, FT, FC, OT, OC = self.settings
+        d = self.device
+        try:
+            self.kernel[blocks, _THREADS_PER_BLOCK](
+                *(d[name] for name in _ARRAYS), int(budget), float(rtol), atol_d, float(hfix), edir, eterm, stops, M, p,
+                self.kinds[0], FT, FC, self.kinds[1], OT, OC, self.live)
+        except Exception as exc:  # noqa: BLE001 -- numba's compile errors, named for the user
+            _refuse_compile(exc)
+        cuda.synchronize()
+        for name in _STATE:
+            d[name].copy_to_host(self.host[name])
+        live = self.live.copy_to_host()
+        # a user function raised: CUDA ended the thread (its state is the call's start), where the CPU sets status 6
+        self.ended = np.flatnonzero((live != 0) & (self.host["ST"] == 0))
+
+    def _compiled(self):
+        return _kernel(self.module, *self.key)
+
+    def resume(self):
+        """Send the caller's arrays back to the GPU (after the CPU ran a call again for some particles)."""
+        for name in _STATE + _RESULTS:
+            self.device[name].copy_to_device(np.ascontiguousarray(self.host[name]))
+        self.fetched = False
+
+    def fetch(self):
+        """Bring the samples and the event records back into the caller's arrays (after the last call; once)."""
+        if self.device is None or self.fetched:
+            return
+        self.fetched = True
+        for name in _RESULTS:
+            self.device[name].copy_to_host(self.host[name])
+
+
+def _refuse_compile(exc):
+    """A kernel that numba cannot compile for the GPU: one line (a `ScenarioError`) with numba's reason.
+
+    On numba's simulator a user function's exception comes here (it runs the threads in Python):
+    it ends the thread, as on a GPU, and the call goes on (`GpuAdvance.ended`).
+    """
+    import numba
+
+    if numba.config.ENABLE_CUDASIM and not isinstance(exc, numba.core.errors.NumbaError):
+        return
+    if not isinstance(exc, numba.core.errors.NumbaError):
+        raise exc
+    from rotframe.problem.callables import numba_reason
+
+    raise ScenarioError(f"simulate: device='gpu': the problem's functions cannot be compiled for the GPU "
+                        f"({numba_reason(exc)}); a GPU force is plain arithmetic returning a tuple, allocating no "
+                        "array; use device='cpu'") from None
+
+
+def gpu_advance(module, method, events, D):
+    """A `GpuAdvance` for one run (the GPU checked to be there first)."""
+    from rotframe.particles.threads import require_gpu
+
+    require_gpu("device")
+    return GpuAdvance(module, method, events, D)

@@ -1,0 +1,106 @@
+"""``rotframe.simulate(device="gpu")``: your own problem on the GPU (`rotframe.problem.gpu`), on numba's simulator.
+
+The GPU runs the engine's own loop (`rotframe.problem.engine.variant_loop`) with the problem's
+functions, built-in and the user's, compiled for it, so it must give the CPU's numbers to
+round-off for every kind of problem it takes: `tools/gpu_user_check.py` runs each case on both
+(a user force with array params beside built-in terms, terminal and non-terminal events, the
+pendulum's string under the order-4 splitting with drag's exact flow, a force in inertial axes,
+a frame given as a table, omega(t) and an accelerating origin as the user's functions). The
+simulator (``NUMBA_ENABLE_CUDASIM=1``, set before numba is imported) runs the kernel in Python:
+a new process, a few particles. Without a GPU, ``device="gpu"`` is refused in one line.
+"""
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rotframe
+from rotframe.errors import ScenarioError
+from rotframe.particles import gpu
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _simulated(args, timeout=900):
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    return subprocess.run([sys.executable, *args], env=env, capture_output=True, text=True, timeout=timeout,
+                          cwd=ROOT)
+
+
+def test_every_kind_of_user_problem_gives_the_cpu_numbers_on_the_gpu():
+    res = _simulated([str(ROOT / "tools" / "gpu_user_check.py"), "3"])
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    lines = [line for line in res.stdout.splitlines() if "samples agree" in line]
+    assert len(lines) == 5 and "worst: " in res.stdout
+    assert all("same NaN pattern True" in line for line in lines)
+    assert float(res.stdout.split("worst: ")[1].split()[0]) <= 1e-12
+
+
+REFUSALS = textwrap.dedent("""
+    import numpy as np, rotframe
+    from numba import config
+    assert config.ENABLE_CUDASIM
+    from rotframe.errors import ScenarioError
+    from rotframe.problem.callables import UserFunctionError
+
+    def spring(t, r, v):
+        return -r[0], -r[1], -r[2]
+
+    common = dict(omega=[0, 0, 0.1], r0=[1.0, 0, 0], v0=[0, 1.0, 0], duration=1.0, forces=[spring], samples=4)
+    for kw in (dict(), dict(method="dop853"), dict(method="rk4", jit=False), dict(method="rk4", max_events=0)):
+        try:
+            rotframe.simulate(**common, **kw, device="gpu")
+        except ScenarioError as exc:
+            print("REFUSED", str(exc).replace(chr(10), " "))
+
+    def breaks(t, r, v):
+        if t > 0.5:
+            raise ValueError("too late")
+        return -r[0], -r[1], -r[2]
+
+    try:
+        rotframe.simulate(**dict(common, forces=[breaks]), method="rk4", step=0.01, device="gpu")
+    except UserFunctionError as exc:
+        print("RAISED", str(exc).replace(chr(10), " "), exc.partial.trajectory.times.size)
+""")
+
+
+def test_the_gpu_refuses_what_it_does_not_run_in_one_line_each_and_names_a_raising_force():
+    res = _simulated(["-c", REFUSALS])
+    assert res.returncode == 0, res.stderr[-3000:]
+    refused = [line for line in res.stdout.splitlines() if line.startswith("REFUSED")]
+    assert len(refused) == 4, res.stdout
+    assert "method: none given" in refused[0] and "rk4" in refused[0] and "dop853" in refused[0]
+    assert "does not run on the GPU" in refused[1] and "rotation-splitting" in refused[1]
+    assert "jit=False" in refused[2]
+    assert "max_events=0" in refused[3]
+    raised = [line for line in res.stdout.splitlines() if line.startswith("RAISED")]
+    assert len(raised) == 1 and "breaks" in raised[0] and "too late" in raised[0], res.stdout
+    assert int(raised[0].split()[-1]) >= 2  # the samples before the failure are kept
+
+
+@pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
+def test_device_gpu_without_a_gpu_is_refused_in_one_line():
+    with pytest.raises(ScenarioError, match="no CUDA GPU") as err:
+        rotframe.simulate(omega=[0, 0, 0], r0=[1.0, 0, 0], v0=[0, 1.0, 0], duration=1.0, method="rk4", device="gpu")
+    assert "\\n" not in str(err.value)
+    with pytest.raises(ScenarioError, match="device: 'tpu'; allowed: cpu, gpu"):
+        rotframe.simulate(omega=[0, 0, 0], r0=[1.0, 0, 0], v0=[0, 1.0, 0], duration=1.0, device="tpu")
+
+
+def test_the_gpu_kernel_is_the_engine_loop_with_the_problems_calls_made_direct():
+    """One source: the GPU compiles `engine.variant_loop`'s own code; only the calls by address are replaced."""
+    from rotframe.problem import calls, engine, gpu as problem_gpu
+    from rotframe.problem.models import RK4
+    from rotframe.problem.signatures import PARTICLE
+
+    loop = engine.variant_loop(PARTICLE, RK4, False)
+    assert loop.__code__ is engine.variant_loop(PARTICLE, RK4, True).__code__  # one loop for every variant
+    replaced = {calls.call_terms, calls.call_event, calls.call_vector, calls.call_varying}
+    source = Path(problem_gpu.__file__).read_text()
+    assert all(f"made[calls.{f.py_func.__name__}]" in source for f in replaced)
