@@ -127,8 +127,11 @@ def test_a_variant_compiles_only_its_own_model_method_and_events(tmp_path):
     env = dict(os.environ, ROTFRAME_CACHE_DIR=str(tmp_path / "problems"), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    particle, body = (set(line.split()) for line in proc.stdout.strip().splitlines()[-2:])
+    lines = proc.stdout.strip().splitlines()[-3:]
+    particle, body = set(lines[0].split()), set(lines[2].split())
     assert {"advance_particle_dop853", "particle_rhs", "dop853_step", "dense_output"} <= particle, particle
+    # the right-hand side is compiled once, marked for LLVM to inline, and no DOP853 stage calls it any more
+    assert lines[1] == "inline True, calls left 0", lines[1]
     assert not particle & {"body_rhs", "own_step", "strang", "rk4_step", "kick_acceleration", "lie_poisson_strang",
                            "sphere_strang", "varying_into", "varying_vector", "hermite"}, particle
     # then a body: its own variant and right-hand side, no particle's
@@ -154,6 +157,10 @@ event.register("numba:compile", Listener())
 rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=1.0,
                   forces=[lambda t, r, v: (-r[0], -r[1], -r[2])], samples=4)
 print(" ".join(names))
+from rotframe.problem import engine, models
+ir = next(iter(engine.dop853_step.overloads.values())).library.get_llvm_str()
+calls = [line for line in ir.splitlines() if " call " in line and "particle_rhs" in line]
+print(f"inline {next(iter(models.particle_rhs.overloads.values())).fndesc.inline}, calls left {len(calls)}")
 names.clear()
 rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.1], q0=[0, 0, 0, 1], duration=1.0, samples=4)
 print(" ".join(names))

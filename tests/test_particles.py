@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from rotframe.app import cli
 from rotframe.particles.integrators import Event, integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.turntable import inertial_line
@@ -188,6 +189,29 @@ def test_compile_s_counts_only_loading_done_by_this_call():
         integrate_particles(model, R0, V0, 1.0, method=method, samples=3)
         again = integrate_particles(model, R0, V0, 1.0, method=method, samples=3)
         assert again.extras["compile_s"] == 0.0
+
+
+def test_linear_propagate_over_long_brackets_scales_and_squares():
+    """A bracket far longer than the Taylor sub-steps allow (a drop from 1e30 m once took 1e11 of them: a hang)
+    is scaled and squared: against scipy's expm where both are meaningful, and a drop from 1e30 m ends."""
+    from scipy.linalg import expm
+
+    from rotframe.particles.linear import MAX_SUBSTEPS, propagate
+
+    rng = np.random.default_rng(3)
+    M = np.zeros((7, 7))
+    M[0:3, 3:6] = np.eye(3)
+    M[3:6, 3:6] = -0.05 * np.eye(3) + np.array([[0, 0.3, 0], [-0.3, 0, 0], [0, 0, 0]])  # drag and a turn
+    M[3:6, 6] = [0.0, 0.0, -9.81]
+    tau = np.array([0.5 * MAX_SUBSTEPS, 3.0 * MAX_SUBSTEPS, 40.0 * MAX_SUBSTEPS])
+    s = np.vstack([rng.normal(size=(6, tau.size)), np.ones((1, tau.size))])
+    got = propagate(M, s, tau)
+    for j, t in enumerate(tau):
+        want = expm(M * t) @ s[:, j]
+        assert np.allclose(got[:, j], want, rtol=1e-10, atol=1e-10 * np.abs(want).max()), t
+    assert np.all(got[6] == 1.0)  # the constant stays exactly 1
+    code = cli.main(["run", "tower-drop", "--set", "height=1e30", "--no-record", "--json"])
+    assert code in (0, 3)
 
 
 def test_linear_propagate_agrees_with_scipy_expm():

@@ -27,7 +27,7 @@ from numba import njit
 from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_inline", "inlined", "uncounted",
+__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_llvm_inline", "jit_inline", "inlined", "uncounted",
            "CompiledOnlyDispatcher", "source_fingerprint"]
 
 #: The package's folder: a kernel defined in a file below it is cached with `source_fingerprint` as its stamp.
@@ -139,13 +139,43 @@ def jit_uncounted(func):
 jit_inline = njit(inline="always", error_model="numpy", nogil=True)
 
 
+def jit_llvm_inline(func):
+    """`jit_uncounted`, compiled once on its own and inlined by LLVM into each compiled caller (``forceinline``).
+
+    The machine code of an inlined call, without numba's IR inlining (`jit_inline`): numba inlines
+    by running its passes over the callee's IR again at every call site, which for a right-hand
+    side that inlines its own helpers cost more of a first compile than the caller's own code.
+    LLVM inlines the compiled function when it optimises the caller, for a fraction of that.
+    """
+    dispatcher = njit(cache=True, error_model="numpy", nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                      _nrt=False, forceinline=True)(_copy(func, "llvm_inline"))
+    dispatcher.__class__ = CompiledOnlyDispatcher
+    return dispatcher
+
+
+def _copy(func, suffix):
+    """``func`` as a new function object named ``<qualname>.<suffix>``, for a copy compiled with other flags.
+
+    numba's disk cache knows a function by its file, qualified name and bytecode, not by the flags it
+    was compiled with: a copy of a cached kernel compiled with other flags (no reference counts,
+    inlined by LLVM) under the same name would load the other's machine code from the cache.
+    """
+    import types
+
+    clone = types.FunctionType(func.__code__, func.__globals__, func.__name__, func.__defaults__, func.__closure__)
+    clone.__qualname__ = f"{func.__qualname__}.{suffix}"
+    clone.__module__ = func.__module__
+    clone.__doc__ = func.__doc__
+    return clone
+
+
 def uncounted(kernel):
     """A copy of compiled ``kernel`` without reference counting (`jit_uncounted`), for callers that are so too.
 
     The same Python function, compiled again: a counted kernel called from an uncounted loop
     still counts the references to its array arguments, atomically, at every call.
     """
-    return jit_uncounted(kernel.py_func)
+    return jit_uncounted(_copy(kernel.py_func, "uncounted"))
 
 
 def inlined(kernel):

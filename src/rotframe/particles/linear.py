@@ -108,7 +108,10 @@ def propagate(M, s, tau):
     """
     s = np.array(s, dtype=np.float64)
     tau = np.asarray(tau, dtype=np.float64)
-    rho_total = float(np.max(np.sum(np.abs(M[:6, :6]), axis=0))) * float(np.max(np.abs(tau), initial=0.0))
+    norm = float(np.max(np.sum(np.abs(M[:6, :6]), axis=0)))
+    rho_total = norm * float(np.max(np.abs(tau), initial=0.0))
+    if rho_total > MAX_SUBSTEPS:
+        return _propagate_squared(M, s, tau, norm)
     n_sub = max(1, int(math.ceil(rho_total)))
     rho, bound, terms = rho_total / n_sub, 1.0, 0
     while bound > 1e-20 or terms < 4:
@@ -122,6 +125,37 @@ def propagate(M, s, tau):
             acc += term
         s = acc
     return s
+
+
+#: sub-steps of `propagate`'s Taylor series at most; a longer ||A tau|| (a drop from 1e30 m: 1e11 sub-steps) is
+#: scaled and squared instead (`_propagate_squared`), whose cost grows with log2 ||A tau||
+MAX_SUBSTEPS = 1024
+
+
+def _propagate_squared(M, s, tau, norm):
+    """`propagate` by scaling and squaring, column by column: exp(M tau_j) = exp(M tau_j / 2^k)^(2^k).
+
+    Each column's matrix exp(M tau_j / 2^k), with ||A tau_j|| / 2^k <= 1, is the Taylor series to
+    the same remainder bound as `propagate`'s; it is squared k times (k = ceil(log2 ||A tau_j||),
+    the columns of one k together), then applied to s_j.
+    """
+    out = np.empty_like(s)
+    rho = norm * np.abs(tau)
+    with np.errstate(divide="ignore"):
+        k = np.where(rho > 1.0, np.ceil(np.log2(np.maximum(rho, 1.0))), 0.0).astype(np.int64)
+    eye = np.eye(M.shape[0])
+    for kk in np.unique(k):
+        cols = np.flatnonzero(k == kk)
+        h = tau[cols] / 2.0 ** int(kk)
+        E = np.broadcast_to(eye, (cols.size,) + eye.shape).copy()
+        term = E.copy()
+        for n in range(1, 24):  # ||A h|| <= 1: 1/23! < 1e-22
+            term = np.matmul(M, term) * (h / n)[:, None, None]
+            E += term
+        for _ in range(int(kk)):
+            E = np.matmul(E, E)
+        out[:, cols] = np.einsum("jab,bj->aj", E, s[:, cols])
+    return out
 
 
 def locate_crossings(M, s_start, dt, g_lo, g_hi, column, value, t_start, max_iter=2200):

@@ -53,22 +53,23 @@ import numpy as np
 from numba import njit, types
 
 from rotframe.numerics import dop853_dense, step_control
-from rotframe.numerics.compiled import jit_inline, jit_uncounted, uncounted
+from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
 from rotframe.problem.calls import RAISED, call_event
-from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs, rhs_inlined
+from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
 A, C, DW = dop853_dense.extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
 E3, E5 = coefficients()[3:]
-# the shared kernels that take arrays, compiled as the engine's own (without reference counts)
+# the shared kernels that take arrays, compiled as the engine's own (without reference counts), the small ones inlined
+# into their one caller (a function compiled apart costs a first run more than its lines: 1 to 2 s for these three)
 dop853_error_norm = uncounted(_counted_error_norm)
-first_step_trial = uncounted(step_control.first_step_trial)
-first_step_final = uncounted(step_control.first_step)
-dense_coefficients = uncounted(dop853_dense.dense_coefficients)
+first_step_trial = inlined(step_control.first_step_trial)
+first_step_final = inlined(step_control.first_step)
+dense_coefficients = inlined(dop853_dense.dense_coefficients)
 dense_value = dop853_dense.dense_value  # inlined into its callers
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
@@ -94,14 +95,14 @@ def stage_state(z, y, h, K, s, D):
 def dop853_step(body, t, y, h, t_end, K, yt, yn, prob, fns, W):
     """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
     D = y.shape[0]
-    for s in range(1, 13):  # the stages, then f at the step's end (one call of the inlined rhs)
+    for s in range(1, 13):  # the stages, then f at the step's end (one call site of the right-hand side)
         z = yt if s < 12 else yn
         if D == 6:  # a particle: the loops of 6 known to the compiler (unrolled), the same arithmetic
             stage_state(z, y, h, K, s, 6)
         else:
             stage_state(z, y, h, K, s, D)
         ts = t + C[s] * h if s < 12 else t_end  # the last: the time the step ends on (a sample time where it lands)
-        rhs_inlined(body, ts, z, K[s], prob, fns, W)
+        rhs(body, ts, z, K[s], prob, fns, W)
 
 
 @jit_uncounted
@@ -122,7 +123,7 @@ def dense_output(body, t, y, yn, h, K, z, F, prob, fns, W):
 def rk4_step(body, t, y, h, K, yt, yn, prob, fns, W):
     """One classical Runge-Kutta step from (t, y) with K[0] = f(t, y)."""
     D = y.shape[0]
-    for s in range(1, 4):  # one call of the inlined rhs
+    for s in range(1, 4):  # one call site of the right-hand side
         c = 0.5 if s < 3 else 1.0
         for j in range(D):
             yt[j] = y[j] + c * h * K[s - 1, j]

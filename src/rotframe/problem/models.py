@@ -39,10 +39,12 @@ fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 (`rotframe.numerics.composition`).
 
 The small functions on the hot path (`vector_of_time`'s constant kinds, `constrain`,
-`attitude_rate`, `rhs`) are inlined into their callers (`rotframe.numerics.compiled.jit_inline`);
-the others are compiled without reference counting (`rotframe.numerics.compiled.jit_uncounted`,
-see `rotframe.problem.engine`). Inlining the large ones too made the engine's first compile take
-two minutes, for no measured gain.
+`attitude_rate`, `rhs`) are inlined into their callers by numba (`rotframe.numerics.compiled.jit_inline`);
+a particle's right-hand side, called from every step, is compiled once and inlined by LLVM
+(`rotframe.numerics.compiled.jit_llvm_inline`: numba's own inlining of it into DOP853's stages
+took more of a first compile than the stages themselves); the others are compiled without
+reference counting (`rotframe.numerics.compiled.jit_uncounted`, see `rotframe.problem.engine`).
+Inlining the large ones too made the engine's first compile take two minutes, for no measured gain.
 
 Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
 vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is
@@ -53,7 +55,7 @@ from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
+from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
@@ -220,7 +222,7 @@ def constrain(M, y, ax, ay, az):
     return ax - c * nx, ay - c * ny, az - c * nz
 
 
-@jit_uncounted
+@jit_llvm_inline
 def particle_rhs(t, y, dy, prob, fns, W):
     wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
     x = y[0]
@@ -285,19 +287,6 @@ def rhs(body, t, y, dy, prob, fns, W):
     """
     if body is None:
         particle_rhs(t, y, dy, prob, fns, W)
-    else:
-        body_rhs(t, y, dy, prob, fns, W)
-
-
-#: `particle_rhs` inlined where DOP853 calls it 12 times a step (a call of it cost about 10 ns)
-particle_rhs_inlined = inlined(particle_rhs)
-
-
-@jit_inline
-def rhs_inlined(body, t, y, dy, prob, fns, W):
-    """`rhs`, the particle's right-hand side inlined into the caller (DOP853's stages)."""
-    if body is None:
-        particle_rhs_inlined(t, y, dy, prob, fns, W)
     else:
         body_rhs(t, y, dy, prob, fns, W)
 
