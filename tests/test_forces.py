@@ -20,7 +20,7 @@ from rotframe.errors import ScenarioError
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe import forces
-from rotframe.problem.particles import simulate_particles
+from rotframe.problem.particles import Force, simulate_particles
 
 W = np.array([0.0, 4.6e-5, 5.7e-5])
 RTOL = 1e-12
@@ -155,8 +155,8 @@ def test_a_built_in_term_and_the_same_user_force_give_the_same_trajectory_to_the
     assert np.array_equal(single.trajectory.v, users.trajectory.v)
 
 
-def test_a_built_in_term_beside_a_force_with_params_ignores_them():
-    """The run's params go to every force: a built-in term takes them and ignores them (its constants are its own)."""
+def test_a_built_in_term_sits_beside_a_force_with_params():
+    """The run's params go to your forces, not to a built-in term (its constants are its own): they sit side by side."""
 
     def users_gravity(t, r, v, gz, shear):
         return 0.0, shear[0] * r[2], gz
@@ -170,6 +170,17 @@ def test_a_built_in_term_beside_a_force_with_params_ignores_them():
     own = simulate_particles(forces=[users_gravity], **common)
     assert np.max(np.abs(mixed.trajectory.r - own.trajectory.r)) <= 1e-12 * np.max(np.abs(own.trajectory.r))
     assert np.max(np.abs(own.trajectory.r[-1, 0, 1])) > 1.0  # the wind's params reached it
+    # potentials too: a built-in spring's (no params) and one of yours (params) summed for the energy diagnostic
+
+    def pull(t, r, v, gz, shear):
+        return 0.0, 0.0, gz
+
+    def pull_potential(t, r, gz, shear):
+        return -gz * r[2]
+
+    run = simulate_particles(forces=[forces.spring(2.0), Force(pull, potential=pull_potential)],
+                             **dict(common, omega=[0.0, 0.0, 0.0], method="dop853", step=None, rtol=1e-11))
+    assert run.diagnostics["energy_rel_drift"] < 1e-9
 
 
 # ---- the pendulum's string ---------------------------------------------------------------------

@@ -22,8 +22,9 @@ force of yours that does the same arithmetic give the same trajectory to the las
 against the scenes' compiled kernels in the same test file; each factory's docstring names the
 scene term it is. A term's constants are compiled into its function: a run with other
 constants compiles its driver once (cached on disk like any other). A value you vary from run
-to run is cheaper as a ``params`` entry of a force of your own. The run's ``params`` go to every
-force: a built-in term takes them and ignores them, so it sits beside forces of yours that use them.
+to run is cheaper as a ``params`` entry of a force of your own. The run's ``params`` go to your
+forces, not to a built-in term (``Force.takes_params`` False), so it sits beside forces of yours
+that use them.
 
 The frame's own terms (Coriolis, centrifugal, Euler, the origin's acceleration) are not terms
 to add: ``rotframe.simulate`` adds them from ``omega`` and ``origin_acceleration``.
@@ -80,13 +81,13 @@ def gravity(g) -> Force:
     """
     gx, gy, gz = _vector("gravity", "g", g)
 
-    def gravity(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def gravity(t, r, v):
         return gx, gy, gz
 
-    def potential(t, r, *params):
+    def potential(t, r):
         return -(gx * r[0] + gy * r[1] + gz * r[2])
 
-    return Force(gravity, potential=potential, name="gravity")
+    return Force(gravity, potential=potential, name="gravity", takes_params=False)
 
 
 def altitude_gravity(g0, radius) -> Force:
@@ -99,14 +100,14 @@ def altitude_gravity(g0, radius) -> Force:
     if not R > 0:
         raise ScenarioError(f"altitude_gravity: radius={R!r} must be > 0 (m)")
 
-    def gravity(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def gravity(t, r, v):
         s = R / (R + r[2])
         return 0.0, 0.0, -g0 * s * s
 
-    def potential(t, r, *params):
+    def potential(t, r):
         return -g0 * R * R / (R + r[2])
 
-    return Force(gravity, potential=potential, name="altitude-gravity")
+    return Force(gravity, potential=potential, name="altitude-gravity", takes_params=False)
 
 
 def central_gravity(gm, centre) -> Force:
@@ -119,7 +120,7 @@ def central_gravity(gm, centre) -> Force:
     GM = float(gm)
     cx, cy, cz = _vector("central_gravity", "centre", centre)
 
-    def gravity(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def gravity(t, r, v):
         dx = r[0] - cx
         dy = r[1] - cy
         dz = r[2] - cz
@@ -127,13 +128,13 @@ def central_gravity(gm, centre) -> Force:
         f = -GM / (d2 * math.sqrt(d2))
         return f * dx, f * dy, f * dz
 
-    def potential(t, r, *params):
+    def potential(t, r):
         dx = r[0] - cx
         dy = r[1] - cy
         dz = r[2] - cz
         return -GM / math.sqrt(dx * dx + dy * dy + dz * dz)
 
-    return Force(gravity, potential=potential, name="central-gravity")
+    return Force(gravity, potential=potential, name="central-gravity", takes_params=False)
 
 
 def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
@@ -159,12 +160,12 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
         raise ScenarioError("drag: give linear=k1 (1/s) or quadratic=k2 (1/m), or both")
     name = "linear-drag" if k2 == 0.0 else "quadratic-drag" if k1 == 0.0 else "linear-drag, quadratic-drag"
 
-    def drag(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def drag(t, r, v):
         air = math.exp(-r[2] / H) if H > 0.0 else 1.0
         c = (k1 + k2 * math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])) * air
         return -c * v[0], -c * v[1], -c * v[2]
 
-    return Force(drag, name=name, flow=("drag", k1, k2, H))
+    return Force(drag, name=name, flow=("drag", k1, k2, H), takes_params=False)
 
 
 def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
@@ -179,16 +180,16 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
     ax_, ay_, az_ = _vector("spring", "anchor", anchor)
     vertical = 0.0 if horizontal else 1.0
 
-    def spring(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def spring(t, r, v):
         return -k * (r[0] - ax_), -k * (r[1] - ay_), -k * vertical * (r[2] - az_)
 
-    def potential(t, r, *params):
+    def potential(t, r):
         dx = r[0] - ax_
         dy = r[1] - ay_
         dz = r[2] - az_
         return 0.5 * k * (dx * dx + dy * dy + vertical * dz * dz)
 
-    return Force(spring, potential=potential, name="spring")
+    return Force(spring, potential=potential, name="spring", takes_params=False)
 
 
 def pendulum(length, pivot=(0.0, 0.0, 0.0)) -> StringConstraint:
@@ -226,8 +227,8 @@ def lorentz(q_over_m, B, E=(0.0, 0.0, 0.0)) -> Force:
     bx, by, bz = _vector("lorentz", "B", B)
     ex, ey, ez = _vector("lorentz", "E", E)
 
-    def force(t, r, v, *params):  # the run's params are for your own forces: ignored
+    def force(t, r, v):
         return (qm * (ex + v[1] * bz - v[2] * by), qm * (ey + v[2] * bx - v[0] * bz),
                 qm * (ez + v[0] * by - v[1] * bx))
 
-    return Force(force, name="Lorentz force")
+    return Force(force, name="Lorentz force", takes_params=False)

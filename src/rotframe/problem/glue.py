@@ -94,7 +94,7 @@ def particle_source(forces, events, params, *, splitting: bool, omega: str, orig
     for k, f in enumerate(forces):
         if splitting and f.flow:  # the splitting applies this term's exact flow
             continue
-        src.append(f"    a = force_{k}(t, r, v{args})\n")
+        src.append(f"    a = force_{k}(t, r, v{args if f.takes_params else ''})\n")
         src.append(_TO_FRAME_AXES if f.axes == "inertial" else "    ax += a[0]\n    ay += a[1]\n    az += a[2]\n")
     src.append("    out[0] = ax\n    out[1] = ay\n    out[2] = az\n")
     if events:
@@ -103,7 +103,8 @@ def particle_source(forces, events, params, *, splitting: bool, omega: str, orig
         src.append("    return 0.0\n")
     if any(f.potential is not None for f in forces):
         src += ["\n@jit(POTENTIAL_SIG)\ndef potential(t, y, p):\n", "    r = readonly(y[0:3])\n", unpack, "    u = 0.0\n"]
-        src += [f"    u += float(potential_{k}(t, r{args}))\n" for k, f in enumerate(forces) if f.potential is not None]
+        src += [f"    u += float(potential_{k}(t, r{args if f.takes_params else ''}))\n" for k, f in enumerate(forces)
+                if f.potential is not None]
         src.append("    return u\n")
     if omega:
         src += ["\n@jit(VECTOR_SIG)\ndef omega(t, out):\n", "    w = omega_fn(t)\n",

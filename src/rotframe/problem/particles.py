@@ -119,15 +119,15 @@ def _check_functions(forces, events, params, r, v, t0, labels):
     """Each force, potential and event once, in plain Python, at the start: shape, finiteness, raises."""
     when = f"at t = {t0:g} s, r = {r.tolist()}, v = {v.tolist()}"
     for k, f in enumerate(forces):
-        uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *params), (3,), when=when)
+        uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *f.params_for(params)), (3,), when=when)
         if f.potential is not None:
-            uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *params), (), when=when)
+            uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
     for k, g in enumerate(events):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
 
 def _blame(functions, params, t, y, dt, labels, frame_roles=()):
-    """After a failed step: which of ``functions`` (forces' accelerations or events, named by ``labels``), called
+    """After a failed step: which of ``functions`` (`Force` terms or events, named by ``labels``), called
     at the last finite state ``y``, or of ``frame_roles`` (omega(t), a0(t)), raises or gives non-finite values.
 
     Returns ``(text, raised)`` (`rotframe.problem.callables.blame_in_step`).
@@ -135,10 +135,11 @@ def _blame(functions, params, t, y, dt, labels, frame_roles=()):
     r, v = y[:3].copy(), y[3:6].copy()
     where = f", r = {r.tolist()}, v = {v.tolist()}"
 
-    def at_state(tp):
-        return (tp, *uf.read_only_args((r, v)), *params)
+    def at_state(own):
+        return lambda tp: (tp, *uf.read_only_args((r, v)), *own)
 
-    candidates = [(labels[k], f, at_state, where) for k, f in enumerate(functions)]
+    candidates = [(labels[k], f.accel, at_state(f.params_for(params)), where) if isinstance(f, Force)
+                  else (labels[k], f, at_state(params), where) for k, f in enumerate(functions)]
     candidates += [(role, f, lambda tp: (tp,), "") for role, f in frame_roles]
     return uf.blame_in_step(candidates, t, dt)
 
@@ -227,7 +228,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         import numba
 
         if isinstance(exc, numba.core.errors.NumbaError):
-            _compile_failure(exc, roles, params, r[0], v[0], frame)
+            _compile_failure(exc, roles, params, r[0], v[0], frame,
+                             {labels[k] for k, f in enumerate(forces) if not f.takes_params})
         raise
     prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None),
                          flatten_params(params), frame, origin)
@@ -324,7 +326,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         if code == 5:
             blame, raised = _blame(events, params, t_bad, y[i], dt_failed, [f"events[{k}]" for k in range(len(events))])
         else:
-            blame, raised = _blame([f.accel for f in forces], params, t_bad, y[i], dt_failed, labels,
+            blame, raised = _blame(forces, params, t_bad, y[i], dt_failed, labels,
                                    _roles(frame, origin, [], [], []))
         partial = _trajectory(times, OUT, state, events, method, good)
         state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
@@ -435,7 +437,7 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
                 advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
-                blame = _blame([f.accel for f in forces], params, t, yi, dt, labels)[0]
+                blame = _blame(forces, params, t, yi, dt, labels)[0]
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
                 state["TC"][i] = t
@@ -452,12 +454,15 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
                                _trajectory(times, OUT, state, events, method, good)) from None
 
 
-def _compile_failure(exc, roles, params, r, v, frame):
+def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
+    """Name the function numba could not compile (``without_params``: the roles of the built-in terms, which take
+    no ``params``)."""
     def sample_args(role):
+        own = () if role.split(".")[0] in without_params else params
         if role.startswith("forces") and role.endswith("potential"):
-            return (0.0, r.copy(), *params)
+            return (0.0, r.copy(), *own)
         if role.startswith(("forces", "events")):
-            return (0.0, r.copy(), v.copy(), *params)
+            return (0.0, r.copy(), v.copy(), *own)
         return (0.0,)
 
     found = uf.diagnose_compile(roles, sample_args)

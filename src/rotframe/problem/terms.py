@@ -40,6 +40,10 @@ class Force:
         The term's exact flow, where it has one that the splittings use instead of a kick:
         ``("drag", k1, k2, H)`` for `rotframe.forces.drag` (`model_constants`). Set by the built-in
         terms; a force of your own leaves it empty.
+    takes_params : bool
+        Whether ``accel`` and ``potential`` take the run's ``params`` after their own arguments
+        (default True). The built-in terms of `rotframe.forces` do not: their constants are their
+        own, and they sit beside forces of yours that take ``params``.
     """
 
     accel: object
@@ -47,6 +51,11 @@ class Force:
     axes: str = "frame"
     name: str = ""
     flow: tuple = ()
+    takes_params: bool = True
+
+    def params_for(self, params) -> tuple:
+        """The ``params`` this force's functions are called with: the run's, or none (`takes_params`)."""
+        return tuple(params) if self.takes_params else ()
 
     def __call__(self, *args):
         return self.accel(*args)
