@@ -41,6 +41,9 @@ _THREADS_PER_BLOCK = 128
 _OMEGA, _ORIGIN = 1, 2
 #: (driver module, method code, events, D) -> the compiled kernel
 _KERNELS: dict = {}
+#: particle-calls of this process that a user function's exception ended on the GPU and the CPU ran again
+#: (`GpuAdvance.ended`): `tools/gpu_user_check.py` shows that none of its checks were answered by the CPU
+RERUNS = [0]
 #: the per-particle arrays of the loop that come back after every call (the pacing and the progress read them)
 _STATE = ("Y", "TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
 #: the arrays that come back at the end (`GpuAdvance.fetch`)
@@ -207,6 +210,7 @@ class GpuAdvance:
         live = self.live.copy_to_host()
         # a user function raised: CUDA ended the thread (its state is the call's start), where the CPU sets status 6
         self.ended = np.flatnonzero((live != 0) & (self.host["ST"] == 0))
+        RERUNS[0] += int(self.ended.size)
 
     def _compiled(self):
         return _kernel(self.module, *self.key)
