@@ -8,6 +8,7 @@ under a minute. The named cases below are the ones found by hand (issue 12).
 
 import json
 
+import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
@@ -317,3 +318,21 @@ def test_hypothesis_junk_to_the_python_api(value):
             c()
         except RotframeError as exc:
             assert isinstance(exc, ValueError)
+
+
+@pytest.mark.parametrize("value", ["INF", float("inf"), [0.0, float("-inf"), 1.0]])
+def test_an_infinite_angle_is_refused_in_one_line_even_with_warnings_as_errors(value):
+    """numpy's warning of cos(inf) is not the answer: the guard's one-line NaN refusal is, also where the caller's
+    filters turn warnings into errors (a test suite, ``python -W error``)."""
+    import warnings
+
+    from rotframe import frames
+    from rotframe.errors import RotframeError
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for call in (lambda: frames.elemental("x", value), lambda: frames.euler_to_dcm(
+                np.broadcast_to(np.asarray(value if not isinstance(value, str) else np.inf, float), (3,)), "ZXZ")):
+            with pytest.raises(RotframeError) as err:
+                call()
+            assert isinstance(err.value, ValueError) and "\n" not in str(err.value)

@@ -70,7 +70,10 @@ def _guard(func, error_cls, error_for=None):
             if _has_complex(value):
                 raise _error(error_cls, error_for, func.__name__, f"{name} has complex values; allowed: real numbers")
         try:
-            result = func(*args, **kwargs)
+            # numpy's warnings of an invalid or infinite input (cos(inf)) are not the answer: the NaN check below is,
+            # in one line (a warning turned into an error by the caller's filters would escape as a traceback)
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                result = func(*args, **kwargs)
         except RotframeError:
             raise
         except (TypeError, ValueError, IndexError, ArithmeticError) as exc:
