@@ -104,7 +104,8 @@ def propagate(M, s, tau):
 
     The interval is cut into sub-steps with ||A h||_1 <= 1 for the linear block
     A = M[:6, :6]; the number of terms is fixed in advance by the remainder bound
-    rho^n / n! < 1e-20, so no per-term convergence test is needed.
+    rho^n / n! < 1e-20, so no per-term convergence test is needed. Past `MAX_SUBSTEPS` sub-steps
+    the columns are scaled and squared instead (`_propagate_squared`).
     """
     s = np.array(s, dtype=np.float64)
     tau = np.asarray(tau, dtype=np.float64)

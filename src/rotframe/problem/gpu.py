@@ -33,10 +33,8 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["GpuAdvance", "gpu_advance"]
+__all__ = ["GpuAdvance"]
 
-#: threads per block of the kernel
-_THREADS_PER_BLOCK = 128
 #: the tags that stand for the addresses of the frame's and the origin's functions (`_overrides`)
 _OMEGA, _ORIGIN = 1, 2
 #: (driver module, method code, events, D) -> the compiled kernel
@@ -70,10 +68,7 @@ def _overrides(module):
 
     def device(template, **names):
         """``template`` compiled for the GPU with its capitalised global names bound to ``names``."""
-        import types
-
-        clone = types.FunctionType(template.__code__, dict(template.__globals__, **names), template.__name__)
-        return cuda.jit(device=True, **inline_options())(clone)
+        return cuda.jit(device=True, **inline_options())(_bound(template, template.__name__, **names))
 
     def own(name, stub):
         return device_function(getattr(module, name, None) or stub, made)
@@ -85,6 +80,14 @@ def _overrides(module):
                                      ORIGIN=own("origin", stubs.no_vector))
     made[calls.call_varying] = device(_call_varying, VARYING=device_function(models.varying_into, made))
     return made
+
+
+def _bound(template, name, **names):
+    """A copy of the function ``template`` named ``name``, with the global ``names`` bound (the templates below)."""
+    import types
+
+    return types.FunctionType(template.__code__, dict(template.__globals__, **names), name, template.__defaults__,
+                              template.__closure__)
 
 
 # the templates of `_overrides`: the names in capitals are bound per problem
@@ -137,8 +140,6 @@ def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
 
 def _kernel(module, method, events, D):
     """The compiled kernel of one problem (its glue ``module``), method code and events, for states of D numbers."""
-    import types
-
     key = (module.__name__, int(method), bool(events), int(D))
     done = _KERNELS.get(key)
     if done is not None:
@@ -149,13 +150,9 @@ def _kernel(module, method, events, D):
     from rotframe.problem import engine, models
     from rotframe.problem.signatures import PARTICLE
 
-    made = _overrides(module)
-    loop = device_function(engine.variant_loop(PARTICLE, method, events), made)
-    names = dict(_kernel_source.__globals__)
-    names.update(cuda=cuda, float64=float64, loop=loop, DIM=int(D), SCRATCH=models.SCRATCH)
-    fn = _kernel_source
-    clone = types.FunctionType(fn.__code__, names, "rotframe_problem_kernel", fn.__defaults__, fn.__closure__)
-    done = _KERNELS[key] = cuda.jit(clone)
+    loop = device_function(engine.variant_loop(PARTICLE, method, events), _overrides(module))
+    done = _KERNELS[key] = cuda.jit(_bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
+                                           loop=loop, DIM=int(D), SCRATCH=models.SCRATCH))
     return done
 
 
@@ -184,26 +181,25 @@ class GpuAdvance:
                  rtol, atol, hfix, EDIR, ETERM, S, prob, fns):
         from numba import cuda
 
+        from rotframe.particles.gpu import launch_shape
+
         host = dict(zip(_ARRAYS, (T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV)))
         if self.device is None:
-            kernel = self._compiled()
+            self.kernel = _kernel(self.module, *self.key)
             self.host = host
             self.device = {name: cuda.to_device(np.ascontiguousarray(a)) for name, a in host.items()}
             self.settings = [cuda.to_device(np.ascontiguousarray(a)) for a in (atol, EDIR, ETERM, S, prob[1], prob[2],
                                                                                  prob[4], prob[5], prob[7], prob[8])]
             self.kinds = (int(prob[3]), int(prob[6]))
             self.live = cuda.to_device(np.zeros(Y.shape[0], np.int64))
-            self.kernel = kernel
-        n = Y.shape[0]
-        blocks = (n + _THREADS_PER_BLOCK - 1) // _THREADS_PER_BLOCK
         atol_d, edir, eterm, stops, M, p, FT, FC, OT, OC = self.settings
         d = self.device
         try:
-            self.kernel[blocks, _THREADS_PER_BLOCK](
+            self.kernel[launch_shape(Y.shape[0])](
                 *(d[name] for name in _ARRAYS), int(budget), float(rtol), atol_d, float(hfix), edir, eterm, stops, M, p,
                 self.kinds[0], FT, FC, self.kinds[1], OT, OC, self.live)
         except Exception as exc:  # noqa: BLE001 -- numba's compile errors, named for the user
-            _refuse_compile(exc)
+            _launch_failed(exc)
         cuda.synchronize()
         for name in _STATE:
             d[name].copy_to_host(self.host[name])
@@ -211,9 +207,6 @@ class GpuAdvance:
         # a user function raised: CUDA ended the thread (its state is the call's start), where the CPU sets status 6
         self.ended = np.flatnonzero((live != 0) & (self.host["ST"] == 0))
         RERUNS[0] += int(self.ended.size)
-
-    def _compiled(self):
-        return _kernel(self.module, *self.key)
 
     def resume(self):
         """Send the caller's arrays back to the GPU (after the CPU ran a call again for some particles)."""
@@ -230,7 +223,7 @@ class GpuAdvance:
             self.device[name].copy_to_host(self.host[name])
 
 
-def _refuse_compile(exc):
+def _launch_failed(exc):
     """A kernel that numba cannot compile for the GPU: one line (a `ScenarioError`) with numba's reason.
 
     On numba's simulator a user function's exception comes here (it runs the threads in Python):
@@ -247,11 +240,3 @@ def _refuse_compile(exc):
     raise ScenarioError(f"simulate: device='gpu': the problem's functions cannot be compiled for the GPU "
                         f"({numba_reason(exc)}); a GPU force is plain arithmetic returning a tuple, allocating no "
                         "array; use device='cpu'") from None
-
-
-def gpu_advance(module, method, events, D):
-    """A `GpuAdvance` for one run (the GPU checked to be there first)."""
-    from rotframe.particles.threads import require_gpu
-
-    require_gpu("device")
-    return GpuAdvance(module, method, events, D)

@@ -265,9 +265,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     code = _CODES[method]
     first = True
     if on_gpu:  # the same loop on the GPU: every particle at once, the arrays kept there between calls
-        from rotframe.problem.gpu import gpu_advance
+        from rotframe.problem.gpu import GpuAdvance
 
-        gpu = gpu_advance(driver.module, code, bool(events), D)
+        gpu = GpuAdvance(driver.module, code, bool(events), D)  # the GPU is there: `_check_device`
     else:
         gpu = None
     try:
