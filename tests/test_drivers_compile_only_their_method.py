@@ -19,7 +19,7 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 PROBE = r'''
 import sys
 import numpy as np
-from rotframe.particles import dop853_steps, kernels
+from rotframe.particles import dop853_particles, kernels
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.particles.trajectory import Event
@@ -31,7 +31,7 @@ traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 3.0, method
                            events=[ground])
 assert len(traj.event_times["ground"][0]) == 1
 fixed = [kernels._free_steps, kernels._sphere_steps, kernels._rk4_steps]
-print(sum(len(f.signatures) for f in fixed), len(dop853_steps.dop853_step.signatures))
+print(sum(len(f.signatures) for f in fixed), len(dop853_particles.particle_stages.signatures))
 '''
 
 
@@ -57,7 +57,7 @@ def test_fixed_step_driver_compiles_no_dop853_step(tmp_path):
 PRUNED = r'''
 import sys
 import numpy as np
-from rotframe.particles import events, schedule
+from rotframe.particles import dop853_particles, events, schedule
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
@@ -66,8 +66,8 @@ model = ParticleModel(("gravity", "coriolis", "linear-drag"), omega=OmegaSchedul
                       g=np.array([0.0, 0.0, -9.81]), k_linear=0.01)
 traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 1.0, method=sys.argv[1], samples=3)
 assert np.all(np.isfinite(traj.r))
-watchers = [events.event_value, events.start_value, events.locate_event, events.locate_event_dop853,
-            events.record_event]
+watchers = [events.event_value, events.start_value, events.locate_event, dop853_particles.locate_event_dop853,
+            dop853_particles.watch_events, events.record_event]
 readers = [schedule.omega_magnitude, schedule.omega_rate, schedule.omega_angle, schedule.node_index]
 print(sum(len(f.signatures) for f in watchers), sum(len(f.signatures) for f in readers))
 '''
@@ -124,7 +124,7 @@ def test_a_free_particle_compiles_only_its_own_step_family(tmp_path):
 
 STEADY = r'''
 import numpy as np
-from rotframe.particles import dop853_steps, dop853_steady, drivers, forces
+from rotframe.particles import dop853_particles, dop853_steady, drivers, forces
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
@@ -132,7 +132,8 @@ model = ParticleModel(("gravity", "coriolis", "pendulum"), omega=OmegaSchedule.c
                       g=np.array([0.0, 0.0, -9.81]), pendulum_length=10.0, pivot=np.array([0.0, 0.0, 10.0]))
 traj = integrate_particles(model, [1.0, 0.0, 10.0 - np.sqrt(99.0)], [0.0, 0.0, 0.0], 5.0, method="dop853", samples=5)
 assert np.all(np.isfinite(traj.r))
-general = [drivers.run_dop853, dop853_steps.dop853_step, forces.state_acceleration]
+general = [drivers.run_dop853, dop853_particles.particle_stages, dop853_particles.particle_rhs,
+           forces.state_acceleration]
 print(sum(len(f.signatures) for f in general), len(dop853_steady.run_dop853_steady.signatures))
 '''
 

@@ -8,7 +8,7 @@ Layer 2 of the house (see ``docs/architecture.md``): imports only
 - `schedule`: the rotation-rate schedule w(t), compiled.
 - `forces`: compiled accelerations (one source for every method).
 - `kernels`: compiled fixed-step one-step maps (splitting, splitting4, rk4).
-- `dop853_steps`: one compiled Dormand-Prince 8(5,3) step.
+- `dop853_particles`: the particle on the one DOP853 loop (`rotframe.numerics.dop853_loop`).
 - `events`: event functions, crossings, their location by bisection.
 - `drivers`: compiled ensemble drivers (fixed-step and DOP853).
 - [`integrators`][rotframe.particles.integrators]: the method registry and chunked driver.

@@ -23,6 +23,7 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe import limits
 from rotframe.particles import threads
 from rotframe.particles.advice import remedy
+from rotframe.particles.dop853_particles import WORK_ROWS
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
 __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
@@ -106,7 +107,7 @@ class KernelSetup:
         # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
-        self.steady_args = None  # (q, tab) of the specialised DOP853 driver, where the model allows it
+        self.steady_args = None  # q, the parameters of the specialised DOP853 driver, where the model allows it
         self.fixed = info.step == "fixed"
         # the arguments of every fixed-step driver call that do not change (unpacked into it)
         self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
@@ -122,18 +123,14 @@ class KernelSetup:
             self.h = dt / self.sps
             self.evals_per_step = EVALS_PER_STEP[info.name]
         else:
-            from rotframe.numerics.dop853 import coefficients
-            from rotframe.numerics.dop853_dense import extended_tableau
-            from rotframe.particles.dop853_steady import is_steady_model, steady_parameters, steady_tableau
+            from rotframe.particles.dop853_steady import is_steady_model, steady_parameters
 
             self.sps = 0
             self.h = 0.0
-            A, C, D = extended_tableau()
-            self.tableau = (A, C, D) + coefficients()[3:]  # A, C, D, E3, E5
             # a steady model without events runs the specialised driver (bitwise the same results,
             # a smaller first compile): rotframe.particles.dop853_steady
             if is_steady_model(model, self.events, self.P):
-                self.steady_args = (steady_parameters(model, self.P), steady_tableau())
+                self.steady_args = steady_parameters(model, self.P)
 
     def kernel(self):
         """The compiled driver of this method."""
@@ -230,18 +227,16 @@ class KernelSetup:
             kernel = drivers.run_dop853
             steady = False
         if steady:
-            q, tab = self.steady_args
+            q = self.steady_args
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, start, times, q, self.rtol, atol, span, tab, np.empty((28, 6)), out_r, out_v,
+                return kernel(r, v, start, times, q, self.rtol, atol, span, np.empty((WORK_ROWS, 6)), out_r, out_v,
                               h_state)
         else:
-            A, C, D, E3, E5 = self.tableau
-
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span, A, C,
-                              D, E3, E5, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events,
-                              h_state, np.empty((16, 6)), np.empty((13, 6)), np.empty((12, 6)))
+                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span,
+                              self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state,
+                              np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
         return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
 
     def warm_up(self):

@@ -15,14 +15,11 @@ import numpy as np
 from numba import njit
 
 from rotframe.numerics.compiled import inlined
-from rotframe.numerics.dop853 import dop853_error_norm
-from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
-from rotframe.numerics.dop853_dense import dense_coefficients, dense_value
-from rotframe.particles.dop853_steps import dense_stages, dop853_step
-from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, locate_event_dop853, record_event, start_value
-from rotframe.particles.forces import state_acceleration
+from rotframe.particles.dop853_particles import (particle_rhs, particle_trajectory, particle_trajectory_events,
+                                                 run_particles)
+from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
 from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
-from rotframe.particles.packed import NFEV, as_state, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
+from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
 __all__ = ["run_fixed", "run_dop853"]
@@ -232,161 +229,31 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 
 @jit_kernel
-def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, A, C, D, E3, E5,
-               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state, K, Kt, rows):
-    """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble.
+def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, events, out_r, out_v, ev_t, ev_r, ev_v,
+               ev_count, ev_which, max_events, h_state, work, Kt):
+    """Adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, II.10) for an ensemble, any model.
 
-    Error control as in Hairer's DOP853 (5th- and 3rd-order estimates combined).
-    Output at ``sample_times``: the state at a sample time inside an accepted
-    step is Hairer's dense output of order 7 (three more stages in a step that
-    holds a sample; `rotframe.numerics.dop853_dense`). Events are located on the
-    method's own steps: bisection on the length of one extra DOP853 step from the
-    step's start. ``A``, ``C``, ``D``: `rotframe.numerics.dop853_dense.extended_tableau`.
-    ``h_state`` (N,) carries each particle's step size between calls; where it is 0, the
-    particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the
-    same in every call, so that the steps do not depend on how the run is cut into calls).
-    ``events`` None (no event table) prunes the event code at compile time,
-    as in `run_fixed`; so does ``wt`` None (a steady rotation rate).
-    ``K`` (16, 6), ``Kt`` (13, 6) and ``rows`` (12, 6) are work arrays from the caller (a
-    kernel that allocates compiles numpy's allocators on a first run).
+    The one DOP853 loop (`rotframe.numerics.dop853_loop`) with the particle's right-hand side
+    (`rotframe.particles.dop853_particles`): Hairer's error control, step control and starting
+    step; the samples at ``sample_times`` inside a step are its dense output of order 7. Events are
+    located on the method's own steps: bisection on the length of one extra DOP853 step from the
+    step's start. ``h_state`` (N,) carries each particle's step between calls; where it is 0, the
+    particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the same
+    in every call, so that the steps do not depend on how the run is cut into calls). ``events``
+    None (no event table) prunes the event code at compile time, as in `run_fixed`; so does ``wt``
+    None (a steady rotation rate). ``work`` (`rotframe.particles.dop853_particles.WORK_ROWS`, 6)
+    and ``Kt`` (13, 6, the event locator's stages) are work arrays from the caller (a kernel that
+    allocates compiles numpy's allocators on a first run).
 
     Returns (n_done, bad, nfev, steps) like `run_fixed` (cost of particle 0).
     """
     m = unpack(P, wt, wv)
-    n = r.shape[0]
-    n_out = sample_times.shape[0]
-    n_ev = 0 if events is None else events.shape[0]
-    y, y_new, yt, tmp, atol_vec = rows[0], rows[1], rows[2], rows[3], rows[4]
-    F = rows[5:12]  # the interpolant's coefficients of the current step
-    for j in range(6):
-        atol_vec[j] = atol
-    if events is not None:
-        g_old = np.empty(n_ev)
-    nfev0 = 0
-    steps0 = 0
-    n_done = n_out
-    bad = -1
-    t_end = sample_times[n_out - 1]
-    for p in range(n):
-        for i in range(3):
-            y[i] = r[p, i]
-            y[3 + i] = v[p, i]
-        t = t0
-        h = h_state[p]
-        is_alive = alive[p]
-        w, wd = rates(t, m.steady, m.w, wt, wv)
-        ax, ay, az = state_acceleration(as_state(y), m, w, wd)
-        f0 = (y[3], y[4], y[5], ax, ay, az)
-        nf = 1
-        if h <= 0.0:  # Hairer's starting step (numerics.step_control), one more evaluation at its trial step
-            for j in range(6):
-                K[0, j] = f0[j]
-            h0 = first_step_trial(y, K[0], rtol, atol_vec, span)
-            for j in range(6):
-                yt[j] = y[j] + h0 * f0[j]
-            w1, wd1 = rates(t + h0, m.steady, m.w, wt, wv)
-            ax, ay, az = state_acceleration(as_state(yt), m, w1, wd1)
-            K[1, 0], K[1, 1], K[1, 2], K[1, 3], K[1, 4], K[1, 5] = yt[3], yt[4], yt[5], ax, ay, az
-            h = first_step(y, K[0], K[1], h0, rtol, atol_vec, span)
-            nf += 1
-        rejected = False
-        if events is not None:
-            for e in range(n_ev):
-                g_old[e] = start_value(events, e, as_state(y), m, w, wd)
-        k_out = int(0)  # an int64: a literal 0 would compile store a second time
-        while k_out < n_out and sample_times[k_out] <= t:
-            store(out_r, out_v, k_out, p, y)
-            k_out += 1
-        failed = False
-        while is_alive and t < t_end:
-            # one accepted step
-            accepted = False
-            at_end = False
-            truncated = False
-            while not accepted:
-                h_ctrl = h
-                truncated = t + h > t_end
-                if truncated:
-                    h = t_end - t
-                if step_collapsed(h, t):
-                    if step_collapsed(t_end - t, t):
-                        # the steps summed to within a few ulp of the end: it is reached (the state
-                        # is off by |f| * 10 ulp(t), far below any tolerance); not a collapsed step
-                        at_end = True
-                        h = h_ctrl  # the next call starts from the controller's step, not from the ulps
-                    else:
-                        failed = True
-                    break
-                dop853_step(t, y, f0, h, m, wt, wv, A, C, K, y_new, tmp)
-                nf += 12
-                err = dop853_error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
-                accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
-                rejected = not accepted
-                h_used = h
-                h = h_next
-            if failed:
-                break
-            if at_end:
-                t = t_end
-                break
-            # a step cut to land on t_end ends there exactly (t + (t_end - t) may round below it)
-            t_new = t_end if truncated else t + h_used
-            if p == 0:
-                steps0 += 1
-            # events inside (t, t_new]
-            stop = False
-            t_stop = t_new
-            if events is not None:
-                for e in range(n_ev):
-                    g_new = event_value(events, e, as_state(y_new), m.radius)
-                    if crossed(events[e, 3], g_old[e], g_new):
-                        hi, hit = locate_event_dop853(events, e, g_old[e], t, h_used, m, wt, wv, A, C, f0, Kt, y, tmp,
-                                                      yt)
-                        record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
-                        if events[e, 4] != 0.0 and t + hi <= t_stop:
-                            stop = True
-                            t_stop = t + hi
-                    g_old[e] = g_new
-            # samples inside (t, t_stop]: the dense output inside the step, the new state at its end
-            dense = False
-            while k_out < n_out and sample_times[k_out] <= t_stop:
-                ts = sample_times[k_out]
-                if ts == t_new:
-                    store(out_r, out_v, k_out, p, y_new)
-                else:
-                    if not dense:
-                        dense_stages(t, y, h_used, m, wt, wv, A, C, K, tmp)
-                        dense_coefficients(y, y_new, K, h_used, D, F)
-                        nf += 3
-                        dense = True
-                    x = (ts - t) / h_used
-                    for j in range(6):
-                        yt[j] = dense_value(F, y, x, j)
-                    store(out_r, out_v, k_out, p, yt)
-                k_out += 1
-            if stop:
-                dop853_step(t, y, f0, t_stop - t, m, wt, wv, A, C, Kt, yt, tmp)
-                for j in range(6):
-                    y[j] = yt[j]
-                t = t_stop
-                is_alive = False
-                break
-            for j in range(6):
-                y[j] = y_new[j]
-            f0 = as_state(K[12])
-            t = t_new
-            if not is_finite(as_state(y)):
-                failed = True
-                break
-        if failed:
-            n_done, bad = _failed(n_done, bad, k_out, p)
-        # a stopped particle keeps its final state in the remaining samples
-        while k_out < n_out:
-            store(out_r, out_v, k_out, p, y)
-            k_out += 1
-        store_particle(r, v, p, y)
-        alive[p] = is_alive
-        h_state[p] = h
-        if p == 0:
-            nfev0 = nf
-    return n_done, bad, nfev0, steps0
+    ctx = (m, wt, wv)
+    if events is None:
+        return run_particles(particle_rhs, particle_trajectory, ctx, r, v, alive, t0, sample_times, rtol, atol, span,
+                             out_r, out_v, h_state, work, None, None)
+    g_old = np.empty(events.shape[0])
+    # the locator's scratch states are the loop's (free while it watches: rotframe.particles.dop853_particles)
+    wctx = (events, g_old, m.radius, Kt, work[18], work[19], ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
+    return run_particles(particle_rhs, particle_trajectory_events, ctx, r, v, alive, t0, sample_times, rtol, atol,
+                         span, out_r, out_v, h_state, work, wctx, g_old)

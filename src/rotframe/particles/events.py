@@ -6,7 +6,8 @@ An event row is ``(kind, component, value, direction, terminal)``
 bisection on the length of a re-step from the step's start with the method's own
 one-step map, so the event time is exact for the method's discrete trajectory
 (docs/physics/events.md). The fixed-step drivers re-step with their method
-(`locate_event`), the DOP853 driver with DOP853 (`locate_event_dop853`),
+(`locate_event`), the DOP853 driver with DOP853
+(`rotframe.particles.dop853_particles.locate_event_dop853`),
 so that neither compiles the other's steps; both bisect by one rule
 (`bisection_midpoint`, `narrow`) and record by `record_event`.
 """
@@ -17,7 +18,6 @@ import math
 
 from numba import njit
 
-from rotframe.particles.dop853_steps import dop853_step
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import as_state, jit_internal
@@ -25,7 +25,7 @@ from rotframe.particles.packed import as_state, jit_internal
 _inline = njit(inline="always", error_model="numpy", nogil=True)
 
 __all__ = ["event_value", "event_row", "row_value", "watch_steps", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
-           "locate_event", "locate_event_dop853", "record_event"]
+           "locate_event", "record_event"]
 
 
 @jit_internal
@@ -198,28 +198,6 @@ def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, 
         g_mid = event_value(events, e, fixed_trial(method, start, t, mid, m, wt, wv, wint, rk4, sphere), m.radius)
         lo, hi, g_lo = narrow(lo, hi, g_lo, mid, g_mid)
     return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint, rk4, sphere)
-
-
-@jit_internal
-def locate_event_dop853(events, e, g_start, t, h, m, wt, wv, A, C, f0, K, y, tmp, y_out):
-    """`locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
-
-    The step starts from ``y`` (6,) at t with ``f0 = f(t, y)``; ``A, C`` are the tableau
-    (`rotframe.numerics.dop853_dense.extended_tableau`), ``K`` (13, 6) and ``tmp`` (6,) scratch, and
-    ``y_out`` (6,) receives the state (`rotframe.particles.dop853_steps.dop853_step`). Returns tau and
-    the state at the event (a 6-tuple).
-    """
-    lo = 0.0
-    hi = h
-    g_lo = g_start
-    for _ in range(MAX_HALVINGS):
-        mid = bisection_midpoint(lo, hi)
-        if mid < 0.0:
-            break
-        dop853_step(t, y, f0, mid, m, wt, wv, A, C, K, y_out, tmp)
-        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, event_value(events, e, as_state(y_out), m.radius))
-    dop853_step(t, y, f0, hi, m, wt, wv, A, C, K, y_out, tmp)
-    return hi, as_state(y_out)
 
 
 @jit_internal

@@ -9,7 +9,7 @@ piecewise linear in time (a constant is a one-node table). Each term is
 switched by a flag in ``P``; a term that is off costs one branch.
 
 The step kernels (`rotframe.particles.kernels`), the DOP853 stages
-(`rotframe.particles.dop853_steps`) and the event rules
+(`rotframe.particles.dop853_particles`) and the event rules
 (`rotframe.particles.events`) all evaluate forces here.
 """
 

@@ -1,4 +1,4 @@
-"""Adaptive Dormand-Prince 8(5,3) for a rigid body, compiled in one function.
+"""Adaptive Dormand-Prince 8(5,3) for a rigid body: the one DOP853 loop with the body's right-hand side.
 
 The state is ``y = (L_body, q)``: angular momentum in principal body axes
 (kg m^2/s) and the body -> space orientation quaternion, scalar-last. The
@@ -9,9 +9,9 @@ torque of a heavy symmetric top ``mgl (z_b[1], -z_b[0], 0)``, a constant body
 torque and a constant space torque turned into body axes with ``q/|q|``.
 
 The method is Hairer's DOP853 (Hairer, Norsett & Wanner, Solving ODEs I,
-II.10): 12 stages, the combined 5th/3rd-order error estimate, Hairer's step-size
-control and first step (II.4), shared by every DOP853 loop of rotframe
-(`rotframe.numerics.step_control`), and the 7th-order dense output (3 extra stages, only in
+II.10) as the scenes' one loop runs it (`rotframe.numerics.dop853_loop`): 12 stages, the
+combined 5th/3rd-order error estimate, Hairer's step-size control and first step (II.4,
+`rotframe.numerics.step_control`), and the 7th-order dense output (3 extra stages, only in
 steps that hold an output time) for samples between steps. Tolerances are
 relative: component ``j`` is scaled by ``atol_j + rtol max(|y_j|, |y_new_j|)``
 with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
@@ -19,32 +19,24 @@ with ``atol_j = atol |L0|`` for the momentum and ``atol`` for the quaternion
 not projected during the run (the exact flow keeps ``|q| = 1``, and the drift
 is of the order of the tolerance); outputs are normalised.
 
-Every step and every sample is one compiled call (`_steps`, the tableau
-passed as arrays); the checks, sample 0 and the first step run in Python (a few
+Every step and every sample is one compiled call (`_trajectory`); the checks, sample 0 and the first step run in Python (a few
 microseconds), so that the kernel a first run compiles is as small as it can be
 (docs/architecture.md, "What a first run compiles").
 """
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import inlined, jit_kernel
-
-import functools
 import math
 
 import numpy as np
+
 from rotframe.numerics import step_control
+from rotframe.numerics.compiled import jit_llvm_inline
+from rotframe.numerics.dop853_loop import NONFINITE, dop853_stages, dop853_trajectory
 from rotframe.numerics.plain import plain
-from rotframe.numerics.dop853 import coefficients, dop853_error_norm
-from rotframe.numerics.step_control import next_step, step_collapsed
-from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.rigid.kernels import euler_rates
 
 __all__ = ["rigid_dop853", "RigidRun", "dop853_kernel", "dop853_from", "steps_estimate"]
-
-# the shared error norm, inlined into the kernel (numba IR): one compiled function less on a first run
-_error_norm = inlined(dop853_error_norm)
-
 
 class RigidRun:
     """Samples of one adaptive run: ``times``, ``L`` (n, 3), ``q`` (n, 4), ``nfev``, ``steps``."""
@@ -55,100 +47,26 @@ class RigidRun:
         self.times, self.L, self.q, self.nfev, self.steps = times, L, q, nfev, steps
 
 
-@functools.cache
-def _tableau():
-    """(A (16, 16), E3 (13,), E5 (13,), D (4, 16)): DOP853 with its dense output in one stage loop.
-
-    ``A`` and ``D`` as `rotframe.numerics.dop853_dense.extended_tableau` gives them (row 12 of
-    ``A`` the order-8 weights, rows 13..15 the dense-output stages).
-    """
-    A, _, D = extended_tableau()
-    _, _, _, E3, E5 = coefficients()
-    return A, E3, E5, D
+@jit_llvm_inline
+def _rigid_rhs(p, t, z, K, s):
+    """``K[s] = f(z)``: `rotframe.rigid.kernels.euler_rates` of ``z = (L_body, q)`` with ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``."""
+    K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
+        z[0], z[1], z[2], z[3], z[4], z[5], z[6], p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
 
 
-@jit_kernel
-def _steps(y, K, t, h, p, times, k_out, rtol, atol_vec, h_max, A, E3, E5, D, out_L, out_q, y_new, tmp, F):
-    """Take the steps from ``t`` (state ``y``, ``K[0] = f(y)``, first step ``h``) to ``times[-1]``.
+@jit_llvm_inline
+def _store_sample(out, k, p, y):
+    """Sample ``k``: ``L`` into ``out[0]`` (n, 3), the normalised quaternion into ``out[1]`` (n, 4)."""
+    out_L, out_q = out
+    n = math.sqrt(y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6])
+    for i in range(3):
+        out_L[k, i] = y[i]
+    for i in range(4):
+        out_q[k, i] = y[3 + i] / n
 
-    Samples ``k_out..`` of ``times`` go to ``out_L`` and ``out_q`` (normalised);
-    ``y_new``, ``tmp`` (7,) and ``F`` (7, 7) are work arrays.
-    ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``; ``A`` as `_tableau`
-    returns it. Returns (samples done, right-hand sides evaluated, accepted steps);
-    samples done < len(times) when the step size collapsed or the state became
-    non-finite.
 
-    The kernel a run waits for on its first call is compiled from this function,
-    whose cost grows with its number of statements: everything that runs once per
-    call (checks, first step) is in `rigid_dop853`, and the right-hand side
-    is called from one place (every stage, ``f(y_new)`` and the dense-output stages).
-    """
-    n_out = times.shape[0]
-    t_end = times[n_out - 1]
-    i0, i1, i2, mgl = p[0], p[1], p[2], p[3]
-    nb0, nb1, nb2, ns0, ns1, ns2 = p[4], p[5], p[6], p[7], p[8], p[9]
-    nfev = 0
-    steps = 0
-    rejected = False
-    while t < t_end:
-        # a step cut to end at t_end lands on it exactly (t + (t_end - t) can round to an ulp short)
-        h_ctrl = h
-        clipped = t + h >= t_end
-        if clipped:
-            h = t_end - t
-        if step_collapsed(h, t):
-            return k_out, nfev, steps
-        t_new = t_end if clipped else t + h
-        dense = False
-        for s in range(1, 16):
-            if s == 13:  # tmp holds y_new (stage 12): estimate the error
-                nfev += 12
-                for j in range(7):
-                    y_new[j] = tmp[j]
-                err = _error_norm(K, h, y, y_new, rtol, atol_vec, E3, E5)
-                # the 7th-order dense output needs stages 13..15, when the step holds a sample
-                if not (err <= 1.0 and k_out < n_out and times[k_out] < t_new):
-                    break
-                nfev += 3
-                dense = True
-            for j in range(7):
-                acc = 0.0
-                for q in range(s):
-                    acc += A[s, q] * K[q, j]
-                tmp[j] = y[j] + h * acc
-            K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
-                tmp[0], tmp[1], tmp[2], tmp[3], tmp[4], tmp[5], tmp[6], i0, i1, i2, mgl, nb0, nb1, nb2,
-                ns0, ns1, ns2)
-        accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
-        rejected = not accepted
-        if not accepted:
-            h = h_next
-            continue
-        steps += 1
-        if dense:  # the interpolant's coefficients (Hairer's dense output)
-            dense_coefficients(y, y_new, K, h, D, F)
-        # the samples in (t, t_new]: interpolated inside, the new state at t_new
-        while k_out < n_out and times[k_out] <= t_new:
-            x = (times[k_out] - t) / h
-            for j in range(7):
-                tmp[j] = dense_value(F, y, x, j) if times[k_out] < t_new else y_new[j]
-            n = math.sqrt(tmp[3] * tmp[3] + tmp[4] * tmp[4] + tmp[5] * tmp[5] + tmp[6] * tmp[6])
-            for i in range(7):
-                if i < 3:
-                    out_L[k_out, i] = tmp[i]
-                else:
-                    out_q[k_out, i - 3] = tmp[i] / n
-            k_out += 1
-        finite = True
-        for j in range(7):
-            y[j] = y_new[j]
-            K[0, j] = K[12, j]
-            finite = finite and math.isfinite(y[j])
-        t = t_new
-        if not finite:
-            return k_out - 1, nfev, steps
-        h = h_max if h_max < h_next else h_next  # min(h_next, h_max)
-    return k_out, nfev, steps
+#: the one DOP853 loop for the body (`rotframe.numerics.dop853_loop`), called from Python: every step and sample
+_trajectory = dop853_trajectory("rigid", dop853_stages("rigid", _rigid_rhs, 7), _store_sample, 7, entry=True)
 
 
 def _first_step(y, K, p, h_max, atol_vec, rtol):
@@ -206,7 +124,7 @@ def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
 
     ``y0[3:]`` is normalised in place. Sample 0 and the first step in Python
     (Python floats: the same IEEE double operations as float64 scalars, in the
-    order of Hairer's code), the steps in `_steps`. For callers that check
+    order of Hairer's code), the steps in `_trajectory`. For callers that check
     once and run many times ([`rotframe.rigid.prepared.PreparedBodyRun`][rotframe.rigid.prepared.PreparedBodyRun]).
     """
     n_out = times.shape[0]
@@ -225,9 +143,12 @@ def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
     K = np.empty((16, 7))
     t_span = float(times[n_out - 1] - times[0])
     h = _first_step(y, K, p, min(abs(t_span), h_max), atol_vec, rtol)
-    A, E3, E5, D = _tableau()
-    done, nfev, steps = _steps(np.array(y), K, times[0], h, p, times, 1, rtol, atol_vec, h_max, A, E3, E5, D,
-                               out_L, out_q, np.empty(7), np.empty(7), np.empty((7, 7)))
+    work = np.empty((10, 7))  # three states and the interpolant
+    _, _, done, status, nfev, steps = _trajectory(p, times[0], np.array(y), h, times[n_out - 1], h_max, times, 1,
+                                                  (out_L, out_q), 0, rtol, atol_vec, K, work[0], work[1], work[2],
+                                                  work[3:10], None)
+    if status == NONFINITE:
+        done -= 1  # the sample that holds the non-finite state is not done
     return done, nfev + 2, steps
 
 

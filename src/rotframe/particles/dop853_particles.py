@@ -1,0 +1,186 @@
+"""A particle ensemble on the one DOP853 loop: the particle's right-hand side, its samples and its events.
+
+`rotframe.numerics.dop853_loop.dop853_trajectory` integrates one trajectory; `run_particles`
+runs it for each particle of an ensemble, from the particle's own last step (``h_state``) or
+Hairer's starting step, and fills the samples of a particle that stopped or failed. The two
+scene drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853`
+with `particle_rhs` (every term, rotation schedule and event), and
+`rotframe.particles.dop853_steady.run_dop853_steady` with a steady model's force (a smaller first
+compile). Events are watched after each accepted step (`watch_events`) and located by bisection on
+the length of one DOP853 step from the step's start (`locate_event_dop853`).
+
+Work arrays (`WORK_ROWS`, 6): rows 0..15 the stages ``K``, 16 ``y``, 17 ``y_new``, 18 and 19
+scratch states, 20 the absolute tolerances, 21..27 the interpolant's coefficients.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounted
+from rotframe.numerics.dop853_loop import REACHED, STOPPED, dop853_stages, dop853_start, dop853_step, dop853_trajectory
+from rotframe.particles.events import MAX_HALVINGS, bisection_midpoint, crossed, event_value, narrow, record_event, start_value
+from rotframe.particles.forces import state_acceleration
+from rotframe.particles.packed import as_state
+from rotframe.particles.schedule import rates
+
+__all__ = ["particle_rhs", "particle_stages", "particle_trajectory", "particle_trajectory_events", "store_sample",
+           "locate_event_dop853", "watch_events", "run_particles", "WORK_ROWS"]
+
+#: rows of the (WORK_ROWS, 6) work array of `run_particles`
+WORK_ROWS = 28
+
+#: the force, inlined into the right-hand side (numba IR: twelve evaluations a step)
+_acceleration = njit(inline="always", error_model="numpy", nogil=True)(state_acceleration.py_func)
+
+
+@jit_llvm_inline
+def particle_rhs(ctx, t, z, K, s):
+    """``K[s] = f(t, z)`` for a particle: velocity, then the model's acceleration; ``ctx = (m, wt, wv)``."""
+    m, wt, wv = ctx
+    w, wd = rates(t, m.steady, m.w, wt, wv)
+    K[s, 3], K[s, 4], K[s, 5] = _acceleration(as_state(z), m, w, wd)
+    K[s, 0], K[s, 1], K[s, 2] = z[3], z[4], z[5]
+
+
+#: the particle's stages (`rotframe.numerics.dop853_loop.dop853_stages`)
+particle_stages = dop853_stages("particle", particle_rhs, 6)
+
+
+@jit_llvm_inline
+def store_sample(out, k, p, y):
+    """Sample ``k`` of particle ``p``: ``y`` (6,) into ``out = (out_r, out_v)``, each (n, N, 3)."""
+    out_r, out_v = out
+    for i in range(3):
+        out_r[k, p, i] = y[i]
+        out_v[k, p, i] = y[3 + i]
+
+
+@jit_uncounted
+def locate_event_dop853(ctx, events, e, radius, g_start, t, h, K, Kt, y, tmp, y_out):
+    """`rotframe.particles.events.locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
+
+    The step starts from ``y`` (6,) at t with ``K[0] = f(t, y)`` of the particle's right-hand side
+    (`particle_rhs` with ``ctx``); ``Kt`` (13, 6) and ``tmp`` (6,) are scratch, and
+    ``y_out`` (6,) receives the state. Returns tau and the state at the event (a 6-tuple).
+    """
+    for j in range(6):
+        Kt[0, j] = K[0, j]
+    lo = 0.0
+    hi = h
+    g_lo = g_start
+    for _ in range(MAX_HALVINGS):
+        mid = bisection_midpoint(lo, hi)
+        if mid < 0.0:
+            break
+        dop853_step(particle_stages, ctx, t, y, mid, Kt, y_out, tmp)
+        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, event_value(events, e, as_state(y_out), radius))
+    dop853_step(particle_stages, ctx, t, y, hi, Kt, y_out, tmp)
+    return hi, as_state(y_out)
+
+
+@jit_uncounted
+def watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
+    """The event rows' crossings over the accepted step ``(t, y) -> (t_new, y_new)``: each located and recorded.
+
+    ``wctx = (events, g_old, radius, Kt, tmp, yt, ev_t, ev_r, ev_v, ev_count, ev_which,
+    max_events)``: ``g_old`` each event's value at ``t`` (updated), ``Kt`` (13, 6) the locator's
+    stages, ``tmp`` and ``yt`` (6,) its scratch (free while the loop watches). Returns
+    ``(stop, t_stop)``: whether a terminal event ends the particle in the step, and the earliest
+    such time.
+    """
+    events, g_old, radius, Kt, tmp, yt, ev_t, ev_r, ev_v, ev_count, ev_which, max_events = wctx
+    stop = False
+    t_stop = t_new
+    for e in range(events.shape[0]):
+        g_new = event_value(events, e, as_state(y_new), radius)
+        if crossed(events[e, 3], g_old[e], g_new):
+            hi, hit = locate_event_dop853(ctx, events, e, radius, g_old[e], t, h, K, Kt, y, tmp, yt)
+            record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
+            if events[e, 4] != 0.0 and t + hi <= t_stop:
+                stop = True
+                t_stop = t + hi
+        g_old[e] = g_new
+    return stop, t_stop
+
+
+#: the particle's trajectory loop without events and with them (`watch_events`)
+particle_trajectory = dop853_trajectory("particle", particle_stages, store_sample, 6)
+particle_trajectory_events = dop853_trajectory("particle_events", particle_stages, store_sample, 6,
+                                               watch_events)
+
+
+@jit_inline
+def run_particles(rhs, trajectory, ctx, r, v, alive, t0, times, rtol, atol, span, out_r, out_v, h_state, work, wctx,
+                  g_old):
+    """Each particle of ``r, v`` (N, 3) from ``t0`` over the sample ``times``, by `dop853_trajectory`.
+
+    ``h_state`` (N,) each particle's next step (0: Hairer's starting step, at most ``span``, the
+    whole run's length, so that the steps do not depend on how a run is cut into calls);
+    ``alive`` (N,) whether it moves (None: all do; a terminal event clears it); ``rhs`` and
+    ``trajectory`` the system's (`particle_trajectory`, or `particle_trajectory_events` with the
+    events' data ``wctx``, None for none), with ``g_old`` the events' values of the particle being
+    run (``wctx[1]``), set here from ``ctx = (m, wt, wv)``. ``r, v`` receive the
+    states at the end, ``out_r, out_v`` (n, N, 3) the samples: a particle that stopped or failed
+    keeps its last state in the rest. Returns ``(n_done, bad, nfev, steps)``: samples completed
+    by every particle, the first particle that failed (or -1), and particle 0's cost.
+
+    Inlined into each driver (numba IR), so that ``rhs`` and ``trajectory`` are the driver's globals:
+    a function passed on from an argument is compiled as a dynamic address, which numba cannot cache.
+    """
+    K = work[0:16]
+    y = work[16]
+    y_new = work[17]
+    tmp = work[18]
+    yt = work[19]
+    atol_vec = work[20]
+    F = work[21:28]
+    for j in range(6):
+        atol_vec[j] = atol
+    n_out = times.shape[0]
+    t_end = times[n_out - 1]
+    n_done = n_out
+    bad = -1
+    nfev0 = 0
+    steps0 = 0
+    for p in range(r.shape[0]):
+        for i in range(3):
+            y[i] = r[p, i]
+            y[3 + i] = v[p, i]
+        t = t0
+        h = h_state[p]
+        rhs(ctx, t, y, K, 0)
+        nf = 1
+        if h <= 0.0:  # Hairer's starting step, one more evaluation at its trial step
+            h = dop853_start(rhs, ctx, t, y, K, yt, rtol, atol_vec, span)
+            nf += 1
+        if wctx is not None:
+            m, wt, wv = ctx
+            w, wd = rates(t, m.steady, m.w, wt, wv)
+            for e in range(g_old.shape[0]):
+                g_old[e] = start_value(wctx[0], e, as_state(y), m, w, wd)
+        k_out = 0
+        steps = 0
+        if alive is None or alive[p]:
+            t, h, k_out, status, n_steps_f, steps = trajectory(ctx, t, y, h, t_end, math.inf, times, 0, (out_r, out_v),
+                                                               p, rtol, atol_vec, K, y_new, tmp, yt, F, wctx)
+            nf += n_steps_f
+            if status == STOPPED:
+                if alive is not None:
+                    alive[p] = False
+            elif status != REACHED:  # the step size collapsed, or the state is not finite
+                bad = p if bad < 0 else bad
+                n_done = k_out if k_out < n_done else n_done
+        while k_out < n_out:
+            store_sample((out_r, out_v), k_out, p, y)
+            k_out += 1
+        for i in range(3):
+            r[p, i] = y[i]
+            v[p, i] = y[3 + i]
+        h_state[p] = h
+        if p == 0:
+            nfev0 = nf
+            steps0 = steps
+    return n_done, bad, nfev0, steps0
