@@ -220,8 +220,9 @@ class KernelSetup:
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
         steady = self.steady_args is not None
         if steady and (r.shape[0] if kernel_for is None else kernel_for) > threads.BLOCK:
-            # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py):
-            # its force is inlined into the stages, the specialised one keeps calls (a smaller first compile)
+            # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py), as
+            # it did when only the general force was inlined into the stages; both are now (rotframe.numerics.
+            # dop853_loop), and whether the switch still pays is not measured
             from rotframe.particles import drivers
 
             kernel = drivers.run_dop853
