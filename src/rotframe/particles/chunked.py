@@ -23,7 +23,6 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe import limits
 from rotframe.particles import threads
 from rotframe.particles.advice import remedy
-from rotframe.particles.dop853_particles import WORK_ROWS
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
 __all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
@@ -218,6 +217,8 @@ class KernelSetup:
         span = self.duration  # the starting step's bound: the whole run, however it is cut into calls
         end = first + 1 + max(count, 1)
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
+        from rotframe.particles.dop853_ensemble import WORK_ROWS  # here: importing a scene compiles nothing
+
         steady = self.steady_args is not None
         if steady and (r.shape[0] if kernel_for is None else kernel_for) > threads.BLOCK:
             # a large ensemble takes the general driver (bitwise the same results, tests/test_dop853_steady.py), as

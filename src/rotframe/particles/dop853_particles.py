@@ -15,22 +15,18 @@ scratch states, 20 the absolute tolerances, 21..27 the interpolant's coefficient
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
-from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounted
-from rotframe.numerics.dop853_loop import REACHED, STOPPED, dop853_stages, dop853_start, dop853_step, dop853_trajectory
+from rotframe.numerics.compiled import jit_llvm_inline, jit_uncounted
+from rotframe.numerics.dop853_loop import dop853_stages, dop853_step, dop853_trajectory
+from rotframe.particles.dop853_ensemble import WORK_ROWS, run_particles, store_sample  # noqa: F401 (re-exported)
 from rotframe.particles.events import MAX_HALVINGS, bisection_midpoint, crossed, event_value, narrow, record_event, start_value
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.packed import as_state
 from rotframe.particles.schedule import rates
 
 __all__ = ["particle_rhs", "particle_stages", "particle_trajectory", "particle_trajectory_events", "store_sample",
-           "locate_event_dop853", "watch_events", "run_particles", "WORK_ROWS"]
-
-#: rows of the (WORK_ROWS, 6) work array of `run_particles`
-WORK_ROWS = 28
+           "locate_event_dop853", "watch_events", "start_events", "run_particles", "WORK_ROWS"]
 
 #: the force, inlined into the right-hand side (numba IR: twelve evaluations a step)
 _acceleration = njit(inline="always", error_model="numpy", nogil=True)(state_acceleration.py_func)
@@ -47,15 +43,6 @@ def particle_rhs(ctx, t, z, K, s):
 
 #: the particle's stages (`rotframe.numerics.dop853_loop.dop853_stages`)
 particle_stages = dop853_stages("particle", particle_rhs, 6)
-
-
-@jit_llvm_inline
-def store_sample(out, k, p, y):
-    """Sample ``k`` of particle ``p``: ``y`` (6,) into ``out = (out_r, out_v)``, each (n, N, 3)."""
-    out_r, out_v = out
-    for i in range(3):
-        out_r[k, p, i] = y[i]
-        out_v[k, p, i] = y[3 + i]
 
 
 @jit_uncounted
@@ -112,75 +99,11 @@ particle_trajectory_events = dop853_trajectory("particle_events", particle_stage
                                                watch_events)
 
 
-@jit_inline
-def run_particles(rhs, trajectory, ctx, r, v, alive, t0, times, rtol, atol, span, out_r, out_v, h_state, work, wctx,
-                  g_old):
-    """Each particle of ``r, v`` (N, 3) from ``t0`` over the sample ``times``, by `dop853_trajectory`.
-
-    ``h_state`` (N,) each particle's next step (0: Hairer's starting step, at most ``span``, the
-    whole run's length, so that the steps do not depend on how a run is cut into calls);
-    ``alive`` (N,) whether it moves (None: all do; a terminal event clears it); ``rhs`` and
-    ``trajectory`` the system's (`particle_trajectory`, or `particle_trajectory_events` with the
-    events' data ``wctx``, None for none), with ``g_old`` the events' values of the particle being
-    run (``wctx[1]``), set here from ``ctx = (m, wt, wv)``. ``r, v`` receive the
-    states at the end, ``out_r, out_v`` (n, N, 3) the samples: a particle that stopped or failed
-    keeps its last state in the rest. Returns ``(n_done, bad, nfev, steps)``: samples completed
-    by every particle, the first particle that failed (or -1), and particle 0's cost.
-
-    Inlined into each driver (numba IR), so that ``rhs`` and ``trajectory`` are the driver's globals:
-    a function passed on from an argument is compiled as a dynamic address, which numba cannot cache.
-    """
-    K = work[0:16]
-    y = work[16]
-    y_new = work[17]
-    tmp = work[18]
-    yt = work[19]
-    atol_vec = work[20]
-    F = work[21:28]
-    for j in range(6):
-        atol_vec[j] = atol
-    n_out = times.shape[0]
-    t_end = times[n_out - 1]
-    n_done = n_out
-    bad = -1
-    nfev0 = 0
-    steps0 = 0
-    for p in range(r.shape[0]):
-        for i in range(3):
-            y[i] = r[p, i]
-            y[3 + i] = v[p, i]
-        t = t0
-        h = h_state[p]
-        rhs(ctx, t, y, K, 0)
-        nf = 1
-        if h <= 0.0:  # Hairer's starting step, one more evaluation at its trial step
-            h = dop853_start(rhs, ctx, t, y, K, yt, rtol, atol_vec, span)
-            nf += 1
-        if wctx is not None:
-            m, wt, wv = ctx
-            w, wd = rates(t, m.steady, m.w, wt, wv)
-            for e in range(g_old.shape[0]):
-                g_old[e] = start_value(wctx[0], e, as_state(y), m, w, wd)
-        k_out = 0
-        steps = 0
-        if alive is None or alive[p]:
-            t, h, k_out, status, n_steps_f, steps = trajectory(ctx, t, y, h, t_end, math.inf, times, 0, (out_r, out_v),
-                                                               p, rtol, atol_vec, K, y_new, tmp, yt, F, wctx)
-            nf += n_steps_f
-            if status == STOPPED:
-                if alive is not None:
-                    alive[p] = False
-            elif status != REACHED:  # the step size collapsed, or the state is not finite
-                bad = p if bad < 0 else bad
-                n_done = k_out if k_out < n_done else n_done
-        while k_out < n_out:
-            store_sample((out_r, out_v), k_out, p, y)
-            k_out += 1
-        for i in range(3):
-            r[p, i] = y[i]
-            v[p, i] = y[3 + i]
-        h_state[p] = h
-        if p == 0:
-            nfev0 = nf
-            steps0 = steps
-    return n_done, bad, nfev0, steps0
+@jit_uncounted
+def start_events(wctx, ctx, t, y):
+    """Each event's value at the particle's start ``(t, y)`` into ``g_old = wctx[1]``; ``ctx = (m, wt, wv)``."""
+    m, wt, wv = ctx
+    w, wd = rates(t, m.steady, m.w, wt, wv)
+    g_old = wctx[1]
+    for e in range(g_old.shape[0]):
+        g_old[e] = start_value(wctx[0], e, as_state(y), m, w, wd)

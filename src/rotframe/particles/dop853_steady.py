@@ -24,7 +24,7 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_internal, jit_kernel, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_trajectory
-from rotframe.particles.dop853_particles import run_particles, store_sample
+from rotframe.particles.dop853_ensemble import run_particles, store_sample
 
 __all__ = ["is_steady_model", "steady_parameters", "run_dop853_steady", "STEADY_TERMS"]
 
@@ -138,5 +138,5 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, 
     `steady_parameters`. There are no events, so every particle stays alive. Returns
     ``(n_done, bad, nfev, steps)`` (cost of particle 0).
     """
-    return run_particles(_steady_rhs, _steady_trajectory, q, r, v, None, t0, sample_times, rtol, atol, span, out_r,
-                         out_v, h_state, work, None, None)
+    return run_particles(_steady_rhs, _steady_trajectory, None, q, r, v, None, t0, sample_times, rtol, atol, span,
+                         out_r, out_v, h_state, work, None)

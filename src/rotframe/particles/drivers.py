@@ -16,7 +16,7 @@ from numba import njit
 
 from rotframe.numerics.compiled import inlined
 from rotframe.particles.dop853_particles import (particle_rhs, particle_trajectory, particle_trajectory_events,
-                                                 run_particles)
+                                                 run_particles, start_events)
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
 from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
@@ -250,10 +250,10 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, event
     m = unpack(P, wt, wv)
     ctx = (m, wt, wv)
     if events is None:
-        return run_particles(particle_rhs, particle_trajectory, ctx, r, v, alive, t0, sample_times, rtol, atol, span,
-                             out_r, out_v, h_state, work, None, None)
+        return run_particles(particle_rhs, particle_trajectory, None, ctx, r, v, alive, t0, sample_times, rtol, atol,
+                             span, out_r, out_v, h_state, work, None)
     g_old = np.empty(events.shape[0])
     # the locator's scratch states are the loop's (free while it watches: rotframe.particles.dop853_particles)
     wctx = (events, g_old, m.radius, Kt, work[18], work[19], ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-    return run_particles(particle_rhs, particle_trajectory_events, ctx, r, v, alive, t0, sample_times, rtol, atol,
-                         span, out_r, out_v, h_state, work, wctx, g_old)
+    return run_particles(particle_rhs, particle_trajectory_events, start_events, ctx, r, v, alive, t0, sample_times,
+                         rtol, atol, span, out_r, out_v, h_state, work, wctx)
