@@ -1,16 +1,12 @@
 """A particle ensemble on the one DOP853 loop: the particle's right-hand side, its samples and its events.
 
-`rotframe.numerics.dop853_loop.dop853_trajectory` integrates one trajectory; `run_particles`
-runs it for each particle of an ensemble, from the particle's own last step (``h_state``) or
-Hairer's starting step, and fills the samples of a particle that stopped or failed. The two
+`rotframe.numerics.dop853_loop.dop853_trajectory` integrates one trajectory;
+`rotframe.particles.dop853_ensemble.run_particles` runs it for each particle of an ensemble. The two
 scene drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853`
 with `particle_rhs` (every term, rotation schedule and event), and
 `rotframe.particles.dop853_steady.run_dop853_steady` with a steady model's force (a smaller first
 compile). Events are watched after each accepted step (`watch_events`) and located by bisection on
 the length of one DOP853 step from the step's start (`locate_event_dop853`).
-
-Work arrays (`WORK_ROWS`, 6): rows 0..15 the stages ``K``, 16 ``y``, 17 ``y_new``, 18 and 19
-scratch states, 20 the absolute tolerances, 21..27 the interpolant's coefficients.
 """
 
 from __future__ import annotations
@@ -19,14 +15,14 @@ from numba import njit
 
 from rotframe.numerics.compiled import jit_llvm_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step, dop853_trajectory
-from rotframe.particles.dop853_ensemble import WORK_ROWS, run_particles, store_sample  # noqa: F401 (re-exported)
+from rotframe.particles.dop853_ensemble import store_sample
 from rotframe.particles.events import MAX_HALVINGS, bisection_midpoint, crossed, event_value, narrow, record_event, start_value
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.packed import as_state
 from rotframe.particles.schedule import rates
 
-__all__ = ["particle_rhs", "particle_stages", "particle_trajectory", "particle_trajectory_events", "store_sample",
-           "locate_event_dop853", "watch_events", "start_events", "run_particles", "WORK_ROWS"]
+__all__ = ["particle_rhs", "particle_stages", "particle_trajectory", "particle_trajectory_events",
+           "locate_event_dop853", "watch_events", "start_events"]
 
 #: the force, inlined into the right-hand side (numba IR: twelve evaluations a step)
 _acceleration = njit(inline="always", error_model="numpy", nogil=True)(state_acceleration.py_func)

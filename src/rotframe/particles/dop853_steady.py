@@ -9,7 +9,7 @@ code with it. Most scenes that run DOP853 need much less:
 - any of **Coriolis**, **centrifugal** and a **pendulum** string;
 - no drag, no spring, no events.
 
-For such a model `run_dop853_steady` runs the same loop (`rotframe.particles.dop853_particles.run_particles`
+For such a model `run_dop853_steady` runs the same loop (`rotframe.particles.dop853_ensemble.run_particles`
 on `rotframe.numerics.dop853_loop`) with the force written in place (`_acceleration`), in the
 floating-point order of the general force, so that its results are bitwise those of the general
 driver (``tests/test_dop853_steady.py`` checks this on random models).

@@ -15,8 +15,8 @@ import numpy as np
 from numba import njit
 
 from rotframe.numerics.compiled import inlined
-from rotframe.particles.dop853_particles import (particle_rhs, particle_trajectory, particle_trajectory_events,
-                                                 run_particles, start_events)
+from rotframe.particles.dop853_ensemble import run_particles
+from rotframe.particles.dop853_particles import particle_rhs, particle_trajectory, particle_trajectory_events, start_events
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
 from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
@@ -241,7 +241,7 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, event
     particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the same
     in every call, so that the steps do not depend on how the run is cut into calls). ``events``
     None (no event table) prunes the event code at compile time, as in `run_fixed`; so does ``wt``
-    None (a steady rotation rate). ``work`` (`rotframe.particles.dop853_particles.WORK_ROWS`, 6)
+    None (a steady rotation rate). ``work`` (`rotframe.particles.dop853_ensemble.WORK_ROWS`, 6)
     and ``Kt`` (13, 6, the event locator's stages) are work arrays from the caller (a kernel that
     allocates compiles numpy's allocators on a first run).
 
