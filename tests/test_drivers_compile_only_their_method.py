@@ -32,6 +32,10 @@ traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 3.0, method
 assert len(traj.event_times["ground"][0]) == 1
 fixed = [kernels._free_steps, kernels._sphere_steps, kernels._rk4_steps]
 print(sum(len(f.signatures) for f in fixed), len(dop853_particles.particle_stages.signatures))
+# the event-free loops: a run with events compiles none of them (numba prunes ``events is None`` only where it is)
+from rotframe.particles import drivers
+event_free = [drivers.run_fixed, drivers.run_dop853, drivers._steady_run, dop853_particles.particle_trajectory]
+print(sum(len(f.signatures) for f in event_free))
 '''
 
 
@@ -40,18 +44,40 @@ def compiled_counts(method, tmp_path):
     res = subprocess.run([sys.executable, "-c", PROBE, method], capture_output=True, text=True, env=env,
                          timeout=600)
     assert res.returncode == 0, res.stderr
-    fixed, dop = map(int, res.stdout.split())
-    return fixed, dop
+    fixed, dop, event_free = map(int, res.stdout.split())
+    return fixed, dop, event_free
 
 
-def test_dop853_driver_compiles_no_fixed_step_method(tmp_path):
-    fixed, dop = compiled_counts("dop853", tmp_path)
-    assert dop == 1 and fixed == 0
+def test_dop853_driver_compiles_no_fixed_step_method_and_no_event_free_loop(tmp_path):
+    fixed, dop, event_free = compiled_counts("dop853", tmp_path)
+    assert dop == 1 and fixed == 0 and event_free == 0
 
 
-def test_fixed_step_driver_compiles_no_dop853_step(tmp_path):
-    fixed, dop = compiled_counts("rotation-splitting", tmp_path)
-    assert fixed >= 1 and dop == 0
+def test_fixed_step_driver_compiles_no_dop853_step_and_no_event_free_loop(tmp_path):
+    fixed, dop, event_free = compiled_counts("rotation-splitting", tmp_path)
+    assert fixed >= 1 and dop == 0 and event_free == 0
+
+
+def test_a_driver_without_events_refuses_an_event_table():
+    # the event-free kernels do not watch events: given a table, they say so instead of ignoring it
+    import numpy as np
+    import pytest
+
+    from rotframe.particles import drivers
+    from rotframe.particles.dop853_ensemble import WORK_ROWS
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    model = ParticleModel(("gravity",), omega=OmegaSchedule.constant([0.0, 0.0, 0.0]), g=np.array([0.0, 0.0, -9.81]))
+    r, v, alive = np.zeros((1, 3)), np.zeros((1, 3)), np.ones(1, dtype=np.bool_)
+    out = np.empty((1, 1, 3))
+    table = np.array([[0.0, 2.0, -1.0, 0.0, 1.0]])
+    with pytest.raises(ValueError, match="run_fixed_events"):
+        drivers.run_fixed(0, r, v, alive, 0.0, 0.1, 1, 1, model.pack(), None, model.omega.values,
+                          model.omega.cumulative(), table, out, out.copy(), None, None, None, None, None, 0, None, None)
+    with pytest.raises(ValueError, match="run_dop853_events"):
+        drivers.run_dop853(r, v, alive, 0.0, np.array([1.0]), model.pack(), None, model.omega.values, 1e-9, 1e-9,
+                           1.0, table, out, out.copy(), None, None, None, None, None, 0, np.zeros(1),
+                           np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
 
 
 PRUNED = r'''

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rotframe.particles import kernels
-from rotframe.particles.drivers import run_fixed
+from rotframe.particles.drivers import run_fixed, run_fixed_events
 from rotframe.particles.forces import acceleration
 from rotframe.particles.schedule import omega_angle, omega_magnitude, omega_rate
 from rotframe.errors import IntegrationError
@@ -62,9 +62,10 @@ def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samp
     out_v = np.empty((n_samples, n, 3))
     records = (np.full((n, 4), np.nan), np.zeros((n, 4, 3)), np.zeros((n, 4, 3)), np.zeros(n, np.int64),
                np.zeros((n, 4), np.int64), 4)
-    result = run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
-                               wt, model.omega.values, model.omega.cumulative(), events,
-                               out_r, out_v, *records, *family)
+    kernel = run_fixed if events is None else run_fixed_events
+    result = kernel(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
+                    wt, model.omega.values, model.omega.cumulative(), events,
+                    out_r, out_v, *records, *family)
     return result, out_r, out_v, r, v
 
 

@@ -143,7 +143,11 @@ class KernelSetup:
         else:
             from rotframe.particles import drivers
 
-            kernel = drivers.run_fixed if self.info.step == "fixed" else drivers.run_dop853
+            # a kernel of its own with events (rotframe.particles.drivers): a run compiles only its own loops
+            if self.info.step == "fixed":
+                kernel = drivers.run_fixed if self.ev_tab is None else drivers.run_fixed_events
+            else:
+                kernel = drivers.run_dop853 if self.ev_tab is None else drivers.run_dop853_events
         self._kernel = kernel
         return kernel
 

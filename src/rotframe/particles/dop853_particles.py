@@ -1,9 +1,10 @@
 """A particle ensemble on the one DOP853 loop: the particle's right-hand side, its samples and its events.
 
 `rotframe.numerics.dop853_loop.dop853_trajectory` integrates one trajectory;
-`rotframe.particles.dop853_ensemble.run_particles` runs it for each particle of an ensemble. The two
-scene drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853`
-with `particle_rhs` (every term, rotation schedule and event), and
+`rotframe.particles.dop853_ensemble.run_particles` runs it for each particle of an ensemble. The scene
+drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853` and
+`run_dop853_events` with `particle_rhs` (every term and rotation schedule; the second watches
+the events), and
 `rotframe.particles.dop853_steady.run_dop853_steady` with a steady model's force (a smaller first
 compile). Events are watched after each accepted step (`watch_events`) and located by bisection on
 the length of one DOP853 step from the step's start (`locate_event_dop853`).

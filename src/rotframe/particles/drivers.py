@@ -2,10 +2,17 @@
 
 `run_fixed` runs a fixed-step method (`rotframe.particles.kernels`),
 `run_dop853` the adaptive Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner
-II.10). Both advance ``r, v`` (N, 3) in place, fill output samples, record
-events (`rotframe.particles.events`) and report a non-finite state instead
-of raising; the Python side ([`rotframe.particles.integrators`][rotframe.particles.integrators]) calls them in
-chunks of output samples, so that progress, Ctrl-C and a numerical failure are
+II.10); `run_fixed_events` and `run_dop853_events` are the same with an event table
+(`rotframe.particles.events`). All advance ``r, v`` (N, 3) in place, fill output samples
+and report a non-finite state instead of raising.
+
+A kernel per event table's presence, not one with a branch on ``events is None``: numba
+prunes such a branch before it types a function only where the argument is None, so a
+run with events compiled the event-free loops too (a DOP853 run's second trajectory loop,
+a fixed-step run's throughput loop: seconds of a first run).
+
+The Python side ([`rotframe.particles.integrators`][rotframe.particles.integrators]) calls
+them in chunks of output samples, so that progress, Ctrl-C and a numerical failure are
 handled between chunks without losing data.
 """
 
@@ -22,7 +29,7 @@ from rotframe.particles.kernels import advance, free_step, make_plan, method_ste
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
-__all__ = ["run_fixed", "run_dop853"]
+__all__ = ["run_fixed", "run_fixed_events", "run_dop853", "run_dop853_events"]
 
 # inlined into run_fixed: a call per sample interval that passes arrays (the schedule, the output)
 # costs their reference counts, some 20 ns a particle and sample, as much as a few steps
@@ -107,13 +114,10 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
         Particles still moving; a terminal event clears the flag (in place).
     h : float
         Step (s). Samples are stored every ``steps_per_sample`` steps.
-    events : (E, 5) array or None
-        Event table (see module docstring); None when there is none, which
-        numba prunes at compile time (a run without events compiles none of
-        the event code). Crossings are located by
-        re-stepping from the last state before the crossing with a shorter step
-        (bisection to round-off), so an event time is exact for the method's own
-        discrete trajectory.
+    events : None
+        No event table (an array raises `ValueError`): a run with one calls
+        `run_fixed_events`, with the same arguments (each kernel compiles only
+        its own loops).
     out_r, out_v : (n_samples, N, 3) arrays
         Filled with the state after each sample interval; a stopped particle
         keeps its state at the terminal event.
@@ -133,39 +137,67 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     nfev : int
         Force evaluations of particle 0 (the cost of one trajectory).
     """
+    if events is not None:
+        raise ValueError("run_fixed takes no event table (events=None): a run with one calls run_fixed_events")
     m = unpack(P, wt, wv)
     plan = make_plan(method, t0, h, m, wt, wv, wint)
     nfev_step = NFEV[method]
-    n = r.shape[0]
-    if events is None and (wt is None or m.steady):
+    if wt is None or m.steady:
         # the throughput path: one loop compiled once for every variant of this driver
         n_done, bad, steps0 = _steady_run(method, r, v, alive, n_samples, steps_per_sample, h, m, plan, rk4, sphere,
                                           out_r, out_v)
         return n_done, bad, nfev_step * steps0
-    n_ev = 0 if events is None else events.shape[0]
-    if events is not None:
-        g_old = np.empty(n_ev)
-        row = event_row(events, 0) if n_ev > 0 else (0.0, 0, 0.0, 0.0)  # the watch loop's event, read once
     nfev0 = 0
     n_done = n_samples
     bad = -1
-    for p in range(n):
+    for p in range(r.shape[0]):
+        state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
+        k_step = int(0)  # an int64: a literal 0 would compile advance a second time
+        for s in range(n_samples):
+            if alive[p]:
+                # a varying rate: the whole sample interval in one call
+                state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4, sphere)
+                k_step += steps_per_sample
+                if p == 0:
+                    nfev0 += nfev_step * steps_per_sample
+                if not _is_finite(state):
+                    n_done, bad = _failed(n_done, bad, s, p)
+                    break
+            _store(out_r, out_v, s, p, state)  # inlined: a call passing two arrays costs their reference counts
+        store_particle(r, v, p, state)
+    return n_done, bad, nfev0
+
+
+@jit_kernel
+def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
+                     events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, rk4, sphere):
+    """`run_fixed` with an event table ``events`` (E, 5) (`rotframe.particles.events.event_table`).
+
+    The same arguments and results. Each step is followed by the events' functions; a crossing is
+    located by re-stepping from the last state before it with a shorter step (bisection to
+    round-off), so an event time is exact for the method's own discrete trajectory, and recorded
+    in ``ev_t, ev_r, ev_v, ev_count, ev_which`` (at most ``max_events`` a particle). A terminal
+    event clears the particle's ``alive`` flag; it keeps its state at the event in later samples.
+    """
+    m = unpack(P, wt, wv)
+    plan = make_plan(method, t0, h, m, wt, wv, wint)
+    nfev_step = NFEV[method]
+    n_ev = events.shape[0]
+    g_old = np.empty(n_ev)
+    row = event_row(events, 0) if n_ev > 0 else (0.0, 0, 0.0, 0.0)  # the watch loop's event, read once
+    nfev0 = 0
+    n_done = n_samples
+    bad = -1
+    for p in range(r.shape[0]):
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
         k_step = int(0)  # an int64: a literal 0 would compile advance a second time
-        if events is not None:
-            w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
-            for e in range(n_ev):
-                g_old[e] = start_value(events, e, state, m, w0, wd0)
+        w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
+        for e in range(n_ev):
+            g_old[e] = start_value(events, e, state, m, w0, wd0)
         for s in range(n_samples):
             if is_alive:
-                if events is None:
-                    # a varying rate, no event to watch: the whole sample interval in one call
-                    state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4, sphere)
-                    k_step += steps_per_sample
-                    if p == 0:
-                        nfev0 += nfev_step * steps_per_sample
-                elif n_ev == 1 and (wt is None or m.steady):
+                if n_ev == 1 and (wt is None or m.steady):
                     # one event at a steady rate (an ensemble to the ground): the watch loop keeps the
                     # step and the event test in registers; the same steps, tests and location as below
                     k = 0
@@ -237,23 +269,36 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, event
     (`rotframe.particles.dop853_particles`): Hairer's error control, step control and starting
     step; the samples at ``sample_times`` inside a step are its dense output of order 7. Events are
     located on the method's own steps: bisection on the length of one extra DOP853 step from the
-    step's start. ``h_state`` (N,) carries each particle's step between calls; where it is 0, the
+    step's start (`run_dop853_events`). ``h_state`` (N,) carries each particle's step between calls; where it is 0, the
     particle starts with Hairer's starting step, at most ``span`` (the whole run's length, the same
     in every call, so that the steps do not depend on how the run is cut into calls). ``events``
-    None (no event table) prunes the event code at compile time, as in `run_fixed`; so does ``wt``
-    None (a steady rotation rate). ``work`` (`rotframe.particles.dop853_ensemble.WORK_ROWS`, 6)
+    is None (a run with an event table calls `run_dop853_events`); ``wt`` None (a steady
+    rotation rate) prunes the schedule readers at compile time. ``work`` (`rotframe.particles.dop853_ensemble.WORK_ROWS`, 6)
     and ``Kt`` (13, 6, the event locator's stages) are work arrays from the caller (a kernel that
     allocates compiles numpy's allocators on a first run).
 
     Returns (n_done, bad, nfev, steps) like `run_fixed` (cost of particle 0).
     """
+    if events is not None:
+        raise ValueError("run_dop853 takes no event table (events=None): a run with one calls run_dop853_events")
     m = unpack(P, wt, wv)
-    ctx = (m, wt, wv)
-    if events is None:
-        return run_particles(particle_rhs, particle_trajectory, None, ctx, r, v, alive, t0, sample_times, rtol, atol,
-                             span, out_r, out_v, h_state, work, None)
+    return run_particles(particle_rhs, particle_trajectory, None, (m, wt, wv), r, v, alive, t0, sample_times, rtol,
+                         atol, span, out_r, out_v, h_state, work, None)
+
+
+@jit_kernel
+def run_dop853_events(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, events, out_r, out_v, ev_t, ev_r,
+                      ev_v, ev_count, ev_which, max_events, h_state, work, Kt):
+    """`run_dop853` with an event table ``events`` (E, 5): the trajectory loop that watches them.
+
+    The same arguments and results. Events are located on the method's own steps: bisection on
+    the length of one extra DOP853 step from the step's start
+    (`rotframe.particles.dop853_particles.watch_events`), recorded in ``ev_t, ev_r, ev_v,
+    ev_count, ev_which``; a terminal event clears the particle's ``alive`` flag.
+    """
+    m = unpack(P, wt, wv)
     g_old = np.empty(events.shape[0])
     # the locator's scratch states are the loop's (free while it watches: rotframe.particles.dop853_particles)
     wctx = (events, g_old, m.radius, Kt, work[18], work[19], ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
-    return run_particles(particle_rhs, particle_trajectory_events, start_events, ctx, r, v, alive, t0, sample_times,
-                         rtol, atol, span, out_r, out_v, h_state, work, wctx)
+    return run_particles(particle_rhs, particle_trajectory_events, start_events, (m, wt, wv), r, v, alive, t0,
+                         sample_times, rtol, atol, span, out_r, out_v, h_state, work, wctx)
