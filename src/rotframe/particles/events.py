@@ -8,8 +8,9 @@ one-step map, so the event time is exact for the method's discrete trajectory
 (docs/physics/events.md). The fixed-step drivers re-step with their method
 (`locate_event`), the DOP853 driver with DOP853
 (`rotframe.particles.dop853_particles.locate_event_dop853`),
-so that neither compiles the other's steps; both bisect by one rule
-(`bisection_midpoint`, `narrow`) and record by `record_event`.
+so that neither compiles the other's steps; both bisect by rotframe's one rule
+(`rotframe.numerics.bisection`: `bisection_midpoint`, `narrow`, re-exported here) and
+record by `record_event`.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import math
 
 from numba import njit
 
+from rotframe.numerics.bisection import MAX_HALVINGS, bisection_midpoint, narrow
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import as_state, jit_internal
@@ -141,32 +143,6 @@ def crossed(direction, g0, g1):
 
 
 _crossed = _inline(crossed.py_func)  # the same rule, inlined into the watch loop
-
-#: Most halvings of a bracket: enough to reach round-off of tau from any step length
-#: (even a crossing at tau ~ 1e-161 s, which a fixed 60 halvings of h would miss by 1e140).
-MAX_HALVINGS = 2200
-
-
-@jit_internal
-def bisection_midpoint(lo, hi):
-    """The midpoint of the bracket [lo, hi] (0 <= lo < hi), or -1.0 when it cannot shrink (round-off)."""
-    mid = 0.5 * (lo + hi)
-    if mid <= lo or mid >= hi:
-        return -1.0
-    return mid
-
-
-@jit_internal
-def narrow(lo, hi, g_lo, mid, g_mid):
-    """The half of [lo, hi] that keeps the crossing, given g at ``mid``: ``(lo, hi, g_lo)``.
-
-    The crossing is in [mid, hi] when g keeps the sign it has at ``lo`` (a zero
-    counts as crossed), so ``hi`` is always at or past the event.
-    """
-    if (g_lo < 0.0) == (g_mid < 0.0) and g_mid != 0.0:
-        return mid, hi, g_mid
-    return lo, mid, g_lo
-
 
 @jit_internal
 def fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere):

@@ -52,7 +52,8 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics import dop853_dense, step_control
+from rotframe.numerics import bisection, dop853_dense, step_control
+from rotframe.numerics.bisection import MAX_HALVINGS
 from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
@@ -71,6 +72,8 @@ first_step_trial = inlined(step_control.first_step_trial)
 first_step_final = inlined(step_control.first_step)
 dense_coefficients = inlined(dop853_dense.dense_coefficients)
 dense_value = dop853_dense.dense_value  # inlined into its callers
+bisection_midpoint = inlined(bisection.bisection_midpoint)
+narrow = inlined(bisection.narrow)
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 #: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
@@ -182,22 +185,19 @@ def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
     Returns tau in (0, h]; ``yhi`` holds the state there (the full step's end on entry). The
-    crossing is bracketed to round-off in time on the method's own discrete trajectory.
+    crossing is bracketed to round-off in time on the method's own discrete trajectory, by
+    rotframe's one bisection rule (`rotframe.numerics.bisection`), as the scenes' locators.
     """
     lo = 0.0
     hi = h
     rhs(body, t, y, Kb[0], prob, fns, W)
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if not (lo < mid < hi):
+    for _ in range(MAX_HALVINGS):
+        mid = bisection_midpoint(lo, hi)
+        if mid < 0.0:
             break
         take_step(body, method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
-        gm = call_event(fns[1], k, t + mid, ybuf, prob[2])
-        if (gm < 0.0) == (g_lo < 0.0) and gm != 0.0:
-            lo = mid
-            g_lo = gm
-        else:
-            hi = mid
+        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, call_event(fns[1], k, t + mid, ybuf, prob[2]))
+        if hi == mid:  # the crossing is in [lo, mid]: the state at hi is this trial's
             for j in range(y.shape[0]):
                 yhi[j] = ybuf[j]
     return hi

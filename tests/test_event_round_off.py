@@ -1,0 +1,53 @@
+"""Every event locator brackets a crossing to round-off in time, however small the crossing's offset in its step.
+
+A crossing at tau = 1e-100 s inside a step of some 0.01 s needs some 320 halvings of the
+bracket, one at 1e-300 s some 990. The scenes' locators bisect until the bracket cannot shrink
+(`rotframe.numerics.bisection`); the engine of `rotframe.simulate` once stopped after 200 and
+reported the first crossing at 2e-62 s. Here a free particle moving at 1 m/s from x = 0
+crosses x = c at t = c exactly, and every trial state is x = tau to one rounding, so the
+located time must be c to a few ulp.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import rotframe
+from rotframe.particles.integrators import Event, integrate_particles
+from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+OFFSETS = [1e-100, 1e-300]
+
+
+def _ulps(got, want):
+    return abs(got - want) / math.ulp(want)
+
+
+@pytest.mark.parametrize("c", OFFSETS)
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_a_user_event_a_hair_after_the_start_is_located_to_round_off(method, c):
+    def crossing(t, r, v):
+        return r[0] - c
+
+    crossing.direction = 1
+    step = {} if method == "dop853" else {"step": 0.01}
+    res = rotframe.simulate(omega=[0.0, 0.0, 0.0], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=1.0,
+                            events=[crossing], samples=4, method=method, **step)
+    times = res.trajectory.event_times["crossing"][0]
+    assert len(times) == 1
+    assert _ulps(times[0], c) <= 4, (times[0], c)
+
+
+@pytest.mark.parametrize("c", OFFSETS)
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_a_scene_event_a_hair_after_the_start_is_located_to_round_off(method, c):
+    # the scenes' drivers (a position event row), for the same crossing
+    model = ParticleModel(("coriolis",), omega=OmegaSchedule.constant([0.0, 0.0, 0.0]), g=np.zeros(3))
+    event = Event("crossing", "r", 0, c, 1, False)
+    step = {} if method == "dop853" else {"step": 0.01}
+    traj = integrate_particles(model, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 1.0, method=method, samples=4,
+                               events=[event], **step)
+    times = traj.event_times["crossing"][0]
+    assert len(times) == 1
+    assert _ulps(times[0], c) <= 4, (times[0], c)
