@@ -51,3 +51,47 @@ def test_a_scene_event_a_hair_after_the_start_is_located_to_round_off(method, c)
     times = traj.event_times["crossing"][0]
     assert len(times) == 1
     assert _ulps(times[0], c) <= 4, (times[0], c)
+
+
+# a function exactly zero at the start takes the sign it has just after it: the start is never an event, and a hop
+# shorter than the first step still lands (docs/physics/events.md)
+
+def _hop(method, vz, use_scene):
+    g = 9.81
+    step = {} if method == "dop853" else {"step": 0.01}
+    if use_scene:
+        model = ParticleModel(("gravity",), omega=OmegaSchedule.constant([0.0, 0.0, 0.0]), g=np.array([0.0, 0.0, -g]))
+        traj = integrate_particles(model, [0.0, 0.0, 0.0], [1.0, 0.0, vz], 1.0, method=method, samples=4,
+                                   events=[Event("ground", "r", 2, 0.0, -1, True)], **step)
+        return traj.event_times["ground"][0], traj.r[-1, 0]
+
+    def gravity(t, r, v):
+        return np.array([0.0, 0.0, -g])
+
+    def ground(t, r, v):
+        return r[2]
+
+    ground.direction = -1
+    ground.terminal = True
+    res = rotframe.simulate(omega=[0.0, 0.0, 0.0], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, vz], duration=1.0,
+                            forces=[gravity], events=[ground], samples=4, method=method, **step)
+    return res.trajectory.event_times["ground"][0], res.trajectory.r[-1, 0]
+
+
+@pytest.mark.parametrize("use_scene", [False, True], ids=["simulate", "scene"])
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_a_hop_inside_the_first_step_lands(method, use_scene):
+    # fired up at 1 mm/s from the ground: it lands at 2 v / g = 0.2 ms, inside the first step of every method
+    vz, g = 1e-3, 9.81
+    times, final = _hop(method, vz, use_scene)
+    assert len(times) == 1
+    assert abs(times[0] - 2 * vz / g) <= 1e-12 * (2 * vz / g), times
+    assert abs(final[2]) <= 1e-15  # stopped on the ground, not fallen through it
+
+
+@pytest.mark.parametrize("use_scene", [False, True], ids=["simulate", "scene"])
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_fired_into_the_ground_is_no_event(method, use_scene):
+    times, final = _hop(method, -1e-3, use_scene)
+    assert len(times) == 0
+    assert final[2] < -1.0  # it went on down: nothing stopped it

@@ -203,6 +203,38 @@ def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     return hi
 
 
+@jit_inline
+def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
+    """Event k's value just after the start ``(t, y)``, for a function that is exactly zero there.
+
+    The rule of every locator (docs/physics/events.md): the start itself is never an event, and
+    a function that is zero there takes the sign it has just after it. The trials are re-steps
+    by the method from ``(t, y)`` of lengths ``h / 2, h / 4, ...``; the value kept is the one
+    nearest the start that is not zero, until a trial no longer moves the state (or tau
+    underflows). A projectile fired from the ground thus lands at its first return to it
+    however soon, inside the first step too, and one fired into the ground is not an event.
+    Returns 0.0 when g stays zero (no sign to take).
+    """
+    rhs(body, t, y, Kb[0], prob, fns, W)
+    g_near = 0.0
+    tau = h
+    for _ in range(MAX_HALVINGS):
+        tau = 0.5 * tau
+        if tau == 0.0:
+            break
+        take_step(body, method, t, y, tau, t + tau, Kb, ytb, ybuf, prob, fns, W)
+        g = call_event(fns[1], k, t + tau, ybuf, prob[2])
+        if g != 0.0 and math.isfinite(g):
+            g_near = g
+        moved = False
+        for j in range(y.shape[0]):
+            if ybuf[j] != y[j]:
+                moved = True
+        if not moved:
+            break
+    return g_near
+
+
 def _variant_kernel(model, method, events):
     """The compiled loop of one variant (`variant_loop`), for the CPU: an entry point without reference counts."""
     return _uncounted_entry(variant_loop(model, method, events))
@@ -324,6 +356,8 @@ def variant_loop(model, method, events):
                             status = 5
                             break
                         g_old = GPREV[i, k]
+                        if g_old == 0.0 and t == T[0]:  # zero at the start: the sign just after it (start_sign)
+                            g_old = start_sign(body, method, k, t, y, t_new - t, Kb, ytb, ybuf, prob, fns, W)
                         rising = g_old < 0.0 and g_new >= 0.0
                         falling = g_old > 0.0 and g_new <= 0.0
                         if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
