@@ -116,24 +116,25 @@ def test_threads_scope_is_not_seen_by_other_threads():
     assert seen["n"] == ensemble.resolve_threads(None)
 
 
-def test_large_steady_dop853_run_takes_the_general_driver_bitwise(monkeypatch):
-    """More particles than a block run DOP853 on the general driver; it matches the specialised one bitwise."""
-    from rotframe.particles import drivers
+def test_large_steady_dop853_run_takes_the_steady_driver_in_blocks_bitwise(monkeypatch):
+    """More particles than a block run DOP853 on the steady driver, block by block; the same bits as one block."""
+    from rotframe.particles import blocks
 
     r0, v0 = _start(12, seed=9)
     model = _model()
     one = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
     monkeypatch.setattr(threads, "BLOCK", 5)
     calls = []
-    real = drivers.run_dop853
+    real = blocks.run_blocks
 
-    def spy(*args):
-        calls.append(args[0].shape[0])
-        return real(*args)
+    def spy(one_block, n, per_particle, outputs):
+        kernel = dict(zip(one_block.__code__.co_freevars, (c.cell_contents for c in one_block.__closure__)))["kernel"]
+        calls.append(kernel.py_func.__name__)
+        return real(one_block, n, per_particle, outputs)
 
-    monkeypatch.setattr(drivers, "run_dop853", spy)
+    monkeypatch.setattr(blocks, "run_blocks", spy)
     many = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
-    assert calls  # the general driver ran
+    assert calls and set(calls) == {"run_dop853_steady"}  # the steady driver ran, in blocks
     assert np.array_equal(one.r, many.r) and np.array_equal(one.v, many.v)
 
 
