@@ -80,9 +80,11 @@ def _hop(method, vz, use_scene):
 
 @pytest.mark.parametrize("use_scene", [False, True], ids=["simulate", "scene"])
 @pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
-def test_a_hop_inside_the_first_step_lands(method, use_scene):
-    # fired up at 1 mm/s from the ground: it lands at 2 v / g = 0.2 ms, inside the first step of every method
-    vz, g = 1e-3, 9.81
+@pytest.mark.parametrize("vz", [1e-3, 1e-12])
+def test_a_hop_inside_the_first_step_lands(method, use_scene, vz):
+    # fired up at 1 mm/s (or 1 pm/s) from the ground: it lands at 2 v / g = 0.2 ms (0.2 ps), inside the first step of
+    # every method; at 1 pm/s g is ruled by gravity's term down to trials of some 1e-13 s, and only below by v
+    g = 9.81
     times, final = _hop(method, vz, use_scene)
     assert len(times) == 1
     assert abs(times[0] - 2 * vz / g) <= 1e-12 * (2 * vz / g), times
@@ -91,7 +93,9 @@ def test_a_hop_inside_the_first_step_lands(method, use_scene):
 
 @pytest.mark.parametrize("use_scene", [False, True], ids=["simulate", "scene"])
 @pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
-def test_fired_into_the_ground_is_no_event(method, use_scene):
-    times, final = _hop(method, -1e-3, use_scene)
+@pytest.mark.parametrize("vz", [-1e-3, 0.0])
+def test_fired_into_the_ground_is_no_event(method, use_scene, vz):
+    # down, or level (g's first derivative zero, its second -g: below the ground just after the start)
+    times, final = _hop(method, vz, use_scene)
     assert len(times) == 0
     assert final[2] < -1.0  # it went on down: nothing stopped it

@@ -210,13 +210,16 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
     The rule of every locator (docs/physics/events.md): the start itself is never an event, and
     a function that is zero there takes the sign it has just after it. The trials are re-steps
     by the method from ``(t, y)`` of lengths ``h / 2, h / 4, ...``; the value kept is the one
-    nearest the start that is not zero, until a trial no longer moves the state (or tau
-    underflows). A projectile fired from the ground thus lands at its first return to it
+    nearest the start that is not zero. The halving stops where g halves with tau (its first
+    derivative rules below there: one or two trials for a shot fired from the ground), else
+    where a trial no longer moves the state or tau underflows (a function whose first
+    derivative is zero at the start: some thousand trials, once). A projectile fired from the ground thus lands at its first return to it
     however soon, inside the first step too, and one fired into the ground is not an event.
     Returns 0.0 when g stays zero (no sign to take).
     """
     rhs(body, t, y, Kb[0], prob, fns, W)
     g_near = 0.0
+    g_before = 0.0  # g at the trial before (twice as long)
     tau = h
     for _ in range(MAX_HALVINGS):
         tau = 0.5 * tau
@@ -224,8 +227,15 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
             break
         take_step(body, method, t, y, tau, t + tau, Kb, ytb, ybuf, prob, fns, W)
         g = call_event(fns[1], k, t + tau, ybuf, prob[2])
-        if g != 0.0 and math.isfinite(g):
+        if not math.isfinite(g):
+            g = 0.0
+        if g != 0.0:
             g_near = g
+            if (g_before > 0.0) == (g > 0.0) and g_before != 0.0 and 1.75 <= g_before / g <= 2.25:
+                # g halves with tau: its first derivative rules, and its sign holds nearer the start (a hop
+                # shorter than tau would have g fall faster than tau, or change sign, between the two trials)
+                break
+        g_before = g
         moved = False
         for j in range(y.shape[0]):
             if ybuf[j] != y[j]:
