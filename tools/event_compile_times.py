@@ -54,7 +54,8 @@ def cpu_seconds(method: str, event: str) -> float:
 
 def main() -> int:
     for method, event in CASES:
-        print(f"{method:20s} {'ground event' if event == 'event' else 'no event':12s} {cpu_seconds(method, event):6.1f} s")
+        label = "ground event" if event == "event" else "no event"
+        print(f"{method:20s} {label:12s} {cpu_seconds(method, event):6.1f} s")
     return 0
 
 

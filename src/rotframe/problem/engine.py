@@ -213,9 +213,9 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
     nearest the start that is not zero. The halving stops where g halves with tau (its first
     derivative rules below there: one or two trials for a shot fired from the ground), else
     where a trial no longer moves the state or tau underflows (a function whose first
-    derivative is zero at the start: some thousand trials, once). A projectile fired from the ground thus lands at its first return to it
-    however soon, inside the first step too, and one fired into the ground is not an event.
-    Returns 0.0 when g stays zero (no sign to take).
+    derivative is zero at the start: some thousand trials, once). A projectile fired from the
+    ground thus lands at its first return to it however soon, inside the first step too, and one
+    fired into the ground is not an event. Returns 0.0 when g stays zero (no sign to take).
     """
     rhs(body, t, y, Kb[0], prob, fns, W)
     g_near = 0.0
