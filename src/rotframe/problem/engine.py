@@ -53,7 +53,6 @@ import numpy as np
 from numba import njit, types
 
 from rotframe.numerics import bisection, dop853_dense, step_control
-from rotframe.numerics.bisection import MAX_HALVINGS
 from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted, uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
 from rotframe.numerics.step_control import next_step, step_collapsed
@@ -74,6 +73,7 @@ dense_coefficients = inlined(dop853_dense.dense_coefficients)
 dense_value = dop853_dense.dense_value  # inlined into its callers
 bisection_midpoint = inlined(bisection.bisection_midpoint)
 narrow = inlined(bisection.narrow)
+MAX_HALVINGS = bisection.MAX_HALVINGS
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 #: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
@@ -231,7 +231,7 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
             g = 0.0
         if g != 0.0:
             g_near = g
-            if (g_before > 0.0) == (g > 0.0) and g_before != 0.0 and 1.75 <= g_before / g <= 2.25:
+            if g_before != 0.0 and 1.75 <= g_before / g <= 2.25:  # a positive ratio: the same sign
                 # g halves with tau: its first derivative rules, and its sign holds nearer the start (a hop
                 # shorter than tau would have g fall faster than tau, or change sign, between the two trials)
                 break
