@@ -27,7 +27,7 @@ from numba import njit
 from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_llvm_inline", "jit_inline", "inlined", "uncounted",
+__all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_llvm_inline", "jit_inline", "inlined", "uncounted", "bound",
            "CompiledOnlyDispatcher", "source_fingerprint"]
 
 #: The package's folder: a kernel defined in a file below it is cached with `source_fingerprint` as its stamp.
@@ -166,6 +166,28 @@ def _copy(func, suffix):
     clone.__qualname__ = f"{func.__qualname__}.{suffix}"
     clone.__module__ = func.__module__
     clone.__doc__ = func.__doc__
+    return clone
+
+
+def bound(template, name, **names):
+    """A copy of the function ``template`` named ``name`` that reads ``names`` as its globals.
+
+    How a loop is compiled for a system's functions (`rotframe.numerics.dop853_loop`, the engine's
+    variants, the GPU's kernels): the template reads them as global names, which numba freezes as
+    constants (direct calls, pruned branches). Not as a closure's variables: numba's disk cache
+    keys a closure by a pickle of its cells, and a numba function pickles with a random id of its
+    process, so a loop that closes over one is compiled again in every process (measured: the
+    heavy top's DOP853 loop, 2.2 s each run). A copy's globals are not in the key; its name is
+    (the cache file), so each system's copy is named apart, and the package's fingerprint stamps
+    it (`source_fingerprint`).
+    """
+    import types
+
+    clone = types.FunctionType(template.__code__, dict(template.__globals__, **names), name, template.__defaults__,
+                               template.__closure__)
+    clone.__qualname__ = name
+    clone.__module__ = template.__module__
+    clone.__doc__ = template.__doc__
     return clone
 
 

@@ -12,17 +12,23 @@ each system's right-hand side:
 * the samples inside an accepted step from Hairer's dense output of order 7 (three more stages,
   only in a step that holds one), the new state at a sample on the step's end;
 * an optional watcher of events after each accepted step (the particle scenes' event rows:
-  `rotframe.particles.drivers`), which may stop the trajectory at a time inside the step; the
-  state there is one DOP853 step of that length from the step's start.
+  `rotframe.particles.dop853_particles`; a problem's event functions: `rotframe.problem.engine`),
+  which may stop the trajectory at a time inside the step; the state there is one DOP853 step of
+  that length from the step's start;
+* a budget of accepted steps per call (a caller that must see signals, or pace its calls), and an
+  optional check after each try that the system's functions did not fail (a user function that
+  raised: `rotframe.problem.calls`).
 
 A system is ``rhs(ctx, t, z, K, s)``, a compiled function that writes ``f(t, z)`` into row ``s`` of
 ``K``, with its data ``ctx``. `dop853_stages` and `dop853_trajectory` compile the loop for a
-system: the system's functions are closure variables of the loop's code, so numba calls them
-directly (a right-hand side compiled with `rotframe.numerics.compiled.jit_llvm_inline` is inlined
-into the one stage loop), prunes the event code of a system without events, and caches each
-system's loop on disk under its own name. Functions passed as arguments instead would have to be
-inlined into every caller to be cached (numba compiles a function value passed on as an address,
-which it cannot cache), which made a first run compile twice as long.
+system: the system's functions are global names of a copy of the loop's code
+(`rotframe.numerics.compiled.bound`), so numba calls them directly (a right-hand side compiled
+with `rotframe.numerics.compiled.jit_llvm_inline` is inlined into the one stage loop), prunes the
+event code of a system without events, and caches each system's loop on disk under its own name.
+Functions passed as arguments instead would have to be inlined into every caller to be cached
+(numba compiles a function value passed on as an address, which it cannot cache), which made a
+first run compile twice as long; held in a closure's cells, they made numba's cache key change
+with every process (`bound`).
 """
 
 from __future__ import annotations
@@ -31,16 +37,21 @@ import math
 
 from numba import njit
 
-from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted
+from rotframe.numerics.compiled import bound, inlined, jit_inline, jit_uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
 
 __all__ = ["dop853_stages", "dop853_trajectory", "dop853_step", "dop853_start", "REACHED", "STOPPED", "COLLAPSED",
-           "NONFINITE"]
+           "NONFINITE", "PAUSED", "WATCH_FAILED", "ABORTED", "DIVERGED", "UNLIMITED"]
 
-#: how `dop853_trajectory` ended: ``t_end`` reached, a terminal event, the step size collapsed, a non-finite state
-REACHED, STOPPED, COLLAPSED, NONFINITE = 0, 1, 2, 3
+#: how `dop853_trajectory` ended: ``t_end`` reached; a terminal event; the step size collapsed (finite errors); an
+#: accepted step's state not finite; the budget of steps spent (``t < t_end``); the watcher could not tell (NaN); the
+#: system's ``aborted`` check; the step size collapsed where the last rejected try's state was not finite (the
+#: solution diverges, or f is not finite past a time)
+REACHED, STOPPED, COLLAPSED, NONFINITE, PAUSED, WATCH_FAILED, ABORTED, DIVERGED = 0, 1, 2, 3, 4, 5, 6, 7
+#: the step budget of a call that runs to its end (a caller that bounds its calls by their samples)
+UNLIMITED = 1 << 62
 
 #: a loop called from Python: an entry point without reference counts (its caller owns every array)
 _uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
@@ -64,26 +75,32 @@ def _stage_state(z, y, h, K, s, D):
 def dop853_stages(name, rhs, D):
     """The stage function of the system ``rhs``, compiled for it (cached on disk as ``dop853_stages_<name>``).
 
-    ``D`` is the length of the state. ``stages(ctx, first, last, t, y, h, K, z, z12)`` forms stages ``first .. last - 1`` of the step
-    ``(t, y, h)``: each state ``y + h sum_{q < s} A[s, q] K[q]`` (into ``z12`` for stage 12, the
-    step's end with the order-8 weights, else into ``z``), then ``K[s] = f(t + C[s] h, state)``, the
-    one call site of the right-hand side. ``stages(ctx, 1, 13, ...)`` is a step (`dop853_step`),
-    ``stages(ctx, 13, 16, ...)`` the dense output's three more.
+    ``D`` is the length of the state. ``stages(ctx, first, last, t, y, h, K, z, z12, t12)`` forms stages
+    ``first .. last - 1`` of the step ``(t, y, h)``: each state ``y + h sum_{q < s} A[s, q] K[q]`` (into
+    ``z12`` for stage 12, the step's end with the order-8 weights, else into ``z``), then
+    ``K[s] = f(t + C[s] h, state)``, the one call site of the right-hand side. Stage 12 is f at ``t12``,
+    the time the step ends on: ``t + h``, or the target a cut step lands on, which ``t + h`` may miss by
+    an ulp (on the wrong side of a table's knot, where f jumps; ``K[12]`` starts the next step).
+    ``stages(ctx, 1, 13, ...)`` is a step (`dop853_step`), ``stages(ctx, 13, 16, ...)`` the dense
+    output's three more.
     """
 
-    def stages(ctx, first, last, t, y, h, K, z, z12):
-        for s in range(first, last):
-            zs = z12 if s == 12 else z
-            _stage_state(zs, y, h, K, s, D)  # D a constant of the code: loops the compiler unrolls
-            rhs(ctx, t + C[s] * h, zs, K, s)
-
-    return jit_uncounted(_named(stages, f"dop853_stages_{name}"))
+    return jit_uncounted(bound(_stages, f"dop853_stages_{name}", RHS=rhs, DIM=int(D)))
 
 
-def _named(func, name):
-    func.__name__ = name
-    func.__qualname__ = name
-    return func
+# the names a system binds (`rotframe.numerics.compiled.bound`): its right-hand side, the length of its state, its
+# stage function, sample writer, watcher and check; None or 0 in the templates themselves, which are never compiled
+RHS = STAGES = STORE = WATCH = CHECK = None
+DIM = 0
+WATCHED = CHECKED = False
+
+
+def _stages(ctx, first, last, t, y, h, K, z, z12, t12):
+    """The template of `dop853_stages`."""
+    for s in range(first, last):
+        zs = z12 if s == 12 else z
+        _stage_state(zs, y, h, K, s, DIM)  # DIM a constant of the code: loops the compiler unrolls
+        RHS(ctx, t12 if s == 12 else t + C[s] * h, zs, K, s)
 
 
 @jit_inline
@@ -92,7 +109,7 @@ def dop853_step(stages, ctx, t, y, h, K, y_new, tmp):
 
     ``stages`` a system's (`dop853_stages`), a global of the caller.
     """
-    stages(ctx, int(1), int(13), t, y, h, K, tmp, y_new)  # int64 values, not literals: one compiled `stages`
+    stages(ctx, int(1), int(13), t, y, h, K, tmp, y_new, t + h)  # int64 values, not literals: one compiled `stages`
 
 
 @jit_inline
@@ -105,121 +122,149 @@ def dop853_start(rhs, ctx, t, y, K, yt, rtol, atol, h_max):
     return first_step(y, K[0], K[1], h0, rtol, atol, h_max)
 
 
-def dop853_trajectory(name, stages, store, D, watch=None, entry=False):
+def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=None):
     """The trajectory loop of one system, compiled for it (cached on disk as ``dop853_trajectory_<name>``).
 
     ``stages`` the system's (`dop853_stages`), ``D`` the length of its state; ``store(out, k, p, y)`` writes sample ``k`` of
-    trajectory ``p``; ``watch(wctx, ctx, p, t, h, t_new, y, y_new, K) -> (stop, t_stop)`` is called
-    after each accepted step ``(t, y) -> (t_new, y_new)`` (it may not change ``K``), and a stop at
-    ``t_stop`` in ``(t, t_new]`` ends the trajectory there; None compiles no event code. With
-    ``entry`` the loop is also callable from Python (a kernel of its own, not only a callee).
+    trajectory ``p``; ``watch(wctx, ctx, p, t, h, t_new, y, y_new, K) -> (stop, tau)`` is called
+    after each accepted step ``(t, y) -> (t_new, y_new)`` of length ``h`` (it may not change ``K``):
+    a stop with ``tau`` in ``(0, h]`` ends the trajectory at ``t + tau``, a stop with a NaN ``tau``
+    ends it at the step's start (`WATCH_FAILED`: the watcher could not tell); None compiles no event
+    code. ``aborted(ctx) -> bool``, checked after each try's stages and the dense output's, ends the
+    trajectory at the step's start (`ABORTED`: a function of the system failed); None compiles no
+    check. With ``entry`` the loop is also callable from Python (a kernel of its own, not only a callee).
 
     The loop, ``trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new,
-    tmp, yt, F, wctx)``, integrates one trajectory from ``(t, y)``, ``K[0] = f(t, y)``, to ``t_end``:
+    tmp, yt, F, wctx, budget)``, integrates one trajectory from ``(t, y)``, ``K[0] = f(t, y)``, to ``t_end``:
 
     * ``y`` is the state at the end on return (at the stop, the collapse or the non-finite state);
+      ``K[0]`` is f there, where the trajectory goes on (`REACHED`, `PAUSED`);
     * ``h`` the first step to try (> 0: Hairer's starting step, `dop853_start`, or the last call's);
     * ``t_end``, ``h_max``: the end (the last step is cut to land on it exactly), the largest step
       taken after an accepted one (``inf`` for none);
     * ``times``, ``k_out``: increasing sample times, and the first not yet stored (samples at or
       before ``t`` are stored first, then each as the run passes it), into ``out`` for trajectory ``p``;
     * ``rtol``, ``atol`` (D,): the tolerances; ``K`` (16, D) the stages, ``y_new``, ``tmp``, ``yt``
-      (D,) states and ``F`` (7, D) the interpolant: work arrays; ``wctx`` the watcher's data.
+      (D,) states and ``F`` (7, D) the interpolant: work arrays; ``wctx`` the watcher's data;
+    * ``budget``: the accepted steps this call may take (`PAUSED` after that many, short of ``t_end``).
+      A call ends after an accepted step, never after a rejected try, so a trajectory cut into calls
+      takes the same steps as one call, to the bit.
 
     It returns ``(t, h, k_out, status, nfev, steps)``: the time reached, the next step to try, the
-    next sample, `REACHED`, `STOPPED`, `COLLAPSED` or `NONFINITE`, the right-hand sides evaluated and
-    the accepted steps.
+    next sample, how it ended (`REACHED`, `STOPPED`, `COLLAPSED`, `NONFINITE`, `PAUSED`,
+    `WATCH_FAILED`, `ABORTED`, `DIVERGED`), the right-hand sides evaluated and the accepted steps.
     """
 
-    def trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx):
-        # the stage ranges as int64 values, not literals: one compiled `stages` for every range
-        _FIRST, _END, _DENSE, _DENSE_END = int(1), int(13), int(13), int(16)
-        n_out = times.shape[0]
-        nf = 0
-        steps = 0
-        status = REACHED
-        rejected = False
-        while k_out < n_out and times[k_out] <= t:
-            store(out, k_out, p, y)
-            k_out += 1
-        while t < t_end:
-            # one accepted step
-            accepted = False
-            at_end = False
-            truncated = False
-            h_used = h
-            while not accepted:
-                h_ctrl = h
-                truncated = t + h > t_end
-                if truncated:
-                    h = t_end - t
-                if step_collapsed(h, t):
-                    if step_collapsed(t_end - t, t):
-                        # the steps summed to within a few ulp of the end: it is reached (the state is off by
-                        # |f| * 10 ulp(t), far below any tolerance); not a collapsed step
-                        at_end = True
-                        h = h_ctrl  # the next call starts from the controller's step, not from the ulps
-                    else:
-                        status = COLLAPSED
-                    break
-                stages(ctx, _FIRST, _END, t, y, h, K, tmp, y_new)
-                nf += 12
-                err = _error_norm(K, h, y, y_new, rtol, atol, E3, E5)
-                accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
-                rejected = not accepted
-                h_used = h
-                h = h_next
-            if status != REACHED:
-                break
-            if at_end:
-                t = t_end
-                break
-            if h > h_max:
-                h = h_max
-            # a step cut to land on t_end ends there exactly (t + (t_end - t) may round below it)
-            t_new = t_end if truncated else t + h_used
-            steps += 1
-            stop = False
-            t_stop = t_new
-            if watched:
-                stop, t_stop = watch(wctx, ctx, p, t, h_used, t_new, y, y_new, K)
-            # samples inside (t, t_stop]: the dense output inside the step, the new state at its end
-            dense = False
-            while k_out < n_out and times[k_out] <= t_stop:
-                ts = times[k_out]
-                if ts == t_new:
-                    store(out, k_out, p, y_new)
-                else:
-                    if not dense:
-                        stages(ctx, _DENSE, _DENSE_END, t, y, h_used, K, tmp, tmp)
-                        _dense_coefficients(y, y_new, K, h_used, DW, F)
-                        nf += 3
-                        dense = True
-                    x = (ts - t) / h_used
-                    for j in range(D):
-                        yt[j] = dense_value(F, y, x, j)
-                    store(out, k_out, p, yt)
-                k_out += 1
-            if stop:
-                # the state at the stop: one step of that length from the step's start (K[0] is still f(t, y))
-                stages(ctx, _FIRST, _END, t, y, t_stop - t, K, tmp, yt)
-                for j in range(D):
-                    y[j] = yt[j]
-                t = t_stop
-                status = STOPPED
-                break
-            finite = True
-            for j in range(D):
-                y[j] = y_new[j]
-                K[0, j] = K[12, j]
-                if not math.isfinite(y[j]):
-                    finite = False
-            t = t_new
-            if not finite:
-                status = NONFINITE
-                break
-        return t, h, k_out, status, nf, steps
-
-    watched = watch is not None
     compile = _uncounted_entry if entry else jit_uncounted
-    return compile(_named(trajectory, f"dop853_trajectory_{name}"))
+    return compile(bound(_trajectory, f"dop853_trajectory_{name}", STAGES=stages, STORE=store, WATCH=watch,
+                         CHECK=aborted, DIM=int(D), WATCHED=watch is not None, CHECKED=aborted is not None))
+
+
+def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
+    """The template of `dop853_trajectory`."""
+    # the stage ranges as int64 values, not literals: one compiled `stages` for every range
+    _FIRST, _END, _DENSE, _DENSE_END = int(1), int(13), int(13), int(16)
+    n_out = times.shape[0]
+    nf = 0
+    steps = 0
+    status = REACHED
+    rejected = False
+    finite_rejection = True  # whether the last rejected try's state was finite (else a collapse is divergence)
+    while k_out < n_out and times[k_out] <= t:
+        STORE(out, k_out, p, y)
+        k_out += 1
+    while t < t_end:
+        if steps >= budget:
+            status = PAUSED
+            break
+        # one accepted step
+        accepted = False
+        at_end = False
+        truncated = False
+        h_used = h
+        while not accepted:
+            h_ctrl = h
+            truncated = t + h > t_end
+            if truncated:
+                h = t_end - t
+            if step_collapsed(h, t):
+                if step_collapsed(t_end - t, t):
+                    # the steps summed to within a few ulp of the end: it is reached (the state is off by
+                    # |f| * 10 ulp(t), far below any tolerance); not a collapsed step
+                    at_end = True
+                    h = h_ctrl  # the next call starts from the controller's step, not from the ulps
+                else:
+                    status = COLLAPSED if finite_rejection else DIVERGED
+                break
+            STAGES(ctx, _FIRST, _END, t, y, h, K, tmp, y_new, t_end if truncated else t + h)
+            nf += 12
+            if CHECKED and CHECK(ctx):
+                status = ABORTED
+                break
+            err = _error_norm(K, h, y, y_new, rtol, atol, E3, E5)
+            accepted, h_next = next_step(h, h_ctrl, err, rejected)  # Hairer's control (numerics.step_control)
+            rejected = not accepted
+            if rejected:
+                finite_rejection = math.isfinite(err)
+            h_used = h
+            h = h_next
+        if status != REACHED:
+            break
+        if at_end:
+            t = t_end
+            break
+        if h > h_max:
+            h = h_max
+        # a step cut to land on t_end ends there exactly (t + (t_end - t) may round below it)
+        t_new = t_end if truncated else t + h_used
+        steps += 1
+        stop = False
+        tau = h_used
+        if WATCHED:
+            stop, tau = WATCH(wctx, ctx, p, t, h_used, t_new, y, y_new, K)
+            if stop and not tau > 0.0:  # NaN: the watcher could not tell
+                status = WATCH_FAILED
+                break
+        t_stop = t + tau if stop else t_new
+        # samples inside (t, t_stop]: the dense output inside the step, the new state at its end
+        dense = False
+        while k_out < n_out and times[k_out] <= t_stop:
+            ts = times[k_out]
+            if ts == t_new:
+                STORE(out, k_out, p, y_new)
+            else:
+                if not dense:
+                    STAGES(ctx, _DENSE, _DENSE_END, t, y, h_used, K, tmp, tmp, t_new)
+                    nf += 3
+                    if CHECKED and CHECK(ctx):
+                        status = ABORTED
+                        break
+                    _dense_coefficients(y, y_new, K, h_used, DW, F)
+                    dense = True
+                x = (ts - t) / h_used
+                for j in range(DIM):
+                    yt[j] = dense_value(F, y, x, j)
+                STORE(out, k_out, p, yt)
+            k_out += 1
+        if status != REACHED:
+            break
+        if stop:
+            # the state at the stop: one step of length tau from the step's start (K[0] is still f(t, y))
+            STAGES(ctx, _FIRST, _END, t, y, tau, K, tmp, yt, t_stop)
+            for j in range(DIM):
+                y[j] = yt[j]
+            t = t_stop
+            status = STOPPED
+            break
+        finite = True
+        for j in range(DIM):
+            y[j] = y_new[j]
+            K[0, j] = K[12, j]
+            if not math.isfinite(y[j]):
+                finite = False
+        t = t_new
+        if not finite:
+            status = NONFINITE
+            break
+    return t, h, k_out, status, nf, steps
+

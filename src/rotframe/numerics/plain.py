@@ -6,8 +6,8 @@ to compile).
 
 A numba dispatcher's ``py_func`` is the Python function it was made from, but that function
 still calls its module's compiled neighbours, which cannot take plain Python functions as
-arguments. `plain` remakes a function over a copy of its module's globals in which every
-numba dispatcher is itself remade this way, so a whole call tree runs as Python (slow: for a
+arguments. `plain` remakes a function over a copy of its globals in which every numba dispatcher is itself
+remade this way (and so are the dispatchers a closure holds), so a whole call tree runs as Python (slow: for a
 user function numba cannot compile). No source is copied: the code objects are the modules' own.
 """
 
@@ -24,17 +24,32 @@ _SPACES: dict[str, dict] = {}
 _PLAIN: dict[int, types.FunctionType] = {}
 
 
-def _space(module_name: str) -> dict:
-    """The globals of ``module_name`` with each numba dispatcher replaced by its plain remake (made once)."""
-    space = _SPACES.get(module_name)
+def _space(py) -> dict:
+    """The globals of function ``py`` with each numba dispatcher replaced by its plain remake (made once).
+
+    Its module's, or its own where it has globals of its own (a loop bound to a system's functions:
+    `rotframe.numerics.compiled.bound`).
+    """
+    original = py.__globals__
+    module = sys.modules.get(py.__module__)
+    key = py.__module__ if module is not None and vars(module) is original else f"{py.__module__}:{id(original)}"
+    space = _SPACES.get(key)
     if space is None:
-        original = vars(sys.modules[module_name])
         space = dict(original)
-        _SPACES[module_name] = space  # before the remakes: a module's functions call each other
+        _SPACES[key] = space  # before the remakes: a module's functions call each other
         for name, value in original.items():
             if isinstance(value, Dispatcher):
                 space[name] = plain(value)
     return space
+
+
+def _plain_cells(closure):
+    """A closure's cells, each that holds a numba dispatcher holding its plain remake instead (a loop compiled per
+    system holds its system's functions there: `rotframe.numerics.dop853_loop`)."""
+    if not closure:
+        return closure
+    return tuple(types.CellType(plain(cell.cell_contents)) if isinstance(cell.cell_contents, Dispatcher) else cell
+                 for cell in closure)
 
 
 def plain(f):
@@ -45,7 +60,8 @@ def plain(f):
     py = getattr(f, "py_func", f)
     made = _PLAIN.get(id(py))
     if made is None:
-        made = types.FunctionType(py.__code__, _space(py.__module__), py.__name__, py.__defaults__, py.__closure__)
+        made = types.FunctionType(py.__code__, _space(py), py.__name__, py.__defaults__,
+                                  _plain_cells(py.__closure__))
         made.__doc__ = py.__doc__
         _PLAIN[id(py)] = made
     return made

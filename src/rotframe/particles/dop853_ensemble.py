@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from rotframe.numerics.compiled import jit_inline, jit_llvm_inline
-from rotframe.numerics.dop853_loop import REACHED, STOPPED, dop853_start
+from rotframe.numerics.dop853_loop import REACHED, STOPPED, UNLIMITED, dop853_start
 
 __all__ = ["run_particles", "store_sample", "WORK_ROWS"]
 
@@ -81,7 +81,8 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
         steps = 0
         if alive is None or alive[p]:
             t, h, k_out, status, n_steps_f, steps = trajectory(ctx, t, y, h, t_end, math.inf, times, 0, (out_r, out_v),
-                                                               p, rtol, atol_vec, K, y_new, tmp, yt, F, wctx)
+                                                               p, rtol, atol_vec, K, y_new, tmp, yt, F, wctx,
+                                                               UNLIMITED)
             nf += n_steps_f
             if status == STOPPED:
                 if alive is not None:

@@ -72,22 +72,22 @@ def watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
     ``wctx = (events, g_old, radius, Kt, tmp, yt, ev_t, ev_r, ev_v, ev_count, ev_which,
     max_events)``: ``g_old`` each event's value at ``t`` (updated), ``Kt`` (13, 6) the locator's
     stages, ``tmp`` and ``yt`` (6,) its scratch (free while the loop watches). Returns
-    ``(stop, t_stop)``: whether a terminal event ends the particle in the step, and the earliest
-    such time.
+    ``(stop, tau)``: whether a terminal event ends the particle in the step, and the earliest such
+    time's offset from ``t`` (the loop's state there is the step of that length, as the record's).
     """
     events, g_old, radius, Kt, tmp, yt, ev_t, ev_r, ev_v, ev_count, ev_which, max_events = wctx
     stop = False
-    t_stop = t_new
+    tau = h
     for e in range(events.shape[0]):
         g_new = event_value(events, e, as_state(y_new), radius)
         if crossed(events[e, 3], g_old[e], g_new):
             hi, hit = locate_event_dop853(ctx, events, e, radius, g_old[e], t, h, K, Kt, y, tmp, yt)
             record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, e, t + hi, hit)
-            if events[e, 4] != 0.0 and t + hi <= t_stop:
+            if events[e, 4] != 0.0 and hi <= tau:
                 stop = True
-                t_stop = t + hi
+                tau = hi
         g_old[e] = g_new
-    return stop, t_stop
+    return stop, tau
 
 
 #: the particle's trajectory loop without events and with them (`watch_events`)

@@ -6,17 +6,17 @@ hands them the addresses of its own compiled functions (`rotframe.problem.calls`
 as the `rotframe.problem.signatures.PROBLEM` tuple (`rotframe.problem.glue` compiles those few small
 functions, and nothing else, per problem). The equations are `rotframe.problem.models`'.
 
-The loop is one function, written once, compiled as a *variant* per model (particle or body),
-method and whether there are events (`variant`): those three are constants of a variant's code,
-so numba prunes everything else before it compiles (a first DOP853 particle problem compiles no
-body, no splitting, no RK4 and no event locator). Each variant compiles the first time any
-problem needs it, then loads from numba's cache; no problem ever compiles the loop again.
+The loop is compiled as a *variant* per model (particle or body), method and whether there are
+events (`variant`): those three are constants of a variant's code, so numba prunes everything
+else before it compiles (a first DOP853 particle problem compiles no body, no splitting, no RK4
+and no event locator). Each variant compiles the first time any problem needs it, then loads
+from numba's cache; no problem ever compiles the loop again.
 
-* DOP853: Hairer's step control and starting step (hinit), written once for every DOP853 loop in
-  `rotframe.numerics.step_control`; a step lands on the run's end and on the stops, and the
-  samples inside a step are Hairer's dense output of order 7 (three more stages in a step that
-  holds one; `rotframe.numerics.dop853_dense`), as in every DOP853 loop of rotframe. Tableau
-  and error norm: `rotframe.numerics.dop853`.
+* DOP853: the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`, which the scenes'
+  particles and rigid bodies run too), compiled for the model's right-hand side: Hairer's step
+  control and starting step, a step that lands on the run's end and on the stops, the samples
+  inside a step from Hairer's dense output of order 7, the events watched after each accepted
+  step (`watch_events`), a budget of accepted steps per call (`_dop853_loop`).
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
   ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
@@ -30,8 +30,8 @@ problem needs it, then loads from numba's cache; no problem ever compiles the lo
   DifferentialEquations.jl's ``tstops``, so each step integrates a smooth function and keeps its
   order; RK4's grid goes on from the knot. Without this, a finer table gave larger errors.
 * ``atol`` is (N, D), one row per particle (its own scales).
-* Each particle is integrated alone, ``budget`` steps per call, so results do not depend on
-  the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
+* Each particle is integrated alone, ``budget`` steps per call (DOP853's accepted ones), so
+  results do not depend on the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
   particles ``lo:hi``; Python runs blocks of them on threads (the engine holds no GIL). numba's
   ``prange`` was measured at 15 ms a call on the 2-core reference machine (its OpenMP pool
   waking), more than a whole single-particle run.
@@ -52,25 +52,16 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics import bisection, dop853_dense, step_control
-from rotframe.numerics.compiled import inlined, jit_inline, jit_uncounted, uncounted
-from rotframe.numerics.dop853 import coefficients, dop853_error_norm as _counted_error_norm
-from rotframe.numerics.step_control import next_step, step_collapsed
+from rotframe.numerics import bisection
+from rotframe.numerics.compiled import bound, inlined, jit_inline, jit_uncounted
+from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
+                                           WATCH_FAILED, dop853_stages, dop853_start, dop853_trajectory)
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
-from rotframe.problem.signatures import A1, A2, A3, B1, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
+from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
-A, C, DW = dop853_dense.extended_tableau()  # the stages, row 12 the order-8 weights, rows 13-15 the dense output's
-E3, E5 = coefficients()[3:]
-# the shared kernels that take arrays, compiled as the engine's own (without reference counts), the small ones inlined
-# into their one caller (a function compiled apart costs a first run more than its lines: 1 to 2 s for these three)
-dop853_error_norm = uncounted(_counted_error_norm)
-first_step_trial = inlined(step_control.first_step_trial)
-first_step_final = inlined(step_control.first_step)
-dense_coefficients = inlined(dop853_dense.dense_coefficients)
-dense_value = dop853_dense.dense_value  # inlined into its callers
 bisection_midpoint = inlined(bisection.bisection_midpoint)
 narrow = inlined(bisection.narrow)
 MAX_HALVINGS = bisection.MAX_HALVINGS
@@ -79,47 +70,36 @@ _entry = njit(cache=True, error_model="numpy", nogil=True)
 #: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
 #: arrays made by the caller (`scratch`)
 _uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
+#: the length of the state of each model, a constant of its DOP853 loop (a particle whose forces act in inertial
+#: axes carries the frame's attitude too: 10)
+STATE_LENGTH = {PARTICLE: 6, BODY: 7}
 
 
 @jit_inline
-def stage_state(z, y, h, K, s, D):
-    """z = y + h sum_m a_m K[m] for stage s (12: the step's end, weights B; 13-15 the dense output's), in order."""
-    for j in range(D):
-        z[j] = 0.0
-    for m in range(s):
-        a = A[s, m]
-        for j in range(D):
-            z[j] += a * K[m, j]
-    for j in range(D):
-        z[j] = y[j] + h * z[j]
+def particle_system(ctx, t, z, K, s):
+    """A particle's right-hand side as the one DOP853 loop calls it: ``K[s] = f(t, z)``, ``ctx = (prob, fns, W)``."""
+    prob, fns, W = ctx
+    rhs(None, t, z, K[s], prob, fns, W)
 
 
-@jit_uncounted
-def dop853_step(body, t, y, h, t_end, K, yt, yn, prob, fns, W):
-    """One DOP853 step from (t, y) with K[0] = f(t, y): yn and K[1..12] (K[12] = f(t + h, yn))."""
-    D = y.shape[0]
-    for s in range(1, 13):  # the stages, then f at the step's end (one call site of the right-hand side)
-        z = yt if s < 12 else yn
-        if D == 6:  # a particle: the loops of 6 known to the compiler (unrolled), the same arithmetic
-            stage_state(z, y, h, K, s, 6)
-        else:
-            stage_state(z, y, h, K, s, D)
-        ts = t + C[s] * h if s < 12 else t_end  # the last: the time the step ends on (a sample time where it lands)
-        rhs(body, ts, z, K[s], prob, fns, W)
+@jit_inline
+def body_system(ctx, t, z, K, s):
+    """A rigid body's right-hand side as the one DOP853 loop calls it (`particle_system`)."""
+    prob, fns, W = ctx
+    rhs(True, t, z, K[s], prob, fns, W)
 
 
-@jit_uncounted
-def dense_output(body, t, y, yn, h, K, z, F, prob, fns, W):
-    """The interpolant's coefficients ``F`` (7, D) of an accepted DOP853 step (t, y) -> (t + h, yn).
+@jit_inline
+def store_rows(out, k, p, y):
+    """Sample ``k`` of particle ``p``: ``out[k, p] = y``."""
+    for j in range(y.shape[0]):
+        out[k, p, j] = y[j]
 
-    Its three more stages into ``K[13..15]`` (`rotframe.numerics.dop853_dense`), then Hairer's
-    coefficients; `dense_value` evaluates them.
-    """
-    D = y.shape[0]
-    for s in range(13, 16):
-        stage_state(z, y, h, K, s, D)
-        rhs(body, t + C[s] * h, z, K[s], prob, fns, W)
-    dense_coefficients(y, yn, K, h, DW, F)
+
+@jit_inline
+def raised(ctx):
+    """Whether a user function raised since the flag was cleared (`rotframe.problem.calls`)."""
+    return ctx[2][RAISED] != 0.0
 
 
 @jit_uncounted
@@ -136,9 +116,15 @@ def rk4_step(body, t, y, h, K, yt, yn, prob, fns, W):
 
 
 @jit_inline
-def take_step(body, method, t, y, h, t_end, K, yt, yn, prob, fns, W):
+def take_step(stages, body, method, t, y, h, t_end, K, yt, yn, prob, fns, W):
+    """One step of ``method`` from (t, y), K[0] = f(t, y), ending at ``t_end``: ``yn``.
+
+    DOP853's is the one DOP853 loop's stages (``stages``, `rotframe.numerics.dop853_loop`; None in a
+    fixed-step variant), with f at the step's end evaluated at ``t_end``; RK4's `rk4_step`; a
+    splitting the model's own (`rotframe.problem.models.own_step`).
+    """
     if method == DOP853:
-        dop853_step(body, t, y, h, t_end, K, yt, yn, prob, fns, W)
+        stages((prob, fns, W), int(1), int(13), t, y, h, K, yt, yn, t_end)
     elif method == RK4:
         rk4_step(body, t, y, h, K, yt, yn, prob, fns, W)
     else:  # the model's own splitting, of order 2 or 4
@@ -151,16 +137,6 @@ def all_finite(y):
         if not math.isfinite(y[j]):
             return False
     return True
-
-
-@jit_uncounted
-def first_step(body, t, y, K, yt, rtol, atol, prob, fns, W, span):
-    """Hairer's starting step (`rotframe.numerics.step_control`), K[0] = f(t, y) given; K[1] = f at the trial step."""
-    h0 = first_step_trial(y, K[0], rtol, atol, span)
-    for j in range(y.shape[0]):
-        yt[j] = y[j] + h0 * K[0, j]
-    rhs(body, t + h0, yt, K[1], prob, fns, W)
-    return first_step_final(y, K[0], K[1], h0, rtol, atol, span)
 
 
 @jit_inline
@@ -181,7 +157,7 @@ def next_stop(S, t):
 
 
 @jit_inline
-def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
+def locate(stages, body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
     """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
 
     Returns tau in (0, h]; ``yhi`` holds the state there (the full step's end on entry). The
@@ -195,7 +171,7 @@ def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
         mid = bisection_midpoint(lo, hi)
         if mid < 0.0:
             break
-        take_step(body, method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
+        take_step(stages, body, method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
         lo, hi, g_lo = narrow(lo, hi, g_lo, mid, call_event(fns[1], k, t + mid, ybuf, prob[2]))
         if hi == mid:  # the crossing is in [lo, mid]: the state at hi is this trial's
             for j in range(y.shape[0]):
@@ -204,7 +180,7 @@ def locate(body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
 
 
 @jit_inline
-def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
+def start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
     """Event k's value just after the start ``(t, y)``, for a function that is exactly zero there.
 
     The rule of every locator (docs/physics/events.md): the start itself is never an event, and
@@ -225,7 +201,7 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
         tau = 0.5 * tau
         if tau == 0.0:
             break
-        take_step(body, method, t, y, tau, t + tau, Kb, ytb, ybuf, prob, fns, W)
+        take_step(stages, body, method, t, y, tau, t + tau, Kb, ytb, ybuf, prob, fns, W)
         g = call_event(fns[1], k, t + tau, ybuf, prob[2])
         if not math.isfinite(g):
             g = 0.0
@@ -245,43 +221,209 @@ def start_sign(body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
     return g_near
 
 
-def _variant_kernel(model, method, events):
+@jit_inline
+def watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
+    """The data of `watch_events`: the events' arrays, the run's start, the locator's stages ``Kb`` and states
+    ``V[4:7]`` (the loops keep ``V[0:4]`` for their own)."""
+    return (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6])
+
+
+@jit_inline
+def watch_events(stages, body, method, wctx, ctx, p, t, h, t_new, y, y_new):
+    """The events' crossings over the step ``(t, y) -> (t_new, y_new)`` of particle ``p``: each located and recorded.
+
+    ``wctx = (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf)``: each event's value
+    at ``t`` (updated), the records, the directions and terminal flags, the run's start and the
+    locator's scratch; ``ctx = (prob, fns, W)``. A crossing (with its direction) is bisected by
+    `locate` on re-steps of the method (``stages`` DOP853's, None for a fixed-step method); records
+    after the earliest terminal crossing are dropped. Returns ``(stop, tau)``: whether a terminal
+    event ends the particle in the step and its offset from ``t``, or ``(True, NaN)`` where an event
+    function gave NaN or raised (the particle stops at ``t``; Python names the function). The
+    watcher of both loops: `rotframe.numerics.dop853_loop` calls it after each accepted step, the
+    fixed-step loop after each step.
+    """
+    GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf = wctx
+    prob, fns, W = ctx
+    D = y.shape[0]
+    stop = False
+    tau_stop = h
+    for k in range(EDIR.shape[0]):
+        g_new = call_event(fns[1], k, t_new, y_new, prob[2])
+        if not math.isfinite(g_new):  # NaN, or the event function raised
+            return True, math.nan
+        g_old = GPREV[p, k]
+        if g_old == 0.0 and t == t0:  # zero at the start: the sign just after it (start_sign)
+            g_old = start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W)
+        rising = g_old < 0.0 and g_new >= 0.0
+        falling = g_old > 0.0 and g_new <= 0.0
+        if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
+            for j in range(D):
+                yhi[j] = y_new[j]
+            tau = locate(stages, body, method, k, t, y, h, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
+            m = EVN[p]
+            if m < EVT.shape[1]:
+                EVT[p, m] = t + tau
+                EVK[p, m] = k
+                for j in range(D):
+                    EVY[p, m, j] = yhi[j]
+            EVN[p] = m + 1
+            if ETERM[k] and (not stop or tau < tau_stop):
+                stop = True
+                tau_stop = tau
+        GPREV[p, k] = g_new
+    if stop:  # drop the records of non-terminal crossings after the terminal one
+        keep = 0
+        for r in range(min(EVN[p], EVT.shape[1])):
+            if EVT[p, r] <= t + tau_stop:
+                EVT[p, keep] = EVT[p, r]
+                EVK[p, keep] = EVK[p, r]
+                for j in range(D):
+                    EVY[p, keep, j] = EVY[p, r, j]
+                keep += 1
+        EVN[p] = keep
+    return stop, tau_stop
+
+
+def _variant_kernel(model, method, events, D):
     """The compiled loop of one variant (`variant_loop`), for the CPU: an entry point without reference counts."""
-    return _uncounted_entry(variant_loop(model, method, events))
+    return _uncounted_entry(variant_loop(model, method, events, D))
 
 
-def variant_loop(model, method, events):
-    """The loop of one variant, as Python: the model, ``method`` and ``events`` are constants of its code.
+def variant_loop(model, method, events, D=None):
+    """The loop of one variant, as Python: the model, ``method``, ``events`` (and DOP853's ``D``) constants of its code.
 
     numba prunes the branches of the other model, the other methods and the events before it types
     the function (a closure's variables are constants to it; the model reaches the steps as
     ``body``, None for a particle, True for a rigid body: `rotframe.problem.models.rhs`), so a
-    variant compiles only its own right-hand side, step and dense output: a first DOP853 particle
-    problem compiles no body, no splitting and no event locator. Each variant is cached on disk
-    apart (its name, and its constants in numba's cache key). The GPU compiles the same function
+    variant compiles only its own right-hand side and step: a first DOP853 particle problem
+    compiles no body, no splitting and no event locator. Each variant is cached on disk apart (its
+    name, and its constants in numba's cache key).
+
+    DOP853 runs the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`, `_dop853_loop`)
+    for the model's right-hand side, from stop to stop; ``D`` (default `STATE_LENGTH`) is the
+    length of its state. The fixed-step methods run `_fixed_step_loop`, which the GPU compiles too
     (`rotframe.problem.gpu`).
     """
     body = None if model == PARTICLE else True
+    if method == DOP853:
+        loop = _dop853_loop(body, events, STATE_LENGTH[model] if D is None else int(D))
+    else:
+        loop = _fixed_step_loop(body, method, events)
+    suffix = "" if method != DOP853 or D is None or D == STATE_LENGTH[model] else str(D)
+    name = (f"advance_{'particle' if body is None else 'body'}{suffix}_{METHOD_NAMES[method]}"
+            f"{'_events' if events else ''}")
+    loop.__name__ = name
+    loop.__qualname__ = name
+    return loop
+
+
+def _dop853_loop(body, events, D):
+    """The DOP853 variant's loop: `rotframe.numerics.dop853_loop`'s trajectory, per particle, from stop to stop.
+
+    The system is the model's right-hand side (`particle_system`, `body_system`) with ``ctx =
+    (prob, fns, W)``; the events are `watch_events`; a user function that raised ends the
+    trajectory at the step (`raised`). A call takes at most ``budget`` accepted steps per particle
+    and ends after an accepted step, so the steps do not depend on where the budget cut the calls.
+    The template `_dop853_advance` reads the system's functions as globals (`rotframe.numerics.compiled.bound`).
+    """
+    system = particle_system if body is None else body_system
+    kind = f"engine_{'particle' if body is None else 'body'}{D}"
+    stages = dop853_stages(kind, system, D)
+    watch = jit_inline(bound(_dop853_watch, f"watch_{kind}", STAGES=stages, BODY_FLAG=body)) if events else None
+    trajectory = dop853_trajectory(kind + ("_events" if events else ""), stages, store_rows, D, watch, aborted=raised)
+    return bound(_dop853_advance, "advance", SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D))
+
+
+# the names a DOP853 variant binds (`_dop853_loop`): None or 0 in the templates themselves, which are never compiled
+SYSTEM = TRAJECTORY = STAGES = BODY_FLAG = None
+DIM = 0
+
+
+def _dop853_watch(wctx, ctx, p, t, h, t_new, y, y_new, K):
+    """The template of a DOP853 variant's watcher: `watch_events` with DOP853's re-steps (the system's stages)."""
+    return watch_events(STAGES, BODY_FLAG, DOP853, wctx, ctx, p, t, h, t_new, y, y_new)
+
+
+def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
+            atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+    """The template of the DOP853 variant's loop (`_dop853_loop`)."""
+    n = T.shape[0]
+    t_last = T[n - 1]
+    y, yt, yn, tmp = V[0], V[1], V[2], V[3]
+    ctx = (prob, fns, W)
+    wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    for i in range(lo, hi):
+        if ST[i] != 0:
+            continue
+        atol_i = atol[i]
+        for j in range(DIM):
+            y[j] = Y[i, j]
+        t = TC[i]
+        h = H[i]
+        idx = IDX[i]
+        W[RAISED] = 0.0
+        SYSTEM(ctx, t, y, K, 0)
+        NFEV[i] += 1
+        if h <= 0.0:
+            h = dop853_start(SYSTEM, ctx, t, y, K, yt, rtol, atol_i, t_last - T[0])
+            NFEV[i] += 1
+        end = REACHED
+        left = budget
+        while idx < n and left > 0:
+            # to the next stop (a knot of a table or a body frame) or the run's end, whichever is first
+            stop = next_stop(S, t)
+            t, h, idx, end, nf, steps = TRAJECTORY(ctx, t, y, h, stop if stop < t_last else t_last, math.inf, T,
+                                                   idx, OUT, i, rtol, atol_i, K, yn, tmp, yt, F, wctx, left)
+            NFEV[i] += nf
+            NSTEP[i] += steps
+            left -= steps
+            if end != REACHED:
+                break
+        status = 0
+        if end == REACHED or end == PAUSED:
+            status = 1 if idx >= n else 0
+        elif end == STOPPED:
+            status = 2
+            while idx < n:  # samples after a terminal event keep the state at the event
+                for j in range(DIM):
+                    OUT[idx, i, j] = y[j]
+                idx += 1
+        elif end == NONFINITE or end == DIVERGED:
+            status = 3
+        elif end == COLLAPSED:
+            status = 4
+        elif end == WATCH_FAILED:
+            status = 5
+        elif end == ABORTED:
+            status = 6
+        for j in range(DIM):
+            Y[i, j] = y[j]
+        TC[i] = t
+        H[i] = h
+        IDX[i] = idx
+        SUB[i] = 0
+        ST[i] = status
+
+
+def _fixed_step_loop(body, method, events):
+    """The loop of a fixed-step variant (RK4, the model's splittings): a step that divides each sample interval.
+
+    A step ends on the next sample or the next stop, whichever is first; RK4's grid goes on from a
+    stop. The GPU compiles this loop too (`rotframe.problem.gpu`).
+    """
 
     def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
                 atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
-        # K (16, D), Kb (13, D) stages, V (7, D) state vectors, F (7, D) the dense output's coefficients, W the
-        # models' scratch: the caller's (`scratch`), one set for the block
+        # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
+        # set for the block
         n = T.shape[0]
         D = Y.shape[1]
-        NE = EDIR.shape[0]
-        y = V[0]
-        yt = V[1]
-        yn = V[2]
-        ytb = V[3]
-        yhi = V[4]
-        ybuf = V[5]
-        yev = V[6]
-        p = prob[2]
+        y, yt, yn, yev = V[0], V[1], V[2], V[3]
+        ctx = (prob, fns, W)
+        wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
         for i in range(lo, hi):
             if ST[i] != 0:
                 continue
-            atol_i = atol[i]
             for j in range(D):
                 y[j] = Y[i, j]
             t = TC[i]
@@ -291,13 +433,7 @@ def variant_loop(model, method, events):
             W[RAISED] = 0.0
             rhs(body, t, y, K[0], prob, fns, W)
             NFEV[i] += 1
-            if method == DOP853 and h <= 0.0:
-                h = first_step(body, t, y, K, yt, rtol, atol_i, prob, fns, W, T[n - 1] - T[0])
-                NFEV[i] += 1
             steps = 0
-            # DOP853 keeps in SUB whether its last try was rejected (no growth right after a rejection), so that
-            # the steps, and the numbers, do not depend on where the budget cut the calls
-            rejected = method == DOP853 and sub != 0
             status = 0
             while idx < n and steps < budget:
                 if t >= T[idx]:
@@ -306,134 +442,56 @@ def variant_loop(model, method, events):
                     idx += 1
                     sub = 0
                     continue
+                # a step ends on the next sample or the next stop, whichever is first
                 stop = next_stop(S, t)
-                if method == DOP853:
-                    # a step ends on the next stop (a knot of a table or a body frame) or the run's end, whichever is
-                    # first; the samples inside a step are its dense output
-                    target = stop if stop < T[n - 1] else T[n - 1]
-                    span = target - t
-                    hh = h if h < span else span
-                    landing = hh == span
+                at_knot = stop < T[idx]
+                target = stop if at_knot else T[idx]
+                interval = T[idx] - T[idx - 1]
+                on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
+                last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
+                grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
+                if at_knot and stop < grid_next:
+                    hh = stop - t  # to the knot; the grid goes on from there
+                    landing = True
                 else:
-                    # a step ends on the next sample or the next stop, whichever is first
-                    at_knot = stop < T[idx]
-                    target = stop if at_knot else T[idx]
-                    interval = T[idx] - T[idx - 1]
-                    on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-                    last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
-                    grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
-                    if at_knot and stop < grid_next:
-                        hh = stop - t  # to the knot; the grid goes on from there
-                        landing = True
-                    else:
-                        target = T[idx]
-                        hh = hfix if on_grid else grid_next - t
-                        sub += 1
-                        landing = last
-                take_step(body, method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
+                    target = T[idx]
+                    hh = hfix if on_grid else grid_next - t
+                    sub += 1
+                    landing = last
+                take_step(None, body, method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
                 steps += 1
                 NSTEP[i] += 1
-                NFEV[i] += 12 if method == DOP853 else 3 if method == RK4 else 2
+                NFEV[i] += 3 if method == RK4 else 2
                 if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
                     status = 6
                     break
-                ok = all_finite(yn)
-                h_next = h
-                if method == DOP853:
-                    err = dop853_error_norm(K, hh, y, yn, rtol, atol_i, E3, E5) if ok else math.nan
-                    ok = math.isfinite(err)
-                    accepted, h_next = next_step(hh, h, err, rejected)
-                    if not accepted:
-                        h = h_next
-                        rejected = True
-                        if step_collapsed(h, t):
-                            status = 4 if ok else 3
-                            break
-                        continue
-                if not ok:
+                if not all_finite(yn):
                     status = 3
                     break
-                t_new = target if landing else t + hh
-                if method != DOP853 and not landing:
-                    t_new = T[idx - 1] + sub * hfix
-                # events over (t, t_new]: every crossing located; the earliest terminal one ends the particle
-                stop_tau = -1.0
-                stop_k = -1
+                t_new = target if landing else T[idx - 1] + sub * hfix
                 if events:  # a constant of the variant: without events, none of this is compiled
-                    for k in range(NE):
-                        g_new = call_event(fns[1], k, t_new, yn, p)
-                        if not math.isfinite(g_new):  # NaN, or the event function raised: stop here, Python names it
+                    stop_now, tau = watch_events(None, body, method, wctx, ctx, i, t, t_new - t, t_new, y, yn)
+                    if stop_now:
+                        if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
                             status = 5
                             break
-                        g_old = GPREV[i, k]
-                        if g_old == 0.0 and t == T[0]:  # zero at the start: the sign just after it (start_sign)
-                            g_old = start_sign(body, method, k, t, y, t_new - t, Kb, ytb, ybuf, prob, fns, W)
-                        rising = g_old < 0.0 and g_new >= 0.0
-                        falling = g_old > 0.0 and g_new <= 0.0
-                        if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
+                        # the state at the terminal event: the step of that length from the step's start (the
+                        # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
+                        take_step(None, body, method, t, y, tau, t + tau, Kb, V[4], yev, prob, fns, W)
+                        t = t + tau
+                        for j in range(D):
+                            y[j] = yev[j]
+                        while idx < n:
                             for j in range(D):
-                                yhi[j] = yn[j]
-                            tau = locate(body, method, k, t, y, t_new - t, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
-                            m = EVN[i]
-                            if m < EVT.shape[1]:
-                                EVT[i, m] = t + tau
-                                EVK[i, m] = k
-                                for j in range(D):
-                                    EVY[i, m, j] = yhi[j]
-                            EVN[i] = m + 1
-                            if ETERM[k] and (stop_tau < 0.0 or tau < stop_tau):
-                                stop_tau = tau
-                                stop_k = k
-                                for j in range(D):
-                                    yev[j] = yhi[j]
-                        GPREV[i, k] = g_new
-                if status == 5:
-                    break
-                # DOP853's samples inside the step (up to a terminal event's time): its dense output, of order 7
-                t_last = t + stop_tau if stop_k >= 0 else t_new
-                if method == DOP853 and idx < n and T[idx] < t_new and T[idx] <= t_last:
-                    dense_output(body, t, y, yn, hh, K, yt, F, prob, fns, W)
-                    NFEV[i] += 3
-                    if W[RAISED] != 0.0:
-                        status = 6
+                                OUT[idx, i, j] = y[j]
+                            idx += 1
+                        status = 2
                         break
-                    while idx < n and T[idx] < t_new and T[idx] <= t_last:
-                        x = (T[idx] - t) / hh
-                        for j in range(D):
-                            OUT[idx, i, j] = dense_value(F, y, x, j)
-                        idx += 1
-                if stop_k >= 0:
-                    # drop records of non-terminal crossings after the terminal one
-                    m = EVN[i]
-                    keep = 0
-                    for r in range(min(m, EVT.shape[1])):
-                        if EVT[i, r] <= t + stop_tau:
-                            EVT[i, keep] = EVT[i, r]
-                            EVK[i, keep] = EVK[i, r]
-                            for j in range(D):
-                                EVY[i, keep, j] = EVY[i, r, j]
-                            keep += 1
-                    EVN[i] = keep
-                    t = t + stop_tau
-                    for j in range(D):
-                        y[j] = yev[j]
-                    while idx < n:
-                        for j in range(D):
-                            OUT[idx, i, j] = y[j]
-                        idx += 1
-                    status = 2
-                    break
-                if method == DOP853:
-                    h = h_next
-                    rejected = False
-                    for j in range(D):
-                        K[0, j] = K[12, j]
                 t = t_new
                 for j in range(D):
                     y[j] = yn[j]
-                if method != DOP853:
-                    rhs(body, t, y, K[0], prob, fns, W)
-                    NFEV[i] += 1
+                rhs(body, t, y, K[0], prob, fns, W)
+                NFEV[i] += 1
             if status == 0 and idx >= n:
                 status = 1
             for j in range(D):
@@ -441,12 +499,9 @@ def variant_loop(model, method, events):
             TC[i] = t
             H[i] = h
             IDX[i] = idx
-            SUB[i] = sub if method != DOP853 else (1 if rejected else 0)
+            SUB[i] = sub
             ST[i] = status
 
-    name = f"advance_{'particle' if body is None else 'body'}_{METHOD_NAMES[method]}{'_events' if events else ''}"
-    advance.__name__ = name
-    advance.__qualname__ = name
     return advance
 
 
@@ -455,14 +510,16 @@ METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4
 _VARIANTS: dict = {}
 
 
-def variant(model, method, events, compiled=True):
+def variant(model, method, events, compiled=True, D=None):
     """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a code of `rotframe.problem.models`) and
     ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
-    when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`)."""
-    key = (int(model), int(method), bool(events), bool(compiled))
+    when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`). ``D``, the
+    length of the state, is a constant of DOP853's loop (default the model's, `STATE_LENGTH`)."""
+    D = STATE_LENGTH[int(model)] if D is None or method != DOP853 else int(D)
+    key = (int(model), int(method), bool(events), D, bool(compiled))
     kernel = _VARIANTS.get(key)
     if kernel is None:
-        kernel = _variant_kernel(*key[:3])
+        kernel = _variant_kernel(*key[:4])
         if compiled:
             kernel.compile(VARIANT_SIGNATURE)
             kernel.disable_compile()
@@ -490,7 +547,7 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
     Runs the problem's `variant` of the loop (``compiled=False``: as plain Python) with work arrays of its own.
     """
-    kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled)
+    kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled, Y.shape[1])
     kernel(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
            EDIR, ETERM, S, prob, fns, *scratch(Y.shape[1]))
 

@@ -32,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from rotframe.errors import ScenarioError
+from rotframe.numerics.compiled import bound
 
 __all__ = ["GpuAdvance"]
 
@@ -68,7 +69,7 @@ def _overrides(module):
 
     def device(template, **names):
         """``template`` compiled for the GPU with its capitalised global names bound to ``names``."""
-        return cuda.jit(device=True, **inline_options())(_bound(template, template.__name__, **names))
+        return cuda.jit(device=True, **inline_options())(bound(template, template.__name__, **names))
 
     def own(name, stub):
         return device_function(getattr(module, name, None) or stub, made)
@@ -80,14 +81,6 @@ def _overrides(module):
                                      ORIGIN=own("origin", stubs.no_vector))
     made[calls.call_varying] = device(_call_varying, VARYING=device_function(models.varying_into, made))
     return made
-
-
-def _bound(template, name, **names):
-    """A copy of the function ``template`` named ``name``, with the global ``names`` bound (the templates below)."""
-    import types
-
-    return types.FunctionType(template.__code__, dict(template.__globals__, **names), name, template.__defaults__,
-                              template.__closure__)
 
 
 # the templates of `_overrides`: the names in capitals are bound per problem
@@ -151,7 +144,7 @@ def _kernel(module, method, events, D):
     from rotframe.problem.signatures import PARTICLE
 
     loop = device_function(engine.variant_loop(PARTICLE, method, events), _overrides(module))
-    done = _KERNELS[key] = cuda.jit(_bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
+    done = _KERNELS[key] = cuda.jit(bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
                                            loop=loop, DIM=int(D), SCRATCH=models.SCRATCH))
     return done
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from rotframe.numerics import step_control
 from rotframe.numerics.compiled import jit_llvm_inline
-from rotframe.numerics.dop853_loop import NONFINITE, dop853_stages, dop853_trajectory
+from rotframe.numerics.dop853_loop import NONFINITE, UNLIMITED, dop853_stages, dop853_trajectory
 from rotframe.numerics.plain import plain
 from rotframe.rigid.kernels import euler_rates
 
@@ -146,7 +146,7 @@ def dop853_from(y0, p, times, rtol, atol, h_max, out_L, out_q):
     work = np.empty((10, 7))  # three states and the interpolant
     _, _, done, status, nfev, steps = _trajectory(p, times[0], np.array(y), h, times[n_out - 1], h_max, times, 1,
                                                   (out_L, out_q), 0, rtol, atol_vec, K, work[0], work[1], work[2],
-                                                  work[3:10], None)
+                                                  work[3:10], None, UNLIMITED)
     if status == NONFINITE:
         done -= 1  # the sample that holds the non-finite state is not done
     return done, nfev + 2, steps
