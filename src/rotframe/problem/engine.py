@@ -53,9 +53,10 @@ import numpy as np
 from numba import njit, types
 
 from rotframe.numerics import bisection
-from rotframe.numerics.compiled import bound, inlined, jit_inline, jit_uncounted
+from rotframe.numerics.compiled import bound, inlined, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_stages, dop853_start, dop853_trajectory)
+from rotframe.numerics.rk4 import rk4_step
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
@@ -102,17 +103,9 @@ def raised(ctx):
     return ctx[2][RAISED] != 0.0
 
 
-@jit_uncounted
-def rk4_step(body, t, y, h, K, yt, yn, prob, fns, W):
-    """One classical Runge-Kutta step from (t, y) with K[0] = f(t, y)."""
-    D = y.shape[0]
-    for s in range(1, 4):  # one call site of the right-hand side
-        c = 0.5 if s < 3 else 1.0
-        for j in range(D):
-            yt[j] = y[j] + c * h * K[s - 1, j]
-        rhs(body, t + c * h, yt, K[s], prob, fns, W)
-    for j in range(D):
-        yn[j] = y[j] + h * (K[0, j] + 2.0 * K[1, j] + 2.0 * K[2, j] + K[3, j]) / 6.0
+#: the one RK4 step (`rotframe.numerics.rk4`) for each model's right-hand side
+particle_rk4 = rk4_step("engine_particle", particle_system)
+body_rk4 = rk4_step("engine_body", body_system)
 
 
 @jit_inline
@@ -120,13 +113,16 @@ def take_step(stages, body, method, t, y, h, t_end, K, yt, yn, prob, fns, W):
     """One step of ``method`` from (t, y), K[0] = f(t, y), ending at ``t_end``: ``yn``.
 
     DOP853's is the one DOP853 loop's stages (``stages``, `rotframe.numerics.dop853_loop`; None in a
-    fixed-step variant), with f at the step's end evaluated at ``t_end``; RK4's `rk4_step`; a
-    splitting the model's own (`rotframe.problem.models.own_step`).
+    fixed-step variant), with f at the step's end evaluated at ``t_end``; RK4 the one RK4 step
+    (`rotframe.numerics.rk4`); a splitting the model's own (`rotframe.problem.models.own_step`).
     """
     if method == DOP853:
         stages((prob, fns, W), int(1), int(13), t, y, h, K, yt, yn, t_end)
     elif method == RK4:
-        rk4_step(body, t, y, h, K, yt, yn, prob, fns, W)
+        if body is None:
+            particle_rk4((prob, fns, W), t, y, h, K, yt, yn)
+        else:
+            body_rk4((prob, fns, W), t, y, h, K, yt, yn)
     else:  # the model's own splitting, of order 2 or 4
         own_step(body, method, t, y, h, yn, prob, fns, W)
 

@@ -34,7 +34,7 @@ from rotframe.numerics import step_control
 from rotframe.numerics.compiled import jit_llvm_inline
 from rotframe.numerics.dop853_loop import NONFINITE, UNLIMITED, dop853_stages, dop853_trajectory
 from rotframe.numerics.plain import plain
-from rotframe.rigid.kernels import euler_rates
+from rotframe.rigid.kernels import euler_rates, euler_system
 
 __all__ = ["rigid_dop853", "RigidRun", "dop853_kernel", "dop853_from", "steps_estimate"]
 
@@ -45,13 +45,6 @@ class RigidRun:
 
     def __init__(self, times, L, q, nfev, steps):
         self.times, self.L, self.q, self.nfev, self.steps = times, L, q, nfev, steps
-
-
-@jit_llvm_inline
-def _rigid_rhs(p, t, z, K, s):
-    """``K[s] = f(z)``: `rotframe.rigid.kernels.euler_rates` of ``z = (L_body, q)`` with ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``."""
-    K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
-        z[0], z[1], z[2], z[3], z[4], z[5], z[6], p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
 
 
 @jit_llvm_inline
@@ -66,7 +59,7 @@ def _store_sample(out, k, p, y):
 
 
 #: the one DOP853 loop for the body (`rotframe.numerics.dop853_loop`), called from Python: every step and sample
-_trajectory = dop853_trajectory("rigid", dop853_stages("rigid", _rigid_rhs, 7), _store_sample, 7, entry=True)
+_trajectory = dop853_trajectory("rigid", dop853_stages("rigid", euler_system, 7), _store_sample, 7, entry=True)
 
 
 def _first_step(y, K, p, h_max, atol_vec, rtol):

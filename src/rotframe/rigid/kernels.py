@@ -10,21 +10,23 @@ of a heavy symmetric top (see [`rotframe.rigid.torqued.rigid_rhs`][rotframe.rigi
   Lie-Poisson splitting (McLachlan 1993).
 * `split_run`: the Strang composition kick / free / kick over many steps.
 * `euler_rhs`: Euler's equations plus quaternion kinematics.
-* `rk4_run`: classical RK4 on `euler_rhs`.
+* `euler_system`: the same as a system of the one DOP853 loop and the one RK4 step.
+* `rk4_run`: classical RK4 (`rotframe.numerics.rk4`) on `euler_system`.
 """
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import jit_kernel
+from rotframe.numerics.compiled import jit_kernel, jit_llvm_inline
 
 import math
 
 import numpy as np
 from numba import njit
 
+from rotframe.numerics.rk4 import rk4_step
 from rotframe.numerics.rotation import quat_mul, rodrigues_rotate
 
-__all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "rk4_run"]
+__all__ = ["free_step", "split_run", "body_torque", "euler_rates", "euler_rhs", "euler_system", "rk4_run"]
 
 # error_model="numpy": a zero quaternion gives NaN, caught by the callers' finiteness checks
 _jit_nan = jit_kernel
@@ -193,35 +195,48 @@ def euler_rhs(y, inv_i, mgl, torque_body, torque_space):
     return dy
 
 
+@jit_llvm_inline
+def euler_system(p, t, z, K, s):
+    """``K[s] = f(z)``: `euler_rates` of ``z = (L_body, q)`` with ``p = (1/I1, 1/I2, 1/I3, mgl, Nb (3), Ns (3))``.
+
+    The rigid body as a system of the one DOP853 loop and the one RK4 step (``rhs(ctx, t, z, K, s)``:
+    `rotframe.numerics.dop853_loop`, `rotframe.numerics.rk4`; ``t`` unused, the torques are constant).
+    """
+    K[s, 0], K[s, 1], K[s, 2], K[s, 3], K[s, 4], K[s, 5], K[s, 6] = euler_rates(
+        z[0], z[1], z[2], z[3], z[4], z[5], z[6], p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9])
+
+
+#: the one RK4 step (`rotframe.numerics.rk4`) for the rigid body
+_rk4_step = rk4_step("rigid", euler_system)
+
+
 @njit(cache=True)
 def rk4_run(inv_i, mgl, torque_body, torque_space, L0, q0, h, n_steps, sample_every, out_L,
              out_q):
-    """Classical RK4 on euler_rhs; returns samples kept."""
+    """Classical RK4 (`rotframe.numerics.rk4`) on `euler_system`; returns samples kept."""
+    p = np.empty(10)
+    for i in range(3):
+        p[i] = inv_i[i]
+        p[4 + i] = torque_body[i]
+        p[7 + i] = torque_space[i]
+    p[3] = mgl
     y = np.empty(7)
     for i in range(3):
         y[i] = L0[i]
     for i in range(4):
         y[3 + i] = q0[i]
+    K = np.empty((4, 7))
+    yt = np.empty(7)
+    yn = np.empty(7)
     kept = int(0)  # int(), not a literal 0 or 1: one compiled _store_row for every row
     _store_row(out_L, out_q, kept, L0, q0)
     kept += 1
-    # the stage sums element by element (the operations of y + h/2 k1 ... y += h/6 (k1 + 2 k2 + 2 k3 + k4) in
-    # their order, without numba's array expressions to compile on a first run)
-    half, sixth = 0.5 * h, h / 6.0
-    tmp = np.empty(7)
+    first = int(0)
     for step in range(1, n_steps + 1):
-        k1 = euler_rhs(y, inv_i, mgl, torque_body, torque_space)
+        euler_system(p, 0.0, y, K, first)
+        _rk4_step(p, 0.0, y, h, K, yt, yn)
         for i in range(7):
-            tmp[i] = y[i] + half * k1[i]
-        k2 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
-        for i in range(7):
-            tmp[i] = y[i] + half * k2[i]
-        k3 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
-        for i in range(7):
-            tmp[i] = y[i] + h * k3[i]
-        k4 = euler_rhs(tmp, inv_i, mgl, torque_body, torque_space)
-        for i in range(7):
-            y[i] += sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            y[i] = yn[i]
         if step % sample_every == 0 or step == n_steps:
             if not _store_row(out_L, out_q, kept, y[:3], y[3:]):
                 return kept

@@ -1,0 +1,48 @@
+"""The classical Runge-Kutta step (RK4), written once and compiled for each system's right-hand side.
+
+A system is ``rhs(ctx, t, z, K, s)``, a compiled function that writes ``f(t, z)`` into row ``s`` of
+``K`` (the protocol of `rotframe.numerics.dop853_loop`). `rk4_step` compiles, for a system,
+
+    step(ctx, t, y, h, K, yt, yn)
+
+one step from ``(t, y)`` with ``K[0] = f(t, y)`` given: the stages ``K[1] = f(t + h/2, y + h/2 K[0])``,
+``K[2] = f(t + h/2, y + h/2 K[1])``, ``K[3] = f(t + h, y + h K[2])`` (``yt`` their state), then
+``yn = y + h (K[0] + 2 K[1] + 2 K[2] + K[3]) / 6`` (Kutta 1901; Hairer, Norsett & Wanner, *Solving
+Ordinary Differential Equations I*, 2nd ed., II.1). The systems: the
+particle and the body of your own problems (`rotframe.problem.engine`, on the CPU and the GPU) and
+the rigid body's fixed-step RK4 (`rotframe.rigid.kernels.rk4_run`).
+
+The right-hand side is a global name of a copy of the template (`rotframe.numerics.compiled.bound`):
+numba calls it directly, the GPU's compiler rebinds it to its own version
+(`rotframe.particles.gpu.device_function`), and each system's step is cached under its own name.
+
+The scenes' particles keep a step of their own on 6-tuples (`rotframe.particles.kernels.rk4_step`,
+the same arithmetic with the rates of a precomputed plan), which their ensembles run in registers
+on the CPU and the GPU.
+"""
+
+from __future__ import annotations
+
+from rotframe.numerics.compiled import bound, jit_uncounted
+
+__all__ = ["rk4_step"]
+
+#: the system's right-hand side, bound per system (`rk4_step`); None in the template, which is never compiled
+RHS = None
+
+
+def _step(ctx, t, y, h, K, yt, yn):
+    """The template of `rk4_step`."""
+    D = y.shape[0]
+    for s in range(1, 4):  # one call site of the right-hand side
+        c = 0.5 if s < 3 else 1.0
+        for j in range(D):
+            yt[j] = y[j] + c * h * K[s - 1, j]
+        RHS(ctx, t + c * h, yt, K, s)
+    for j in range(D):
+        yn[j] = y[j] + h * (K[0, j] + 2.0 * K[1, j] + 2.0 * K[2, j] + K[3, j]) / 6.0
+
+
+def rk4_step(name, rhs):
+    """The RK4 step of the system ``rhs`` (module docstring), compiled for it (cached as ``rk4_step_<name>``)."""
+    return jit_uncounted(bound(_step, f"rk4_step_{name}", RHS=rhs))
