@@ -85,15 +85,22 @@ def test_a_fixed_step_particle_method_has_the_order_the_registry_states(name):
     assert abs(measured - registry.get(name).order) < 0.3, (name, measured, errors)
 
 
-def test_the_engines_codes_are_named_once_and_map_every_method_it_steps():
-    """The method codes are named in `rotframe.problem.models` alone; each problem maps the registry's names to
-    them, and a splitting's code is the one the engine hands to the model's own step."""
-    from rotframe.problem import body, engine, models, particles
+def test_the_engines_codes_are_named_once_and_never_leave_it():
+    """The method codes are named in `rotframe.problem.models` and mapped from the registry's names in the engine
+    alone (`engine.METHOD_CODES`): every method a problem steps has one, a splitting's is the model's own step's, and
+    the modules that run problems pass the method by name (no code, no map of their own)."""
+    import inspect
 
-    for codes, problem in ((particles._CODES, "particles"), (body._CODES, "bodies")):
-        assert codes["dop853"] == models.DOP853 and codes["rk4"] == models.RK4
-        assert sorted(c for c in codes.values() if c not in (models.DOP853, models.RK4)) == [models.SPLITTING,
-                                                                                             models.SPLITTING4]
-        assert set(codes) == {m.name for m in registry.methods() if problem in m.runs and m.step != "exact"}
+    from rotframe.problem import body, engine, frame_error, gpu, models, particles
+
+    codes = engine.METHOD_CODES
+    stepped = {m.name for m in registry.methods() if {"particles", "bodies"} & set(m.runs) and m.step != "exact"}
+    assert set(codes) == stepped, (set(codes), stepped)
+    assert codes["dop853"] == models.DOP853 and codes["rk4"] == models.RK4
+    assert {codes[n] for n in ("rotation-splitting", "lie-poisson")} == {models.SPLITTING}
+    assert {codes[n] for n in ("rotation-splitting4", "lie-poisson4")} == {models.SPLITTING4}
     assert {models.DOP853, models.RK4, models.SPLITTING, models.SPLITTING4} == {0, 1, 2, 3}
+    for module in (particles, body, frame_error, gpu):
+        source = inspect.getsource(module)
+        assert "_CODES" not in source and "models import DOP853" not in source, module.__name__
     assert "take_step" in vars(engine) and "own_step" in vars(models)

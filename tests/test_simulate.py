@@ -537,9 +537,8 @@ _CACHE_SCRIPT = textwrap.dedent('''
     assert len(mods) == 1, mods
     from rotframe.problem import engine
     # the problem's own glue (with the user's force inside) and the engine that steps it
-    from rotframe.problem.models import DOP853
     from rotframe.problem.signatures import PARTICLE
-    stats = [mods[0].terms.stats, engine.variant(PARTICLE, DOP853, False).stats]
+    stats = [mods[0].terms.stats, engine.variant(PARTICLE, "dop853", False).stats]
     print(json.dumps({"hits": [sum(s.cache_hits.values()) for s in stats],
                       "misses": [sum(s.cache_misses.values()) for s in stats],
                       "r": res.trajectory.r[-1, 0].tolist()}))

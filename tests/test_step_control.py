@@ -401,10 +401,9 @@ def test_every_kernel_is_cached_under_the_whole_packages_sources():
     from rotframe.problem import engine
     from rotframe.rigid import adaptive
 
-    from rotframe.problem.models import DOP853
     from rotframe.problem.signatures import PARTICLE
 
-    for kernel in (engine.variant(PARTICLE, DOP853, False), engine.start_events, adaptive._trajectory):
+    for kernel in (engine.variant(PARTICLE, "dop853", False), engine.start_events, adaptive._trajectory):
         assert kernel._cache._impl._locator.get_source_stamp() == source_fingerprint()
 
     def outside(x):  # a kernel of another package (this test file): numba's own stamp, its file alone

@@ -24,7 +24,6 @@ from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.glue import body_source, flatten_params
-from rotframe.problem.models import DOP853, RK4, SPLITTING, SPLITTING4
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
 from rotframe import method_registry as registry
@@ -34,9 +33,6 @@ from rotframe.validation import refuse_units
 
 __all__ = ["simulate_rigid_body", "BodyRun", "Torque"]
 
-#: The code the engine branches on, for each method it steps (the names are `rotframe.method_registry`'s;
-#: ``exact`` is the elliptic flow, not the engine)
-_CODES = {"dop853": DOP853, "rk4": RK4, "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4}
 #: Lie-Poisson splittings: the torque as a kick at fixed attitude (a torque of (t, q) alone)
 KICK_METHODS = ("lie-poisson", "lie-poisson4")
 
@@ -182,7 +178,6 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
     GPREV = np.zeros((1, 1))
     EDIR, ETERM = np.zeros(0), np.zeros(0, dtype=bool)
-    code = _CODES[method]
     compile_s = None
     prob = (BODY, np.ascontiguousarray(Iinv.ravel()), flatten_params(params), 0, np.zeros(1), np.zeros((1, 1, 3)), 0,
             np.zeros(1), np.zeros((1, 1, 3)))
@@ -190,7 +185,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
 
     def call(budget):
         driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                       st["NSTEP"], st["NFEV"], budget, code, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns)
+                       st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns)
 
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:

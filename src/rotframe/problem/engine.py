@@ -286,7 +286,8 @@ def _variant_kernel(model, method, events, D):
 
 
 def variant_loop(model, method, events, D=None):
-    """The loop of one variant, as Python: the model, ``method``, ``events`` (and DOP853's ``D``) constants of its code.
+    """The loop of one variant, as Python: the model, ``method`` (a name of `METHOD_CODES`), ``events`` (and DOP853's
+    ``D``) constants of its code.
 
     numba prunes the branches of the other model, the other methods and the events before it types
     the function (a closure's variables are constants to it; the model reaches the steps as
@@ -301,6 +302,7 @@ def variant_loop(model, method, events, D=None):
     (`rotframe.problem.gpu`).
     """
     body = None if model == PARTICLE else True
+    method = METHOD_CODES[method]
     if method == DOP853:
         loop = _dop853_loop(body, events, STATE_LENGTH[model] if D is None else int(D))
     else:
@@ -501,18 +503,23 @@ def _fixed_step_loop(body, method, events):
     return advance
 
 
-#: the engine's method codes by name, for the variants' names (the codes never leave this package)
+#: the engine's method codes by name (`rotframe.method_registry`'s names; the codes never leave the engine and its
+#: equations, `rotframe.problem.models`): a particle's rotation splittings and a body's Lie-Poisson splittings are the
+#: model's own splitting of order 2 and 4
+METHOD_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4,
+                "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4}
+#: the variants' names of the codes
 METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4"}
 _VARIANTS: dict = {}
 
 
 def variant(model, method, events, compiled=True, D=None):
-    """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a code of `rotframe.problem.models`) and
+    """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a name of `METHOD_CODES`) and
     ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
     when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`). ``D``, the
     length of the state, is a constant of DOP853's loop (default the model's, `STATE_LENGTH`)."""
-    D = STATE_LENGTH[int(model)] if D is None or method != DOP853 else int(D)
-    key = (int(model), int(method), bool(events), D, bool(compiled))
+    D = STATE_LENGTH[int(model)] if D is None or METHOD_CODES[method] != DOP853 else int(D)
+    key = (int(model), method, bool(events), D, bool(compiled))
     kernel = _VARIANTS.get(key)
     if kernel is None:
         kernel = _variant_kernel(*key[:4])
@@ -541,7 +548,8 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     ``ST`` each particle's time, step, next sample, fixed-step count and status; ``OUT`` (n, N, D)
     the samples; ``EVT``, ``EVY``, ``EVK``, ``EVN`` the event records; ``GPREV`` (N, NE) each
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
-    Runs the problem's `variant` of the loop (``compiled=False``: as plain Python) with work arrays of its own.
+    ``method`` is the method's name (`METHOD_CODES`). Runs the problem's `variant` of the loop (``compiled=False``: as
+    plain Python) with work arrays of its own.
     """
     kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled, Y.shape[1])
     kernel(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,

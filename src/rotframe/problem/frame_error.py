@@ -41,9 +41,9 @@ def frame_interpolation(advance, frame, origin, y0, times, after, OUT, duration,
     TC, H = np.zeros(1), np.zeros(1)
     EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, D)), np.zeros((1, 1), np.int64)
     GPREV = np.zeros((1, 1))
-    code, _, atol, hfix, _, _, _, _, fns = after
+    method, _, atol, hfix, _, _, _, _, fns = after
     no_events = (np.zeros(0), np.zeros(0, dtype=bool))
-    coarse_after = (code, rtol, np.ascontiguousarray(atol[:1]), hfix, *no_events, stop_times((coarse, origin), duration),
+    coarse_after = (method, rtol, np.ascontiguousarray(atol[:1]), hfix, *no_events, stop_times((coarse, origin), duration),
                     problem_in(coarse), fns)
     while st["ST"][0] == 0:
         advance(0, 1, times, Y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT2, EVT, EVY, EVK, st["EVN"], GPREV,

@@ -38,7 +38,7 @@ __all__ = ["GpuAdvance"]
 
 #: the tags that stand for the addresses of the frame's and the origin's functions (`_overrides`)
 _OMEGA, _ORIGIN = 1, 2
-#: (driver module, method code, events, D) -> the compiled kernel
+#: (driver module, method name, events, D) -> the compiled kernel
 _KERNELS: dict = {}
 #: particle-calls of this process that a user function's exception ended on the GPU and the CPU ran again
 #: (`GpuAdvance.ended`): `tools/gpu_user_check.py` shows that none of its checks were answered by the CPU
@@ -132,8 +132,8 @@ def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
 
 
 def _kernel(module, method, events, D):
-    """The compiled kernel of one problem (its glue ``module``), method code and events, for states of D numbers."""
-    key = (module.__name__, int(method), bool(events), int(D))
+    """The compiled kernel of one problem (its glue ``module``), method (its name) and events, for states of D numbers."""
+    key = (module.__name__, method, bool(events), int(D))
     done = _KERNELS.get(key)
     if done is not None:
         return done

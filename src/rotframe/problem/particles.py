@@ -34,15 +34,11 @@ from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.models import DOP853, RK4, SPLITTING, SPLITTING4
 from rotframe.problem.signatures import PARTICLE
 from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, model_constants, one_constraint
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
 
-#: The code the engine branches on (`rotframe.problem.engine.take_step`), for each method it steps; the names
-#: are `rotframe.method_registry`'s.
-_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4}
 #: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
           5: "an event function gave a non-finite value", 6: "a user function raised"}
@@ -262,12 +258,11 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     EDIR = np.array([float(d) for d, _ in settings], dtype=float)
     ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
-    code = _CODES[method]
     first = True
     if on_gpu:  # the same loop on the GPU: every particle at once, the arrays kept there between calls
         from rotframe.problem.gpu import GpuAdvance
 
-        gpu = GpuAdvance(driver.module, code, bool(events), D)  # the GPU is there: `_check_device`
+        gpu = GpuAdvance(driver.module, method, bool(events), D)  # the GPU is there: `_check_device`
     else:
         gpu = None
     try:
@@ -275,7 +270,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             driver.start_events(0.0, y, state["GPREV"], prob, fns)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
-        after = (code, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, fns)
+        after = (method, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, fns)
         while True:
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
