@@ -218,6 +218,26 @@ def start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
 
 
 @jit_inline
+def load_particle(i, Y, TC, H, IDX, y):
+    """Particle ``i``'s state into ``y``; returns its time, step and next sample ``(t, h, idx)``."""
+    for j in range(y.shape[0]):
+        y[j] = Y[i, j]
+    return TC[i], H[i], IDX[i]
+
+
+@jit_inline
+def save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status):
+    """Particle ``i``'s state, time, step, next sample, fixed-step count and status, where the next call goes on."""
+    for j in range(y.shape[0]):
+        Y[i, j] = y[j]
+    TC[i] = t
+    H[i] = h
+    IDX[i] = idx
+    SUB[i] = sub
+    ST[i] = status
+
+
+@jit_inline
 def watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
     """The data of `watch_events`: the events' arrays, the run's start, the locator's stages ``Kb`` and states
     ``V[4:7]`` (the loops keep ``V[0:4]`` for their own)."""
@@ -343,7 +363,7 @@ def _dop853_watch(wctx, ctx, p, t, h, t_new, y, y_new, K):
 
 
 def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
-            atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+                    atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
     """The template of the DOP853 variant's loop (`_dop853_loop`)."""
     n = T.shape[0]
     t_last = T[n - 1]
@@ -354,11 +374,7 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
         if ST[i] != 0:
             continue
         atol_i = atol[i]
-        for j in range(DIM):
-            y[j] = Y[i, j]
-        t = TC[i]
-        h = H[i]
-        idx = IDX[i]
+        t, h, idx = load_particle(i, Y, TC, H, IDX, y)
         W[RAISED] = 0.0
         SYSTEM(ctx, t, y, K, 0)
         NFEV[i] += 1
@@ -394,13 +410,7 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
             status = 5
         elif end == ABORTED:
             status = 6
-        for j in range(DIM):
-            Y[i, j] = y[j]
-        TC[i] = t
-        H[i] = h
-        IDX[i] = idx
-        SUB[i] = 0
-        ST[i] = status
+        save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, 0, status)
 
 
 def _fixed_step_loop(body, method, events):
@@ -422,11 +432,7 @@ def _fixed_step_loop(body, method, events):
         for i in range(lo, hi):
             if ST[i] != 0:
                 continue
-            for j in range(D):
-                y[j] = Y[i, j]
-            t = TC[i]
-            h = H[i]
-            idx = IDX[i]
+            t, h, idx = load_particle(i, Y, TC, H, IDX, y)
             sub = SUB[i]
             W[RAISED] = 0.0
             rhs(body, t, y, K[0], prob, fns, W)
@@ -492,13 +498,7 @@ def _fixed_step_loop(body, method, events):
                 NFEV[i] += 1
             if status == 0 and idx >= n:
                 status = 1
-            for j in range(D):
-                Y[i, j] = y[j]
-            TC[i] = t
-            H[i] = h
-            IDX[i] = idx
-            SUB[i] = sub
-            ST[i] = status
+            save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
 
     return advance
 
