@@ -154,7 +154,6 @@ def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=N
     next sample, how it ended (`REACHED`, `STOPPED`, `COLLAPSED`, `NONFINITE`, `PAUSED`,
     `WATCH_FAILED`, `ABORTED`, `DIVERGED`), the right-hand sides evaluated and the accepted steps.
     """
-
     compile = _uncounted_entry if entry else jit_uncounted
     return compile(bound(_trajectory, f"dop853_trajectory_{name}", STAGES=stages, STORE=store, WATCH=watch,
                          CHECK=aborted, DIM=int(D), WATCHED=watch is not None, CHECKED=aborted is not None))
