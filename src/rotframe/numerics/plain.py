@@ -6,21 +6,20 @@ to compile).
 
 A numba dispatcher's ``py_func`` is the Python function it was made from, but that function
 still calls its module's compiled neighbours, which cannot take plain Python functions as
-arguments. `plain` remakes a function over a copy of its globals in which every numba dispatcher is itself
-remade this way (and so are the dispatchers a closure holds), so a whole call tree runs as Python (slow: for a
-user function numba cannot compile). No source is copied: the code objects are the modules' own.
+arguments. `plain` remakes a function over a copy of its globals in which every numba
+dispatcher is itself remade this way, so a whole call tree runs as Python (slow: for a user
+function numba cannot compile). No source is copied: the code objects are the modules' own.
 """
 
 from __future__ import annotations
 
-import sys
 import types
 
 from numba.core.dispatcher import Dispatcher
 
 __all__ = ["plain"]
 
-_SPACES: dict[str, dict] = {}
+_SPACES: dict[int, dict] = {}  # id of a globals dict (a module's, or a bound copy's) -> its plain remake
 _PLAIN: dict[int, types.FunctionType] = {}
 
 
@@ -31,25 +30,14 @@ def _space(py) -> dict:
     `rotframe.numerics.compiled.bound`).
     """
     original = py.__globals__
-    module = sys.modules.get(py.__module__)
-    key = py.__module__ if module is not None and vars(module) is original else f"{py.__module__}:{id(original)}"
-    space = _SPACES.get(key)
+    space = _SPACES.get(id(original))
     if space is None:
         space = dict(original)
-        _SPACES[key] = space  # before the remakes: a module's functions call each other
+        _SPACES[id(original)] = space  # before the remakes: a module's functions call each other
         for name, value in original.items():
             if isinstance(value, Dispatcher):
                 space[name] = plain(value)
     return space
-
-
-def _plain_cells(closure):
-    """A closure's cells, each that holds a numba dispatcher holding its plain remake instead (a loop compiled per
-    system holds its system's functions there: `rotframe.numerics.dop853_loop`)."""
-    if not closure:
-        return closure
-    return tuple(types.CellType(plain(cell.cell_contents)) if isinstance(cell.cell_contents, Dispatcher) else cell
-                 for cell in closure)
 
 
 def plain(f):
@@ -60,8 +48,7 @@ def plain(f):
     py = getattr(f, "py_func", f)
     made = _PLAIN.get(id(py))
     if made is None:
-        made = types.FunctionType(py.__code__, _space(py), py.__name__, py.__defaults__,
-                                  _plain_cells(py.__closure__))
+        made = types.FunctionType(py.__code__, _space(py), py.__name__, py.__defaults__, py.__closure__)
         made.__doc__ = py.__doc__
         _PLAIN[id(py)] = made
     return made

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 from numba import njit
 
+from rotframe.numerics.bisection import MAX_HALVINGS, bisection_midpoint, narrow
 from rotframe.numerics.compiled import jit_llvm_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step, dop853_trajectory
 from rotframe.particles.dop853_ensemble import store_sample
-from rotframe.particles.events import MAX_HALVINGS, bisection_midpoint, crossed, event_value, narrow, record_event, start_value
+from rotframe.particles.events import crossed, event_value, record_event, start_value
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.packed import as_state
 from rotframe.particles.schedule import rates

@@ -9,8 +9,7 @@ one-step map, so the event time is exact for the method's discrete trajectory
 (`locate_event`), the DOP853 driver with DOP853
 (`rotframe.particles.dop853_particles.locate_event_dop853`),
 so that neither compiles the other's steps; both bisect by rotframe's one rule
-(`rotframe.numerics.bisection`: `bisection_midpoint`, `narrow`, re-exported here) and
-record by `record_event`.
+(`rotframe.numerics.bisection`: `bisection_midpoint`, `narrow`) and record by `record_event`.
 """
 
 from __future__ import annotations

@@ -55,7 +55,8 @@ from numba import njit, types
 from rotframe.numerics import bisection
 from rotframe.numerics.compiled import bound, inlined, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
-                                           WATCH_FAILED, dop853_stages, dop853_start, dop853_trajectory)
+                                           WATCH_FAILED, dop853_stages, dop853_start, dop853_step,
+                                           dop853_trajectory)
 from rotframe.numerics.rk4 import rk4_step
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
@@ -109,15 +110,15 @@ body_rk4 = rk4_step("engine_body", body_system)
 
 
 @jit_inline
-def take_step(stages, body, method, t, y, h, t_end, K, yt, yn, prob, fns, W):
-    """One step of ``method`` from (t, y), K[0] = f(t, y), ending at ``t_end``: ``yn``.
+def take_step(stages, body, method, t, y, h, K, yt, yn, prob, fns, W):
+    """One step of ``method`` of length ``h`` from (t, y), K[0] = f(t, y): ``yn``.
 
-    DOP853's is the one DOP853 loop's stages (``stages``, `rotframe.numerics.dop853_loop`; None in a
-    fixed-step variant), with f at the step's end evaluated at ``t_end``; RK4 the one RK4 step
-    (`rotframe.numerics.rk4`); a splitting the model's own (`rotframe.problem.models.own_step`).
+    DOP853's is the one DOP853 loop's step (`rotframe.numerics.dop853_loop.dop853_step` with the
+    system's ``stages``; None in a fixed-step variant, which takes no DOP853 step); RK4 the one RK4
+    step (`rotframe.numerics.rk4`); a splitting the model's own (`rotframe.problem.models.own_step`).
     """
-    if method == DOP853:
-        stages((prob, fns, W), int(1), int(13), t, y, h, K, yt, yn, t_end)
+    if method == DOP853:  # only the event locators' trials (the DOP853 loop steps on its own)
+        dop853_step(stages, (prob, fns, W), t, y, h, K, yn, yt)
     elif method == RK4:
         if body is None:
             particle_rk4((prob, fns, W), t, y, h, K, yt, yn)
@@ -167,7 +168,7 @@ def locate(stages, body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns
         mid = bisection_midpoint(lo, hi)
         if mid < 0.0:
             break
-        take_step(stages, body, method, t, y, mid, t + mid, Kb, ytb, ybuf, prob, fns, W)
+        take_step(stages, body, method, t, y, mid, Kb, ytb, ybuf, prob, fns, W)
         lo, hi, g_lo = narrow(lo, hi, g_lo, mid, call_event(fns[1], k, t + mid, ybuf, prob[2]))
         if hi == mid:  # the crossing is in [lo, mid]: the state at hi is this trial's
             for j in range(y.shape[0]):
@@ -197,7 +198,7 @@ def start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
         tau = 0.5 * tau
         if tau == 0.0:
             break
-        take_step(stages, body, method, t, y, tau, t + tau, Kb, ytb, ybuf, prob, fns, W)
+        take_step(stages, body, method, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
         g = call_event(fns[1], k, t + tau, ybuf, prob[2])
         if not math.isfinite(g):
             g = 0.0
@@ -323,11 +324,9 @@ def variant_loop(model, method, events, D=None):
     """
     body = None if model == PARTICLE else True
     method = METHOD_CODES[method]
-    if method == DOP853:
-        loop = _dop853_loop(body, events, STATE_LENGTH[model] if D is None else int(D))
-    else:
-        loop = _fixed_step_loop(body, method, events)
-    suffix = "" if method != DOP853 or D is None or D == STATE_LENGTH[model] else str(D)
+    D = STATE_LENGTH[model] if D is None else int(D)
+    loop = _dop853_loop(body, events, D) if method == DOP853 else _fixed_step_loop(body, method, events)
+    suffix = "" if method != DOP853 or D == STATE_LENGTH[model] else str(D)
     name = (f"advance_{'particle' if body is None else 'body'}{suffix}_{METHOD_NAMES[method]}"
             f"{'_events' if events else ''}")
     loop.__name__ = name
@@ -462,7 +461,7 @@ def _fixed_step_loop(body, method, events):
                     hh = hfix if on_grid else grid_next - t
                     sub += 1
                     landing = last
-                take_step(None, body, method, t, y, hh, target if landing else t + hh, K, yt, yn, prob, fns, W)
+                take_step(None, body, method, t, y, hh, K, yt, yn, prob, fns, W)
                 steps += 1
                 NSTEP[i] += 1
                 NFEV[i] += 3 if method == RK4 else 2
@@ -481,7 +480,7 @@ def _fixed_step_loop(body, method, events):
                             break
                         # the state at the terminal event: the step of that length from the step's start (the
                         # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                        take_step(None, body, method, t, y, tau, t + tau, Kb, V[4], yev, prob, fns, W)
+                        take_step(None, body, method, t, y, tau, Kb, V[4], yev, prob, fns, W)
                         t = t + tau
                         for j in range(D):
                             y[j] = yev[j]
