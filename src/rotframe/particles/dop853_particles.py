@@ -7,15 +7,16 @@ drivers are this loop with a right-hand side each: `rotframe.particles.drivers.r
 the events), and
 `rotframe.particles.dop853_steady.run_dop853_steady` with a steady model's force (a smaller first
 compile). Events are watched after each accepted step (`watch_events`) and located by bisection on
-the length of one DOP853 step from the step's start (`locate_event_dop853`).
+the length of one DOP853 step from the step's start (`locate_event_dop853`: rotframe's one locator,
+`rotframe.numerics.bisection.locator`, with that trial).
 """
 
 from __future__ import annotations
 
 from numba import njit
 
-from rotframe.numerics.bisection import MAX_HALVINGS, bisection_midpoint, narrow
-from rotframe.numerics.compiled import jit_llvm_inline, jit_uncounted
+from rotframe.numerics.bisection import locator
+from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step, dop853_trajectory
 from rotframe.particles.dop853_ensemble import store_sample
 from rotframe.particles.events import crossed, event_value, record_event, start_value
@@ -24,7 +25,7 @@ from rotframe.particles.packed import as_state
 from rotframe.particles.schedule import rates
 
 __all__ = ["particle_rhs", "particle_stages", "particle_trajectory", "particle_trajectory_events",
-           "locate_event_dop853", "watch_events", "start_events"]
+           "dop853_event_value", "locate_dop853", "locate_event_dop853", "watch_events", "start_events"]
 
 #: the force, inlined into the right-hand side (numba IR: twelve evaluations a step)
 _acceleration = njit(inline="always", error_model="numpy", nogil=True)(state_acceleration.py_func)
@@ -43,6 +44,21 @@ def particle_rhs(ctx, t, z, K, s):
 particle_stages = dop853_stages("particle", particle_rhs, 6)
 
 
+@jit_inline
+def dop853_event_value(lctx, tau):
+    """The event function after one DOP853 step of length ``tau``: the trial of `locate_event_dop853`'s locator.
+
+    ``lctx = (ctx, events, e, radius, t, y, Kt, tmp, y_out)`` (`locate_event_dop853`).
+    """
+    ctx, events, e, radius, t, y, Kt, tmp, y_out = lctx
+    dop853_step(particle_stages, ctx, t, y, tau, Kt, y_out, tmp)
+    return event_value(events, e, as_state(y_out), radius)
+
+
+#: rotframe's one event locator (`rotframe.numerics.bisection.locator`) on the particle's DOP853 step
+locate_dop853 = locator("dop853_particle", dop853_event_value)
+
+
 @jit_uncounted
 def locate_event_dop853(ctx, events, e, radius, g_start, t, h, K, Kt, y, tmp, y_out):
     """`rotframe.particles.events.locate_event` for a DOP853 step: the trial state is one DOP853 step of length tau.
@@ -53,17 +69,9 @@ def locate_event_dop853(ctx, events, e, radius, g_start, t, h, K, Kt, y, tmp, y_
     """
     for j in range(6):
         Kt[0, j] = K[0, j]
-    lo = 0.0
-    hi = h
-    g_lo = g_start
-    for _ in range(MAX_HALVINGS):
-        mid = bisection_midpoint(lo, hi)
-        if mid < 0.0:
-            break
-        dop853_step(particle_stages, ctx, t, y, mid, Kt, y_out, tmp)
-        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, event_value(events, e, as_state(y_out), radius))
-    dop853_step(particle_stages, ctx, t, y, hi, Kt, y_out, tmp)
-    return hi, as_state(y_out)
+    tau = locate_dop853((ctx, events, e, radius, t, y, Kt, tmp, y_out), h, g_start)
+    dop853_step(particle_stages, ctx, t, y, tau, Kt, y_out, tmp)
+    return tau, as_state(y_out)
 
 
 @jit_uncounted

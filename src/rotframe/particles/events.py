@@ -8,8 +8,8 @@ one-step map, so the event time is exact for the method's discrete trajectory
 (docs/physics/events.md). The fixed-step drivers re-step with their method
 (`locate_event`), the DOP853 driver with DOP853
 (`rotframe.particles.dop853_particles.locate_event_dop853`),
-so that neither compiles the other's steps; both bisect by rotframe's one rule
-(`rotframe.numerics.bisection`: `bisection_midpoint`, `narrow`) and record by `record_event`.
+so that neither compiles the other's steps; both are rotframe's one locator
+(`rotframe.numerics.bisection.locator`) with their own trial, and record by `record_event`.
 """
 
 from __future__ import annotations
@@ -18,15 +18,15 @@ import math
 
 from numba import njit
 
-from rotframe.numerics.bisection import MAX_HALVINGS, bisection_midpoint, narrow
+from rotframe.numerics.bisection import locator
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import as_state, jit_internal
 
 _inline = njit(inline="always", error_model="numpy", nogil=True)
 
-__all__ = ["event_value", "event_row", "row_value", "watch_steps", "start_value", "crossed", "MAX_HALVINGS", "bisection_midpoint", "narrow", "fixed_trial",
-           "locate_event", "record_event"]
+__all__ = ["event_value", "event_row", "row_value", "watch_steps", "start_value", "crossed", "fixed_trial",
+           "fixed_event_value", "locate_fixed", "locate_event", "record_event"]
 
 
 @jit_internal
@@ -153,26 +153,31 @@ def fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere):
                         sphere)  # int64 1
 
 
+@_inline
+def fixed_event_value(ctx, tau):
+    """The event function after `fixed_trial` of length ``tau``: the trial of `locate_event`'s locator.
+
+    ``ctx = (method, events, e, start, t, m, wt, wv, wint, rk4, sphere)``.
+    """
+    method, events, e, start, t, m, wt, wv, wint, rk4, sphere = ctx
+    return event_value(events, e, fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere), m.radius)
+
+
+#: rotframe's one event locator (`rotframe.numerics.bisection.locator`) on the fixed-step map
+locate_fixed = locator("fixed_step", fixed_event_value)
+
+
 @jit_internal
 def locate_event(method, events, e, start, g_start, t, h, m, wt, wv, wint, rk4, sphere):
     """Sub-step tau in (0, h] at which event ``e`` of the fixed-step map from ``start`` vanishes.
 
-    Bisection on tau of g(`fixed_trial` (start, tau)), halving until the
-    bracket cannot shrink (`bisection_midpoint`, `narrow`).
-    ``g_start`` is the event function at ``start`` as used for the crossing test
-    (its sign just after the start when it is zero there, `start_value`).
+    rotframe's one locator (`locate_fixed`): bisection on tau of g(`fixed_trial` (start, tau)) until
+    the bracket cannot shrink. ``g_start`` is the event function at ``start`` as used for the
+    crossing test (its sign just after the start when it is zero there, `start_value`).
     Returns tau and the state at the event (a 6-tuple).
     """
-    lo = 0.0
-    hi = h
-    g_lo = g_start
-    for _ in range(MAX_HALVINGS):
-        mid = bisection_midpoint(lo, hi)
-        if mid < 0.0:
-            break
-        g_mid = event_value(events, e, fixed_trial(method, start, t, mid, m, wt, wv, wint, rk4, sphere), m.radius)
-        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, g_mid)
-    return hi, fixed_trial(method, start, t, hi, m, wt, wv, wint, rk4, sphere)
+    tau = locate_fixed((method, events, e, start, t, m, wt, wv, wint, rk4, sphere), h, g_start)
+    return tau, fixed_trial(method, start, t, tau, m, wt, wv, wint, rk4, sphere)
 
 
 @jit_internal

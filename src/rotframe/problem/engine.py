@@ -16,7 +16,7 @@ from numba's cache; no problem ever compiles the loop again.
   particles and rigid bodies run too), compiled for the model's right-hand side: Hairer's step
   control and starting step, a step that lands on the run's end and on the stops, the samples
   inside a step from Hairer's dense output of order 7, the events watched after each accepted
-  step (`watch_events`), a budget of accepted steps per call (`_dop853_loop`).
+  step (`_watch_events`), a budget of accepted steps per call (`_dop853_loop`).
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
   ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
@@ -52,8 +52,8 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics import bisection
-from rotframe.numerics.compiled import bound, inlined, jit_inline
+from rotframe.numerics.bisection import MAX_HALVINGS, locator
+from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_stages, dop853_start, dop853_step,
                                            dop853_trajectory)
@@ -63,10 +63,6 @@ from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4,
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
-
-bisection_midpoint = inlined(bisection.bisection_midpoint)
-narrow = inlined(bisection.narrow)
-MAX_HALVINGS = bisection.MAX_HALVINGS
 
 _entry = njit(cache=True, error_model="numpy", nogil=True)
 #: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
@@ -153,44 +149,41 @@ def next_stop(S, t):
     return S[lo]
 
 
-@jit_inline
-def locate(stages, body, method, k, t, y, h, g_lo, Kb, ytb, yhi, ybuf, prob, fns, W):
-    """Bisect for event k's crossing inside the step (t, t + h], re-stepping from (t, y) with the method.
+# the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
+SYSTEM = TRAJECTORY = STAGES = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
+METHOD = DIM = 0
+EVENTS = False
 
-    Returns tau in (0, h]; ``yhi`` holds the state there (the full step's end on entry). The
-    crossing is bracketed to round-off in time on the method's own discrete trajectory, by
-    rotframe's one bisection rule (`rotframe.numerics.bisection`), as the scenes' locators.
+
+def _event_trial(tctx, tau):
+    """The template of a variant's event trial: event k's value after a re-step of length ``tau``.
+
+    ``tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)``: the re-step is the variant's method from
+    ``(t, y)`` (`take_step` with the variant's ``STAGES``, ``BODY_FLAG`` and ``METHOD``; ``Kb[0]`` is
+    f(t, y)), its state left in ``ybuf``. The trial of rotframe's one event locator
+    (`rotframe.numerics.bisection.locator`) and of `_start_sign`.
     """
-    lo = 0.0
-    hi = h
-    rhs(body, t, y, Kb[0], prob, fns, W)
-    for _ in range(MAX_HALVINGS):
-        mid = bisection_midpoint(lo, hi)
-        if mid < 0.0:
-            break
-        take_step(stages, body, method, t, y, mid, Kb, ytb, ybuf, prob, fns, W)
-        lo, hi, g_lo = narrow(lo, hi, g_lo, mid, call_event(fns[1], k, t + mid, ybuf, prob[2]))
-        if hi == mid:  # the crossing is in [lo, mid]: the state at hi is this trial's
-            for j in range(y.shape[0]):
-                yhi[j] = ybuf[j]
-    return hi
+    k, t, y, Kb, ytb, ybuf, prob, fns, W = tctx
+    take_step(STAGES, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
+    return call_event(fns[1], k, t + tau, ybuf, prob[2])
 
 
-@jit_inline
-def start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
-    """Event k's value just after the start ``(t, y)``, for a function that is exactly zero there.
+def _start_sign(tctx, h):
+    """The template of a variant's start rule: event k's value just after the start, for a function zero there.
 
     The rule of every locator (docs/physics/events.md): the start itself is never an event, and
-    a function that is zero there takes the sign it has just after it. The trials are re-steps
-    by the method from ``(t, y)`` of lengths ``h / 2, h / 4, ...``; the value kept is the one
-    nearest the start that is not zero. The halving stops where g halves with tau (its first
-    derivative rules below there: one or two trials for a shot fired from the ground), else
-    where a trial no longer moves the state or tau underflows (a function whose first
-    derivative is zero at the start: some thousand trials, once). A projectile fired from the
-    ground thus lands at its first return to it however soon, inside the first step too, and one
-    fired into the ground is not an event. Returns 0.0 when g stays zero (no sign to take).
+    a function that is zero there takes the sign it has just after it. The trials (``TRIAL``, the
+    variant's `_event_trial` with ``tctx``) are re-steps by the method from ``(t, y)`` of lengths
+    ``h / 2, h / 4, ...``; the value kept is the one nearest the start that is not zero. The
+    halving stops where g halves with tau (its first derivative rules below there: one or two
+    trials for a shot fired from the ground), else where a trial no longer moves the state or tau
+    underflows (a function whose first derivative is zero at the start: some thousand trials,
+    once). A projectile fired from the ground thus lands at its first return to it however soon,
+    inside the first step too, and one fired into the ground is not an event. Returns 0.0 when g
+    stays zero (no sign to take).
     """
-    rhs(body, t, y, Kb[0], prob, fns, W)
+    y = tctx[2]
+    ybuf = tctx[5]
     g_near = 0.0
     g_before = 0.0  # g at the trial before (twice as long)
     tau = h
@@ -198,8 +191,7 @@ def start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W):
         tau = 0.5 * tau
         if tau == 0.0:
             break
-        take_step(stages, body, method, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
-        g = call_event(fns[1], k, t + tau, ybuf, prob[2])
+        g = TRIAL(tctx, tau)
         if not math.isfinite(g):
             g = 0.0
         if g != 0.0:
@@ -240,24 +232,26 @@ def save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status):
 
 @jit_inline
 def watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
-    """The data of `watch_events`: the events' arrays, the run's start, the locator's stages ``Kb`` and states
+    """The data of `_watch_events`: the events' arrays, the run's start, the locator's stages ``Kb`` and states
     ``V[4:7]`` (the loops keep ``V[0:4]`` for their own)."""
     return (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6])
 
 
-@jit_inline
-def watch_events(stages, body, method, wctx, ctx, p, t, h, t_new, y, y_new):
-    """The events' crossings over the step ``(t, y) -> (t_new, y_new)`` of particle ``p``: each located and recorded.
+def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
+    """The template of a variant's watcher: the crossings over the step ``(t, y) -> (t_new, y_new)`` of particle ``p``.
 
     ``wctx = (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf)``: each event's value
     at ``t`` (updated), the records, the directions and terminal flags, the run's start and the
-    locator's scratch; ``ctx = (prob, fns, W)``. A crossing (with its direction) is bisected by
-    `locate` on re-steps of the method (``stages`` DOP853's, None for a fixed-step method); records
-    after the earliest terminal crossing are dropped. Returns ``(stop, tau)``: whether a terminal
-    event ends the particle in the step and its offset from ``t``, or ``(True, NaN)`` where an event
-    function gave NaN or raised (the particle stops at ``t``; Python names the function). The
-    watcher of both loops: `rotframe.numerics.dop853_loop` calls it after each accepted step, the
-    fixed-step loop after each step.
+    locator's scratch; ``ctx = (prob, fns, W)``. A crossing (with its direction) is located by
+    rotframe's one event locator (``LOCATE``, `rotframe.numerics.bisection.locator`) on re-steps by
+    the variant's method (``TRIAL``, `_event_trial`), a zero at the start by ``START_SIGN``
+    (`_start_sign`); the state at a crossing is the re-step there (the step's own end where the
+    crossing is at it); each is recorded, and the records after the earliest terminal crossing are
+    dropped. Returns ``(stop, tau)``: whether a terminal event ends the particle in the step and its
+    offset from ``t``, or ``(True, NaN)`` where an event function gave NaN or raised (the particle
+    stops at ``t``; Python names the function). The watcher of both loops (`_watcher`):
+    `rotframe.numerics.dop853_loop` calls it after each accepted step, the fixed-step loop after
+    each step.
     """
     GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf = wctx
     prob, fns, W = ctx
@@ -269,14 +263,22 @@ def watch_events(stages, body, method, wctx, ctx, p, t, h, t_new, y, y_new):
         if not math.isfinite(g_new):  # NaN, or the event function raised
             return True, math.nan
         g_old = GPREV[p, k]
-        if g_old == 0.0 and t == t0:  # zero at the start: the sign just after it (start_sign)
-            g_old = start_sign(stages, body, method, k, t, y, h, Kb, ytb, ybuf, prob, fns, W)
+        tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)
+        if g_old == 0.0 and t == t0:  # zero at the start: the sign just after it (_start_sign)
+            rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+            g_old = START_SIGN(tctx, h)
         rising = g_old < 0.0 and g_new >= 0.0
         falling = g_old > 0.0 and g_new <= 0.0
         if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
-            for j in range(D):
-                yhi[j] = y_new[j]
-            tau = locate(stages, body, method, k, t, y, h, g_old, Kb, ytb, yhi, ybuf, prob, fns, W)
+            rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+            tau = LOCATE(tctx, h, g_old)
+            if tau < h:  # the state there: the trial that set the bracket's end, made again
+                TRIAL(tctx, tau)
+                for j in range(D):
+                    yhi[j] = ybuf[j]
+            else:
+                for j in range(D):
+                    yhi[j] = y_new[j]
             m = EVN[p]
             if m < EVT.shape[1]:
                 EVT[p, m] = t + tau
@@ -325,20 +327,32 @@ def variant_loop(model, method, events, D=None):
     body = None if model == PARTICLE else True
     method = METHOD_CODES[method]
     D = STATE_LENGTH[model] if D is None else int(D)
-    loop = _dop853_loop(body, events, D) if method == DOP853 else _fixed_step_loop(body, method, events)
     suffix = "" if method != DOP853 or D == STATE_LENGTH[model] else str(D)
     name = (f"advance_{'particle' if body is None else 'body'}{suffix}_{METHOD_NAMES[method]}"
             f"{'_events' if events else ''}")
-    loop.__name__ = name
-    loop.__qualname__ = name
-    return loop
+    if method == DOP853:
+        return _dop853_loop(name, body, events, D)
+    return _fixed_step_loop(name, body, method, events)
 
 
-def _dop853_loop(body, events, D):
+def _watcher(kind, stages, body, method):
+    """The events' watcher of a variant (`_watch_events`) with its trial, locator and start rule, bound to them.
+
+    ``kind`` names the variant's copies; ``stages`` (DOP853's, None for a fixed-step method),
+    ``body`` and ``method`` are constants of its trial (`_event_trial`), so numba prunes the other
+    methods' steps from it.
+    """
+    trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STAGES=stages, BODY_FLAG=body, METHOD=method))
+    start_sign = jit_inline(bound(_start_sign, f"start_sign_{kind}", TRIAL=trial))
+    return jit_inline(bound(_watch_events, f"watch_{kind}", BODY_FLAG=body, TRIAL=trial, LOCATE=locator(kind, trial),
+                            START_SIGN=start_sign))
+
+
+def _dop853_loop(name, body, events, D):
     """The DOP853 variant's loop: `rotframe.numerics.dop853_loop`'s trajectory, per particle, from stop to stop.
 
     The system is the model's right-hand side (`particle_system`, `body_system`) with ``ctx =
-    (prob, fns, W)``; the events are `watch_events`; a user function that raised ends the
+    (prob, fns, W)``; the events are `_watch_events`; a user function that raised ends the
     trajectory at the step (`raised`). A call takes at most ``budget`` accepted steps per particle
     and ends after an accepted step, so the steps do not depend on where the budget cut the calls.
     The template `_dop853_advance` reads the system's functions as globals (`rotframe.numerics.compiled.bound`).
@@ -346,19 +360,9 @@ def _dop853_loop(body, events, D):
     system = particle_system if body is None else body_system
     kind = f"engine_{'particle' if body is None else 'body'}{D}"
     stages = dop853_stages(kind, system, D)
-    watch = jit_inline(bound(_dop853_watch, f"watch_{kind}", STAGES=stages, BODY_FLAG=body)) if events else None
+    watch = _watcher(kind, stages, body, DOP853) if events else None
     trajectory = dop853_trajectory(kind + ("_events" if events else ""), stages, store_rows, D, watch, aborted=raised)
-    return bound(_dop853_advance, "advance", SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D))
-
-
-# the names a DOP853 variant binds (`_dop853_loop`): None or 0 in the templates themselves, which are never compiled
-SYSTEM = TRAJECTORY = STAGES = BODY_FLAG = None
-DIM = 0
-
-
-def _dop853_watch(wctx, ctx, p, t, h, t_new, y, y_new, K):
-    """The template of a DOP853 variant's watcher: `watch_events` with DOP853's re-steps (the system's stages)."""
-    return watch_events(STAGES, BODY_FLAG, DOP853, wctx, ctx, p, t, h, t_new, y, y_new)
+    return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D))
 
 
 def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
@@ -412,94 +416,97 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
         save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, 0, status)
 
 
-def _fixed_step_loop(body, method, events):
+def _fixed_step_loop(name, body, method, events):
     """The loop of a fixed-step variant (RK4, the model's splittings): a step that divides each sample interval.
 
     A step ends on the next sample or the next stop, whichever is first; RK4's grid goes on from a
-    stop. The GPU compiles this loop too (`rotframe.problem.gpu`).
+    stop. The template `_fixed_step_advance` reads the variant's constants as globals
+    (`rotframe.numerics.compiled.bound`); the GPU compiles this loop too (`rotframe.problem.gpu`).
     """
+    watch = _watcher(name, None, body, method) if events else None
+    return bound(_fixed_step_advance, name, BODY_FLAG=body, METHOD=method, EVENTS=bool(events), WATCH=watch)
 
-    def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
-                atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
-        # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
-        # set for the block
-        n = T.shape[0]
-        D = Y.shape[1]
-        y, yt, yn, yev = V[0], V[1], V[2], V[3]
-        ctx = (prob, fns, W)
-        wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
-        for i in range(lo, hi):
-            if ST[i] != 0:
-                continue
-            t, h, idx = load_particle(i, Y, TC, H, IDX, y)
-            sub = SUB[i]
-            W[RAISED] = 0.0
-            rhs(body, t, y, K[0], prob, fns, W)
-            NFEV[i] += 1
-            steps = 0
-            status = 0
-            while idx < n and steps < budget:
-                if t >= T[idx]:
-                    for j in range(D):
-                        OUT[idx, i, j] = y[j]
-                    idx += 1
-                    sub = 0
-                    continue
-                # a step ends on the next sample or the next stop, whichever is first
-                stop = next_stop(S, t)
-                at_knot = stop < T[idx]
-                target = stop if at_knot else T[idx]
-                interval = T[idx] - T[idx - 1]
-                on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-                last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
-                grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
-                if at_knot and stop < grid_next:
-                    hh = stop - t  # to the knot; the grid goes on from there
-                    landing = True
-                else:
-                    target = T[idx]
-                    hh = hfix if on_grid else grid_next - t
-                    sub += 1
-                    landing = last
-                take_step(None, body, method, t, y, hh, K, yt, yn, prob, fns, W)
-                steps += 1
-                NSTEP[i] += 1
-                NFEV[i] += 3 if method == RK4 else 2
-                if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
-                    status = 6
-                    break
-                if not all_finite(yn):
-                    status = 3
-                    break
-                t_new = target if landing else T[idx - 1] + sub * hfix
-                if events:  # a constant of the variant: without events, none of this is compiled
-                    stop_now, tau = watch_events(None, body, method, wctx, ctx, i, t, t_new - t, t_new, y, yn)
-                    if stop_now:
-                        if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
-                            status = 5
-                            break
-                        # the state at the terminal event: the step of that length from the step's start (the
-                        # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                        take_step(None, body, method, t, y, tau, Kb, V[4], yev, prob, fns, W)
-                        t = t + tau
-                        for j in range(D):
-                            y[j] = yev[j]
-                        while idx < n:
-                            for j in range(D):
-                                OUT[idx, i, j] = y[j]
-                            idx += 1
-                        status = 2
-                        break
-                t = t_new
+
+def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
+                        atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+    """The template of a fixed-step variant's loop (`_fixed_step_loop`)."""
+    # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
+    # set for the block
+    n = T.shape[0]
+    D = Y.shape[1]
+    y, yt, yn, yev = V[0], V[1], V[2], V[3]
+    ctx = (prob, fns, W)
+    wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    for i in range(lo, hi):
+        if ST[i] != 0:
+            continue
+        t, h, idx = load_particle(i, Y, TC, H, IDX, y)
+        sub = SUB[i]
+        W[RAISED] = 0.0
+        rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+        NFEV[i] += 1
+        steps = 0
+        status = 0
+        while idx < n and steps < budget:
+            if t >= T[idx]:
                 for j in range(D):
-                    y[j] = yn[j]
-                rhs(body, t, y, K[0], prob, fns, W)
-                NFEV[i] += 1
-            if status == 0 and idx >= n:
-                status = 1
-            save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
-
-    return advance
+                    OUT[idx, i, j] = y[j]
+                idx += 1
+                sub = 0
+                continue
+            # a step ends on the next sample or the next stop, whichever is first
+            stop = next_stop(S, t)
+            at_knot = stop < T[idx]
+            target = stop if at_knot else T[idx]
+            interval = T[idx] - T[idx - 1]
+            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
+            last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
+            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
+            if at_knot and stop < grid_next:
+                hh = stop - t  # to the knot; the grid goes on from there
+                landing = True
+            else:
+                target = T[idx]
+                hh = hfix if on_grid else grid_next - t
+                sub += 1
+                landing = last
+            take_step(None, BODY_FLAG, METHOD, t, y, hh, K, yt, yn, prob, fns, W)
+            steps += 1
+            NSTEP[i] += 1
+            NFEV[i] += 3 if METHOD == RK4 else 2
+            if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
+                status = 6
+                break
+            if not all_finite(yn):
+                status = 3
+                break
+            t_new = target if landing else T[idx - 1] + sub * hfix
+            if EVENTS:  # a constant of the variant: without events, none of this is compiled
+                stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
+                if stop_now:
+                    if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
+                        status = 5
+                        break
+                    # the state at the terminal event: the step of that length from the step's start (the
+                    # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
+                    take_step(None, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
+                    t = t + tau
+                    for j in range(D):
+                        y[j] = yev[j]
+                    while idx < n:
+                        for j in range(D):
+                            OUT[idx, i, j] = y[j]
+                        idx += 1
+                    status = 2
+                    break
+            t = t_new
+            for j in range(D):
+                y[j] = yn[j]
+            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+            NFEV[i] += 1
+        if status == 0 and idx >= n:
+            status = 1
+        save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
 
 
 #: the engine's method codes by name (`rotframe.method_registry`'s names; the codes never leave the engine and its
