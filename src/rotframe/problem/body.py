@@ -149,9 +149,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if torque is not None:
         uf.check_call("torque", torque, (0.0, L.copy(), q.copy(), *params), (3,),
                       when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")
-        import numba
-
-        fn = numba.njit(uf.plain_function(torque), error_model="numpy") if jit else uf.plain_function(torque)
+        fn = uf.compiled_for_glue(torque) if jit else uf.plain_function(torque)
         functions = {"torque_fn": fn}
         glue = body_source(params)
         key, cache_note = uf.cache_key([("torque", torque)], "")

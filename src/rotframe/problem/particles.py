@@ -75,11 +75,8 @@ def problem_tuple(M, p, frame, origin):
 
 
 def _bind(frame, origin, forces, events, compiled):
-    import numba
-
     def prep(f):
-        f = uf.plain_function(f)
-        return numba.njit(f, error_model="numpy") if compiled else f
+        return uf.compiled_for_glue(f) if compiled else uf.plain_function(f)
 
     functions = {}
     if frame.kind == "function":
