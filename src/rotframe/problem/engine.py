@@ -64,10 +64,11 @@ from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1,
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
-_entry = njit(cache=True, error_model="numpy", nogil=True)
+#: the entry points Python calls (no C entry point: nothing calls them from C)
+_entry = njit(cache=True, error_model="numpy", nogil=True, no_cfunc_wrapper=True)
 #: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
 #: arrays made by the caller (`scratch`)
-_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
+_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False, no_cfunc_wrapper=True)
 #: the length of the state of each model, a constant of its DOP853 loop (a particle whose forces act in inertial
 #: axes carries the frame's attitude too: 10)
 STATE_LENGTH = {PARTICLE: 6, BODY: 7}

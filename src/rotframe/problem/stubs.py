@@ -15,7 +15,8 @@ from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VEC
 
 __all__ = ["no_terms", "no_event", "no_potential", "no_vector"]
 
-_jit = {"cache": True, "error_model": "numpy", "nogil": True}
+#: called by address alone (`rotframe.problem.calls`): no CPython or C entry point to build
+_jit = {"cache": True, "error_model": "numpy", "nogil": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 
 
 @njit(TERMS_SIG, **_jit)

@@ -14,6 +14,13 @@ The problem is a particle on a spring in a steadily rotating frame, 10 s, DOP853
 diffrax's first jit-compiled Dopri8 solve was measured on (0.8 s beyond imports, issue 32). The
 goals are those of issue 32: 3 s, 0.5 s and 0.3 s. A force's constant is drawn anew for every
 measurement, so no run finds the previous one's driver.
+
+Beside them, where jax and diffrax are installed (``pip install 'rotframe[bench]'``), diffrax
+on the same problem in a new process of its own, numpy, jax and diffrax imported before the
+clock (`diffrax_startup_rows`): its first ``jax.jit``-compiled Dopri8 solve (``diffeqsolve``, a
+PID controller, the same tolerances and sample times; jax's compilation cache is off by default,
+so this is both its "first problem ever" and its "new problem"), and in the same process the
+force edited and solved again (its "changed force": a new function, traced and compiled anew).
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ import subprocess
 import sys
 import tempfile
 
-__all__ = ["problem_startup_rows", "PROBLEM_STARTUP_GOALS"]
+__all__ = ["problem_startup_rows", "diffrax_startup_rows", "PROBLEM_STARTUP_GOALS"]
 
 #: Goals of issue 32 (s, beyond imports): the first problem ever, a new problem, a changed force.
 PROBLEM_STARTUP_GOALS = {"first problem ever": 3.0, "new problem": 0.5, "changed force": 0.3}
@@ -49,6 +56,75 @@ first = timed(float(sys.argv[1]))
 changed = timed(float(sys.argv[2]))
 print(json.dumps({"first": first, "changed": changed}))
 '''
+
+
+_DIFFRAX_CHILD = r'''
+import json, sys, time
+import numpy as np
+import jax
+jax.config.update("jax_enable_x64", True)
+jax.config.update("jax_platforms", "cpu")
+import jax.numpy as jnp
+import diffrax  # imported before the clock: the rows count what follows
+
+W = 0.5  # the frame's rate about z (rad/s), as rotframe.simulate's omega=[0, 0, 0.5]
+RTOL = 1e-10  # rotframe's default; atol = rtol * the state's scale (1 here), as rotframe scales it
+
+def timed(k):
+    source = (f"def field(t, y, args):\n"
+              f"    x, yy, z, vx, vy, vz = y[0], y[1], y[2], y[3], y[4], y[5]\n"
+              f"    ax = -{k!r} * x + 2.0 * W * vy + W * W * x\n"
+              f"    ay = -{k!r} * yy - 2.0 * W * vx + W * W * yy\n"
+              f"    az = -{k!r} * z\n"
+              f"    return jnp.stack([vx, vy, vz, ax, ay, az])\n")
+    space = {"jnp": jnp, "W": W}
+    exec(compile(source, f"<force {k!r}>", "exec"), space)  # a new function, as an edited cell makes
+    t0 = time.perf_counter()
+    term = diffrax.ODETerm(space["field"])
+
+    @jax.jit
+    def solve(y0):
+        return diffrax.diffeqsolve(term, diffrax.Dopri8(), t0=0.0, t1=10.0, dt0=None, y0=y0,
+                                   stepsize_controller=diffrax.PIDController(rtol=RTOL, atol=RTOL),
+                                   saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, 10.0, 11)), max_steps=1_000_000).ys
+
+    ys = np.asarray(solve(jnp.array([1.0, 0.0, 0.0, 0.0, 1.0, 0.0])).block_until_ready())
+    return time.perf_counter() - t0, ys
+
+first, ys1 = timed(float(sys.argv[1]))
+changed, _ = timed(float(sys.argv[2]))
+print(json.dumps({"first": first, "changed": changed, "r_end": ys1[-1, :3].tolist(),
+                  "versions": f"jax {jax.__version__}, diffrax {diffrax.__version__}"}))
+'''
+
+
+def diffrax_startup_rows(constants=None):
+    """diffrax's start-up on the problem of `problem_startup_rows`, in a new process (module docstring).
+
+    Two rows, or one row saying why there are none where jax or diffrax is not installed.
+    """
+    import importlib.util
+
+    missing = [name for name in ("jax", "diffrax") if importlib.util.find_spec(name) is None]
+    base = {"scenario": "startup", "method": "diffrax Dopri8 (jax.jit of the whole solve)", "run": "diffrax",
+            "error": math.nan, "error_kind": "start-up", "nfev": 0, "family": "peer"}
+    if missing:
+        return [dict(base, setting="first solve in a process", wall_s=math.nan,
+                     note=f"not measured: {', '.join(missing)} not installed (pip install 'rotframe[bench]')")]
+    rng = random.Random()
+    k1, k2 = constants or (1.0 + rng.random(), 1.0 + rng.random())
+    res = subprocess.run([sys.executable, "-c", _DIFFRAX_CHILD, repr(k1), repr(k2)], capture_output=True, text=True,
+                         timeout=600)
+    if res.returncode != 0:
+        tail = (res.stderr.strip().splitlines() or ["no output"])[-1]
+        return [dict(base, setting="first solve in a process", wall_s=math.nan, note=f"not measured: {tail}")]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    note = (f"{out['versions']}; numpy, jax and diffrax imported before the clock; the same problem, tolerances "
+            "and samples as rotframe's rows")
+    return [dict(base, setting="first solve in a process", wall_s=out["first"], beyond_imports_s=out["first"],
+                 note=note + " (jax's compilation cache off, its default: every new process compiles anew)"),
+            dict(base, setting="changed force", wall_s=out["changed"], beyond_imports_s=out["changed"],
+                 note=note + " (the force a new function in the same process: traced and compiled anew)")]
 
 
 def _child(env, k1, k2):
@@ -74,5 +150,5 @@ def problem_startup_rows():
                      "error_kind": "start-up", "nfev": 0, "import_s": 0.0, "beyond_imports_s": wall,
                      "goal_s": goal, "goal_met": bool(wall <= goal),
                      "note": "the simulate call alone, numpy, numba, scipy and rotframe imported; goals of issue 32 "
-                             "(diffrax's first jit solve of this problem: 0.8 s)"})
-    return rows
+                             "(diffrax's rows beside: its first jit solve of the same problem)"})
+    return rows + diffrax_startup_rows((constants[4], constants[5]))

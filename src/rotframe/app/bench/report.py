@@ -109,6 +109,8 @@ def table(rows, speed) -> str:
             extra = (f"  (imports {r['import_s']:.2f} s, beyond them {r['beyond_imports_s']:.2f} s; goal "
                      f"{r['goal_s']:g} s {'beyond imports' if cold else 'in all'}: "
                      f"{'met' if r['goal_met'] else 'not met'})")
+        if r.get("error_kind") == "start-up" and r.get("family") == "peer":  # diffrax beside a problem of your own
+            extra = f"  ({r['note']})"
         err = r["error"]
         comp = r.get("compile_s")
         lines.append(f"{r['scenario']:<12} {str(r.get('horizon', '')):<22} {r['method'][:22]:<22} "
