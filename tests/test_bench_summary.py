@@ -233,7 +233,11 @@ def test_the_problem_start_up_rows_time_three_runs_against_their_goals(monkeypat
         return {"first": 0.4 if len(calls) == 2 else 4.0, "changed": 0.25}
 
     monkeypatch.setattr(problem_startup, "_child", child)
+    peer = [{"run": "diffrax", "setting": "first solve in a process"}]
+    monkeypatch.setattr(problem_startup, "diffrax_startup_rows", lambda constants: peer)
     rows = problem_startup.problem_startup_rows()
+    assert rows[3:] == peer  # diffrax's rows follow rotframe's (tests/test_bench_diffrax_startup.py)
+    rows = rows[:3]
     assert [r["setting"] for r in rows] == ["first problem ever", "new problem", "changed force"]
     assert [r["wall_s"] for r in rows] == [4.0, 0.4, 0.25]
     assert [r["goal_met"] for r in rows] == [False, True, True]

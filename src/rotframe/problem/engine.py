@@ -232,10 +232,13 @@ def save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status):
 
 
 @jit_inline
-def watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
-    """The data of `_watch_events`: the events' arrays, the run's start, the locator's stages ``Kb`` and states
-    ``V[4:7]`` (the loops keep ``V[0:4]`` for their own)."""
-    return (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6])
+def contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
+    """The data of a variant's loop: the system's ``ctx = (prob, fns, W)`` and the watcher's ``wctx``.
+
+    ``wctx`` (`_watch_events`): the events' arrays, the run's start, the locator's stages ``Kb`` and
+    states ``V[4:7]`` (the loops keep ``V[0:4]`` for their own).
+    """
+    return (prob, fns, W), (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6])
 
 
 def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
@@ -372,8 +375,7 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
     n = T.shape[0]
     t_last = T[n - 1]
     y, yt, yn, tmp = V[0], V[1], V[2], V[3]
-    ctx = (prob, fns, W)
-    wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    ctx, wctx = contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
     for i in range(lo, hi):
         if ST[i] != 0:
             continue
@@ -436,8 +438,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
     n = T.shape[0]
     D = Y.shape[1]
     y, yt, yn, yev = V[0], V[1], V[2], V[3]
-    ctx = (prob, fns, W)
-    wctx = watch_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    ctx, wctx = contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
     for i in range(lo, hi):
         if ST[i] != 0:
             continue
