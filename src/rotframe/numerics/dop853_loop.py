@@ -54,7 +54,7 @@ REACHED, STOPPED, COLLAPSED, NONFINITE, PAUSED, WATCH_FAILED, ABORTED, DIVERGED 
 UNLIMITED = 1 << 62
 
 #: a loop called from Python: an entry point without reference counts (its caller owns every array)
-_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False)
+_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False, no_cfunc_wrapper=True)
 
 A, C, DW = extended_tableau()
 E3, E5 = coefficients()[3:]

@@ -21,7 +21,7 @@ from numba import njit
 from rotframe.numerics.bisection import locator
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
-from rotframe.particles.packed import as_state, jit_internal
+from rotframe.particles.packed import jit_internal
 
 _inline = njit(inline="always", error_model="numpy", nogil=True)
 

@@ -262,6 +262,7 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
     D = y.shape[0]
     stop = False
     tau_stop = h
+    started = False  # whether Kb[0] holds f(t, y), the re-steps' first stage (made once, where a trial needs it)
     for k in range(EDIR.shape[0]):
         g_new = call_event(fns[1], k, t_new, y_new, prob[2])
         if not math.isfinite(g_new):  # NaN, or the event function raised
@@ -269,12 +270,16 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
         g_old = GPREV[p, k]
         tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)
         if g_old == 0.0 and t == t0:  # zero at the start: the sign just after it (_start_sign)
-            rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+            if not started:
+                rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+                started = True
             g_old = START_SIGN(tctx, h)
         rising = g_old < 0.0 and g_new >= 0.0
         falling = g_old > 0.0 and g_new <= 0.0
         if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
-            rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+            if not started:
+                rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+                started = True
             tau = LOCATE(tctx, h, g_old)
             if tau < h:  # the state there: the trial that set the bracket's end, made again
                 TRIAL(tctx, tau)
