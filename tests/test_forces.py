@@ -1,10 +1,12 @@
 """The built-in terms (``rotframe.forces``): against the scenes' kernels, closed forms, and a user's force.
 
 Three oracles:
-- the particle core's own model terms (``integrate_particles`` with a ``ParticleModel``): a
-  different implementation of the same physics (flags in a packed model, compiled kernels)
-  than the closures of ``rotframe.forces`` run by the generated driver. Both run DOP853 at
-  rtol 1e-12; they must agree to the tolerance, not to round-off;
+- the particle core's own model terms (``integrate_particles`` with a ``ParticleModel``): the
+  same arithmetic for each term (`rotframe.particles.accelerations`, whose formulas
+  ``tests/test_accelerations.py`` checks against independent ones), but summed another way (flags
+  in a packed model, the frame's terms about a fixed axis) than the closures of
+  ``rotframe.forces`` run by the engine (the frame's terms as vectors). Both run DOP853 at rtol
+  1e-12; they must agree to the tolerance, not to round-off;
 - closed forms: the charged particle's gyration and drift, the large-amplitude pendulum's
   period (a complete elliptic integral), a Foucault plane turning at Omega sin(lat);
 - a force of the user's doing the same arithmetic: the same trajectory to the last bit,
@@ -135,7 +137,7 @@ def test_the_frame_free_spring_pulls_in_three_dimensions():
 def _users_gravity_and_drag(t, r, v):
     """What forces.gravity([0.3, -0.2, -9.81]) + forces.drag(quadratic=4e-5, scale_height=8000) compute."""
     air = np.exp(-r[2] / 8000.0)
-    c = (0.0 + 4e-5 * np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])) * air
+    c = 0.0 * air + 4e-5 * air * np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])  # k1, k2 at the local air
     return 0.3 + -c * v[0], -0.2 + -c * v[1], -9.81 + -c * v[2]
 
 

@@ -18,7 +18,7 @@ A mutant is *killed* when the tests fail (or run past ``--timeout``), *survived*
 they pass. Usage (from the repository root)::
 
     python tools/mutate.py                         # default targets and tests
-    python tools/mutate.py --target src/rotframe/particles/forces.py:air_density,position_acceleration \\
+    python tools/mutate.py --target src/rotframe/particles/forces.py:drag_coefficients,position_acceleration \\
         --tests "tests/test_i11b_forces.py -k 'not projectile'" -j 2
 
 Prints one line per mutant and the score; exits 1 when any mutant survived
@@ -41,7 +41,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:position_acceleration,state_acceleration,air_density,drag_coefficients,string_normal"]
+DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:position_acceleration,state_acceleration,drag_coefficients,string_normal",
+                   "src/rotframe/particles/accelerations.py:altitude_gravity,central_gravity,air_density,drag_rate,"
+                   "centrifugal_about_axis,coriolis_about_axis,string_tension"]
 DEFAULT_TESTS = "tests/test_i11b_forces.py -k 'not projectile'"
 
 

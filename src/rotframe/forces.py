@@ -17,10 +17,10 @@ beside your own::
 A built-in term goes the same way into the same compiled driver as your force (its function
 is plain arithmetic on ``t, r, v``, compiled with numba like yours), so a built-in term and a
 force of yours that does the same arithmetic give the same trajectory to the last bit
-(``tests/test_forces.py``). Their physics is that of the scenes' model terms
-([`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel]), checked
-against the scenes' compiled kernels in the same test file; each factory's docstring names the
-scene term it is. A term's constants are compiled into its function: a run with other
+(``tests/test_forces.py``). Their arithmetic is the scenes' own: a term's acceleration is
+written once, in `rotframe.particles.accelerations`, which both the scenes' compiled kernels
+([`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel]) and these
+functions call; each factory's docstring names the scene term it is. A term's constants are compiled into its function: a run with other
 constants compiles its driver once (cached on disk like any other). A value you vary from run
 to run is cheaper as a ``params`` entry of a force of your own. The run's ``params`` go to your
 forces, not to a built-in term (``Force.takes_params`` False), so it sits beside forces of yours
@@ -50,8 +50,13 @@ import math
 import numpy as np
 
 from rotframe.errors import ScenarioError
-from rotframe.validation import check_vector3
+# the terms' arithmetic, written once (imported by name, so a GPU compile rebinds them to its own versions)
+from rotframe.particles.accelerations import air_density as _air_density
+from rotframe.particles.accelerations import drag_rate as _drag_rate
+from rotframe.particles.accelerations import altitude_gravity as _altitude_gravity
+from rotframe.particles.accelerations import central_gravity as _central_gravity
 from rotframe.problem.particles import Force, StringConstraint
+from rotframe.validation import check_vector3
 
 __all__ = ["Force", "gravity", "altitude_gravity", "central_gravity", "drag", "spring", "pendulum", "lorentz"]
 
@@ -101,8 +106,7 @@ def altitude_gravity(g0, radius) -> Force:
         raise ScenarioError(f"altitude_gravity: radius={R!r} must be > 0 (m)")
 
     def gravity(t, r, v):
-        s = R / (R + r[2])
-        return 0.0, 0.0, -g0 * s * s
+        return 0.0, 0.0, _altitude_gravity(r[2], g0, R)
 
     def potential(t, r):
         return -g0 * R * R / (R + r[2])
@@ -121,12 +125,7 @@ def central_gravity(gm, centre) -> Force:
     cx, cy, cz = _vector("central_gravity", "centre", centre)
 
     def gravity(t, r, v):
-        dx = r[0] - cx
-        dy = r[1] - cy
-        dz = r[2] - cz
-        d2 = dx * dx + dy * dy + dz * dz
-        f = -GM / (d2 * math.sqrt(d2))
-        return f * dx, f * dy, f * dz
+        return _central_gravity(r[0] - cx, r[1] - cy, r[2] - cz, GM)
 
     def potential(t, r):
         dx = r[0] - cx
@@ -161,8 +160,8 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
     name = "linear-drag" if k2 == 0.0 else "quadratic-drag" if k1 == 0.0 else "linear-drag, quadratic-drag"
 
     def drag(t, r, v):
-        air = math.exp(-r[2] / H) if H > 0.0 else 1.0
-        c = (k1 + k2 * math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])) * air
+        air = _air_density(r[2], H)
+        c = _drag_rate(v[0], v[1], v[2], k1 * air, k2 * air)
         return -c * v[0], -c * v[1], -c * v[2]
 
     return Force(drag, name=name, flow=("drag", k1, k2, H), takes_params=False)

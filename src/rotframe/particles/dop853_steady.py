@@ -10,9 +10,10 @@ code with it. Most scenes that run DOP853 need much less:
 - no drag, no spring, no events.
 
 For such a model `run_dop853_steady` runs the same loop (`rotframe.particles.dop853_ensemble.run_particles`
-on `rotframe.numerics.dop853_loop`) with the force written in place (`_acceleration`), in the
-floating-point order of the general force, so that its results are bitwise those of the general
-driver (``tests/test_dop853_steady.py`` checks this on random models).
+on `rotframe.numerics.dop853_loop`) with a force of its own (`_acceleration`: the terms of
+`rotframe.particles.accelerations` on a vector of 13 numbers), in the floating-point order of
+the general force, so that its results are bitwise those of the general driver
+(``tests/test_dop853_steady.py`` checks this on random models).
 
 `steady_parameters` packs the model for it; `is_steady_model` says
 whether a model qualifies.
@@ -24,14 +25,15 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_internal, jit_kernel, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_trajectory
+from rotframe.particles.accelerations import centrifugal_about_axis, coriolis_about_axis, string_tension
 from rotframe.particles.dop853_ensemble import run_particles, store_sample
 
 __all__ = ["is_steady_model", "steady_parameters", "run_dop853_steady", "STEADY_TERMS"]
 
-# The force (rotframe.particles.forces.state_acceleration, its string constraint
-# included) is written in place below, in the same order, rather than shared: calling the general force
-# compiles the packed model and its helpers (what this driver exists to avoid). tests/test_dop853_steady.py
-# keeps the two bitwise the same.
+# The force sums the terms of rotframe.particles.accelerations (each term's arithmetic, written once) over
+# the steady vector, in the order of rotframe.particles.forces.state_acceleration, rather than calling that
+# general force: it would compile the packed model and its helpers (what this driver exists to avoid).
+# tests/test_dop853_steady.py keeps the two bitwise the same.
 
 #: The terms that the steady driver evaluates (a model with any other term runs the general driver).
 STEADY_TERMS = frozenset({"gravity", "coriolis", "centrifugal", "pendulum"})
@@ -90,31 +92,18 @@ def _acceleration(x, y, z, vx, vy, vz, q):
     uz = q[_W + 2]
     w = q[_W_MAG]
     if q[_CENTRIFUGAL] != 0.0:
-        d = ux * x + uy * y + uz * z
-        w2 = w * w
-        ax += w2 * (x - d * ux)
-        ay += w2 * (y - d * uy)
-        az += w2 * (z - d * uz)
+        cx, cy, cz = centrifugal_about_axis(x, y, z, ux, uy, uz, w)
+        ax += cx
+        ay += cy
+        az += cz
     if q[_CORIOLIS] != 0.0:
-        w2 = 2.0 * w
-        cx = ux * w2
-        cy = uy * w2
-        cz = uz * w2
-        ax -= cy * vz - cz * vy
-        ay -= cz * vx - cx * vz
-        az -= cx * vy - cy * vx
+        cx, cy, cz = coriolis_about_axis(vx, vy, vz, ux, uy, uz, w)
+        ax -= cx
+        ay -= cy
+        az -= cz
     L = q[_L]
     if L > 0.0:
-        nx = (x - q[_PIVOT]) / L
-        ny = (y - q[_PIVOT + 1]) / L
-        nz = (z - q[_PIVOT + 2]) / L
-        an = ax * nx + ay * ny + az * nz
-        vn = vx * nx + vy * ny + vz * nz
-        v2t = vx * vx + vy * vy + vz * vz - vn * vn
-        c = an + v2t / L
-        ax -= c * nx
-        ay -= c * ny
-        az -= c * nz
+        ax, ay, az = string_tension(ax, ay, az, x, y, z, vx, vy, vz, q[_PIVOT], q[_PIVOT + 1], q[_PIVOT + 2], L)
     return ax, ay, az
 
 

@@ -6,7 +6,9 @@ Equation of motion (rotating frame, docs/physics/rotating-frames.md)::
 
 with ``w(t) = w_hat * w(t)``, a fixed unit axis times a magnitude that is
 piecewise linear in time (a constant is a one-node table). Each term is
-switched by a flag in ``P``; a term that is off costs one branch.
+switched by a flag in ``P``; a term that is off costs one branch. The arithmetic of each term is
+`rotframe.particles.accelerations`' (written once, for the scenes and your own problems alike); here
+it is summed over the packed model's terms.
 
 The step kernels (`rotframe.particles.kernels`), the DOP853 stages
 (`rotframe.particles.dop853_particles`) and the event rules
@@ -19,11 +21,13 @@ import math
 
 from numba import njit
 
+from rotframe.particles.accelerations import (air_density, altitude_gravity, central_gravity, centrifugal_about_axis,
+                                              coriolis_about_axis, drag_rate, string_tension)
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
-__all__ = ["position_acceleration", "state_acceleration", "acceleration", "air_density",
-           "drag_coefficients", "drag_flow", "string_normal"]
+__all__ = ["position_acceleration", "state_acceleration", "acceleration", "drag_coefficients", "drag_flow",
+           "string_normal"]
 
 
 @jit_internal
@@ -34,18 +38,11 @@ def position_acceleration(x, y, z, m, w, wd):
     """
     mode = m.gmode
     if mode == 1.0:
-        R = m.radius
-        s = R / (R + z)
         ax = 0.0
         ay = 0.0
-        az = -m.g0 * s * s
+        az = altitude_gravity(z, m.g0, m.radius)
     elif mode == 2.0:
-        dz = z + m.radius
-        d2 = x * x + y * y + dz * dz
-        f = -m.gm / (d2 * math.sqrt(d2))
-        ax = f * x
-        ay = f * y
-        az = f * dz
+        ax, ay, az = central_gravity(x, y, z + m.radius, m.gm)  # Earth's centre at (0, 0, -R)
     else:
         ax, ay, az = m.g
     k = m.spring
@@ -54,12 +51,10 @@ def position_acceleration(x, y, z, m, w, wd):
         ay -= k * y
     ux, uy, uz = m.axis
     if m.centrifugal:
-        # -w x (w x r) = w^2 (r - (w_hat . r) w_hat)
-        d = ux * x + uy * y + uz * z
-        w2 = w * w
-        ax += w2 * (x - d * ux)
-        ay += w2 * (y - d * uy)
-        az += w2 * (z - d * uz)
+        cx, cy, cz = centrifugal_about_axis(x, y, z, ux, uy, uz, w)
+        ax += cx
+        ay += cy
+        az += cz
     if m.euler:
         # -w' x r with w' = w'(t) w_hat (fixed axis)
         ax -= wd * (uy * z - uz * y)
@@ -79,30 +74,19 @@ def state_acceleration(state, m, w, wd):
     x, y, z, vx, vy, vz = state
     ax, ay, az = _position_acceleration(x, y, z, m, w, wd)
     if m.coriolis:
-        w2 = 2.0 * w
-        ux = m.axis[0] * w2
-        uy = m.axis[1] * w2
-        uz = m.axis[2] * w2
-        ax -= uy * vz - uz * vy
-        ay -= uz * vx - ux * vz
-        az -= ux * vy - uy * vx
+        cx, cy, cz = coriolis_about_axis(vx, vy, vz, m.axis[0], m.axis[1], m.axis[2], w)
+        ax -= cx
+        ay -= cy
+        az -= cz
     if m.drag:
         k1, k2 = drag_coefficients(z, m)
-        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-        k = k1 + k2 * speed
+        k = drag_rate(vx, vy, vz, k1, k2)
         ax -= k * vx
         ay -= k * vy
         az -= k * vz
     L = m.length
     if L > 0.0:
-        nx, ny, nz = string_normal(x, y, z, m)
-        an = ax * nx + ay * ny + az * nz
-        vn = vx * nx + vy * ny + vz * nz
-        v2t = vx * vx + vy * vy + vz * vz - vn * vn
-        c = an + v2t / L
-        ax -= c * nx
-        ay -= c * ny
-        az -= c * nz
+        ax, ay, az = string_tension(ax, ay, az, x, y, z, vx, vy, vz, m.pivot[0], m.pivot[1], m.pivot[2], L)
     return ax, ay, az
 
 
@@ -117,15 +101,6 @@ def acceleration(r, v, t, P, wt, wv, out):
     m = unpack(P, wt, wv)
     w, wd = rates(t, m.steady, m.w, wt, wv)
     out[0], out[1], out[2] = state_acceleration((r[0], r[1], r[2], v[0], v[1], v[2]), m, w, wd)
-
-
-@jit_internal
-def air_density(z, m):
-    """Relative air density exp(-z / H) at height z, or 1 for uniform air (H = 0)."""
-    H = m.scale_h
-    if H > 0.0:
-        return math.exp(-z / H)
-    return 1.0
 
 
 @jit_internal
@@ -148,7 +123,7 @@ def drag_flow(vx, vy, vz, k1, k2, h):
 @jit_internal
 def drag_coefficients(z, m):
     """Drag coefficients (k1 (1/s), k2 (1/m)) at height z: the sea-level ones times `air_density`."""
-    air = air_density(z, m)
+    air = air_density(z, m.scale_h)
     return m.k1 * air, m.k2 * air
 
 

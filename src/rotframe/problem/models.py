@@ -59,8 +59,9 @@ from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounte
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
-from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
+from rotframe.particles.accelerations import air_density, string_tension
 from rotframe.particles.forces import drag_flow
+from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
            "SPLITTING4", "SCRATCH", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
@@ -209,17 +210,10 @@ def attitude_rate(y, dy, k, wx, wy, wz):
 
 @jit_inline
 def constrain(M, y, ax, ay, az):
-    """The total acceleration kept on the string's sphere: a <- a - (a . n + |v_t|^2 / L) n (or as it is)."""
+    """The total acceleration kept on the string's sphere (`rotframe.particles.accelerations.string_tension`), or as it is."""
     if M[0] == 0.0:
         return ax, ay, az
-    L = M[4]
-    nx = (y[0] - M[1]) / L
-    ny = (y[1] - M[2]) / L
-    nz = (y[2] - M[3]) / L
-    an = ax * nx + ay * ny + az * nz
-    vn = y[3] * nx + y[4] * ny + y[5] * nz
-    c = an + (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] - vn * vn) / L
-    return ax - c * nx, ay - c * ny, az - c * nz
+    return string_tension(ax, ay, az, y[0], y[1], y[2], y[3], y[4], y[5], M[1], M[2], M[3], M[4])
 
 
 @jit_llvm_inline
@@ -317,7 +311,7 @@ def drag_rates(M, y):
     """The drag term's coefficients at the particle's height, for its exact flow (zero without one)."""
     if M[5] == 0.0:
         return 0.0, 0.0
-    air = math.exp(-y[2] / M[8]) if M[8] > 0.0 else 1.0
+    air = air_density(y[2], M[8])
     return M[6] * air, M[7] * air
 
 
