@@ -7,7 +7,9 @@ written from the physics (docs/physics/rotating-frames.md), not from the functio
 
 - the gravities: the inverse-square law, ``-GM d / |d|^3`` and ``-g0 R^2 / (R + z)^2``;
 - drag: ``-(k1 + k2 |v|) exp(-z / H) v``;
-- the frame's terms about a fixed axis: ``-w x (w x r)`` and ``-2 w x v`` with ``w = w u``;
+- the frame's terms, about a fixed axis (``w = w u``) and for any vector omega: ``-w x (w x r)``,
+  ``-2 w x v`` and ``-w' x r``;
+- a spring: ``-k (r - anchor)``;
 - the pendulum's tension: what the constraint ``|r - p| = L`` demands of the constrained
   acceleration ``a'``: its part along the string is the centripetal ``-|v_t|^2 / L``, its part across
   the string is that of ``a``.
@@ -26,7 +28,8 @@ from rotframe.particles import accelerations as acc
 
 mpmath.mp.dps = 50
 
-finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
+# zero or of physical size: squares of 1e-266 underflow in the oracles' norms, not in the physics
+finite = st.one_of(st.just(0.0), st.floats(1e-6, 1e3), st.floats(-1e3, -1e-6))
 vec = st.tuples(finite, finite, finite)
 positive = st.floats(1e-3, 1e3)
 
@@ -96,6 +99,30 @@ def test_the_frame_terms_about_a_fixed_axis_are_the_cross_products(r, axis, w):
     assert np.max(np.abs(coriolis - expected)) <= 1e-13 * abs(w) * max(np.linalg.norm(v), 1e-300) + 1e-300
 
 
+@given(r=vec, w=vec, wd=vec)
+@settings(max_examples=60, deadline=None)
+def test_the_frame_terms_for_any_omega_are_the_cross_products(r, w, wd):
+    r, w, wd = np.array(r), np.array(w) * 1e-3, np.array(wd) * 1e-6
+    v = r[[1, 2, 0]]  # any velocity
+    tol = 1e-13 * (1.0 + np.linalg.norm(w)) ** 2 * max(np.linalg.norm(r), 1e-300) + 1e-300
+    assert np.max(np.abs(np.array(acc.centrifugal(*r, *w)) + np.cross(w, np.cross(w, r)))) <= tol
+    assert np.max(np.abs(np.array(acc.coriolis(*v, *w)) - 2.0 * np.cross(w, v))) <= tol
+    assert np.max(np.abs(np.array(acc.euler(*r, *wd)) - np.cross(wd, r))) <= tol
+
+
+@given(r=vec, axis=vec, wd=st.floats(-1e-3, 1e-3), k=st.floats(0.0, 1e2))
+@settings(max_examples=40, deadline=None)
+def test_the_euler_term_about_an_axis_and_the_spring(r, axis, wd, k):
+    u = np.array(axis)
+    if np.linalg.norm(u) < 1e-3:
+        return
+    u = u / np.linalg.norm(u)
+    r = np.array(r)
+    got = np.array(acc.euler_about_axis(*r, *u, wd))
+    assert np.max(np.abs(got - np.cross(wd * u, r))) <= 1e-13 * abs(wd) * max(np.linalg.norm(r), 1e-300) + 1e-300
+    assert np.array_equal(np.array(acc.spring_pull(*r, k)), -k * r)  # one product each: exact to the bit
+
+
 @given(a=vec, direction=vec, v_seed=vec, pivot=vec, L=st.floats(0.1, 100.0))
 @settings(max_examples=80, deadline=None)
 def test_the_string_tension_keeps_the_particle_on_its_sphere(a, direction, v_seed, pivot, L):
@@ -111,8 +138,10 @@ def test_the_string_tension_keeps_the_particle_on_its_sphere(a, direction, v_see
     got = np.array(acc.string_tension(a[0], a[1], a[2], r[0], r[1], r[2], v[0], v[1], v[2], p[0], p[1], p[2], L))
     n_exact = (r - p) / L  # as the function forms it: |n_exact| = 1 to the round-off of r - p, eps |p| / L
     scale = max(np.linalg.norm(a), np.dot(v, v) / L, 1e-300) * (1.0 + np.linalg.norm(p) / L)
-    # along the string: the centripetal acceleration of a circle of radius L (d2/dt2 |r - p|^2 = 0)
-    assert abs(np.dot(got, n_exact) + np.dot(v, v) / L) <= 1e-12 * scale
+    # along the string: the centripetal acceleration of a circle of radius L (d2/dt2 |r - p|^2 = 0), from the
+    # velocity across the string (v's own, but for what round-off left along it)
+    v_across = v - np.dot(v, n_exact) * n_exact
+    assert abs(np.dot(got, n_exact) + np.dot(v_across, v_across) / L) <= 1e-12 * scale
     # across it: what the other forces give
     across = got - np.dot(got, n_exact) * n_exact
     assert np.max(np.abs(across - (a - np.dot(a, n_exact) * n_exact))) <= 1e-12 * scale

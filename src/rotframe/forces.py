@@ -53,6 +53,7 @@ from rotframe.errors import ScenarioError
 # the terms' arithmetic, written once (imported by name, so a GPU compile rebinds them to its own versions)
 from rotframe.particles.accelerations import air_density as _air_density
 from rotframe.particles.accelerations import drag_rate as _drag_rate
+from rotframe.particles.accelerations import spring_pull as _spring_pull
 from rotframe.particles.accelerations import altitude_gravity as _altitude_gravity
 from rotframe.particles.accelerations import central_gravity as _central_gravity
 from rotframe.problem.particles import Force, StringConstraint
@@ -180,7 +181,7 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
     vertical = 0.0 if horizontal else 1.0
 
     def spring(t, r, v):
-        return -k * (r[0] - ax_), -k * (r[1] - ay_), -k * vertical * (r[2] - az_)
+        return _spring_pull(r[0] - ax_, r[1] - ay_, vertical * (r[2] - az_), k)
 
     def potential(t, r):
         dx = r[0] - ax_

@@ -13,9 +13,10 @@ functions (numba IR, `rotframe.numerics.compiled.jit_inline`: no call of their o
 Each function takes and returns floats, so a caller keeps its own layout of the data (the packed
 model, the steady vector, a closure's constants). Conventions: SI units, per unit mass, the
 rotating frame's axes; docs/physics/rotating-frames.md for the equation of motion. The frame's own
-terms appear twice on purpose: here about a fixed unit axis ``u`` with a rate ``w`` (the scenes'
-schedules, `rotframe.particles.model.OmegaSchedule`), and as vectors of time for any omega in the
-engine (`rotframe.problem.models.particle_rhs`), whose omega may turn.
+terms are here in two forms, each the fast one where it runs: about a fixed unit axis ``u`` with a
+rate ``w`` (``*_about_axis``: the scenes' schedules, `rotframe.particles.model.OmegaSchedule`), and
+for any vector omega, which may turn (`centrifugal`, `coriolis`, `euler`: the engine of your own
+problems, `rotframe.problem.models`). The two give the same physics to round-off, not the same bits.
 
 Called from Python (a built-in term's ``accel``, plain-Python runs), numba compiles them on first use.
 """
@@ -26,8 +27,8 @@ import math
 
 from rotframe.numerics.compiled import jit_inline
 
-__all__ = ["altitude_gravity", "central_gravity", "air_density", "drag_rate", "centrifugal_about_axis",
-           "coriolis_about_axis", "string_tension"]
+__all__ = ["altitude_gravity", "central_gravity", "spring_pull", "air_density", "drag_rate", "centrifugal_about_axis",
+           "coriolis_about_axis", "euler_about_axis", "centrifugal", "coriolis", "euler", "string_tension"]
 
 
 @jit_inline
@@ -47,6 +48,12 @@ def central_gravity(dx, dy, dz, gm):
     d2 = dx * dx + dy * dy + dz * dz
     f = -gm / (d2 * math.sqrt(d2))
     return f * dx, f * dy, f * dz
+
+
+@jit_inline
+def spring_pull(dx, dy, dz, k):
+    """``-k d`` (m/s^2): a linear spring per unit mass, ``d = r - anchor`` (m), ``k`` its constant over the mass (1/s^2)."""
+    return -k * dx, -k * dy, -k * dz
 
 
 @jit_inline
@@ -84,6 +91,32 @@ def coriolis_about_axis(vx, vy, vz, ux, uy, uz, w):
     cy = uy * w2
     cz = uz * w2
     return cy * vz - cz * vy, cz * vx - cx * vz, cx * vy - cy * vx
+
+
+@jit_inline
+def euler_about_axis(x, y, z, ux, uy, uz, wd):
+    """``w' x r`` for omega' ``= w' u`` about the unit axis ``u`` (rad/s^2): the Euler acceleration is minus this."""
+    return wd * (uy * z - uz * y), wd * (uz * x - ux * z), wd * (ux * y - uy * x)
+
+
+@jit_inline
+def centrifugal(x, y, z, wx, wy, wz):
+    """``-w x (w x r) = |w|^2 r - (w . r) w`` for any vector omega ``w`` (rad/s)."""
+    wr = wx * x + wy * y + wz * z
+    w2 = wx * wx + wy * wy + wz * wz
+    return w2 * x - wr * wx, w2 * y - wr * wy, w2 * z - wr * wz
+
+
+@jit_inline
+def coriolis(vx, vy, vz, wx, wy, wz):
+    """``2 w x v`` for any vector omega ``w`` (rad/s): the Coriolis acceleration is minus this."""
+    return 2.0 * (wy * vz - wz * vy), 2.0 * (wz * vx - wx * vz), 2.0 * (wx * vy - wy * vx)
+
+
+@jit_inline
+def euler(x, y, z, ex, ey, ez):
+    """``w' x r`` for any vector omega' ``(ex, ey, ez)`` (rad/s^2): the Euler acceleration is minus this."""
+    return ey * z - ez * y, ez * x - ex * z, ex * y - ey * x
 
 
 @jit_inline

@@ -22,7 +22,8 @@ import math
 from numba import njit
 
 from rotframe.particles.accelerations import (air_density, altitude_gravity, central_gravity, centrifugal_about_axis,
-                                              coriolis_about_axis, drag_rate, string_tension)
+                                              coriolis_about_axis, drag_rate, euler_about_axis, spring_pull,
+                                              string_tension)
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
@@ -46,9 +47,10 @@ def position_acceleration(x, y, z, m, w, wd):
     else:
         ax, ay, az = m.g
     k = m.spring
-    if k != 0.0:
-        ax -= k * x
-        ay -= k * y
+    if k != 0.0:  # horizontal, anchored at the origin (the small-angle pendulum)
+        sx, sy, _ = spring_pull(x, y, 0.0, k)
+        ax += sx
+        ay += sy
     ux, uy, uz = m.axis
     if m.centrifugal:
         cx, cy, cz = centrifugal_about_axis(x, y, z, ux, uy, uz, w)
@@ -56,10 +58,10 @@ def position_acceleration(x, y, z, m, w, wd):
         ay += cy
         az += cz
     if m.euler:
-        # -w' x r with w' = w'(t) w_hat (fixed axis)
-        ax -= wd * (uy * z - uz * y)
-        ay -= wd * (uz * x - ux * z)
-        az -= wd * (ux * y - uy * x)
+        ex, ey, ez = euler_about_axis(x, y, z, ux, uy, uz, wd)
+        ax -= ex
+        ay -= ey
+        az -= ez
     return ax, ay, az
 
 
