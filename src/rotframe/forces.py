@@ -20,11 +20,11 @@ force of yours that does the same arithmetic give the same trajectory to the las
 (``tests/test_forces.py``). Their arithmetic is the scenes' own: a term's acceleration is
 written once, in `rotframe.particles.accelerations`, which both the scenes' compiled kernels
 ([`rotframe.particles.model.ParticleModel`][rotframe.particles.model.ParticleModel]) and these
-functions call; each factory's docstring names the scene term it is. A term's constants are compiled into its function: a run with other
-constants compiles its driver once (cached on disk like any other). A value you vary from run
-to run is cheaper as a ``params`` entry of a force of your own. The run's ``params`` go to your
-forces, not to a built-in term (``Force.takes_params`` False), so it sits beside forces of yours
-that use them.
+functions call; each factory's docstring names the scene term it is. A term's constants are
+compiled into its function: a run with other constants compiles its driver once (cached on disk
+like any other). A value you vary from run to run is cheaper as a ``params`` entry of a force of
+your own. The run's ``params`` go to your forces, not to a built-in term (``Force.takes_params``
+False), so it sits beside forces of yours that use them.
 
 The frame's own terms (Coriolis, centrifugal, Euler, the origin's acceleration) are not terms
 to add: ``rotframe.simulate`` adds them from ``omega`` and ``origin_acceleration``.
@@ -52,10 +52,10 @@ import numpy as np
 from rotframe.errors import ScenarioError
 # the terms' arithmetic, written once (imported by name, so a GPU compile rebinds them to its own versions)
 from rotframe.particles.accelerations import air_density as _air_density
-from rotframe.particles.accelerations import drag_rate as _drag_rate
-from rotframe.particles.accelerations import spring_pull as _spring_pull
 from rotframe.particles.accelerations import altitude_gravity as _altitude_gravity
 from rotframe.particles.accelerations import central_gravity as _central_gravity
+from rotframe.particles.accelerations import drag_rate as _drag_rate
+from rotframe.particles.accelerations import spring_pull as _spring_pull
 from rotframe.problem.particles import Force, StringConstraint
 from rotframe.validation import check_vector3
 

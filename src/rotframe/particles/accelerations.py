@@ -1,7 +1,9 @@
 """The arithmetic of the built-in terms, written once: each a compiled function of scalars.
 
-A term's acceleration is computed here and nowhere else. Three kinds of caller inline these
-functions (numba IR, `rotframe.numerics.compiled.jit_inline`: no call of their own on a hot path):
+A term that the scenes and your own problems share has its acceleration computed here and nowhere
+else (uniform gravity is a constant; the Lorentz force, which no scene uses, is `rotframe.forces`'
+alone). Three kinds of caller inline these functions (numba IR,
+`rotframe.numerics.compiled.jit_inline`: no call of their own on a hot path):
 
 - the scenes' compiled forces (`rotframe.particles.forces`, on the packed model, and the steady
   DOP853 force `rotframe.particles.dop853_steady`);
@@ -52,7 +54,7 @@ def central_gravity(dx, dy, dz, gm):
 
 @jit_inline
 def spring_pull(dx, dy, dz, k):
-    """``-k d`` (m/s^2): a linear spring per unit mass, ``d = r - anchor`` (m), ``k`` its constant over the mass (1/s^2)."""
+    """``-k d`` (m/s^2): a linear spring per unit mass, ``d = r - anchor`` (m), ``k`` over the mass (1/s^2)."""
     return -k * dx, -k * dy, -k * dz
 
 

@@ -212,7 +212,8 @@ def attitude_rate(y, dy, k, wx, wy, wz):
 
 @jit_inline
 def constrain(M, y, ax, ay, az):
-    """The total acceleration kept on the string's sphere (`rotframe.particles.accelerations.string_tension`), or as it is."""
+    """The total acceleration kept on the string's sphere (`rotframe.particles.accelerations.string_tension`),
+    or as it is without a string."""
     if M[0] == 0.0:
         return ax, ay, az
     return string_tension(ax, ay, az, y[0], y[1], y[2], y[3], y[4], y[5], M[1], M[2], M[3], M[4])
