@@ -6,7 +6,9 @@ alone). Three kinds of caller inline these functions (numba IR,
 `rotframe.numerics.compiled.jit_inline`: no call of their own on a hot path):
 
 - the scenes' compiled forces (`rotframe.particles.forces`, on the packed model, and the steady
-  DOP853 force `rotframe.particles.dop853_steady`);
+  DOP853 force `rotframe.particles.dop853_steady`; the general force keeps the Coriolis term in
+  place, the same arithmetic as `coriolis_about_axis`: called, it measured slower on the ensembles'
+  hot path);
 - the built-in terms of your own problems (`rotframe.forces`), which are compiled with your forces
   into a problem's glue and run by the engine (`rotframe.problem.engine`), and their exact flows in
   the engine's splittings (`rotframe.problem.models`);

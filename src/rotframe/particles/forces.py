@@ -8,7 +8,9 @@ with ``w(t) = w_hat * w(t)``, a fixed unit axis times a magnitude that is
 piecewise linear in time (a constant is a one-node table). Each term is
 switched by a flag in ``P``; a term that is off costs one branch. The arithmetic of each term is
 `rotframe.particles.accelerations`' (written once, for the scenes and your own problems alike); here
-it is summed over the packed model's terms.
+it is summed over the packed model's terms. One exception, measured: the Coriolis term is written in
+place (`state_acceleration`), the same arithmetic as `coriolis_about_axis`, which
+``tests/test_dop853_steady.py`` keeps bitwise equal to it.
 
 The step kernels (`rotframe.particles.kernels`), the DOP853 stages
 (`rotframe.particles.dop853_particles`) and the event rules
@@ -22,8 +24,7 @@ import math
 from numba import njit
 
 from rotframe.particles.accelerations import (air_density, altitude_gravity, central_gravity, centrifugal_about_axis,
-                                              coriolis_about_axis, drag_rate, euler_about_axis, spring_pull,
-                                              string_tension)
+                                              drag_rate, euler_about_axis, spring_pull, string_tension)
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
@@ -76,10 +77,15 @@ def state_acceleration(state, m, w, wd):
     x, y, z, vx, vy, vz = state
     ax, ay, az = _position_acceleration(x, y, z, m, w, wd)
     if m.coriolis:
-        cx, cy, cz = coriolis_about_axis(vx, vy, vz, m.axis[0], m.axis[1], m.axis[2], w)
-        ax -= cx
-        ay -= cy
-        az -= cz
+        # -2 w x v written in place, the arithmetic of accelerations.coriolis_about_axis: called (inlined), it made
+        # the RK4 ensemble with the ground event 7 to 9 % slower (3 interleaved runs a tree, 2026-11-29)
+        w2 = 2.0 * w
+        ux = m.axis[0] * w2
+        uy = m.axis[1] * w2
+        uz = m.axis[2] * w2
+        ax -= uy * vz - uz * vy
+        ay -= uz * vx - ux * vz
+        az -= ux * vy - uy * vx
     if m.drag:
         k1, k2 = drag_coefficients(z, m)
         k = drag_rate(vx, vy, vz, k1, k2)
