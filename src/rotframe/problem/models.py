@@ -233,7 +233,7 @@ def particle_rhs(t, y, dy, prob, fns, W):
     ax = W[0]
     ay = W[1]
     az = W[2]
-    # the frame's terms in place, the arithmetic of accelerations.coriolis, centrifugal and euler: called
+    # the frame's terms in place, the arithmetic of accelerations.centrifugal and euler: called
     # (inlined), they made a user force's evaluation 4 % slower (bench user-force, 2026-11-29)
     ax -= 2.0 * (wy * vz - wz * vy)  # Coriolis: -2 w x v
     ay -= 2.0 * (wz * vx - wx * vz)
