@@ -88,11 +88,12 @@ def _result(scn, scene, scene_result, summary):
 
 def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(), method=None,
              rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None, jit=True,
-             progress=None, threads=None, device=None, max_events=256):
+             progress=None, threads=None, device=None, max_events=256, frame_terms=None):
     """Particles under your forces in any rotating frame; returns a [`rotframe.Result`][rotframe.app.api.Result].
 
     Solves ``r'' = sum f(t, r, v) - 2 w x v - w x (w x r) - w' x r - a0(t)`` in the frame's
-    axes (the fictitious forces are rotframe's; never add them yourself).
+    axes (the fictitious forces are rotframe's; never add them yourself: ``frame_terms`` chooses
+    which of them act).
 
     Parameters
     ----------
@@ -139,6 +140,14 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         ``rotation-splitting``, ``rotation-splitting4``; name one), numbers that agree with the
         CPU's to round-off. Your functions must compile for the GPU too: arithmetic returning a
         tuple, no array made.
+    frame_terms : sequence of str, optional
+        Which of the frame's terms act: names from ``"coriolis"`` (``-2 w x v``),
+        ``"centrifugal"`` (``-w x (w x r)``) and ``"euler"`` (``-w' x r``); default all three.
+        Leave one out only where your forces already hold it, as the scenes do: on the Earth the
+        centrifugal term is inside the local (effective) gravity, so a problem with
+        ``rotframe.forces.gravity`` of the local g takes ``frame_terms=("coriolis",)`` (the
+        Foucault pendulum, a dropped body). The energy diagnostic follows: the Jacobi integral
+        where the centrifugal term acts in a rotating frame, ``v^2/2 + U`` where it does not.
 
     Raises
     ------
@@ -177,13 +186,15 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
                                      origin_acceleration=origin_acceleration, events=events, method=method,
                                      rtol=rtol, step=step, samples=samples, omega_dot=omega_dot, atol=atol,
                                      frame_attitude=frame_attitude, jit=jit, progress=bar, device=device,
-                                     max_events=max_events)
+                                     max_events=max_events, frame_terms=frame_terms)
     except (IntegrationError, RunInterrupted, ScenarioError) as exc:  # what was computed, as rotframe.run's Result
         partial = getattr(exc, "partial", None)
         if partial is not None and hasattr(partial, "r"):
             from rotframe.problem.frame import frame_spec
+            from rotframe.problem.terms import check_frame_terms
 
-            stopped = ProblemRun(partial, {}, ["the run stopped early: " + str(exc)], [], frame_spec(omega, omega_dot))
+            stopped = ProblemRun(partial, {}, ["the run stopped early: " + str(exc)], [], frame_spec(omega, omega_dot),
+                                 frame_terms=check_frame_terms(frame_terms))
             exc.partial = _particle_result(stopped, forces, origin_acceleration, duration,
                                            time.perf_counter() - t0)
         raise
@@ -197,7 +208,7 @@ def _particle_result(run, forces, origin_acceleration, duration, simulate_s):
     from rotframe.scenes.user_problem import ParticleProblemScene
 
     traj = run.trajectory
-    terms = [_describe(f) for f in forces] + ["coriolis", "centrifugal", "euler"]
+    terms = [_describe(f) for f in forces] + list(run.frame_terms)
     if origin_acceleration is not None:
         terms.append("origin acceleration")
     params_out = {"duration": float(duration), "particles": int(traj.r.shape[1]), "frame": run.frame.kind}

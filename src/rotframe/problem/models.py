@@ -11,9 +11,12 @@ Equation of motion (docs/physics/rotating-frames.md)::
 
     r'' = sum f - 2 w x v - w x (w x r) - w' x r - a0(t)   [+ the string's tension]
 
-``M = (string, px, py, pz, length, drag, k1, k2, H)``: the pendulum's string (1 or 0, its
-pivot and length; `rotframe.problem.terms.StringConstraint`) and, for the splittings, a drag
-term's exact flow (1 or 0 and ``v' = -(k1 + k2 |v|) exp(-z / H) v``, ``H = 0``: uniform air).
+``M = (string, px, py, pz, length, drag, k1, k2, H, coriolis, centrifugal, euler)``: the
+pendulum's string (1 or 0, its pivot and length; `rotframe.problem.terms.StringConstraint`),
+for the splittings a drag term's exact flow (1 or 0 and ``v' = -(k1 + k2 |v|) exp(-z / H) v``,
+``H = 0``: uniform air), and 1 or 0 for each of the frame's terms the run keeps
+(`rotframe.problem.terms.FRAME_TERMS`: a term left out is skipped, in the right-hand side, the
+splittings' kick and their Coriolis turn alike).
 
 **A rigid body** (``model = BODY``), state ``(L1, L2, L3, qx, qy, qz, qw)``, the angular
 momentum in body axes and the attitude (body to space, scalar last)::
@@ -233,21 +236,26 @@ def particle_rhs(t, y, dy, prob, fns, W):
     ax = W[0]
     ay = W[1]
     az = W[2]
+    M = prob[1]
     # the frame's terms in place, the arithmetic of accelerations.centrifugal and euler: called
-    # (inlined), they made a user force's evaluation 4 % slower (bench user-force, 2026-11-29)
-    ax -= 2.0 * (wy * vz - wz * vy)  # Coriolis: -2 w x v
-    ay -= 2.0 * (wz * vx - wx * vz)
-    az -= 2.0 * (wx * vy - wy * vx)
-    wr = wx * x + wy * yy + wz * z  # centrifugal: -w x (w x r) = |w|^2 r - (w . r) w
-    w2 = wx * wx + wy * wy + wz * wz
-    ax += w2 * x - wr * wx
-    ay += w2 * yy - wr * wy
-    az += w2 * z - wr * wz
-    ax -= ey * z - ez * yy  # Euler: -w' x r
-    ay -= ez * x - ex * z
-    az -= ex * yy - ey * x
+    # (inlined), they made a user force's evaluation 4 % slower (bench user-force, 2026-11-29);
+    # each where the run keeps it (M[9:12], `rotframe.problem.terms.check_frame_terms`)
+    if M[9] != 0.0:
+        ax -= 2.0 * (wy * vz - wz * vy)  # Coriolis: -2 w x v
+        ay -= 2.0 * (wz * vx - wx * vz)
+        az -= 2.0 * (wx * vy - wy * vx)
+    if M[10] != 0.0:
+        wr = wx * x + wy * yy + wz * z  # centrifugal: -w x (w x r) = |w|^2 r - (w . r) w
+        w2 = wx * wx + wy * wy + wz * wz
+        ax += w2 * x - wr * wx
+        ay += w2 * yy - wr * wy
+        az += w2 * z - wr * wz
+    if M[11] != 0.0:
+        ax -= ey * z - ez * yy  # Euler: -w' x r
+        ay -= ez * x - ex * z
+        az -= ex * yy - ey * x
     ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
-    ax, ay, az = constrain(prob[1], y, ax - ox, ay - oy, az - oz)
+    ax, ay, az = constrain(M, y, ax - ox, ay - oy, az - oz)
     dy[0] = vx
     dy[1] = vy
     dy[2] = vz
@@ -291,8 +299,10 @@ def rhs(body, t, y, dy, prob, fns, W):
 @jit_uncounted
 def kick_acceleration(t, y, prob, fns, W):
     """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
-    centrifugal, Euler and the origin's, with omega at t (returned too, for the Coriolis turn)."""
+    centrifugal and Euler (where the run keeps them, ``M[10:12]``) and the origin's, with omega at t (returned
+    too, for the Coriolis turn)."""
     wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
+    M = prob[1]
     x = y[0]
     yy = y[1]
     z = y[2]
@@ -301,8 +311,8 @@ def kick_acceleration(t, y, prob, fns, W):
     ay = W[1]
     az = W[2]
     ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
-    cx, cy, cz = centrifugal(x, yy, z, wx, wy, wz)
-    qx, qy, qz = euler(x, yy, z, ex, ey, ez)
+    cx, cy, cz = centrifugal(x, yy, z, wx, wy, wz) if M[10] != 0.0 else (0.0, 0.0, 0.0)
+    qx, qy, qz = euler(x, yy, z, ex, ey, ez) if M[11] != 0.0 else (0.0, 0.0, 0.0)
     ax += cx - qx - ox
     ay += cy - qy - oy
     az += cz - qz - oz
@@ -334,7 +344,7 @@ def rotation_strang(t, h, yn, prob, fns, W):
     k1, k2 = drag_rates(prob[1], yn)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if w > 0.0:
+    if w > 0.0 and prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term
         angle = -2.0 * w * h
         vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, math.cos(angle), math.sin(angle))
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
@@ -370,8 +380,9 @@ def sphere_strang(t, h, yn, prob, fns, W):
     ax, ay, az, vx, vy, vz = kick_across(vx, vy, vz, ax, ay, az, nx, ny, nz, hh)
     k1, k2 = drag_rates(M, yn)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
-    angle = -2.0 * (wx * nx + wy * ny + wz * nz) * h
-    vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, math.cos(angle), math.sin(angle))
+    if M[9] != 0.0:  # the Coriolis flow, where the run keeps the term
+        angle = -2.0 * (wx * nx + wy * ny + wz * nz) * h
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, math.cos(angle), math.sin(angle))
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     vx += hh * ax
     vy += hh * ay

@@ -35,7 +35,8 @@ from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
 from rotframe.problem.signatures import PARTICLE
-from rotframe.problem.terms import Force, StringConstraint, as_term, check_splitting, model_constants, one_constraint
+from rotframe.problem.terms import (FRAME_TERMS, Force, StringConstraint, as_term, check_frame_terms, check_splitting,
+                                    model_constants, one_constraint)
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
 
@@ -54,6 +55,8 @@ class ProblemRun:
     notes: list
     frame: object
     compile_s: float = 0.0
+    #: the frame's terms that acted (`rotframe.problem.terms.FRAME_TERMS`, ``frame_terms=``)
+    frame_terms: tuple = FRAME_TERMS
 
 
 def _states(r0, v0):
@@ -160,7 +163,8 @@ def _scales(r, v, duration, rtol, atol, D):
 
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
-                       frame_attitude=None, jit=True, progress=None, max_events=256, device=None) -> ProblemRun:
+                       frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
+                       frame_terms=None) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -178,6 +182,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
         raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
+    frame_terms = check_frame_terms(frame_terms)
     r, v = _states(r0, v0)
     N = r.shape[0]
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method != "dop853",
@@ -224,8 +229,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             _compile_failure(exc, roles, params, r[0], v[0], frame,
                              {labels[k] for k, f in enumerate(forces) if not f.takes_params})
         raise
-    prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None),
-                         flatten_params(params), frame, origin)
+    prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None,
+                                         frame_terms), flatten_params(params), frame, origin)
     fns = driver.functions(prob)
     slots = max_events if events else 1  # event records: none are kept without events
     n = samples + 1
@@ -332,7 +337,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
-    _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes)
+    _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes, frame_terms)
     try:
         frame_interpolation(driver.advance, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
                             warnings, notes, lambda spec: problem_tuple(prob[1], prob[2], spec, origin))
@@ -344,7 +349,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if dropped:
         warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
     traj.extras["compile_s"] = compile_s
-    return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s)
+    return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s, frame_terms)
 
 
 def _check_device(device, method, jit) -> bool:
@@ -500,8 +505,12 @@ def _event_names(events):
     return names
 
 
-def _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes):
-    """Energy (inertial frame) or Jacobi integral (steadily rotating frame) and its relative drift."""
+def _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, diagnostics, notes, frame_terms):
+    """Energy (inertial frame) or Jacobi integral (steadily rotating frame) and its relative drift.
+
+    The Coriolis term does no work, so in a steadily rotating frame ``v^2/2 + U`` minus the
+    centrifugal potential ``|omega x r|^2 / 2`` is kept, or ``v^2/2 + U`` alone where the run left
+    the centrifugal term out (``frame_terms``)."""
     if not forces or any(f.potential is None for f in forces):
         return
     if origin.kind != "zero" or not frame.is_constant or frame.kind == "function":
@@ -509,7 +518,7 @@ def _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, dia
                      "accelerates: no energy diagnostic")
         return
     w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
-    rotating = bool(np.any(w != 0.0))
+    rotating = bool(np.any(w != 0.0)) and "centrifugal" in frame_terms
     E = driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, fns, driver.potential(),
                         rotating)
     traj.extras["energy"] = E
@@ -522,3 +531,6 @@ def _energy_diagnostics(driver, prob, fns, traj, OUT, frame, origin, forces, dia
         notes.append(f"{name} is 0 at the start for some particle: its drift is absolute (J/kg) there")
     if rotating:
         notes.append("jacobi_rel_drift: the Jacobi integral v^2/2 + U - |omega x r|^2/2 of the steadily rotating frame")
+    elif np.any(w != 0.0):
+        notes.append("energy_rel_drift: v^2/2 + U in the rotating frame, kept because the centrifugal term is left "
+                     "out (frame_terms) and the Coriolis term does no work")

@@ -5,7 +5,8 @@ should know about it (its potential, its axes); the built-in terms of `rotframe.
 Forces too. A `StringConstraint` is not a force but the condition ``|r - pivot| = length``,
 kept by removing the normal part of the total acceleration (`rotframe.problem.models.constrain`,
 its constants from `model_constants`). `as_term` checks one entry of ``forces=``; `check_splitting` says what a
-splitting method cannot take as a kick.
+splitting method cannot take as a kick. The frame's own terms (`FRAME_TERMS`: Coriolis, centrifugal, Euler)
+are not forces to add: the run chooses which of them act (`check_frame_terms`; every one unless told).
 """
 
 from __future__ import annotations
@@ -17,7 +18,12 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "model_constants"]
+__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "model_constants",
+           "FRAME_TERMS", "check_frame_terms"]
+
+#: The frame's own terms, by the scenes' names for them (``-2 w x v``, ``-w x (w x r)``, ``-w' x r``): the ones a
+#: run may choose with ``frame_terms`` (every one by default).
+FRAME_TERMS = ("coriolis", "centrifugal", "euler")
 
 
 @dataclass(frozen=True)
@@ -140,15 +146,47 @@ def one_constraint(terms, r, v):
     return c
 
 
-def model_constants(constraint, drag):
-    """The particle model's constants ``M`` for the engine (`rotframe.problem.models`): the string, a drag's flow.
+def check_frame_terms(frame_terms) -> tuple:
+    """The frame's terms a run keeps (`FRAME_TERMS`, in their order): ``None`` for all of them, else the names given.
 
-    ``M = (string, px, py, pz, length, drag, k1, k2, H)``: the `StringConstraint` (1 and its pivot
-    and length, or zeros) and, under a splitting, the drag term whose exact flow it applies
-    (``drag.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v``, ``rho = exp(-z / H)``,
-    1 for ``H = 0``; the flow itself is the scenes' `rotframe.particles.forces.drag_flow`), or zeros.
+    One name may be given as a string. An unknown name, or a value that is not a name, is a
+    one-line ScenarioError naming it and the names allowed.
+
+    A term is left out where the problem holds it elsewhere, as the scenes do: on the Earth the
+    centrifugal term is inside the effective gravity (``frame_terms=("coriolis",)`` with
+    `rotframe.forces.gravity` of the local g), and the inertial oscillation's f-plane keeps the
+    Coriolis term alone.
     """
-    M = np.zeros(9)
+    if frame_terms is None:
+        return FRAME_TERMS
+    names = (frame_terms,) if isinstance(frame_terms, str) else frame_terms
+    try:
+        names = list(names)
+    except TypeError:
+        raise ScenarioError(f"frame_terms={frame_terms!r}: a sequence of names from {', '.join(FRAME_TERMS)} "
+                            "(or None for all of them)") from None
+    for name in names:
+        if not isinstance(name, str) or name.lower() not in FRAME_TERMS:
+            raise ScenarioError(f"frame_terms: {name!r} is not a term of the frame; allowed: {', '.join(FRAME_TERMS)} "
+                                "(None for all of them)")
+    chosen = {name.lower() for name in names}
+    return tuple(name for name in FRAME_TERMS if name in chosen)
+
+
+def model_constants(constraint, drag, frame_terms=FRAME_TERMS):
+    """The particle model's constants ``M`` for the engine (`rotframe.problem.models`): the string, a drag's flow,
+    the frame's terms.
+
+    ``M = (string, px, py, pz, length, drag, k1, k2, H, coriolis, centrifugal, euler)``: the
+    `StringConstraint` (1 and its pivot and length, or zeros); under a splitting, the drag term
+    whose exact flow it applies (``drag.flow = ("drag", k1, k2, H)``: ``v' = -(k1 + k2 |v|) rho(z) v``,
+    ``rho = exp(-z / H)``, 1 for ``H = 0``; the flow itself is the scenes'
+    `rotframe.particles.forces.drag_flow`), or zeros; and 1 or 0 for each of the frame's terms
+    (`FRAME_TERMS`) the run keeps (`check_frame_terms`).
+    """
+    M = np.zeros(12)
+    for k, name in enumerate(FRAME_TERMS):
+        M[9 + k] = float(name in frame_terms)
     if constraint is not None:
         M[0] = 1.0
         M[1:4] = np.asarray(constraint.pivot, dtype=float)
