@@ -53,7 +53,7 @@ def test_simulate_refuses_by_name_a_method_it_does_not_run(method):
         rotframe.simulate(omega=[0, 0, 1.0], r0=[1.0, 0, 0], v0=[0, 0, 0], duration=1.0, method=method)
     msg = str(info.value)
     assert f"method={method!r} does not run rotframe.simulate" in msg and "\n" not in msg
-    assert "allowed: rotation-splitting, rotation-splitting4, rk4, dop853" in msg
+    assert "allowed: exact, rotation-splitting, rotation-splitting4, rk4, dop853" in msg
 
 
 @pytest.mark.parametrize("method", [m.name for m in registry.methods() if "bodies" not in m.runs])

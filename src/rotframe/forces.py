@@ -27,7 +27,13 @@ your own. The run's ``params`` go to your forces, not to a built-in term (``Forc
 False), so it sits beside forces of yours that use them.
 
 The frame's own terms (Coriolis, centrifugal, Euler, the origin's acceleration) are not terms
-to add: ``rotframe.simulate`` adds them from ``omega`` and ``origin_acceleration``.
+to add: ``rotframe.simulate`` adds them from ``omega`` and ``origin_acceleration`` (``frame_terms``
+chooses which of the frame's act).
+
+The terms linear in ``(r, v)`` with constant coefficients carry their part of
+``a = K r + C v + b`` (``Force.linear``): ``gravity``, ``spring``, ``drag`` with ``linear`` alone in
+uniform air, and ``lorentz``. A problem of those terms alone, in a steady frame, runs under
+``method="exact"``, the exact flow (`rotframe.problem.exact`).
 
 =========================  ===============================  =======================
 factory                     acceleration (frame axes)        the scenes' term
@@ -62,6 +68,15 @@ from rotframe.validation import check_vector3
 __all__ = ["Force", "gravity", "altitude_gravity", "central_gravity", "drag", "spring", "pendulum", "lorentz"]
 
 
+#: a 3 x 3 zero, as the rows of a term's linear form (`Force.linear`)
+_ZERO3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+def _diagonal(a, b, c):
+    """The rows of diag(a, b, c), for a term's linear form (`Force.linear`)."""
+    return ((a, 0.0, 0.0), (0.0, b, 0.0), (0.0, 0.0, c))
+
+
 def _finite(name, **values):
     for key, v in values.items():
         try:
@@ -93,7 +108,8 @@ def gravity(g) -> Force:
     def potential(t, r):
         return -(gx * r[0] + gy * r[1] + gz * r[2])
 
-    return Force(gravity, potential=potential, name="gravity", takes_params=False)
+    return Force(gravity, potential=potential, name="gravity", takes_params=False,
+                 linear=(_ZERO3, _ZERO3, (gx, gy, gz)))
 
 
 def altitude_gravity(g0, radius) -> Force:
@@ -165,7 +181,9 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
         c = _drag_rate(v[0], v[1], v[2], k1 * air, k2 * air)
         return -c * v[0], -c * v[1], -c * v[2]
 
-    return Force(drag, name=name, flow=("drag", k1, k2, H), takes_params=False)
+    # linear in v with a constant coefficient only without the quadratic part, in uniform air
+    linear = (_ZERO3, _diagonal(-k1, -k1, -k1), (0.0, 0.0, 0.0)) if k2 == 0.0 and H == 0.0 else ()
+    return Force(drag, name=name, flow=("drag", k1, k2, H), takes_params=False, linear=linear)
 
 
 def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
@@ -189,7 +207,8 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
         dz = r[2] - az_
         return 0.5 * k * (dx * dx + dy * dy + vertical * dz * dz)
 
-    return Force(spring, potential=potential, name="spring", takes_params=False)
+    return Force(spring, potential=potential, name="spring", takes_params=False,
+                 linear=(_diagonal(-k, -k, -vertical * k), _ZERO3, (k * ax_, k * ay_, vertical * k * az_)))
 
 
 def pendulum(length, pivot=(0.0, 0.0, 0.0)) -> StringConstraint:
@@ -207,7 +226,8 @@ def pendulum(length, pivot=(0.0, 0.0, 0.0)) -> StringConstraint:
         w = 7.292115e-5 * np.array([0.0, np.cos(lat), np.sin(lat)])
         res = rotframe.simulate(omega=w, r0=[1.0, 0.0, 67.0 - np.sqrt(67.0**2 - 1.0)], v0=[0, 0, 0],
                                 duration=600.0, forces=[forces.gravity([0, 0, -9.81]),
-                                                        forces.pendulum(67.0, pivot=[0, 0, 67.0])])
+                                                        forces.pendulum(67.0, pivot=[0, 0, 67.0])],
+                                frame_terms=("coriolis",))  # the local g holds the centrifugal term
     """
     _finite("pendulum", length=length)
     L = float(length)
@@ -231,4 +251,6 @@ def lorentz(q_over_m, B, E=(0.0, 0.0, 0.0)) -> Force:
         return (qm * (ex + v[1] * bz - v[2] * by), qm * (ey + v[2] * bx - v[0] * bz),
                 qm * (ez + v[0] * by - v[1] * bx))
 
-    return Force(force, name="Lorentz force", takes_params=False)
+    # v x B = C v with C = [[0, bz, -by], [-bz, 0, bx], [by, -bx, 0]]
+    C = ((0.0, qm * bz, -qm * by), (-qm * bz, 0.0, qm * bx), (qm * by, -qm * bx, 0.0))
+    return Force(force, name="Lorentz force", takes_params=False, linear=(_ZERO3, C, (qm * ex, qm * ey, qm * ez)))

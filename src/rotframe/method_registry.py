@@ -91,8 +91,10 @@ _ROTATION = "|v| under the Coriolis force, the pendulum's constraint exactly; ti
 
 _REGISTRY = (
     Method("exact", None, "exact", "everything (the exact flow)",
-           "a linear particle model with constant coefficients or a force-free one (only the frame's terms); "
-           "a torque-free body", ("particle scenes", "bodies", "free body")),
+           "a linear particle model with constant coefficients or a force-free one (only the frame's terms): in "
+           "rotframe.simulate the built-in linear terms (gravity, spring, linear drag in uniform air, the Lorentz "
+           "force) in a steady frame, refusing any other term, events and a varying frame by name; a torque-free "
+           "body", ("particle scenes", "particles", "bodies", "free body")),
     Method("rotation-splitting", 2, "fixed", _ROTATION,
            "the frame's Coriolis term as an exact rotation of v (exact for omega of fixed direction over a "
            "step), forces of (t, r) alone as kicks, drag (rotframe.forces.drag) as its exact flow, the "

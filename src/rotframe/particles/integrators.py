@@ -173,7 +173,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}) "
                             "or a force-free one (only coriolis, centrifugal and euler); "
                             "use rotation-splitting, rotation-splitting4, rk4 or dop853")
-    return _integrate_exact(model, r0, v0, duration, samples, events, progress)
+    return integrate_exact(model, r0, v0, duration, samples, events, progress)
 
 
 # ---------------------------------------------------------------------------
@@ -263,8 +263,12 @@ def fastest_rate(model) -> float:
     return rate if math.isfinite(rate) else math.inf
 
 
-def _integrate_exact(model, r0, v0, duration, samples, events, progress):
+def integrate_exact(model, r0, v0, duration, samples, events, progress, ordered=False):
     """The exact flow (`rotframe.particles.linear.ExactFlow`): s(t_k) = Phi_k s(0), s = (r, v, 1).
+
+    ``model``: what `ExactFlow` reads (a linear or force-free `ParticleModel`, or a problem of your
+    own's `rotframe.problem.exact.LinearProblem`); ``r0``, ``v0`` (N, 3) float arrays; ``ordered``:
+    each particle's numbers independent of N (`rotframe.particles.linear.ordered_product`).
 
     Events are located on the exact flow of a linear model for all particles at
     once (`rotframe.particles.linear.locate_crossings`).
@@ -292,7 +296,7 @@ def _integrate_exact(model, r0, v0, duration, samples, events, progress):
             # an overflow (an unstable linear model run far) is caught below as a non-finite state
             warnings.simplefilter("ignore", RuntimeWarning)
             flow = ExactFlow(model, times)
-            flow.states(s0, out, count)
+            flow.states(s0, out, count, ordered)
     except KeyboardInterrupt:
         partial = Trajectory(times, np.transpose(out[:, 0:3, :], (0, 2, 1)), np.transpose(out[:, 3:6, :], (0, 2, 1)),
                              "exact", 1, 0).truncated(max(done, 1)) if done else None

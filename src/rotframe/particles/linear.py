@@ -26,7 +26,8 @@ import math
 
 import numpy as np
 
-__all__ = ["flow_matrix", "flow_at", "propagate", "locate_crossings", "turned_angle", "free_flow_matrices", "ExactFlow"]
+__all__ = ["flow_matrix", "flow_at", "propagate", "locate_crossings", "turned_angle", "free_flow_matrices", "ExactFlow",
+           "ordered_product"]
 
 
 def flow_matrix(model) -> np.ndarray:
@@ -263,6 +264,18 @@ def free_flow_matrices(model, times):
     return phi
 
 
+def ordered_product(P, S):
+    """``P @ S`` for ``P`` (..., 7, 7) and ``S`` (7, N), each entry summed over the columns of P in order.
+
+    numpy's elementwise arithmetic gives each entry the same bits whatever N is, where a BLAS
+    product may not (its kernel, and so its order of summation, depends on the shapes).
+    """
+    total = P[..., :, 0, None] * S[0]
+    for j in range(1, P.shape[-1]):
+        total = total + P[..., :, j, None] * S[j]
+    return total
+
+
 class ExactFlow:
     """The exact flow of a model over a uniform sample grid, applied to any initial states.
 
@@ -302,6 +315,7 @@ class ExactFlow:
             for _ in range(self.BLOCK - 1):
                 powers.append(step_matrix @ powers[-1])
             self.powers = powers
+            self.stacked_powers = np.stack(powers)
 
     def _block(self, start):
         """expm at the block's first sample (linear), or Phi_k of the block's samples (force-free)."""
@@ -309,21 +323,29 @@ class ExactFlow:
             return flow_at(self.M, self.times[start])
         return free_flow_matrices(self.model, self.times[start:start + self.BLOCK])
 
-    def states(self, s0, out, progress=None):
+    def states(self, s0, out, progress=None, ordered=False):
         """Fill ``out`` (K, 7, N) with the states from ``s0`` (7, N); ``progress(fraction)`` after each block.
 
+        ``ordered``: each product summed column by column in a fixed order (`ordered_product`), so
+        that a particle's numbers do not depend on how many are run with it (BLAS's matrix
+        products sum in an order of their own, which changes with N); the scenes' runs keep BLAS's.
         Returns the number of samples written (all of them unless interrupted).
         """
+        product = ordered_product if ordered else np.matmul
         K = self.times.size
         done = 0
         for start in range(0, K, self.BLOCK):
             block = self._block(start)
             if self.linear:
-                anchor = block @ s0
-                for j in range(min(self.BLOCK, K - start)):
-                    out[start + j] = self.powers[j] @ anchor
+                anchor = product(block, s0)
+                m = min(self.BLOCK, K - start)
+                if ordered:  # the block's samples in one product (the same bits as one at a time)
+                    out[start:start + m] = ordered_product(self.stacked_powers[:m], anchor)
+                else:
+                    for j in range(m):
+                        out[start + j] = self.powers[j] @ anchor
             else:
-                out[start:start + block.shape[0]] = block @ s0
+                out[start:start + block.shape[0]] = product(block, s0)
             done = min(K, start + self.BLOCK)
             if progress is not None:
                 progress(done / K)

@@ -50,6 +50,12 @@ class Force:
         Whether ``accel`` and ``potential`` take the run's ``params`` after their own arguments
         (default True). The built-in terms of `rotframe.forces` do not: their constants are their
         own, and they sit beside forces of yours that take ``params``.
+    linear : tuple, optional
+        ``(K, C, b)`` where the term is linear in ``(r, v)`` with constant coefficients,
+        ``a = K r + C v + b`` (K and C as three rows of three, b three numbers): what the exact
+        flow takes (``method="exact"``, `rotframe.problem.exact`). Set by the built-in terms that
+        are (uniform gravity, a spring, linear drag in uniform air, the Lorentz force); empty
+        otherwise, and for a force of your own.
     """
 
     accel: object
@@ -58,6 +64,7 @@ class Force:
     name: str = ""
     flow: tuple = ()
     takes_params: bool = True
+    linear: tuple = ()
 
     def params_for(self, params) -> tuple:
         """The ``params`` this force's functions are called with: the run's, or none (`takes_params`)."""

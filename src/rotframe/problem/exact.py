@@ -1,0 +1,101 @@
+"""The exact flow of a linear problem of your own: ``rotframe.simulate(method="exact")``.
+
+Where every force is linear in ``(r, v)`` with constant coefficients and the frame turns
+steadily, the equation of motion is ``r'' = K r + C v + b`` with constant ``K``, ``C``, ``b``
+(docs/physics/earth.md, the exact linear flow), and its flow is exact: the scenes' own
+(`rotframe.particles.linear.ExactFlow`, ``s(t) = expm(M t) s(0)`` with ``s = (r, v, 1)``; the
+inertial straight line turned into the frame for a particle under the frame's terms alone).
+The engine chooses it from the terms, as the scenes choose it from theirs:
+
+- each built-in term that is linear carries its part, ``Force.linear`` (`rotframe.forces`:
+  uniform gravity ``b += g``, a spring ``K -= k``, linear drag in uniform air ``C -= k1``, the
+  Lorentz force ``C += (q/m) [. x B]``, ``b += (q/m) E``);
+- the frame's terms add theirs, those the run keeps (``frame_terms``): Coriolis
+  ``C -= 2 [w x]``, centrifugal ``K -= [w x]^2`` (Euler's is zero in a steady frame);
+- a constant acceleration of the origin ``b -= a0``.
+
+Anything else is refused by name, in one line: a force of your own or a nonlinear built-in
+term (no linear form), the pendulum's string, a frame whose omega is not constant, an origin
+whose acceleration is not, events (the exact flow locates only the scenes' own), the GPU. The
+matrices are summed in the order the scenes' model sums them
+(`rotframe.particles.model.ParticleModel.linear_matrices`), so a scene's model and the same
+terms given here have the same flow to the bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+from rotframe.problem.terms import Force, StringConstraint
+
+__all__ = ["LinearProblem", "linear_problem"]
+
+
+class LinearProblem:
+    """What the exact flow (`rotframe.particles.linear.ExactFlow`) reads of a model: a linear problem's matrices.
+
+    Attributes
+    ----------
+    terms : tuple of str
+        The terms, by name (the frame's by the scenes' names).
+    omega : OmegaSchedule
+        The frame's steady rotation (its exact angle, for a particle under the frame's terms alone).
+    is_force_free : bool
+        Only the frame's Coriolis and centrifugal terms act: the inertial straight line, turned
+        into the frame, is the flow (exact at every sample however long the run).
+    """
+
+    is_linear = True
+
+    def __init__(self, terms, omega, K, C, b, force_free):
+        self.terms = tuple(terms)
+        self.omega = omega
+        self._matrices = (K, C, b)
+        self.is_force_free = bool(force_free)
+
+    def linear_matrices(self):
+        """``(K, C, b)`` of ``r'' = K r + C v + b``."""
+        K, C, b = self._matrices
+        return K.copy(), C.copy(), b.copy()
+
+
+def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearProblem:
+    """The linear problem of the run's ``terms`` (`Force` or `StringConstraint`, named by ``labels``), or a one-line
+    ScenarioError naming what the exact flow cannot take."""
+    from rotframe.numerics.hat import skew
+    from rotframe.particles.model import OmegaSchedule
+
+    refusal = "method='exact' takes terms linear in (r, v) with constant coefficients in a steady frame"
+    if events:
+        raise ScenarioError(f"events[0]: {refusal}, and locates no events of your own; use dop853")
+    if frame.kind != "constant":
+        raise ScenarioError(f"omega: {refusal}; this frame's omega is a {frame.kind}, not a constant vector; use "
+                            "dop853")
+    if origin.kind not in ("zero", "constant"):
+        raise ScenarioError(f"origin_acceleration: {refusal}; a0 is a {origin.kind}, not a constant; use dop853")
+    omega = OmegaSchedule.constant(frame.data[0])
+    W = skew(omega.vector(0.0))
+    K, C, b = np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3)
+    if "coriolis" in frame_terms:  # the frame's terms first, then the forces: the scenes' order of the sums
+        C -= 2.0 * W
+    if "centrifugal" in frame_terms:
+        K -= W @ W
+    names = []
+    for term, label in zip(terms, labels):
+        if isinstance(term, StringConstraint):
+            raise ScenarioError(f"{label} (pendulum): {refusal}; the string's constraint is not linear; use "
+                                "rotation-splitting, rotation-splitting4, dop853 or rk4")
+        if not isinstance(term, Force) or not term.linear or term.axes != "frame":
+            what = term.name or "a force of your own"
+            raise ScenarioError(f"{label} ({what}): {refusal}; it has no linear form (the built-in terms that do: "
+                                "gravity, spring, drag(linear=...) in uniform air, lorentz); use dop853")
+        Kf, Cf, bf = (np.asarray(m, dtype=float) for m in term.linear)
+        K += Kf
+        C += Cf
+        b += bf
+        names.append(term.name)
+    if origin.kind == "constant":
+        b -= np.asarray(origin.data[0], dtype=float)
+    force_free = not terms and origin.kind == "zero" and {"coriolis", "centrifugal"} <= set(frame_terms)
+    return LinearProblem(names + list(frame_terms), omega, K, C, b, force_free)
