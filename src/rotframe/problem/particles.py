@@ -34,7 +34,6 @@ from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.signatures import PARTICLE
 from rotframe.problem.terms import (FRAME_TERMS, Force, StringConstraint, as_term, check_frame_terms, check_splitting,
                                     model_constants, one_constraint)
 
@@ -74,6 +73,8 @@ def _states(r0, v0):
 
 def problem_tuple(M, p, frame, origin):
     """The engine's `rotframe.problem.signatures.PROBLEM` tuple of a particle problem."""
+    from rotframe.problem.signatures import PARTICLE  # numba's types: imported by the runs that compile
+
     return (PARTICLE, M, p, *frame.packed(), *origin.packed(derivative=False))
 
 
@@ -310,11 +311,11 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     except KeyboardInterrupt:
         if gpu is not None:
             gpu.fetch()
-        traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])))
+        traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])), hfix)
         raise RunInterrupted(traj) from None
     if gpu is not None:
         gpu.fetch()
-    traj = _trajectory(times, OUT, state, events, method, n)
+    traj = _trajectory(times, OUT, state, events, method, n, hfix)
     if np.any(state["ST"] >= 3):
         i = int(np.flatnonzero(state["ST"] >= 3)[0])
         good = int(state["IDX"][i])
@@ -327,7 +328,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         else:
             blame, raised = _blame(forces, params, t_bad, y[i], dt_failed, labels,
                                    _roles(frame, origin, [], [], []))
-        partial = _trajectory(times, OUT, state, events, method, good)
+        partial = _trajectory(times, OUT, state, events, method, good, hfix)
         state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
         if code == 6 or raised:  # a user function raised (compiled: the engine stopped at once)
             raise uf.raised_during_run(f"simulate: particle {i}: a user function raised in the step from "
@@ -454,7 +455,7 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
         where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
     good = int(np.min(state["IDX"]))
     raise uf.raised_during_run(f"simulate: {where}; samples up to there are kept", float(times[max(good, 1) - 1]),
-                               _trajectory(times, OUT, state, events, method, good)) from None
+                               _trajectory(times, OUT, state, events, method, good, hfix)) from None
 
 
 def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
@@ -473,7 +474,8 @@ def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
     raise uf.UserFunctionError(f"simulate: {reason}; pass jit=False to run it in plain Python (slow)") from None
 
 
-def _trajectory(times, OUT, state, events, method, n_kept):
+def _trajectory(times, OUT, state, events, method, n_kept, step=0.0):
+    """The `Trajectory` of the first ``n_kept`` samples; ``step``: a fixed-step method's (``extras["step"]``)."""
     n_kept = max(int(n_kept), 1)
     r = OUT[:n_kept, :, :3].copy()
     v = OUT[:n_kept, :, 3:6].copy()
@@ -493,6 +495,8 @@ def _trajectory(times, OUT, state, events, method, n_kept):
         traj.event_times[name] = np.split(state["EVT"][i, j], cuts)
         traj.event_states[name] = np.split(state["EVY"][i, j, :6], cuts)
     traj.extras["status"] = state["ST"].copy()
+    if step:
+        traj.extras["step"] = step
     return traj
 
 

@@ -6,6 +6,11 @@ level surface takes that), so x'' = f y', y'' = -f x' with f = 2 Omega sin(lat).
 The velocity turns at rate -f: period 2 pi / |f|, radius |v| / |f|, clockwise
 in the north, counter-clockwise in the south, a straight line on the equator.
 The model is linear, so the exact propagator is the default.
+
+Built on the engine of your own problems (`rotframe.problem.particles.simulate_particles`), as
+``cr3bp`` and ``tumbling-ball`` are: the scene chooses its frame (the f-plane's omega), its terms
+(the frame's, by name: ``frame_terms``; Coriolis alone by default) and its theory, and the engine
+chooses the flow (the exact one of a linear problem, `rotframe.problem.exact`, for ``exact``).
 """
 
 from __future__ import annotations
@@ -18,10 +23,9 @@ import numpy as np
 from rotframe import analytic
 from rotframe.numerics.linefit import line_fit
 from rotframe.numerics.vectors import norm3
-from rotframe.particles.integrators import default_method
-from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, method_rel_error, particle_methods,
-                                  reject_subnormal, rel_drift, run_particles, samples_for, unresolved_note,
+from rotframe.errors import ScenarioError
+from rotframe.scenes.base import (guarded, run_setting, SceneResult, earth_model_constants, method_rel_error,
+                                  particle_methods, reject_subnormal, rel_drift, samples_for, unresolved_note,
                                   with_parameters)
 
 
@@ -42,33 +46,45 @@ PARAMETERS = InertialOscillationParameters
 #: Every particle integrator (the registry's names; its old names accepted too).
 METHODS = particle_methods()
 #: What runs when ``--method`` names none (``rotframe show`` prints it).
-DEFAULT_METHOD = "exact where the model is linear (the default terms), else rotation-splitting"
+DEFAULT_METHOD = "exact (the model is linear: the frame's terms in a steady frame)"
 
 
 @with_parameters(InertialOscillationParameters)
 def build(p, terms):
+    """``(omega, frame_terms, r0, v0, Omega)``: the f-plane's omega (its vertical part, rad/s), the frame's terms
+    the model names (a term that is not the frame's is refused: nothing else acts on the puck), the start."""
+    from rotframe.problem.terms import FRAME_TERMS  # the engine's modules import numba: when a run needs them
+
+    others = [t for t in terms if t not in FRAME_TERMS]
+    if others:
+        raise ScenarioError(f"model: {others[0]!r} is not a term of this scene; the puck feels the frame's terms "
+                            f"alone ({', '.join(FRAME_TERMS)})")
     Omega, w, g = earth_model_constants(p.latitude)
     f_plane = np.array([0.0, 0.0, w[2]])
-    model = ParticleModel(tuple(terms), omega=OmegaSchedule.constant(f_plane))
     az = math.radians(p.heading)
     v0 = p.speed * np.array([math.sin(az), math.cos(az), 0.0])
-    return model, np.zeros(3), v0, Omega
+    return f_plane, tuple(terms), np.zeros(3), v0, Omega
 
 
 @with_parameters(InertialOscillationParameters)
 def simulate(p, terms, method, run, progress):
+    from rotframe.problem.particles import simulate_particles
+
     reject_subnormal(p)
-    model, r0, v0, Omega = build(p, terms)
-    method = method or default_method(model)
+    f_plane, frame_terms, r0, v0, Omega = build(p, terms)
+    method = particle_methods().canonical(method) if method else "exact"  # the model is linear
     f = abs(2 * Omega * math.sin(math.radians(p.latitude)))
     period = 2 * math.pi / f if f > 0 else math.inf
     samples, resolved = samples_for(p.duration, period, run_setting(run, "samples"))
 
-    def finish(traj):
-        return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
+    def finish(res):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(res, "trajectory", res)
+        return SceneResult(traj, list(frame_terms), traj.method, traj.steps, traj.nfev,
                            extras={"Omega": Omega, "resolved": resolved, "period": period})
 
-    return run_particles(model, r0, v0, p.duration, method, dict(run, samples=samples), progress, finish)
+    return guarded(finish, simulate_particles, omega=f_plane, r0=r0, v0=v0, duration=p.duration, method=method,
+                   frame_terms=frame_terms, rtol=run_setting(run, "rtol"), step=run.get("step"), samples=samples,
+                   progress=progress)
 
 
 #: A heading that turns by less than this (rad) over the run is round-off, not rotation.
