@@ -19,6 +19,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import rotframe
+from inertial_circle import inertial_circle
 from rotframe import forces
 from rotframe.errors import ScenarioError
 from rotframe.problem.terms import FRAME_TERMS, check_frame_terms
@@ -101,10 +102,7 @@ def test_coriolis_alone_turns_the_velocity_clockwise_at_2_omega(method):
     v0 = np.array([3.0, 1.0, 0.0])
     res = rotframe.simulate(omega=W_F, r0=[0.0, 0.0, 0.0], v0=v0, duration=period, method=method, samples=40,
                             frame_terms=("coriolis",), step=None if method == "dop853" else h)
-    t = res.trajectory.times
-    c, s = np.cos(f * t), np.sin(f * t)
-    v = np.stack([c * v0[0] + s * v0[1], -s * v0[0] + c * v0[1], 0.0 * t], axis=1)
-    r = np.stack([(s * v0[0] + (1 - c) * v0[1]) / f, ((c - 1) * v0[0] + s * v0[1]) / f, 0.0 * t], axis=1)
+    r, v = inertial_circle(f, v0, res.trajectory.times)
     speed = np.linalg.norm(v0)
     assert np.max(np.abs(res.trajectory.v[:, 0] - v)) < 1e-8 * speed
     tol = (f * h) ** 2 if method == "rotation-splitting" else 1e-8

@@ -17,6 +17,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 import rotframe
+from inertial_circle import inertial_circle
 from rotframe import forces
 from rotframe.errors import ScenarioError
 
@@ -31,10 +32,7 @@ def test_coriolis_alone_is_the_inertial_circle_and_the_scenes_exact_flow():
     v0 = np.array([3.0, 1.0, 0.0])
     res = rotframe.simulate(omega=w, r0=[0.0, 0.0, 0.0], v0=v0, duration=3 * period, method="exact", samples=90,
                             frame_terms=("coriolis",))
-    t = res.trajectory.times
-    c, s = np.cos(f * t), np.sin(f * t)
-    v = np.stack([c * v0[0] + s * v0[1], -s * v0[0] + c * v0[1], 0.0 * t], axis=1)
-    r = np.stack([(s * v0[0] + (1 - c) * v0[1]) / f, ((c - 1) * v0[0] + s * v0[1]) / f, 0.0 * t], axis=1)
+    r, v = inertial_circle(f, v0, res.trajectory.times)
     speed = np.linalg.norm(v0)
     assert np.max(np.abs(res.trajectory.v[:, 0] - v)) < 1e-12 * speed
     assert np.max(np.abs(res.trajectory.r[:, 0] - r)) < 1e-12 * speed / f
@@ -174,3 +172,12 @@ def test_what_the_exact_flow_cannot_take_is_refused_by_name(kwargs, words):
 def test_methods_lists_exact_for_your_own_particles():
     exact = next(m for m in rotframe.methods() if m["name"] == "exact")
     assert "particles" in exact["runs"] and not exact["gpu"]
+
+
+def test_settings_the_exact_flow_has_no_use_for_are_named_in_a_note():
+    res = rotframe.simulate(omega=[0.0, 0.0, 1e-4], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=100.0,
+                            method="exact", step=1.0, atol=1e-9)
+    assert any("step, atol not used" in note for note in res.notes)
+    quiet = rotframe.simulate(omega=[0.0, 0.0, 1e-4], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=100.0,
+                              method="exact")
+    assert not any("not used" in note for note in quiet.notes)

@@ -119,8 +119,10 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     events : sequence of callables
         ``g(t, r, v, *params) -> float`` with optional ``terminal`` and ``direction``
         attributes, as in ``scipy.integrate.solve_ivp``; times in ``trajectory.event_times``.
-    method : {"dop853", "rk4", "rotation-splitting", "rotation-splitting4"}, optional
-        Any case; default DOP853 at ``rtol`` (default 1e-10).
+    method : {"dop853", "rk4", "rotation-splitting", "rotation-splitting4", "exact"}, optional
+        Any case; default DOP853 at ``rtol`` (default 1e-10). ``"exact"``: the exact flow of a
+        linear problem (the built-in linear terms in a steady frame, `rotframe.problem.exact`;
+        anything else refused by name), no step and no tolerance.
     rtol, step, samples : optional
         DOP853's tolerance; RK4's step (s); samples kept (default 1000 intervals).
     max_events : int

@@ -4,7 +4,8 @@
 SI units, no printing, no files. It builds (or finds in the cache) a driver compiled for the
 problem's functions (`rotframe.problem.codegen`), integrates every particle on its own
 (DOP853 with Hairer's step control; RK4 or the rotation splittings of order 2 and 4 at a fixed
-step, the splittings with the forces as kicks: `rotframe.problem.terms.check_splitting`), locates the events by bisection
+step, the splittings with the forces as kicks: `rotframe.problem.terms.check_splitting`; the
+exact flow of a linear problem, nothing compiled: `rotframe.problem.exact`), locates the events by bisection
 on the method's own re-steps, and reports the energy or the Jacobi integral where the forces
 give their potentials.
 
@@ -184,9 +185,11 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
         raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
     frame_terms = check_frame_terms(frame_terms)
+    rtol_given = rtol
     r, v = _states(r0, v0)
     N = r.shape[0]
-    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=method not in ("dop853", "exact"),
+    fixed = method not in ("dop853", "exact")
+    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed,
                                                     what=f"method {method}", particles=N)
     frame = frame_spec(omega, omega_dot)
     origin = origin_spec(origin_acceleration)
@@ -206,7 +209,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if method.startswith("rotation-splitting"):
         check_splitting(method, forces, labels)
     if method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
-        return _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress)
+        ignored = [key for key, value in (("step", step), ("rtol", rtol_given), ("atol", atol)) if value is not None]
+        return _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress, ignored)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
@@ -340,6 +344,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
+
     def energies(rotating):
         return driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, fns, driver.potential(),
                                rotating)
@@ -515,9 +520,10 @@ def _event_names(events):
     return names
 
 
-def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress) -> ProblemRun:
+def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress, ignored) -> ProblemRun:
     """``method="exact"``: the exact flow of the run's linear problem (`rotframe.problem.exact`), the scenes' own
-    (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
+    (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials.
+    ``ignored``: the settings given that the exact flow has no use for (a note names them)."""
     from rotframe.particles.integrators import integrate_exact
     from rotframe.problem.exact import linear_problem
 
@@ -528,6 +534,8 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     diagnostics = {}
     notes = list(frame.notes) + ["method exact: the flow of r'' = K r + C v + b (the terms' linear forms and the "
                                  "frame's), to round-off"]
+    if ignored:
+        notes.append(f"method exact has no step and no tolerance: {', '.join(ignored)} not used")
 
     def energies(rotating):
         n, N = traj.r.shape[:2]
