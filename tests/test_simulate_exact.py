@@ -174,10 +174,20 @@ def test_methods_lists_exact_for_your_own_particles():
     assert "particles" in exact["runs"] and not exact["gpu"]
 
 
-def test_settings_the_exact_flow_has_no_use_for_are_named_in_a_note():
-    res = rotframe.simulate(omega=[0.0, 0.0, 1e-4], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=100.0,
-                            method="exact", step=1.0, atol=1e-9)
-    assert any("step, atol not used" in note for note in res.notes)
-    quiet = rotframe.simulate(omega=[0.0, 0.0, 1e-4], r0=[0.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=100.0,
-                              method="exact")
-    assert not any("not used" in note for note in quiet.notes)
+@pytest.mark.parametrize("method, given, flagged", [
+    ("exact", {"step": 1.0, "atol": 1e-9}, ["step", "atol"]),
+    ("exact", {"rtol": 1e-8}, ["rtol"]),
+    ("dop853", {"step": 1.0, "rtol": 1e-9}, ["step"]),
+    ("rk4", {"rtol": 1e-6, "atol": 1e-9, "step": 1.0}, ["rtol", "atol"]),
+    ("rotation-splitting", {"step": 1.0}, []),
+])
+def test_a_setting_the_method_does_not_read_is_flagged_and_changes_nothing(method, given, flagged):
+    """The scenes' rule (`rotframe.method_registry.unread_settings`) in ``rotframe.simulate``: each unread setting
+    the caller gave is named in a warning, and two values of it give the same numbers to the bit."""
+    kw = dict(omega=[0.0, 0.0, 1e-2], r0=[1.0, 0.0, 0.0], v0=[1.0, 0.0, 0.0], duration=10.0, method=method, samples=5)
+    res = rotframe.simulate(**kw, **given)
+    warned = [w.split(" = ")[0] for w in res.warnings if "is not used" in w]
+    assert warned == flagged
+    for key in flagged:
+        other = rotframe.simulate(**kw, **dict(given, **{key: given[key] * 0.5}))
+        assert np.array_equal(res.trajectory.r, other.trajectory.r)

@@ -27,7 +27,7 @@ from dataclasses import dataclass, fields
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["Method", "MethodNames", "methods", "get", "names", "check", "PROBLEMS"]
+__all__ = ["Method", "MethodNames", "methods", "get", "names", "check", "PROBLEMS", "UNREAD", "unread_settings"]
 
 #: The problems a method may run (``Method.runs``), in the order `methods` lists them.
 PROBLEMS = ("particle scenes", "particles", "bodies", "free body", "heavy top")
@@ -134,7 +134,7 @@ def methods(runs: str | None = None) -> list:
     Examples
     --------
     >>> [m.name for m in methods("particles")]
-    ['rotation-splitting', 'rotation-splitting4', 'rk4', 'dop853']
+    ['exact', 'rotation-splitting', 'rotation-splitting4', 'rk4', 'dop853']
     >>> get("rotation-splitting4").order, get("rotation-splitting4").gpu
     (4, True)
     """
@@ -142,6 +142,28 @@ def methods(runs: str | None = None) -> list:
         return list(_REGISTRY)
     _check_problem(runs)
     return [m for m in _REGISTRY if runs in m.runs]
+
+
+#: The run settings each kind of method does not read (`Method.step`): an adaptive method chooses its own steps,
+#: a fixed-step one has no tolerance, the exact flow neither.
+UNREAD = {"exact": ("step", "rtol", "atol"), "adaptive": ("step",), "fixed": ("rtol", "atol")}
+
+
+def unread_settings(method: str, given: dict) -> list:
+    """Warnings for the settings in ``given`` (name -> value, as the caller set them) that ``method`` does not read.
+
+    ``exact`` reads neither a step nor a tolerance, ``dop853`` (adaptive) chooses its own steps
+    from ``rtol``, and every other method takes fixed steps and has no tolerance (`UNREAD`). The
+    one rule of the scenes' runs (`rotframe.app.runner.unused_settings`) and ``rotframe.simulate``'s.
+
+    >>> unread_settings("dop853", {"step": 0.5, "rtol": 1e-10})
+    ['step = 0.5 is not used: dop853 is adaptive and chooses its own steps (set rtol instead)']
+    """
+    kind = "exact" if method == "exact" else "adaptive" if method == "dop853" else "fixed"
+    why = {"exact": f"{method} evaluates the exact flow, with no steps and no tolerance",
+           "adaptive": f"{method} is adaptive and chooses its own steps (set rtol instead)",
+           "fixed": f"{method} takes fixed steps and has no tolerance (set step instead)"}[kind]
+    return [f"{key} = {given[key]} is not used: {why}" for key in UNREAD[kind] if key in given]
 
 
 def get(name: str) -> Method:

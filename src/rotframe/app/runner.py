@@ -107,27 +107,20 @@ def summarize(scn, values, result, timing, given=()):
     return summary
 
 
-#: The run settings that each kind of method does not read: an adaptive method chooses its own steps,
-#: a fixed-step one has no tolerance, the exact flow neither.
-_UNREAD = {"exact": ("step", "rtol"), "adaptive": ("step",), "fixed": ("rtol",)}
-
-
 def unused_settings(given, run, method):
     """Warnings for the run settings a caller set (keys in ``given``) that ``method`` does not read.
 
-    ``exact`` reads neither ``step`` nor ``rtol``, ``dop853`` (adaptive) chooses its own
-    steps from ``rtol``, and every other method (particle and rigid) takes fixed steps and
-    has no tolerance. A setting the scenario file gives is not warned about: files set both
-    for whichever method runs.
+    The registry's one rule (`rotframe.method_registry.unread_settings`): ``exact`` reads neither
+    ``step`` nor ``rtol``, ``dop853`` (adaptive) chooses its own steps from ``rtol``, and every
+    other method (particle and rigid) takes fixed steps and has no tolerance. A setting the
+    scenario file gives is not warned about: files set both for whichever method runs.
 
     >>> unused_settings({"step": "0.5"}, {"step": 0.5, "rtol": 1e-10}, "dop853")
     ['step = 0.5 is not used: dop853 is adaptive and chooses its own steps (set rtol instead)']
     """
-    kind = "exact" if method == "exact" else "adaptive" if method == "dop853" else "fixed"
-    why = {"exact": f"{method} evaluates the exact flow, with no steps and no tolerance",
-           "adaptive": f"{method} is adaptive and chooses its own steps (set rtol instead)",
-           "fixed": f"{method} takes fixed steps and has no tolerance (set step instead)"}[kind]
-    return [f"{key} = {run.get(key)} is not used: {why}" for key in _UNREAD[kind] if key in given]
+    from rotframe.method_registry import unread_settings
+
+    return unread_settings(method, {key: run.get(key) for key in given})
 
 
 def _gpu_unused(scn, result):
