@@ -10,6 +10,7 @@ the body's frame (omega from the rigid solution, Euler force from Euler's equati
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
@@ -59,3 +60,19 @@ def test_the_frame_knots_bound_the_steps_and_both_tolerances_hold():
         assert res.metrics["position_error_m"] < 10 * rtol * max(res.metrics["curl_m"], 1.0)
         assert not res.warnings
     assert tight.metrics["position_error_m"] <= 2 * loose.metrics["position_error_m"]
+
+
+@pytest.mark.parametrize("duration, samples", [(1.0, 1000), (3.7, 333), (0.05, 7)])
+def test_any_duration_and_sample_count_runs(duration, samples):
+    """The ball's samples are always among the body's (the oracle reads the attitude there): a whole number of
+    body samples between two of the ball's, whatever the duration and the sample count (a duration of 1 s with
+    1000 samples was an internal error)."""
+    res = rotframe.run("tumbling-ball", duration=duration, samples=samples)
+    assert res.trajectory.times.size == samples + 1
+    p = res.params
+    I = np.array([p["i1"], p["i2"], p["i3"]])
+    w0, r0, v0 = (np.array(p[k], dtype=float) for k in ("omega", "position", "velocity"))
+    t = res.trajectory.times
+    line = r0 + t[:, None] * (v0 + np.cross(w0, r0))
+    exact = Rotation.from_quat(_body_attitude(I, w0, t)).inv().apply(line)
+    assert np.max(np.linalg.norm(res.trajectory.r[:, 0] - exact, axis=1)) < 1e-9 * np.max(np.linalg.norm(line, axis=1))

@@ -22,6 +22,8 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+from rotframe import method_registry as registry
+
 __all__ = ["simulate", "simulate_body", "ProblemScenario"]
 
 
@@ -203,6 +205,9 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     finally:
         if progress is True:  # the bar is ours to end
             bar.close()
+    # a setting the caller gave that the method does not read is flagged, as in the scenes' runs (the registry's rule)
+    given = {key: value for key, value in (("step", step), ("rtol", rtol), ("atol", atol)) if value is not None}
+    run.warnings[:0] = registry.unread_settings(run.trajectory.method, given)
     return _particle_result(run, forces, origin_acceleration, duration, time.perf_counter() - t0)
 
 

@@ -185,9 +185,6 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
         raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
     frame_terms = check_frame_terms(frame_terms)
-    # a setting the method does not read is flagged (the scenes' rule, `rotframe.method_registry.unread_settings`)
-    unread = registry.unread_settings(method, {key: value for key, value in (("step", step), ("rtol", rtol),
-                                                                             ("atol", atol)) if value is not None})
     r, v = _states(r0, v0)
     N = r.shape[0]
     fixed = method not in ("dop853", "exact")
@@ -211,7 +208,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     if method.startswith("rotation-splitting"):
         check_splitting(method, forces, labels)
     if method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
-        return _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress, unread)
+        return _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress)
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
@@ -341,7 +338,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                                        t_bad, partial)
         raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
                                f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
-    warnings, notes, diagnostics = list(unread), list(frame.notes) + cache_notes, {}
+    warnings, notes, diagnostics = [], list(frame.notes) + cache_notes, {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
@@ -521,10 +518,9 @@ def _event_names(events):
     return names
 
 
-def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress, unread) -> ProblemRun:
+def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress) -> ProblemRun:
     """``method="exact"``: the exact flow of the run's linear problem (`rotframe.problem.exact`), the scenes' own
-    (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials.
-    ``unread``: the warnings for the settings given that the exact flow does not read."""
+    (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
     from rotframe.particles.integrators import integrate_exact
     from rotframe.problem.exact import linear_problem
 
@@ -548,7 +544,7 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
         return E.reshape(n, N)
 
     _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)
-    return ProblemRun(traj, diagnostics, list(unread), notes, frame, 0.0, frame_terms)
+    return ProblemRun(traj, diagnostics, [], notes, frame, 0.0, frame_terms)
 
 
 def _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms):

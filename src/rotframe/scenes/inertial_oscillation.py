@@ -80,7 +80,9 @@ def simulate(p, terms, method, run, progress):
     def finish(res):  # a ProblemRun, or the trajectory up to an early stop
         traj = getattr(res, "trajectory", res)
         return SceneResult(traj, list(frame_terms), traj.method, traj.steps, traj.nfev,
-                           extras={"Omega": Omega, "resolved": resolved, "period": period})
+                           extras={"Omega": Omega, "resolved": resolved, "period": period,
+                                   "notes": list(getattr(res, "notes", [])),  # the engine's, passed on
+                                   "warnings": list(getattr(res, "warnings", []))})
 
     return guarded(finish, simulate_particles, omega=f_plane, r0=r0, v0=v0, duration=p.duration, method=method,
                    frame_terms=frame_terms, rtol=run_setting(run, "rtol"), step=run.get("step"), samples=samples,
@@ -156,7 +158,8 @@ def analyse(p, result):
         warnings.append(f"sense of rotation: measured {diagnostics['sense']}, but f = 2 Omega sin(latitude) says "
                         + ("clockwise" if expected < 0 else "counter-clockwise"))
     return {"metrics": metrics, "theory": theory_vals, "theory_notes": theory_notes, "tolerance": tolerance,
-            "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
+            "diagnostics": diagnostics, "notes": notes + result.extras.get("notes", []),
+            "warnings": warnings + result.extras.get("warnings", [])}
 
 
 @with_parameters(InertialOscillationParameters, position=1)

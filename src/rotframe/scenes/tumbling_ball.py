@@ -62,7 +62,11 @@ def simulate(p, terms, method, run, progress):
     L0 = inertia * w0
     q0 = np.array([0.0, 0.0, 0.0, 1.0])
     duration = float(p.duration)
+    samples = int(run_setting(run, "samples"))
+    # the body's samples: at least BODY_SAMPLES_PER_S a second, a whole number of them between two of the
+    # ball's, so that every sample of the ball is one of the body's (the oracle reads the attitude there)
     n_body = max(int(math.ceil(BODY_SAMPLES_PER_S * duration)), 16)
+    n_body = samples * max(1, math.ceil(n_body / samples))
     body = simulate_rigid_body(inertia=inertia, L0=L0, q0=q0, duration=duration, method="exact", samples=n_body)
     r0 = np.asarray(p.position, dtype=float)
     v0 = np.asarray(p.velocity, dtype=float)
@@ -76,7 +80,7 @@ def simulate(p, terms, method, run, progress):
 
     return guarded(finish, simulate_particles, omega=body, r0=r0, v0=v0, duration=duration,
                    method=method or DEFAULT_METHOD, rtol=run_setting(run, "rtol"), step=run.get("step"),
-                   samples=int(run_setting(run, "samples")), progress=progress)
+                   samples=samples, progress=progress)
 
 
 def oracle(body, times, r0, v0, w0):
