@@ -45,20 +45,24 @@ def test_coriolis_alone_is_the_inertial_circle_and_the_scenes_exact_flow():
     assert np.max(np.abs(res.trajectory.v[:, 0] - scene.v[:, 0])) < 1e-14 * speed
 
 
-def test_the_cyclotron_orbit_and_the_e_cross_b_drift():
-    """v' = (q/m)(E + v x B), E perpendicular to B: v = u + R(-w_c t)(v0 - u), u = E x B / B^2, w_c = (q/m) |B|."""
-    qm, Bz = 2.0, 0.5
-    E = np.array([0.3, -0.2, 0.0])
+@pytest.mark.parametrize("B, E", [([0.0, 0.0, 0.5], [0.3, -0.2, 0.0]), ([0.3, -0.4, 0.5], [0.2, 0.1, -0.3])])
+def test_the_cyclotron_orbit_and_the_e_cross_b_drift(B, E):
+    """v' = (q/m)(E + v x B): with u = E x B / B^2 and w = v0 - u, v = u + w_par + (q/m) E_par t + R(-w_c t) w_perp,
+    the part across B turned about B at w_c = (q/m) |B| (scipy's Rotation), E along B accelerating along it."""
+    qm = 2.0
+    B, E = np.array(B), np.array(E)
     v0 = np.array([1.0, 0.5, 0.25])
-    wc = qm * Bz
-    u = np.cross(E, [0.0, 0.0, Bz]) / Bz ** 2
+    b = B / np.linalg.norm(B)
+    wc = qm * np.linalg.norm(B)
+    u = np.cross(E, B) / (B @ B)
+    w = v0 - u
+    w_par, E_par = (w @ b) * b, (E @ b) * b
     res = rotframe.simulate(omega=[0.0, 0.0, 0.0], r0=[0.0, 0.0, 0.0], v0=v0, duration=20.0, method="exact",
-                            samples=40, forces=[forces.lorentz(qm, [0.0, 0.0, Bz], E)])
+                            samples=40, forces=[forces.lorentz(qm, B, E)])
     t = res.trajectory.times
-    c, s = np.cos(wc * t), np.sin(wc * t)
-    d = v0 - u
-    v = np.stack([u[0] + c * d[0] + s * d[1], u[1] - s * d[0] + c * d[1], v0[2] + 0.0 * t], axis=1)
-    assert np.max(np.abs(res.trajectory.v[:, 0] - v)) < 1e-12 * np.linalg.norm(v0)
+    turned = Rotation.from_rotvec(-wc * t[:, None] * b).apply(w - w_par)
+    v = u + w_par + qm * t[:, None] * E_par + turned
+    assert np.max(np.abs(res.trajectory.v[:, 0] - v)) < 1e-12 * np.max(np.abs(v))
 
 
 def test_a_damped_spring_about_its_anchor():
@@ -74,6 +78,21 @@ def test_a_damped_spring_about_its_anchor():
     B = (v0 + c / 2 * A) / wd
     x = anchor + np.exp(-c * t / 2) * (A * np.cos(wd * t) + B * np.sin(wd * t))
     assert np.max(np.abs(res.trajectory.r[:, 0] - x)) < 1e-12 * 3.0
+
+
+def test_a_horizontal_spring_under_gravity():
+    """The scenes' small-angle pendulum: x and y pulled back to the anchor at rate sqrt(k), z falling freely."""
+    k, g = 0.25, np.array([0.0, 0.0, -9.81])
+    anchor = np.array([1.0, 2.0, 30.0])  # its height pulls nothing
+    r0, v0 = np.array([0.0, 0.5, 10.0]), np.array([0.3, 0.0, 4.0])
+    res = rotframe.simulate(omega=[0.0, 0.0, 0.0], r0=r0, v0=v0, duration=6.0, method="exact", samples=12,
+                            forces=[forces.spring(k, anchor, horizontal=True), forces.gravity(g)])
+    t = res.trajectory.times[:, None]
+    w = math.sqrt(k)
+    xy = anchor[:2] + (r0[:2] - anchor[:2]) * np.cos(w * t) + v0[:2] / w * np.sin(w * t)
+    z = r0[2] + v0[2] * t[:, 0] + 0.5 * g[2] * t[:, 0] ** 2
+    assert np.max(np.abs(res.trajectory.r[:, 0, :2] - xy)) < 1e-12 * 3.0
+    assert np.max(np.abs(res.trajectory.r[:, 0, 2] - z)) < 1e-12 * 100.0
 
 
 def test_gravity_in_an_accelerating_frame_is_a_parabola():
@@ -135,8 +154,8 @@ def test_an_ensemble_is_each_particle_alone():
 def test_the_energy_diagnostic(terms, name):
     res = rotframe.simulate(omega=[0.0, 0.0, 0.1], r0=[1.0, 0.0, 0.0], v0=[0.0, 0.3, 0.2], duration=60.0,
                             method="exact", samples=50, frame_terms=terms,
-                            forces=[forces.spring(0.04), forces.gravity([0.0, 0.0, -1.0])])
-    assert res.diagnostics[f"{name}_rel_drift"] < 1e-10
+                            forces=[forces.spring(0.04, [0.3, -0.2, 0.1]), forces.gravity([0.1, -0.2, -1.0])])
+    assert res.diagnostics[f"{name}_rel_drift"] < 1e-10  # each potential exercised: a wrong one drifts
     assert len(res.diagnostics) == 1
 
 
