@@ -152,14 +152,17 @@ UNREAD = {"exact": ("step", "rtol", "atol"), "adaptive": ("step",), "fixed": ("r
 def unread_settings(method: str, given: dict) -> list:
     """Warnings for the settings in ``given`` (name -> value, as the caller set them) that ``method`` does not read.
 
-    ``exact`` reads neither a step nor a tolerance, ``dop853`` (adaptive) chooses its own steps
-    from ``rtol``, and every other method takes fixed steps and has no tolerance (`UNREAD`). The
-    one rule of the scenes' runs (`rotframe.app.runner.unused_settings`) and ``rotframe.simulate``'s.
+    The kind is the method's ``step`` in the registry (a method it does not hold, of a scene of
+    your own, counts as fixed-step): ``exact`` reads neither a step nor a
+    tolerance, ``dop853`` (adaptive) chooses its own steps from ``rtol``, and every other method
+    takes fixed steps and has no tolerance (`UNREAD`). The one rule of the scenes' runs
+    (`rotframe.app.runner.unused_settings`) and ``rotframe.simulate``'s.
 
     >>> unread_settings("dop853", {"step": 0.5, "rtol": 1e-10})
     ['step = 0.5 is not used: dop853 is adaptive and chooses its own steps (set rtol instead)']
     """
-    kind = "exact" if method == "exact" else "adaptive" if method == "dop853" else "fixed"
+    known = _BY_NAME.get(method.lower() if isinstance(method, str) else method)
+    kind = known.step if known is not None else "fixed"  # a method of a scene of your own (register_scene): fixed
     why = {"exact": f"{method} evaluates the exact flow, with no steps and no tolerance",
            "adaptive": f"{method} is adaptive and chooses its own steps (set rtol instead)",
            "fixed": f"{method} takes fixed steps and has no tolerance (set step instead)"}[kind]

@@ -314,8 +314,7 @@ class ExactFlow:
             step_matrix = flow_at(self.M, dt)
             for _ in range(self.BLOCK - 1):
                 powers.append(step_matrix @ powers[-1])
-            self.powers = powers
-            self.stacked_powers = np.stack(powers)
+            self.powers = np.stack(powers)  # (BLOCK, 7, 7): Phi of 0, 1, ... BLOCK - 1 intervals
 
     def _block(self, start):
         """expm at the block's first sample (linear), or Phi_k of the block's samples (force-free)."""
@@ -340,7 +339,7 @@ class ExactFlow:
                 anchor = product(block, s0)
                 m = min(self.BLOCK, K - start)
                 if ordered:  # the block's samples in one product (the same bits as one at a time)
-                    out[start:start + m] = ordered_product(self.stacked_powers[:m], anchor)
+                    out[start:start + m] = ordered_product(self.powers[:m], anchor)
                 else:
                     for j in range(m):
                         out[start + j] = self.powers[j] @ anchor

@@ -17,9 +17,10 @@ The engine chooses it from the terms, as the scenes choose it from theirs:
 Anything else is refused by name, in one line: a force of your own or a nonlinear built-in
 term (no linear form), the pendulum's string, a frame whose omega is not constant, an origin
 whose acceleration is not, events (the exact flow locates only the scenes' own), the GPU. The
-matrices are summed in the order the scenes' model sums them
-(`rotframe.particles.model.ParticleModel.linear_matrices`), so a scene's model and the same
-terms given here have the same flow to the bit.
+frame's part is the scenes' model of the frame's terms
+(`rotframe.particles.model.ParticleModel.linear_matrices` and ``is_force_free``), the forces' parts
+added after it in the scenes' order, so a scene's model and the same terms given here have the
+same matrices to the bit.
 """
 
 from __future__ import annotations
@@ -63,8 +64,7 @@ class LinearProblem:
 def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearProblem:
     """The linear problem of the run's ``terms`` (`Force` or `StringConstraint`, named by ``labels``), or a one-line
     ScenarioError naming what the exact flow cannot take."""
-    from rotframe.numerics.hat import skew
-    from rotframe.particles.model import OmegaSchedule
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     refusal = "method='exact' takes terms linear in (r, v) with constant coefficients in a steady frame"
     if events:
@@ -74,13 +74,10 @@ def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearP
                             "dop853")
     if origin.kind not in ("zero", "constant"):
         raise ScenarioError(f"origin_acceleration: {refusal}; a0 is a {origin.kind}, not a constant; use dop853")
-    omega = OmegaSchedule.constant(frame.data[0])
-    W = skew(omega.vector(0.0))
-    K, C, b = np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3)
-    if "coriolis" in frame_terms:  # the frame's terms first, then the forces: the scenes' order of the sums
-        C -= 2.0 * W
-    if "centrifugal" in frame_terms:
-        K -= W @ W
+    # the frame's terms are the scenes' model of them (its matrices, and whether it is force-free), then the
+    # forces are added: the scenes' order of the sums
+    frame_model = ParticleModel(tuple(frame_terms), omega=OmegaSchedule.constant(frame.data[0]))
+    K, C, b = frame_model.linear_matrices()
     names = []
     for term, label in zip(terms, labels):
         if isinstance(term, StringConstraint):
@@ -97,5 +94,5 @@ def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearP
         names.append(term.name)
     if origin.kind == "constant":
         b -= np.asarray(origin.data[0], dtype=float)
-    force_free = not terms and origin.kind == "zero" and {"coriolis", "centrifugal"} <= set(frame_terms)
-    return LinearProblem(names + list(frame_terms), omega, K, C, b, force_free)
+    force_free = not terms and origin.kind == "zero" and frame_model.is_force_free
+    return LinearProblem(names + list(frame_terms), frame_model.omega, K, C, b, force_free)

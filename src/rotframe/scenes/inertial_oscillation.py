@@ -53,7 +53,7 @@ DEFAULT_METHOD = "exact (the model is linear: the frame's terms in a steady fram
 def build(p, terms):
     """``(omega, frame_terms, r0, v0, Omega)``: the f-plane's omega (its vertical part, rad/s), the frame's terms
     the model names (a term that is not the frame's is refused: nothing else acts on the puck), the start."""
-    from rotframe.problem.terms import FRAME_TERMS  # the engine's modules import numba: when a run needs them
+    from rotframe.problem.terms import FRAME_TERMS  # imported by a run, not by listing or describing the scene
 
     others = [t for t in terms if t not in FRAME_TERMS]
     if others:
@@ -68,7 +68,7 @@ def build(p, terms):
 
 @with_parameters(InertialOscillationParameters)
 def simulate(p, terms, method, run, progress):
-    from rotframe.problem.particles import simulate_particles
+    from rotframe.problem.particles import simulate_particles  # the engine's front door: imported by a run
 
     reject_subnormal(p)
     f_plane, frame_terms, r0, v0, Omega = build(p, terms)
