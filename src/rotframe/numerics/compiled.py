@@ -28,7 +28,7 @@ from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_llvm_inline", "jit_inline", "inlined", "uncounted", "bound",
-           "CompiledOnlyDispatcher", "source_fingerprint"]
+           "CompiledOnlyDispatcher", "source_fingerprint", "global_names"]
 
 #: The package's folder: a kernel defined in a file below it is cached with `source_fingerprint` as its stamp.
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -206,3 +206,16 @@ def inlined(kernel):
     For a kernel whose callers are few and large: a first run compiles one function less.
     """
     return njit(inline="always", error_model="numpy", nogil=True)(kernel.py_func)
+
+
+def global_names(code) -> set:
+    """Every global name ``code`` (and the code objects nested in it) may read: what a copy of a compiled function
+    rebinds (`rotframe.particles.gpu.device_function`, `rotframe.problem.inlined`) and what a user function's
+    fingerprint reads (`rotframe.problem.callables.fingerprint`)."""
+    import types
+
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= global_names(const)
+    return names

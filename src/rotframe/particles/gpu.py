@@ -92,13 +92,15 @@ def device_function(kernel, made=None):
     from numba import cuda
     from numba.core.dispatcher import Dispatcher
 
+    from rotframe.numerics.compiled import global_names
+
     made = _DEVICE if made is None else made
     done = made.get(kernel)
     if done is not None:
         return done
     fn = kernel.py_func if isinstance(kernel, Dispatcher) else kernel
     names = dict(fn.__globals__)
-    for name in _global_names(fn.__code__):
+    for name in global_names(fn.__code__):
         value = names.get(name)
         if isinstance(value, Dispatcher) or _replaced(made, value):
             names[name] = device_function(value, made)
@@ -133,15 +135,6 @@ def inline_options():
     if not config.ENABLE_CUDASIM and "forceinline" in inspect.signature(cuda.jit).parameters:
         return {"forceinline": True}
     return {}
-
-
-def _global_names(code):
-    """Every global name ``code`` (and the code objects nested in it) may read."""
-    out = set(code.co_names)
-    for const in code.co_consts:
-        if isinstance(const, types.CodeType):
-            out |= _global_names(const)
-    return out
 
 
 def _ensemble_kernel_source(r, v, t0, h, n_steps, P, wt, wv, wint, events, out, ev_t):

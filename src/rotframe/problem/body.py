@@ -24,6 +24,7 @@ from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.glue import body_source, flatten_params
+from rotframe.problem.inlined import Inlining
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
 from rotframe import method_registry as registry
@@ -101,10 +102,9 @@ def _inertia(inertia):
 
 
 def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
-                        samples=None, jit=True, progress=None) -> BodyRun:
+                        samples=None, jit=True, progress=None, inline=None) -> BodyRun:
     """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
     import time
-
 
     attitude_only = bool(getattr(torque, "attitude_only", False))
     if isinstance(torque, Torque):
@@ -141,6 +141,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if torque is not None and not callable(torque):
         raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
     check_flag(jit, "jit")
+    if inline is not None:
+        check_flag(inline, "inline")
     if torque is not None:
         uf.check_compilable("torque", torque, jit)
     params = check_params(params)
@@ -180,13 +182,18 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     prob = (BODY, np.ascontiguousarray(Iinv.ravel()), flatten_params(params), 0, np.zeros(1), np.zeros((1, 1, 3)), 0,
             np.zeros(1), np.zeros((1, 1, 3)))
     fns = driver.functions(prob)
+    # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
+    inlining = Inlining(driver.module, BODY, method, False, 7, None, inline if jit else False)
+    kernel = [None]
 
     def call(budget):
         driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                       st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns)
+                       st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns,
+                       kernel=kernel[0])
 
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:
+        kernel[0] = inlining.start()
         while True:
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
             budget = pacer.start()
@@ -197,6 +204,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
             pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
+            if pacer.calls > 1 and kernel[0] is None:
+                kernel[0] = inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
+                                                float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
             if progress is not None:
                 progress(float(st["IDX"][0]) / n)
             if st["ST"][0] != 0:
@@ -223,7 +233,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
-    run.notes.extend(cache_notes)
+    run.notes.extend(cache_notes + ([inlining.note] if inlining.note else []))
     return run
 
 

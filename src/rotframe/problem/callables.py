@@ -158,7 +158,9 @@ def _feed(h, obj, seen, names=(), depth=0):
             h.update(f"<seen {target.__qualname__}>".encode())
             return
         seen.add(id(target))
-        code_names = _global_names(target.__code__)
+        from rotframe.numerics.compiled import global_names
+
+        code_names = sorted(global_names(target.__code__))
         h.update(f"fn {target.__module__}.{target.__qualname__}".encode())
         _feed(h, target.__code__, seen, code_names, depth + 1)
         _feed(h, target.__defaults__, seen, code_names, depth + 1)
@@ -223,14 +225,6 @@ def _feed(h, obj, seen, names=(), depth=0):
         h.update(f"builtin {module}.{getattr(obj, '__qualname__', obj.__name__)}".encode())
         return
     raise Unfingerprintable(f"a value of type {type(obj).__module__}.{type(obj).__qualname__}")
-
-
-def _global_names(code):
-    names = set(code.co_names)
-    for c in code.co_consts:
-        if isinstance(c, types.CodeType):
-            names |= _global_names(c)
-    return sorted(names)
 
 
 def fingerprint(*functions) -> str:

@@ -12,6 +12,13 @@ run-time value, so the engine compiled once serves every problem from numba's ca
 
 In plain Python (``jit=False``, `rotframe.numerics.plain`) the "address" is the Python function
 itself and each call helper is a plain call (``.plain`` of the helper).
+
+Where a loop is compiled with a problem's functions in it (the GPU's, `rotframe.problem.gpu`, and
+the CPU's inlined loop of a long run, `rotframe.problem.inlined`), each helper is replaced by a
+direct call of the problem's function: the templates `direct_terms`, `direct_event`,
+`direct_vector` and `direct_varying`, whose names in capitals are bound per problem
+(`rotframe.numerics.compiled.bound`). The frame's and the origin's functions are then told apart
+by the tags `OMEGA_TAG` and `ORIGIN_TAG` where the addresses stand (`direct_functions`).
 """
 
 from __future__ import annotations
@@ -24,7 +31,9 @@ from numba.extending import intrinsic
 from rotframe.numerics.compiled import jit_inline
 from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VARYING_SIG, VECTOR_SIG
 
-__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "RAISED"]
+__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "RAISED",
+           "direct_terms", "direct_event", "direct_vector", "direct_varying", "direct_functions", "OMEGA_TAG",
+           "ORIGIN_TAG"]
 
 
 def address(dispatcher, signature) -> int:
@@ -147,3 +156,38 @@ def _plain_varying(f, kind, T, C, fn, t, out):
 for _helper, _python in ((call_terms, _plain_terms), (call_event, _plain_event), (call_potential, _plain_potential),
                          (call_vector, _plain_vector), (call_varying, _plain_varying)):
     _helper.plain = _python  # what rotframe.numerics.plain calls instead
+
+
+#: the tags that stand for the addresses of the frame's and the origin's functions in a loop compiled with a
+#: problem's functions in it (`direct_functions`, `direct_vector`)
+OMEGA_TAG, ORIGIN_TAG = 1, 2
+
+
+def direct_functions():
+    """What such a loop takes where the engine's takes the addresses (`rotframe.problem.signatures.FUNCTIONS`): the
+    tags of the frame's and the origin's functions, zero for the others (their direct calls ignore it)."""
+    return 0, 0, OMEGA_TAG, ORIGIN_TAG, 0
+
+
+# the templates of the direct calls (module docstring): the names in capitals are bound per problem
+def direct_terms(addr, t, y, p, out):
+    """`call_terms` as a direct call of the problem's terms (``TERMS``)."""
+    TERMS(t, y, p, out)  # noqa: F821
+
+
+def direct_event(addr, k, t, y, p):
+    """`call_event` as a direct call of the problem's events (``EVENT``)."""
+    return EVENT(k, t, y, p)  # noqa: F821
+
+
+def direct_vector(addr, t, out):
+    """`call_vector` as a direct call of the frame's (``OMEGA``) or the origin's (``ORIGIN``) function, by tag."""
+    if addr == OMEGA_TAG:
+        OMEGA(t, out)  # noqa: F821
+    else:
+        ORIGIN(t, out)  # noqa: F821
+
+
+def direct_varying(addr, kind, T, C, fn, t, out):
+    """`call_varying` as a direct call of the engine's evaluator (``VARYING``)."""
+    VARYING(kind, T, C, fn, t, out)  # noqa: F821

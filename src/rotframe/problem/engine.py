@@ -58,7 +58,7 @@ from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINI
                                            WATCH_FAILED, dop853_stages, dop853_start, dop853_step,
                                            dop853_trajectory)
 from rotframe.numerics.rk4 import rk4_step
-from rotframe.problem.calls import RAISED, call_event
+from rotframe.problem.calls import RAISED, call_event, direct_functions
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 
@@ -66,9 +66,10 @@ __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "ene
 
 #: the entry points Python calls (no C entry point: nothing calls them from C)
 _entry = njit(cache=True, error_model="numpy", nogil=True, no_cfunc_wrapper=True)
-#: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`), their work
-#: arrays made by the caller (`scratch`)
-_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False, no_cfunc_wrapper=True)
+#: the options of the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`),
+#: their work arrays made by the caller (`scratch`); a problem's inlined loop too (`rotframe.problem.inlined`)
+ENTRY_OPTIONS = {"cache": True, "error_model": "numpy", "nogil": True, "_nrt": False, "no_cfunc_wrapper": True}
+_uncounted_entry = njit(**ENTRY_OPTIONS)
 #: the length of the state of each model, a constant of its DOP853 loop (a particle whose forces act in inertial
 #: axes carries the frame's attitude too: 10)
 STATE_LENGTH = {PARTICLE: 6, BODY: 7}
@@ -554,7 +555,7 @@ def scratch(D):
 
 
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
-            atol, hfix, EDIR, ETERM, S, prob, fns, compiled=True):
+            atol, hfix, EDIR, ETERM, S, prob, fns, compiled=True, kernel=None):
     """Advance the particles ``lo:hi`` by at most ``budget`` steps each (module docstring); the state is in the arrays.
 
     ``T`` the sample times; ``Y`` (N, D) the states to go on from, ``TC``, ``H``, ``IDX``, ``SUB``,
@@ -562,9 +563,13 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     the samples; ``EVT``, ``EVY``, ``EVK``, ``EVN`` the event records; ``GPREV`` (N, NE) each
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
     ``method`` is the method's name (`METHOD_CODES`). Runs the problem's `variant` of the loop (``compiled=False``: as
-    plain Python) with work arrays of its own.
+    plain Python) with work arrays of its own; or ``kernel``, the same variant with the problem's functions compiled
+    into it (`rotframe.problem.inlined.inlined_loop`), which takes tags where ``fns`` has addresses.
     """
-    kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled, Y.shape[1])
+    if kernel is None:
+        kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled, Y.shape[1])
+    else:
+        fns = direct_functions()
     kernel(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
            EDIR, ETERM, S, prob, fns, *scratch(Y.shape[1]))
 

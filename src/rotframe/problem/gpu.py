@@ -36,8 +36,6 @@ from rotframe.numerics.compiled import bound
 
 __all__ = ["GpuAdvance"]
 
-#: the tags that stand for the addresses of the frame's and the origin's functions (`_overrides`)
-_OMEGA, _ORIGIN = 1, 2
 #: (driver module, method name, events, D) -> the compiled kernel
 _KERNELS: dict = {}
 #: particle-calls of this process that a user function's exception ended on the GPU and the CPU ran again
@@ -55,8 +53,9 @@ def _overrides(module):
     """The GPU versions of the calls by address (`rotframe.problem.calls`): direct calls of ``module``'s functions.
 
     ``module`` is the problem's compiled glue (`rotframe.problem.codegen.build_module`); a role it
-    lacks is the stub the CPU would call (`rotframe.problem.stubs`). The frame's and the origin's
-    functions are told apart by the tags `_OMEGA` and `_ORIGIN` where the CPU has their addresses.
+    lacks is the stub the CPU would call (`rotframe.problem.stubs`). The calls are the templates of
+    `rotframe.problem.calls` (``direct_*``), which tell the frame's and the origin's functions apart
+    by their tags where the CPU has their addresses.
     Returns the dict that `rotframe.particles.gpu.device_function` takes: the replacements, and
     the tree it makes.
     """
@@ -75,36 +74,18 @@ def _overrides(module):
         return device_function(getattr(module, name, None) or stub, made)
 
     made[readonly.readonly] = device(_same_array)  # the read-only check is the CPU compile's (the glue is built there)
-    made[calls.call_terms] = device(_call_terms, TERMS=own("terms", stubs.no_terms))
-    made[calls.call_event] = device(_call_event, EVENT=own("event", stubs.no_event))
-    made[calls.call_vector] = device(_call_vector, OMEGA=own("omega", stubs.no_vector),
+    made[calls.call_terms] = device(calls.direct_terms, TERMS=own("terms", stubs.no_terms))
+    made[calls.call_event] = device(calls.direct_event, EVENT=own("event", stubs.no_event))
+    made[calls.call_vector] = device(calls.direct_vector, OMEGA=own("omega", stubs.no_vector),
                                      ORIGIN=own("origin", stubs.no_vector))
-    made[calls.call_varying] = device(_call_varying, VARYING=device_function(models.varying_into, made))
+    made[calls.call_varying] = device(calls.direct_varying, VARYING=device_function(models.varying_into, made))
     return made
 
 
-# the templates of `_overrides`: the names in capitals are bound per problem
 def _same_array(a):
     return a
 
 
-def _call_terms(addr, t, y, p, out):
-    TERMS(t, y, p, out)  # noqa: F821
-
-
-def _call_event(addr, k, t, y, p):
-    return EVENT(k, t, y, p)  # noqa: F821
-
-
-def _call_vector(addr, t, out):
-    if addr == _OMEGA:
-        OMEGA(t, out)  # noqa: F821
-    else:
-        ORIGIN(t, out)  # noqa: F821
-
-
-def _call_varying(addr, kind, T, C, fn, t, out):
-    VARYING(kind, T, C, fn, t, out)  # noqa: F821
 
 
 def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
@@ -127,7 +108,7 @@ def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
         W[j] = 0.0
     LIVE[i] = 1
     loop(i, i + 1, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,  # noqa: F821
-         atol, hfix, EDIR, ETERM, S, (0, M, p, FK, FT, FC, OK, OT, OC), (0, 0, _OMEGA, _ORIGIN, 0), K, Kb, V, F, W)
+         atol, hfix, EDIR, ETERM, S, (0, M, p, FK, FT, FC, OK, OT, OC), FNS, K, Kb, V, F, W)
     LIVE[i] = 0
 
 
@@ -141,11 +122,13 @@ def _kernel(module, method, events, D):
 
     from rotframe.particles.gpu import device_function
     from rotframe.problem import engine, models
+    from rotframe.problem.calls import direct_functions
     from rotframe.problem.signatures import PARTICLE
 
     loop = device_function(engine.variant_loop(PARTICLE, method, events), _overrides(module))
     done = _KERNELS[key] = cuda.jit(bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
-                                           loop=loop, DIM=int(D), SCRATCH=models.SCRATCH))
+                                           loop=loop, DIM=int(D), SCRATCH=models.SCRATCH,
+                                           FNS=direct_functions()))
     return done
 
 

@@ -44,13 +44,20 @@ fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
 The string's tension, the air's density and the splitting kick's frame terms (centrifugal, Euler, for
 any vector omega) are `rotframe.particles.accelerations`' (each term's arithmetic written once, for
 the scenes too); `particle_rhs` writes the frame's terms in place, the same arithmetic (measured:
-called, they made a user force's evaluation 4 % slower). The small functions on the hot path (those, `vector_of_time`'s constant kinds, `constrain`,
+called, they made a user force's evaluation 4 % slower). The small functions on the hot path (those, `vector_of_time`'s constant kinds,
 `attitude_rate`, `rhs`) are inlined into their callers by numba (`rotframe.numerics.compiled.jit_inline`);
 a particle's right-hand side, called from every step, is compiled once and inlined by LLVM
 (`rotframe.numerics.compiled.jit_llvm_inline`: numba's own inlining of it into DOP853's stages
 took more of a first compile than the stages themselves); the others are compiled without
 reference counting (`rotframe.numerics.compiled.jit_uncounted`, see `rotframe.problem.engine`).
 Inlining the large ones too made the engine's first compile take two minutes, for no measured gain.
+
+A particle's right-hand side is one template (`_particle_rhs`) with two kinds of copy: the
+engine's own (`particle_rhs`), which reads each part of the model (the frame's and the origin's
+kinds, the frame's terms, the string) from the problem's constants as it runs, and the copy a
+loop compiled for one problem takes (`particle_rhs_of`, `rotframe.problem.inlined`), which holds
+them as constants, so that numba and LLVM drop the parts the problem lacks: the same arithmetic,
+in the same order, for the parts it has.
 
 Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
 vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is
@@ -61,7 +68,7 @@ from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import jit_inline, jit_llvm_inline, jit_uncounted
+from rotframe.numerics.compiled import bound, jit_inline, jit_llvm_inline, jit_uncounted
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
@@ -214,18 +221,22 @@ def attitude_rate(y, dy, k, wx, wy, wz):
     dy[k + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
 
 
-@jit_inline
-def constrain(M, y, ax, ay, az):
-    """The total acceleration kept on the string's sphere (`rotframe.particles.accelerations.string_tension`),
-    or as it is without a string."""
-    if M[0] == 0.0:
-        return ax, ay, az
-    return string_tension(ax, ay, az, y[0], y[1], y[2], y[3], y[4], y[5], M[1], M[2], M[3], M[4])
+#: a part of a particle's model read from its constants as the run goes (the engine's own loop, one for every problem),
+#: where a loop compiled for one problem holds it as a constant (`particle_rhs_of`)
+AT_RUN_TIME = -1
+# the template's names of the model's parts (`_particle_rhs`): read at run time in the engine's own copy
+FRAME_KIND = ORIGIN_KIND = CORIOLIS = CENTRIFUGAL = EULER = STRING = AT_RUN_TIME
 
 
-@jit_llvm_inline
-def particle_rhs(t, y, dy, prob, fns, W):
-    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
+def _particle_rhs(t, y, dy, prob, fns, W):
+    """The template of a particle's right-hand side (`particle_rhs`, `particle_rhs_of`).
+
+    Each part of the model (the frame's and the origin's kinds, the frame's terms, the string) is
+    read from ``prob`` where its name in capitals is `AT_RUN_TIME`, else it is that constant.
+    """
+    M = prob[1]
+    fk = prob[3] if FRAME_KIND == AT_RUN_TIME else FRAME_KIND
+    wx, wy, wz, ex, ey, ez = vector_of_time(fk, prob[4], prob[5], fns[2], fns[4], t, W)
     x = y[0]
     yy = y[1]
     z = y[2]
@@ -236,26 +247,30 @@ def particle_rhs(t, y, dy, prob, fns, W):
     ax = W[0]
     ay = W[1]
     az = W[2]
-    M = prob[1]
     # the frame's terms in place, the arithmetic of accelerations.centrifugal and euler: called
     # (inlined), they made a user force's evaluation 4 % slower (bench user-force, 2026-11-29);
     # each where the run keeps it (M[9:12], `rotframe.problem.terms.check_frame_terms`)
-    if M[9] != 0.0:
+    if (M[9] != 0.0) if CORIOLIS == AT_RUN_TIME else CORIOLIS:
         ax -= 2.0 * (wy * vz - wz * vy)  # Coriolis: -2 w x v
         ay -= 2.0 * (wz * vx - wx * vz)
         az -= 2.0 * (wx * vy - wy * vx)
-    if M[10] != 0.0:
+    if (M[10] != 0.0) if CENTRIFUGAL == AT_RUN_TIME else CENTRIFUGAL:
         wr = wx * x + wy * yy + wz * z  # centrifugal: -w x (w x r) = |w|^2 r - (w . r) w
         w2 = wx * wx + wy * wy + wz * wz
         ax += w2 * x - wr * wx
         ay += w2 * yy - wr * wy
         az += w2 * z - wr * wz
-    if M[11] != 0.0:
+    if (M[11] != 0.0) if EULER == AT_RUN_TIME else EULER:
         ax -= ey * z - ez * yy  # Euler: -w' x r
         ay -= ez * x - ex * z
         az -= ex * yy - ey * x
-    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
-    ax, ay, az = constrain(M, y, ax - ox, ay - oy, az - oz)
+    ok = prob[6] if ORIGIN_KIND == AT_RUN_TIME else ORIGIN_KIND
+    ox, oy, oz, _, _, _ = vector_of_time(ok, prob[7], prob[8], fns[3], fns[4], t, W)
+    ax -= ox
+    ay -= oy
+    az -= oz
+    if (M[0] != 0.0) if STRING == AT_RUN_TIME else STRING:
+        ax, ay, az = string_tension(ax, ay, az, x, yy, z, vx, vy, vz, M[1], M[2], M[3], M[4])
     dy[0] = vx
     dy[1] = vy
     dy[2] = vz
@@ -264,6 +279,23 @@ def particle_rhs(t, y, dy, prob, fns, W):
     dy[5] = az
     if y.shape[0] == 10:
         attitude_rate(y, dy, 6, wx, wy, wz)
+
+
+#: a particle's right-hand side in the engine's own loop: every part of the model read from ``prob``
+particle_rhs = jit_llvm_inline(bound(_particle_rhs, "particle_rhs"))
+
+
+def model_parts(prob) -> dict:
+    """The parts of the particle model ``prob`` (`rotframe.problem.signatures.PROBLEM`), by the template's names."""
+    M = prob[1]
+    return {"FRAME_KIND": int(prob[3]), "ORIGIN_KIND": int(prob[6]), "CORIOLIS": int(M[9] != 0.0),
+            "CENTRIFUGAL": int(M[10] != 0.0), "EULER": int(M[11] != 0.0), "STRING": int(M[0] != 0.0)}
+
+
+def particle_rhs_of(parts):
+    """A particle's right-hand side with the model's ``parts`` (`model_parts`) as constants, as Python (to compile
+    where a loop is compiled for one problem, `rotframe.problem.inlined`): the other parts' code pruned."""
+    return bound(_particle_rhs, "particle_rhs_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
 
 
 @jit_uncounted

@@ -57,6 +57,8 @@ class Pacer:
         self.adaptive = bool(adaptive)
         self.budget = FIRST_BUDGET
         self.calls = 0
+        #: the wall time of the last call (s)
+        self.last_seconds = 0.0
         self._started = 0.0
         self._over = False
 
@@ -67,7 +69,7 @@ class Pacer:
 
     def done(self, steps_in_call: float) -> None:
         """After a call that took ``steps_in_call`` steps (all particles): size the next one to CALL_SECONDS."""
-        elapsed = time.perf_counter() - self._started
+        elapsed = self.last_seconds = time.perf_counter() - self._started
         self.calls += 1
         if self.calls == 1 or steps_in_call <= 0:  # the first call compiled: its time says nothing of a step's
             return

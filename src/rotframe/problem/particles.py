@@ -21,6 +21,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import functools
+
 import numpy as np
 
 from rotframe.errors import IntegrationError, ScenarioError
@@ -33,6 +35,7 @@ from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.frame_error import frame_interpolation
+from rotframe.problem.inlined import Inlining
 from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
 from rotframe.problem.terms import (FRAME_TERMS, Force, StringConstraint, as_term, check_frame_terms, check_splitting,
@@ -166,7 +169,7 @@ def _scales(r, v, duration, rtol, atol, D):
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
                        frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
-                       frame_terms=None) -> ProblemRun:
+                       frame_terms=None, inline=None) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -180,6 +183,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     import time
 
     check_flag(jit, "jit")
+    if inline is not None:
+        check_flag(inline, "inline")
     on_gpu = _check_device(device, method, jit)
     method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
@@ -272,7 +277,15 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         gpu = GpuAdvance(driver.module, method, bool(events), D)  # the GPU is there: `_check_device`
     else:
         gpu = None
+    # the engine's loop, or the same loop with the problem's functions compiled in where the run is long (`inlined`)
+    from rotframe.problem.models import model_parts
+
+    inlining = Inlining(driver.module, prob[0], method, events, D, model_parts(prob),
+                        inline if jit and not on_gpu else False)
+    advance = driver.advance
     try:
+        if inlining.start() is not None:
+            advance = functools.partial(driver.advance, kernel=inlining.kernel)
         if events:
             driver.start_events(0.0, y, state["GPREV"], prob, fns)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
@@ -287,20 +300,23 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                     gpu(0, N, *before, budget, *after)
                     if gpu.ended.size:  # a user function raised on the GPU: the CPU runs the call again, to the step
                         gpu.fetch()
-                        _again_on_the_cpu(gpu.ended, driver.advance, y, state, saved, before + (budget,) + after)
+                        _again_on_the_cpu(gpu.ended, advance, y, state, saved, before + (budget,) + after)
                         if np.all(state["ST"][gpu.ended] == 0):  # it did not raise there: the GPU goes on from it
                             gpu.resume()
                 else:
-                    advance_blocks(driver.advance, N, before + (budget,) + after)
+                    advance_blocks(advance, N, before + (budget,) + after)
             except Exception as exc:
                 if gpu is not None:
                     gpu.fetch()
-                _raised_later(exc, driver.advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
+                _raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
                               params, method, hfix, times, OUT, state, events, labels)
             if first:
                 compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
                 first = False
             pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
+            if pacer.calls > 1 and inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
+                                                       float(np.sum(duration - state["TC"][state["ST"] == 0]))):
+                advance = functools.partial(driver.advance, kernel=inlining.kernel)
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
@@ -338,7 +354,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                                        t_bad, partial)
         raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
                                f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
-    warnings, notes, diagnostics = [], list(frame.notes) + cache_notes, {}
+    warnings, notes, diagnostics = [], list(frame.notes) + cache_notes + ([inlining.note] if inlining.note else []), {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")

@@ -3,7 +3,7 @@
 A `Force` is a function of ``(t, r, v, *params)`` giving an acceleration, with what rotframe
 should know about it (its potential, its axes); the built-in terms of `rotframe.forces` are
 Forces too. A `StringConstraint` is not a force but the condition ``|r - pivot| = length``,
-kept by removing the normal part of the total acceleration (`rotframe.problem.models.constrain`,
+kept by removing the normal part of the total acceleration (`rotframe.problem.models.particle_rhs`,
 its constants from `model_constants`). `as_term` checks one entry of ``forces=``; `check_splitting` says what a
 splitting method cannot take as a kick. The frame's own terms (`FRAME_TERMS`: Coriolis, centrifugal, Euler)
 are not forces to add: the run chooses which of them act (`check_frame_terms`; every one unless told).

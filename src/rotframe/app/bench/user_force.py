@@ -55,22 +55,27 @@ def user_force_rows(quick=False):
     def builtin():
         return integrate_particles(model, r0, v0, T, method="dop853", rtol=rtol, samples=10)
 
-    def user():
+    def user(inline):
         return simulate_particles(omega=w, r0=r0, v0=v0, duration=T, forces=[_gravity_spring], params=(gz, k),
-                                  rtol=rtol, samples=10).trajectory
+                                  rtol=rtol, samples=10, inline=inline).trajectory
 
-    builtin(), user()  # compile (or load) both
+    builtin(), user(False), user(True)  # compile (or load) each
     tb, a = _best(builtin, repeats)
-    tu, b = _best(user, repeats)
-    per_b, per_u = tb / max(a.nfev, 1), tu / max(b.nfev, 1)
+    per_b = tb / max(a.nfev, 1)
     scale = float(np.max(np.abs(a.r[-1])))
-    rows = [{"scenario": "user-force", "kind": "user-force", "method": "dop853", "setting": rtol,
-             "wall_s": tu, "builtin_wall_s": tb, "nfev": int(b.nfev), "builtin_nfev": int(a.nfev),
-             "per_eval_s": per_u, "builtin_per_eval_s": per_b, "ratio": per_u / per_b, "goal": 1.5,
-             "met": bool(per_u / per_b <= 1.5), "error": math.nan, "error_kind": "none",
-             "same_answer_rel": float(np.max(np.abs(a.r[-1] - b.r[-1]))) / scale,
-             "note": "gravity + spring as a user force vs the built-in terms, cost per evaluation (includes "
-                     "each driver's per-step work)"}]
+    rows = []
+    for inline, method, note in (
+            (False, "dop853", "gravity + spring as a user force vs the built-in terms, cost per evaluation (includes "
+                              "each driver's per-step work); the engine calls the force by address"),
+            (True, "dop853 inlined", "the same, in the loop compiled with the force in it (inline=True, "
+                                     "rotframe.problem.inlined): what a long run switches to")):
+        tu, b = _best(lambda: user(inline), repeats)
+        per_u = tu / max(b.nfev, 1)
+        rows.append({"scenario": "user-force", "kind": "user-force", "method": method, "setting": rtol,
+                     "wall_s": tu, "builtin_wall_s": tb, "nfev": int(b.nfev), "builtin_nfev": int(a.nfev),
+                     "per_eval_s": per_u, "builtin_per_eval_s": per_b, "ratio": per_u / per_b, "goal": 1.5,
+                     "met": bool(per_u / per_b <= 1.5), "error": math.nan, "error_kind": "none",
+                     "same_answer_rel": float(np.max(np.abs(a.r[-1] - b.r[-1]))) / scale, "note": note})
     rows.extend(_cr3bp_rows(quick, repeats))
     return rows
 

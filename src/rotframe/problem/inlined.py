@@ -1,0 +1,284 @@
+"""A long run's loop with the problem's functions compiled into it: the engine's loop, inlined, cached per problem.
+
+The engine (`rotframe.problem.engine`) is compiled once for every problem and calls a problem's
+functions at their addresses (`rotframe.problem.calls`), so that a new problem starts in a
+fraction of a second. The price is paid at every evaluation: a call by address is opaque to the
+compiler, which can neither inline the force nor keep the state in registers across it. On a
+long run or a large ensemble that price outweighs a compile. `inlined_loop` compiles the
+problem's variant of the loop (`rotframe.problem.engine.variant_loop`) again, with each call
+by address replaced by a direct call of the problem's function (the ``direct_*`` templates of
+`rotframe.problem.calls`), as the GPU's kernel is (`rotframe.problem.gpu`): the same Python
+source, the same steps in the same order, so the same numbers to the bit (numba compiles
+without fast-math: no operation is reordered or fused).
+
+Only what calls a problem's function is compiled again (`_rebuilt`): the loop, the steps and
+the right-hand side; the rest of the engine is shared. The copies are cached on disk beside the
+problem's glue (`rotframe.problem.codegen`): their code names the glue's file, which is named by
+the fingerprint of the user's functions and of rotframe's sources, so a later process loads
+the loop of the same functions instead of compiling it, and an edited function or an upgraded
+rotframe never loads a stale one. A glue built in memory (a function that cannot be
+fingerprinted) has its inlined loop compiled in memory too.
+
+`Inlining` decides, between the engine's calls, whether a run switches to its inlined loop:
+
+* ``inline=False``: never; ``inline=True``: from the first call (compiled, or loaded from the
+  cache, before it);
+* ``inline=None`` (the default): once the run has measured its own pace, when its remaining
+  work at that pace exceeds `WORTH_LOADING_S` and the loop is in the cache (loading it took
+  0.02 to 0.03 s), or exceeds `WORTH_COMPILING_S` (a compile took 3 to 8 s on the 2-core
+  reference machine, and the inlined loop 0.8 to 0.9 of the engine's time, 2026-11-29:
+  `rotframe bench user-force` measures it, the ``dop853 inlined`` row).
+
+What the inlined loop gains is the call by address (opaque to the compiler) and the parts of the
+model the problem lacks (the engine reads them from the problem's constants at every
+evaluation; the inlined loop holds them as constants, `rotframe.problem.models.particle_rhs_of`).
+It does not make the engine's loop as fast as the scenes' kernels, whose steps keep the state in
+registers (docs/architecture.md).
+
+The switch happens at a call's end, where the arrays hold everything a step needs, so a run
+gives the same numbers whichever loop ran which call.
+"""
+
+from __future__ import annotations
+
+import time
+import types
+
+__all__ = ["inlined_loop", "Inlining", "WORTH_COMPILING_S", "WORTH_LOADING_S"]
+
+#: a run switches to a loop it must compile when its remaining work, at its own pace, is longer than this (s): a compile
+#: of up to 8 s repaid by a tenth of the work
+WORTH_COMPILING_S = 80.0
+#: ... and to a loop in the cache when longer than this (s; loading one took 0.02 to 0.03 s)
+WORTH_LOADING_S = 0.5
+#: the run measures its pace over calls worth at least this much wall time, after its first call, before it decides
+MEASURED_S = 0.2
+
+#: (glue module's name, model, method, events, D, the model's parts) -> the compiled loop, made once a process
+_LOOPS: dict = {}
+
+
+def _replacements(module, parts, where):
+    """The direct calls of ``module``'s functions (the problem's glue) in place of the calls by address.
+
+    Returns the dict that `_rebuilt` takes: each helper of `rotframe.problem.calls` -> its direct
+    template bound to the glue's function (a role the glue lacks: the stub the engine would call,
+    `rotframe.problem.stubs`), the engine's evaluator of a varying vector rebuilt on them, and a
+    particle's right-hand side with the model's ``parts`` as constants
+    (`rotframe.problem.models.particle_rhs_of`; None for a body).
+    """
+    from rotframe.numerics.compiled import bound, jit_inline
+    from rotframe.problem import calls, models, stubs
+
+    def own(name, stub):
+        found = getattr(module, name, None)
+        return stub if found is None else found
+
+    def direct(template, **names):
+        return jit_inline(bound(template, template.__name__, **names))
+
+    made: dict = {}
+    made[calls.call_terms] = direct(calls.direct_terms, TERMS=own("terms", stubs.no_terms))
+    made[calls.call_event] = direct(calls.direct_event, EVENT=own("event", stubs.no_event))
+    made[calls.call_vector] = direct(calls.direct_vector, OMEGA=own("omega", stubs.no_vector),
+                                     ORIGIN=own("origin", stubs.no_vector))
+    made[calls.call_varying] = direct(calls.direct_varying, VARYING=_rebuilt(models.varying_into, made, where))
+    if parts is not None:
+        made[models.particle_rhs] = _copy(models.particle_rhs_of(parts), made, where, like=models.particle_rhs)
+    return made
+
+
+def _rebuilt(value, made, where):
+    """``value`` (a numba dispatcher or a Python function) with its compiled callees rebuilt on ``made``.
+
+    A function that calls, at any depth, one that ``made`` replaces is copied (`_copy`); any other
+    is kept as it is, shared with the engine.
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    try:
+        done = made.get(value)
+    except TypeError:  # an unhashable global: a value, not a function
+        return value
+    if done is not None:
+        return done
+    fn = value.py_func if isinstance(value, Dispatcher) else value
+    if not isinstance(fn, types.FunctionType):
+        return value
+    made[value] = value  # while its callees are rebuilt (a recursive function keeps itself)
+    names = _rebound(fn, made, where)
+    if names is None:
+        return value
+    copy = made[value] = _copy(fn, made, where, like=value, names=names)
+    return copy
+
+
+def _rebound(fn, made, where):
+    """``fn``'s globals with each compiled callee rebuilt (`_rebuilt`); None where none changed."""
+    from numba.core.dispatcher import Dispatcher
+
+    from rotframe.numerics.compiled import global_names
+
+    names = dict(fn.__globals__)
+    changed = False
+    for name in global_names(fn.__code__):
+        old = names.get(name)
+        if isinstance(old, (Dispatcher, types.FunctionType)):
+            new = _rebuilt(old, made, where)
+            if new is not old:
+                names[name] = new
+                changed = True
+    return names if changed else None
+
+
+def _copy(fn, made, where, like, names=None):
+    """The Python function ``fn`` copied onto its rebound globals (``names``, else `_rebound`'s), compiled with the
+    options of ``like`` where that is a numba dispatcher.
+
+    ``where`` is ``(file, module name, tag)``: the copy's code names the glue's file (the disk
+    cache's place and stamp; None: compiled in memory), and its name ends in the tag of the
+    model's parts, so that two models of the same functions are two entries of the cache.
+    """
+    from numba import njit
+    from numba.core.dispatcher import Dispatcher
+
+    file, module_name, tag = where
+    if names is None:
+        names = _rebound(fn, made, where) or dict(fn.__globals__)
+    code = fn.__code__ if file is None else fn.__code__.replace(co_filename=file)
+    clone = types.FunctionType(code, names, fn.__name__, fn.__defaults__, fn.__closure__)
+    clone.__qualname__ = f"{fn.__qualname__}__{tag}"
+    clone.__module__ = module_name
+    clone.__doc__ = fn.__doc__
+    if not isinstance(like, Dispatcher):
+        return clone
+    options = {k: v for k, v in like.targetoptions.items() if k != "nopython"}
+    if options.get("cache"):
+        options["cache"] = file is not None
+    copy = njit(**options)(clone)
+    copy.__class__ = type(like)  # a kernel for compiled code only stays so
+    return copy
+
+
+def _dispatcher(module, model, method, events, D, parts):
+    """The inlined loop of ``module``'s problem as a numba dispatcher, not yet compiled."""
+    import os
+
+    from numba import njit
+
+    from rotframe.problem import engine
+
+    file = getattr(module, "__file__", None)
+    tag = "parts" + "".join(f"_{parts[k]}" for k in sorted(parts)) if parts is not None else "body"
+    where = (file if file and os.path.exists(file) else None), module.__name__, tag.replace("-", "m")
+    loop = _rebuilt(engine.variant_loop(model, method, events, D), _replacements(module, parts, where), where)
+    return njit(**dict(engine.ENTRY_OPTIONS, cache=where[0] is not None))(loop)
+
+
+def _loaded(dispatcher, signature) -> bool:
+    """Whether ``dispatcher`` was found in numba's disk cache for ``signature`` (then it is loaded), never compiling.
+
+    numba's `Dispatcher.compile` loads from the cache or compiles; this is its first half alone
+    (numba's own calls), so that a run loads an inlined loop whenever one is there but compiles
+    one only where the run is long enough to repay it. Any failure reads as "not in the cache".
+    """
+    from numba.core.compiler_lock import global_compiler_lock
+
+    try:
+        with global_compiler_lock:
+            cres = dispatcher._cache.load_overload(signature, dispatcher.targetctx)
+            if cres is None:
+                return False
+            dispatcher.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            dispatcher.add_overload(cres)
+    except Exception:  # noqa: BLE001 -- numba's internals changed, or a damaged entry: compile instead, if at all
+        return False
+    return True
+
+
+def _key(module, model, method, events, D, parts):
+    return module.__name__, int(model), method, bool(events), int(D), None if parts is None else tuple(sorted(parts.items()))
+
+
+def inlined_loop(module, model, method, events, D, parts=None, compile=True):
+    """The loop of the engine's variant ``(model, method, events, D)`` with ``module``'s functions in it and a
+    particle model's ``parts`` as constants (`rotframe.problem.models.model_parts`; None for a body) (module
+    docstring), compiled for `rotframe.problem.engine.VARIANT_SIGNATURE`, or loaded from the disk cache.
+
+    With ``compile=False``, only loaded: None where it is neither in this process nor in the cache.
+    It takes the engine's arguments, with `rotframe.problem.calls.direct_functions` for the addresses.
+    """
+    from rotframe.problem import engine
+
+    key = _key(module, model, method, events, D, parts)
+    kernel = _LOOPS.get(key)
+    if kernel is not None:
+        return kernel
+    kernel = _dispatcher(module, model, method, events, D, parts)
+    if not _loaded(kernel, engine.VARIANT_SIGNATURE):
+        if not compile:
+            return None
+        kernel.compile(engine.VARIANT_SIGNATURE)
+    kernel.disable_compile()
+    _LOOPS[key] = kernel
+    return kernel
+
+
+class Inlining:
+    """Whether, and from which call on, a run uses its inlined loop (module docstring).
+
+    Parameters
+    ----------
+    module : module
+        The problem's glue (`rotframe.problem.codegen.build_module`).
+    model, method, events, D
+        The engine's variant (`rotframe.problem.engine.variant`).
+    parts : dict or None
+        A particle model's parts (`rotframe.problem.models.model_parts`), constants of the loop; None for a body.
+    mode : bool or None
+        ``inline``: True, False or None (decided by the run's pace).
+    """
+
+    def __init__(self, module, model, method, events, D, parts, mode):
+        self.variant = (module, model, method, bool(events), int(D), parts)
+        self.mode = mode
+        self.kernel = None
+        self.decided = mode is False
+        self.note = None
+        self._wall = 0.0  # wall time of the calls measured so far, and the simulated time they covered
+        self._covered = 0.0
+
+    def start(self):
+        """Before the first call: the inlined loop where ``inline=True`` (compiled or loaded now), else None."""
+        if self.mode is True:
+            self._switch(compile=True, reason="inline=True")
+        return self.kernel
+
+    def after_call(self, wall, covered, remaining):
+        """After a call (not the first) that took ``wall`` s to cover ``covered`` s of simulated time, summed over the
+        particles, with ``remaining`` s of it still to go: the inlined loop where the run switches now, else None."""
+        if self.decided:
+            return None
+        self._wall += wall
+        self._covered += covered
+        if self._wall < MEASURED_S or self._covered <= 0.0:
+            return None
+        self.decided = True
+        left = self._wall / self._covered * remaining
+        if left > WORTH_LOADING_S:
+            self._switch(compile=left > WORTH_COMPILING_S, reason=f"about {left:.2g} s of work left at its pace")
+        return self.kernel
+
+    def _switch(self, compile, reason):
+        t0 = time.perf_counter()
+        known = _key(*self.variant) in _LOOPS
+        self.kernel = inlined_loop(*self.variant, compile=False)
+        how = "made earlier in this process" if known else "loaded from the disk cache"
+        if self.kernel is None and compile:
+            self.kernel = inlined_loop(*self.variant)
+            how = "compiled"
+        if self.kernel is not None:
+            self.decided = True
+            took = "" if known else f" in {time.perf_counter() - t0:.2g} s"
+            self.note = (f"the run went on in its inlined loop, the problem's functions compiled into the engine's "
+                         f"loop ({reason}; {how}{took}): the same steps and numbers")
