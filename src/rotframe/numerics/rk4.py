@@ -23,7 +23,7 @@ on the CPU and the GPU.
 
 from __future__ import annotations
 
-from rotframe.numerics.compiled import bound, jit_uncounted
+from rotframe.numerics.compiled import bound, jit_llvm_inline
 
 __all__ = ["rk4_step"]
 
@@ -44,5 +44,11 @@ def _step(ctx, t, y, h, K, yt, yn):
 
 
 def rk4_step(name, rhs):
-    """The RK4 step of the system ``rhs`` (module docstring), compiled for it (cached as ``rk4_step_<name>``)."""
-    return jit_uncounted(bound(_step, f"rk4_step_{name}", RHS=rhs))
+    """The RK4 step of the system ``rhs`` (module docstring), compiled for it (cached as ``rk4_step_<name>``).
+
+    Compiled once and inlined by LLVM into each caller (`rotframe.numerics.compiled.jit_llvm_inline`): called,
+    the step passed the system's data (the engine's problem tuple, some fifty numbers) through the call at every
+    step; inlined, the engine's RK4 on the Foucault model took 10.5 to 11.0 ms against 13.7 (one pinned core,
+    2026-11-29). The same arithmetic, so the same numbers.
+    """
+    return jit_llvm_inline(bound(_step, f"rk4_step_{name}", RHS=rhs))
