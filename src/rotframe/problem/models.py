@@ -46,11 +46,15 @@ any vector omega) are `rotframe.particles.accelerations`' (each term's arithmeti
 the scenes too); `particle_rhs` writes the frame's terms in place, the same arithmetic (measured:
 called, they made a user force's evaluation 4 % slower). The small functions on the hot path (those, `vector_of_time`'s constant kinds,
 `attitude_rate`, `rhs`) are inlined into their callers by numba (`rotframe.numerics.compiled.jit_inline`);
-a particle's right-hand side, called from every step, is compiled once and inlined by LLVM
-(`rotframe.numerics.compiled.jit_llvm_inline`: numba's own inlining of it into DOP853's stages
-took more of a first compile than the stages themselves); the others are compiled without
+the right-hand sides and the splittings' steps, called from every step, are compiled once each and
+inlined by LLVM into their callers (`rotframe.numerics.compiled.jit_llvm_inline`: numba's own
+inlining of a right-hand side into DOP853's stages took more of a first compile than the stages
+themselves, and inlining the large ones that way made the engine's first compile take two
+minutes). Called, a splitting's step passed the problem's data through a call at every step:
+LLVM-inlined, `rotation-splitting4` on the Foucault model took 39.5 ms against 59 to 70 (the
+scene's own kernels: 39), with the same first compile (8.8 and 8.9 s, one pinned core,
+2026-11-29). The evaluators of a varying vector and the energy stay compiled apart, without
 reference counting (`rotframe.numerics.compiled.jit_uncounted`, see `rotframe.problem.engine`).
-Inlining the large ones too made the engine's first compile take two minutes, for no measured gain.
 
 A particle's right-hand side is one template (`_particle_rhs`) with two kinds of copy: the
 engine's own (`particle_rhs`), which reads each part of the model (the frame's and the origin's
@@ -298,7 +302,7 @@ def particle_rhs_of(parts):
     return bound(_particle_rhs, "particle_rhs_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
 
 
-@jit_uncounted
+@jit_llvm_inline
 def body_rhs(t, y, dy, prob, fns, W):
     M = prob[1]
     L1 = y[0]
@@ -328,7 +332,7 @@ def rhs(body, t, y, dy, prob, fns, W):
         body_rhs(t, y, dy, prob, fns, W)
 
 
-@jit_uncounted
+@jit_llvm_inline
 def kick_acceleration(t, y, prob, fns, W):
     """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
     centrifugal and Euler (where the run keeps them, ``M[10:12]``) and the origin's, with omega at t (returned
@@ -360,7 +364,7 @@ def drag_rates(M, y):
     return M[6] * air, M[7] * air
 
 
-@jit_uncounted
+@jit_llvm_inline
 def rotation_strang(t, h, yn, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
     drift h/2, kick h/2, a drag term's exact flow h/2, the Coriolis flow v' = -2 w x v (v turned by
@@ -387,7 +391,7 @@ def rotation_strang(t, h, yn, prob, fns, W):
         yn[j] += hh * yn[j + 3]
 
 
-@jit_uncounted
+@jit_llvm_inline
 def sphere_strang(t, h, yn, prob, fns, W):
     """One step of the rotation splitting on the string's sphere, as the scenes' pendulum splitting
     (`rotframe.particles.kernels`; docs/physics/splitting.md): the great-circle flow h/2
@@ -428,7 +432,7 @@ def sphere_strang(t, h, yn, prob, fns, W):
     yn[5] = vz
 
 
-@jit_uncounted
+@jit_llvm_inline
 def turn_about_axis(k, a, yn):
     """The exact flow of H_k = L_k^2 / (2 I_k) for an angle a = h L_k / I_k: L turns by -a about body
     axis k, the attitude by +a about it (q <- q (e_k sin(a/2), cos(a/2)))."""
@@ -455,7 +459,7 @@ def turn_about_axis(k, a, yn):
     yn[6] = qw * hc - (qx * ex + qy * ey + qz * ez)
 
 
-@jit_uncounted
+@jit_llvm_inline
 def torque_kick(t, h, yn, prob, fns, W):
     """L += h tau(t, L, q): exact for a torque of (t, q) alone (the only torques the splittings take)."""
     call_terms(fns[0], t, yn, prob[2], W)
@@ -464,7 +468,7 @@ def torque_kick(t, h, yn, prob, fns, W):
     yn[2] += h * W[2]
 
 
-@jit_uncounted
+@jit_llvm_inline
 def lie_poisson_strang(t, h, yn, prob, fns, W):
     """Kick(h/2) . R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2) . kick(h/2): second order, symplectic on the
     Lie-Poisson manifold (principal axes: ``M`` holds the diagonal I^-1)."""
@@ -478,7 +482,7 @@ def lie_poisson_strang(t, h, yn, prob, fns, W):
     torque_kick(t + h, 0.5 * h, yn, prob, fns, W)
 
 
-@jit_uncounted
+@jit_llvm_inline
 def strang(body, t, h, yn, prob, fns, W):
     if body is None:  # a constant (`rhs`)
         if prob[1][0] != 0.0:  # a pendulum's string: the splitting on its sphere
@@ -489,7 +493,7 @@ def strang(body, t, h, yn, prob, fns, W):
         lie_poisson_strang(t, h, yn, prob, fns, W)
 
 
-@jit_uncounted
+@jit_llvm_inline
 def own_step(body, method, t, y, h, yn, prob, fns, W):
     """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4)."""
     for j in range(y.shape[0]):
