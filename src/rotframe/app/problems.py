@@ -154,7 +154,7 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         where the centrifugal term acts in a rotating frame, ``v^2/2 + U`` where it does not.
     inline : bool, optional
         Whether the run goes on in a loop compiled with your functions in it
-        (`rotframe.problem.inlined`): the same steps and numbers to the bit, in some 0.8 to 0.9 of
+        (`rotframe.problem.inlined`): the same steps and numbers to the bit, in some 0.8 to 0.97 of
         the time, for a compile of a few seconds (cached on disk for the same functions). Default:
         decided by the run once it has measured its pace (a run with over 80 s of work left
         compiles it; one with half a second left loads it where it is cached); True: from the

@@ -26,7 +26,7 @@ fingerprinted) has its inlined loop compiled in memory too.
 * ``inline=None`` (the default): once the run has measured its own pace, when its remaining
   work at that pace exceeds `WORTH_LOADING_S` and the loop is in the cache (loading it took
   0.02 to 0.03 s), or exceeds `WORTH_COMPILING_S` (a compile took 3 to 8 s on the 2-core
-  reference machine, and the inlined loop 0.8 to 0.9 of the engine's time, 2026-11-29:
+  reference machine, and the inlined loop 0.8 to 0.97 of the engine's time, 2026-11-29:
   `rotframe bench user-force` measures it, the ``dop853 inlined`` row).
 
 What the inlined loop gains is the call by address (opaque to the compiler) and the parts of the
