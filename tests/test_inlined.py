@@ -134,23 +134,6 @@ def test_a_short_run_stays_in_the_engines_loop():
     assert not any("inlined loop" in note for note in short.notes)
 
 
-def raise_after_one_second(t, r, v):
-    if t > 1.0:
-        raise ValueError("too late")
-    return -r[0], -r[1], -r[2]
-
-
-def test_a_force_that_raises_in_the_inlined_loop_is_named_with_its_step():
-    with pytest.raises(ScenarioError) as info:
-        rotframe.simulate(omega=[0, 0, 1.0], r0=[1.0, 0.0, 0.0], v0=[0.0, 0.5, 0.0], duration=3.0,
-                          forces=[raise_after_one_second], samples=30, inline=True)
-    msg = str(info.value)
-    assert "\n" not in msg
-    assert "raise_after_one_second" in msg and "ValueError" in msg and "too late" in msg
-    times = info.value.partial.trajectory.times
-    assert 0.0 < times[-1] <= 1.0 and np.all(np.isfinite(info.value.partial.trajectory.r))
-
-
 @pytest.mark.parametrize("value", ["yes", 1, 0.0])
 def test_inline_must_be_a_flag(value):
     with pytest.raises(ScenarioError) as info:

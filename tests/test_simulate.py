@@ -449,11 +449,14 @@ def raise_after_one_second(t, r, v):
     return -r[0], -r[1], -r[2]
 
 
-def test_force_raises_later_gives_time_and_state():
-    """A force that raises inside the compiled run: one line naming it, with the time and the state of the step."""
+@pytest.mark.parametrize("inline", [False, True])
+def test_force_raises_later_gives_time_and_state(inline):
+    """A force that raises inside the compiled run: one line naming it, with the time and the state of the step,
+    in the engine's loop (the call by address flags it) and in the inlined loop (the exception ends the call, which
+    is replayed a step at a time to find the step)."""
     with pytest.raises(ScenarioError) as info:
         rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=3.0, forces=[raise_after_one_second],
-                          samples=30)
+                          samples=30, inline=inline)
     exc = info.value
     msg = _one_line(exc)
     assert "raise_after_one_second" in msg and "ValueError" in msg and "too late" in msg
