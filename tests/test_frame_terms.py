@@ -23,6 +23,7 @@ from inertial_circle import inertial_circle
 from rotframe import forces
 from rotframe.errors import ScenarioError
 from rotframe.problem.terms import FRAME_TERMS, check_frame_terms
+from rotframe.problem.particles import simulate_particles
 
 
 def omega_fn(t):
@@ -226,3 +227,29 @@ def test_check_frame_terms_keeps_the_canonical_order():
     assert check_frame_terms(["euler", "Coriolis", "euler"]) == ("coriolis", "euler")
     assert check_frame_terms("centrifugal") == ("centrifugal",)
     assert check_frame_terms([]) == ()
+
+
+@pytest.mark.parametrize("inline", [False, True])
+def test_foucault_under_dop853_at_the_scenes_tolerance_is_the_scenes_run_to_the_bit(inline):
+    """One DOP853 loop: the Foucault model on the engine, given the scene's absolute tolerance (rtol times the largest
+    start value), takes the scene's very steps and gives its numbers to the bit, in the engine's loop and in the
+    inlined one (docs/architecture.md)."""
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    lat = math.radians(48.85)
+    w = 7.292115e-5 * np.array([0.0, math.cos(lat), math.sin(lat)])
+    g = np.array([0.0, 0.0, -9.81])
+    L = 67.0
+    pivot = np.array([0.0, 0.0, L])
+    r0 = np.array([3.0, 0.0, L - math.sqrt(L * L - 9.0)])
+    rtol = 1e-10
+    atol = rtol * max(1.0, float(np.max(np.abs(r0))))  # the scene's rule (`rotframe.particles.chunked`, abs_tol)
+    engine = simulate_particles(omega=w, r0=r0, v0=np.zeros(3), duration=120.0, rtol=rtol, atol=atol, samples=12,
+                                forces=[forces.gravity(g), forces.pendulum(L, pivot)], frame_terms=("coriolis",),
+                                inline=inline).trajectory
+    model = ParticleModel(("gravity", "coriolis", "pendulum"), omega=OmegaSchedule.constant(w), g=g,
+                          pendulum_length=L, pivot=pivot)
+    scene = integrate_particles(model, r0, np.zeros(3), 120.0, method="dop853", rtol=rtol, samples=12)
+    assert engine.steps == scene.steps > 10
+    assert np.array_equal(engine.r, scene.r) and np.array_equal(engine.v, scene.v)
