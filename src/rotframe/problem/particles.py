@@ -19,9 +19,8 @@ attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 
