@@ -156,3 +156,14 @@ def test_a_bodys_inlined_loop_gives_the_engines_numbers_to_the_bit(method, torqu
     assert np.array_equal(engine.trajectory.q, inlined_run.trajectory.q)
     assert np.ptp(engine.trajectory.L[:, 0]) > 1e-3
     assert any("inlined loop" in note for note in inlined_run.notes)
+
+
+def test_inline_and_plain_python_are_refused_together_in_one_line():
+    for call in (lambda: rotframe.simulate(omega=[0, 0, 1.0], r0=[1.0, 0.0, 0.0], v0=[0.0, 0.5, 0.0], duration=1.0,
+                                           forces=[pull], params=(1.0,), jit=False, inline=True),
+                 lambda: rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[0.1, 2.0, 0.3], q0=[0, 0, 0, 1.0],
+                                                duration=1.0, jit=False, inline=True)):
+        with pytest.raises(ScenarioError) as info:
+            call()
+        msg = str(info.value)
+        assert "\n" not in msg and "inline=True" in msg and "jit=False" in msg

@@ -158,7 +158,8 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
         the time, for a compile of a few seconds (cached on disk for the same functions). Default:
         decided by the run once it has measured its pace (a run with over 80 s of work left
         compiles it; one with half a second left loads it where it is cached); True: from the
-        start; False: never.
+        start; False: never. It needs ``jit=True``; on the GPU the kernel holds your functions
+        already.
 
     Raises
     ------

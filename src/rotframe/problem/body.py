@@ -143,6 +143,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     check_flag(jit, "jit")
     if inline is not None:
         check_flag(inline, "inline")
+        if inline and not jit:
+            raise ScenarioError("inline=True compiles your functions into the engine's loop, jit=False runs them in "
+                                "plain Python: pass one of them")
     if torque is not None:
         uf.check_compilable("torque", torque, jit)
     params = check_params(params)

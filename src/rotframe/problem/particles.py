@@ -184,6 +184,9 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     check_flag(jit, "jit")
     if inline is not None:
         check_flag(inline, "inline")
+        if inline and not jit:
+            raise ScenarioError("inline=True compiles your functions into the engine's loop, jit=False runs them in "
+                                "plain Python: pass one of them")
     on_gpu = _check_device(device, method, jit)
     method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
