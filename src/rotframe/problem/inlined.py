@@ -197,7 +197,8 @@ def _loaded(dispatcher, signature) -> bool:
 
 
 def _key(module, model, method, events, D, parts):
-    return module.__name__, int(model), method, bool(events), int(D), None if parts is None else tuple(sorted(parts.items()))
+    parts = None if parts is None else tuple(sorted(parts.items()))
+    return module.__name__, int(model), method, bool(events), int(D), parts
 
 
 def inlined_loop(module, model, method, events, D, parts=None, compile=True):
