@@ -10,6 +10,7 @@ computation, not a second one.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -126,6 +127,25 @@ def test_a_run_switches_between_calls_without_changing_a_number(monkeypatch):
     switched = run("rk4, a varying frame and origin", None)
     assert any("inlined loop" in note and "work left" in note for note in switched.notes)
     same_run(switched, run("rk4, a varying frame and origin", False))
+
+
+def test_a_switch_mid_run_counts_as_compile_time(monkeypatch):
+    """The time a run spends making its inlined loop after its first call is compile time, not integration."""
+    for inline in (False, True):  # both loops made before: the run below compiles nothing
+        run("rk4, a varying frame and origin", inline)
+    made = inlined.inlined_loop
+
+    def slow(*args, **kwargs):
+        time.sleep(0.5)
+        return made(*args, **kwargs)
+
+    monkeypatch.setattr(inlined, "inlined_loop", slow)
+    monkeypatch.setattr(inlined, "MEASURED_S", 0.0)
+    monkeypatch.setattr(inlined, "WORTH_LOADING_S", 0.0)
+    monkeypatch.setattr(inlined, "WORTH_COMPILING_S", 0.0)
+    switched = run("rk4, a varying frame and origin", None)
+    assert any("inlined loop" in note for note in switched.notes)
+    assert switched.compile_s >= 0.5 > run("rk4, a varying frame and origin", False).compile_s
 
 
 def test_a_short_run_stays_in_the_engines_loop():

@@ -235,6 +235,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                                        t_bad, partial)
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
+    compile_s += inlining.seconds_mid_run  # an inlined loop made after the first call: compile time too
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
     run.notes.extend(cache_notes + ([inlining.note] if inlining.note else []))
     return run

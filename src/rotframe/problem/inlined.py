@@ -246,6 +246,9 @@ class Inlining:
         self.kernel = None
         self.decided = mode is False
         self.note = None
+        #: the seconds spent making the inlined loop after the first call (compiling or loading): a run counts them
+        #: as compile time, not as integration
+        self.seconds_mid_run = 0.0
         self._wall = 0.0  # wall time of the calls measured so far, and the simulated time they covered
         self._covered = 0.0
 
@@ -267,7 +270,9 @@ class Inlining:
         self.decided = True
         left = self._wall / self._covered * remaining
         if left > WORTH_LOADING_S:
+            t0 = time.perf_counter()
             self._switch(compile=left > WORTH_COMPILING_S, reason=f"about {left:.2g} s of work left at its pace")
+            self.seconds_mid_run = time.perf_counter() - t0
         return self.kernel
 
     def _switch(self, compile, reason):
