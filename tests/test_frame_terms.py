@@ -170,6 +170,14 @@ def test_the_conserved_quantity_follows_the_centrifugal_term(terms, name):
     assert not any(key.endswith("_rel_drift") and not key.startswith(name) for key in res.diagnostics)
 
 
+def foucault_model():
+    """The Foucault scene's model in Paris: omega (rad/s), the local g, the string's length and pivot, a bob 3 m out."""
+    lat = math.radians(48.85)
+    w = 7.292115e-5 * np.array([0.0, math.cos(lat), math.sin(lat)])
+    L = 67.0
+    return w, np.array([0.0, 0.0, -9.81]), L, np.array([0.0, 0.0, L]), np.array([3.0, 0.0, L - math.sqrt(L * L - 9.0)])
+
+
 @pytest.mark.parametrize("terms", [("coriolis",), ("coriolis", "centrifugal"), ()])
 @pytest.mark.parametrize("method, step", [("dop853", None), ("rotation-splitting4", 0.01)])
 def test_foucault_on_the_engine_matches_the_scenes_kernels(method, step, terms):
@@ -182,12 +190,7 @@ def test_foucault_on_the_engine_matches_the_scenes_kernels(method, step, terms):
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-    lat = math.radians(48.85)
-    w = 7.292115e-5 * np.array([0.0, math.cos(lat), math.sin(lat)])
-    g = np.array([0.0, 0.0, -9.81])
-    L = 67.0
-    pivot = np.array([0.0, 0.0, L])
-    r0 = np.array([3.0, 0.0, L - math.sqrt(L * L - 9.0)])
+    w, g, L, pivot, r0 = foucault_model()
     v0 = np.zeros(3)
 
     def engine(chosen):
@@ -237,12 +240,7 @@ def test_foucault_under_dop853_at_the_scenes_tolerance_is_the_scenes_run_to_the_
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-    lat = math.radians(48.85)
-    w = 7.292115e-5 * np.array([0.0, math.cos(lat), math.sin(lat)])
-    g = np.array([0.0, 0.0, -9.81])
-    L = 67.0
-    pivot = np.array([0.0, 0.0, L])
-    r0 = np.array([3.0, 0.0, L - math.sqrt(L * L - 9.0)])
+    w, g, L, pivot, r0 = foucault_model()
     rtol = 1e-10
     atol = rtol * max(1.0, float(np.max(np.abs(r0))))  # the scene's rule (`rotframe.particles.chunked`, abs_tol)
     engine = simulate_particles(omega=w, r0=r0, v0=np.zeros(3), duration=120.0, rtol=rtol, atol=atol, samples=12,

@@ -17,7 +17,7 @@ from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 from rotframe.validation import refuse_units
 
-__all__ = ["check_params", "check_event", "run_grid", "number", "sequence_of_callables", "check_flag",
+__all__ = ["check_params", "check_event", "run_grid", "number", "sequence_of_callables", "check_flag", "check_inline",
            "array_of", "DEFAULT_RTOL", "DEFAULT_SAMPLES"]
 
 DEFAULT_RTOL = 1e-10
@@ -57,6 +57,16 @@ def check_flag(value, key: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise ScenarioError(f"{key}={value!r}: True or False")
     return bool(value)
+
+
+def check_inline(inline, jit) -> None:
+    """``inline`` (None, True or False; `rotframe.problem.inlined`), refused in one line where it is no flag or where
+    it asks to compile the functions into the loop that ``jit=False`` runs in plain Python."""
+    if inline is None:
+        return
+    if check_flag(inline, "inline") and not jit:
+        raise ScenarioError("inline=True compiles your functions into the engine's loop, jit=False runs them in "
+                            "plain Python: pass one of them")
 
 
 def check_event(g, k):

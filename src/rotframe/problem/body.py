@@ -28,7 +28,7 @@ from rotframe.problem.inlined import Inlining
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
 from rotframe import method_registry as registry
-from rotframe.problem.arguments import check_flag, check_params, run_grid
+from rotframe.problem.arguments import check_flag, check_inline, check_params, run_grid
 from rotframe.problem.particles import STATUS
 from rotframe.validation import refuse_units
 
@@ -141,11 +141,7 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     if torque is not None and not callable(torque):
         raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
     check_flag(jit, "jit")
-    if inline is not None:
-        check_flag(inline, "inline")
-        if inline and not jit:
-            raise ScenarioError("inline=True compiles your functions into the engine's loop, jit=False runs them in "
-                                "plain Python: pass one of them")
+    check_inline(inline, jit)
     if torque is not None:
         uf.check_compilable("torque", torque, jit)
     params = check_params(params)
@@ -187,16 +183,15 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     fns = driver.functions(prob)
     # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
     inlining = Inlining(driver.module, BODY, method, False, 7, None, inline if jit else False)
-    kernel = [None]
 
     def call(budget):
         driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
                        st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns,
-                       kernel=kernel[0])
+                       kernel=inlining.kernel)
 
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:
-        kernel[0] = inlining.start()
+        inlining.start()
         while True:
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
             budget = pacer.start()
@@ -207,9 +202,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
             pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
-            if pacer.calls > 1 and kernel[0] is None:
-                kernel[0] = inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
-                                                float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
+            inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
+                                float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
             if progress is not None:
                 progress(float(st["IDX"][0]) / n)
             if st["ST"][0] != 0:

@@ -18,7 +18,8 @@ the CPU's inlined loop of a long run, `rotframe.problem.inlined`), each helper i
 direct call of the problem's function: the templates `direct_terms`, `direct_event`,
 `direct_vector` and `direct_varying`, whose names in capitals are bound per problem
 (`rotframe.numerics.compiled.bound`). The frame's and the origin's functions are then told apart
-by the tags `OMEGA_TAG` and `ORIGIN_TAG` where the addresses stand (`direct_functions`).
+by the tags `OMEGA_TAG` and `ORIGIN_TAG` where the addresses stand (`direct_functions`);
+`direct_calls` says which template replaces which helper, bound to which of the problem's functions.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ from rotframe.numerics.compiled import jit_inline
 from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VARYING_SIG, VECTOR_SIG
 
 __all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "RAISED",
-           "direct_terms", "direct_event", "direct_vector", "direct_varying", "direct_functions", "OMEGA_TAG",
-           "ORIGIN_TAG"]
+           "direct_terms", "direct_event", "direct_vector", "direct_varying", "direct_functions", "direct_calls",
+           "OMEGA_TAG", "ORIGIN_TAG"]
 
 
 def address(dispatcher, signature) -> int:
@@ -167,6 +168,29 @@ def direct_functions():
     """What such a loop takes where the engine's takes the addresses (`rotframe.problem.signatures.FUNCTIONS`): the
     tags of the frame's and the origin's functions, zero for the others (their direct calls ignore it)."""
     return 0, 0, OMEGA_TAG, ORIGIN_TAG, 0
+
+
+def direct_calls(module, varying) -> dict:
+    """The direct calls of a loop compiled with the problem's glue ``module`` in it: each helper -> its template and
+    the functions its names in capitals are bound to.
+
+    A role the glue lacks is the stub the engine would call (`rotframe.problem.stubs`); ``VARYING``
+    is ``varying``, the engine's evaluator of a varying vector (`rotframe.problem.models.varying_into`,
+    which calls `call_vector` in turn). The caller compiles each for its target, callees first, in
+    the order given (the GPU's kernel, `rotframe.problem.gpu`; the CPU's inlined loop,
+    `rotframe.problem.inlined`).
+    """
+    from rotframe.problem import stubs
+
+    def own(name, stub):
+        found = getattr(module, name, None)
+        return stub if found is None else found
+
+    return {call_terms: (direct_terms, {"TERMS": own("terms", stubs.no_terms)}),
+            call_event: (direct_event, {"EVENT": own("event", stubs.no_event)}),
+            call_vector: (direct_vector, {"OMEGA": own("omega", stubs.no_vector),
+                                          "ORIGIN": own("origin", stubs.no_vector)}),
+            call_varying: (direct_varying, {"VARYING": varying})}
 
 
 # the templates of the direct calls (module docstring): the names in capitals are bound per problem

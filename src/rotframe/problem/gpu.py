@@ -62,7 +62,7 @@ def _overrides(module):
     from numba import cuda
 
     from rotframe.particles.gpu import inline_options, device_function
-    from rotframe.problem import calls, models, readonly, stubs
+    from rotframe.problem import calls, models, readonly
 
     made: dict = {}
 
@@ -70,22 +70,14 @@ def _overrides(module):
         """``template`` compiled for the GPU with its capitalised global names bound to ``names``."""
         return cuda.jit(device=True, **inline_options())(bound(template, template.__name__, **names))
 
-    def own(name, stub):
-        return device_function(getattr(module, name, None) or stub, made)
-
     made[readonly.readonly] = device(_same_array)  # the read-only check is the CPU compile's (the glue is built there)
-    made[calls.call_terms] = device(calls.direct_terms, TERMS=own("terms", stubs.no_terms))
-    made[calls.call_event] = device(calls.direct_event, EVENT=own("event", stubs.no_event))
-    made[calls.call_vector] = device(calls.direct_vector, OMEGA=own("omega", stubs.no_vector),
-                                     ORIGIN=own("origin", stubs.no_vector))
-    made[calls.call_varying] = device(calls.direct_varying, VARYING=device_function(models.varying_into, made))
+    for helper, (template, names) in calls.direct_calls(module, models.varying_into).items():
+        made[helper] = device(template, **{name: device_function(f, made) for name, f in names.items()})
     return made
 
 
 def _same_array(a):
     return a
-
-
 
 
 def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,

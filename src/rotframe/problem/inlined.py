@@ -62,27 +62,18 @@ def _replacements(module, parts, where):
     """The direct calls of ``module``'s functions (the problem's glue) in place of the calls by address.
 
     Returns the dict that `_rebuilt` takes: each helper of `rotframe.problem.calls` -> its direct
-    template bound to the glue's function (a role the glue lacks: the stub the engine would call,
-    `rotframe.problem.stubs`), the engine's evaluator of a varying vector rebuilt on them, and a
-    particle's right-hand side with the model's ``parts`` as constants
-    (`rotframe.problem.models.particle_rhs_of`; None for a body).
+    template bound to the glue's functions (`rotframe.problem.calls.direct_calls`, the GPU's too;
+    the engine's evaluator of a varying vector rebuilt on them), and a particle's right-hand side
+    with the model's ``parts`` as constants (`rotframe.problem.models.particle_rhs_of`; None for a
+    body).
     """
     from rotframe.numerics.compiled import bound, jit_inline
-    from rotframe.problem import calls, models, stubs
-
-    def own(name, stub):
-        found = getattr(module, name, None)
-        return stub if found is None else found
-
-    def direct(template, **names):
-        return jit_inline(bound(template, template.__name__, **names))
+    from rotframe.problem import calls, models
 
     made: dict = {}
-    made[calls.call_terms] = direct(calls.direct_terms, TERMS=own("terms", stubs.no_terms))
-    made[calls.call_event] = direct(calls.direct_event, EVENT=own("event", stubs.no_event))
-    made[calls.call_vector] = direct(calls.direct_vector, OMEGA=own("omega", stubs.no_vector),
-                                     ORIGIN=own("origin", stubs.no_vector))
-    made[calls.call_varying] = direct(calls.direct_varying, VARYING=_rebuilt(models.varying_into, made, where))
+    for helper, (template, names) in calls.direct_calls(module, models.varying_into).items():
+        made[helper] = jit_inline(bound(template, template.__name__,
+                                        **{name: _rebuilt(f, made, where) for name, f in names.items()}))
     if parts is not None:
         made[models.particle_rhs] = _copy(models.particle_rhs_of(parts), made, where, like=models.particle_rhs)
     return made
@@ -243,39 +234,44 @@ class Inlining:
     def __init__(self, module, model, method, events, D, parts, mode):
         self.variant = (module, model, method, bool(events), int(D), parts)
         self.mode = mode
+        #: the inlined loop once the run has switched to it, else None (the engine's loop runs)
         self.kernel = None
         self.decided = mode is False
         self.note = None
         #: the seconds spent making the inlined loop after the first call (compiling or loading): a run counts them
         #: as compile time, not as integration
         self.seconds_mid_run = 0.0
-        self._wall = 0.0  # wall time of the calls measured so far, and the simulated time they covered
-        self._covered = 0.0
+        self._calls = 0
+        self._wall = 0.0  # wall time of the calls measured so far (the first left out), and the simulated time they
+        self._covered = 0.0  # covered
 
     def start(self):
-        """Before the first call: the inlined loop where ``inline=True`` (compiled or loaded now), else None."""
+        """Before the first call: make the inlined loop (`kernel`) where ``inline=True`` (compiled or loaded now)."""
         if self.mode is True:
             self._switch(compile=True, reason="inline=True")
-        return self.kernel
 
     def after_call(self, wall, covered, remaining):
-        """After a call (not the first) that took ``wall`` s to cover ``covered`` s of simulated time, summed over the
-        particles, with ``remaining`` s of it still to go: the inlined loop where the run switches now, else None."""
-        if self.decided:
-            return None
+        """After each call, which took ``wall`` s to cover ``covered`` s of simulated time, summed over the particles,
+        with ``remaining`` s of it still to go: switch to the inlined loop (`kernel`) where the run's pace says so.
+
+        The first call is not a measure of the pace (it compiles or loads the engine's loop).
+        """
+        self._calls += 1
+        if self.decided or self._calls == 1:
+            return
         self._wall += wall
         self._covered += covered
         if self._wall < MEASURED_S or self._covered <= 0.0:
-            return None
+            return
         self.decided = True
         left = self._wall / self._covered * remaining
         if left > WORTH_LOADING_S:
-            t0 = time.perf_counter()
-            self._switch(compile=left > WORTH_COMPILING_S, reason=f"about {left:.2g} s of work left at its pace")
-            self.seconds_mid_run = time.perf_counter() - t0
-        return self.kernel
+            self.seconds_mid_run = self._switch(compile=left > WORTH_COMPILING_S,
+                                                reason=f"about {left:.2g} s of work left at its pace")
 
-    def _switch(self, compile, reason):
+    def _switch(self, compile, reason) -> float:
+        """Load (or, with ``compile``, else compile) the inlined loop, and say so in `note`; returns the seconds it
+        took."""
         t0 = time.perf_counter()
         known = _key(*self.variant) in _LOOPS
         self.kernel = inlined_loop(*self.variant, compile=False)
@@ -288,3 +284,4 @@ class Inlining:
             took = "" if known else f" in {time.perf_counter() - t0:.2g} s"
             self.note = (f"the run went on in its inlined loop, the problem's functions compiled into the engine's "
                          f"loop ({reason}; {how}{took}): the same steps and numbers")
+        return time.perf_counter() - t0

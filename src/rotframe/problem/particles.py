@@ -19,7 +19,6 @@ attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,7 +27,7 @@ from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory
 from rotframe.problem import callables as uf
 from rotframe import method_registry as registry
-from rotframe.problem.arguments import (array_of, check_event, check_flag, check_params, run_grid,
+from rotframe.problem.arguments import (array_of, check_event, check_flag, check_inline, check_params, run_grid,
                                         sequence_of_callables)
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
@@ -182,11 +181,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     import time
 
     check_flag(jit, "jit")
-    if inline is not None:
-        check_flag(inline, "inline")
-        if inline and not jit:
-            raise ScenarioError("inline=True compiles your functions into the engine's loop, jit=False runs them in "
-                                "plain Python: pass one of them")
+    check_inline(inline, jit)
     on_gpu = _check_device(device, method, jit)
     method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
     if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
@@ -284,10 +279,12 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
 
     inlining = Inlining(driver.module, prob[0], method, events, D, model_parts(prob),
                         inline if jit and not on_gpu else False)
-    advance = driver.advance
+
+    def advance(*args):  # the engine's loop, or the inlined one once the run has switched to it
+        driver.advance(*args, kernel=inlining.kernel)
+
     try:
-        if inlining.start() is not None:
-            advance = functools.partial(driver.advance, kernel=inlining.kernel)
+        inlining.start()
         if events:
             driver.start_events(0.0, y, state["GPREV"], prob, fns)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
@@ -316,9 +313,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                 compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
                 first = False
             pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
-            if pacer.calls > 1 and inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
-                                                       float(np.sum(duration - state["TC"][state["ST"] == 0]))):
-                advance = functools.partial(driver.advance, kernel=inlining.kernel)
+            inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
+                                float(np.sum(duration - state["TC"][state["ST"] == 0])))
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
