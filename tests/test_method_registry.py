@@ -91,7 +91,7 @@ def test_the_engines_codes_are_named_once_and_never_leave_it():
     the modules that run problems pass the method by name (no code, no map of their own)."""
     import inspect
 
-    from rotframe.problem import body, engine, frame_error, gpu, models, particles
+    from rotframe.problem import body, engine, frame_error, gpu, models, particles, steps
 
     codes = engine.METHOD_CODES
     stepped = {m.name for m in registry.methods() if {"particles", "bodies"} & set(m.runs) and m.step != "exact"}
@@ -103,4 +103,4 @@ def test_the_engines_codes_are_named_once_and_never_leave_it():
     for module in (particles, body, frame_error, gpu):
         source = inspect.getsource(module)
         assert "_CODES" not in source and "models import DOP853" not in source, module.__name__
-    assert "take_step" in vars(engine) and "own_step" in vars(models)
+    assert "take_step" in vars(steps) and "own_step" in vars(models)

@@ -55,12 +55,11 @@ from numba import njit, types
 from rotframe.numerics.bisection import MAX_HALVINGS, locator
 from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
-                                           WATCH_FAILED, dop853_stages, dop853_start, dop853_step,
-                                           dop853_trajectory)
-from rotframe.numerics.rk4 import rk4_step
+                                           WATCH_FAILED, dop853_start, dop853_trajectory)
 from rotframe.problem.calls import RAISED, call_event, direct_functions
-from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, own_step, particle_energy, rhs
+from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
+from rotframe.problem.steps import body_system, particle_system, stepper, take_step
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
@@ -76,20 +75,6 @@ STATE_LENGTH = {PARTICLE: 6, BODY: 7}
 
 
 @jit_inline
-def particle_system(ctx, t, z, K, s):
-    """A particle's right-hand side as the one DOP853 loop calls it: ``K[s] = f(t, z)``, ``ctx = (prob, fns, W)``."""
-    prob, fns, W = ctx
-    rhs(None, t, z, K[s], prob, fns, W)
-
-
-@jit_inline
-def body_system(ctx, t, z, K, s):
-    """A rigid body's right-hand side as the one DOP853 loop calls it (`particle_system`)."""
-    prob, fns, W = ctx
-    rhs(True, t, z, K[s], prob, fns, W)
-
-
-@jit_inline
 def store_rows(out, k, p, y):
     """Sample ``k`` of particle ``p``: ``out[k, p] = y``."""
     for j in range(y.shape[0]):
@@ -100,30 +85,6 @@ def store_rows(out, k, p, y):
 def raised(ctx):
     """Whether a user function raised since the flag was cleared (`rotframe.problem.calls`)."""
     return ctx[2][RAISED] != 0.0
-
-
-#: the one RK4 step (`rotframe.numerics.rk4`) for each model's right-hand side
-particle_rk4 = rk4_step("engine_particle", particle_system)
-body_rk4 = rk4_step("engine_body", body_system)
-
-
-@jit_inline
-def take_step(stages, body, method, t, y, h, K, yt, yn, prob, fns, W):
-    """One step of ``method`` of length ``h`` from (t, y), K[0] = f(t, y): ``yn``.
-
-    DOP853's is the one DOP853 loop's step (`rotframe.numerics.dop853_loop.dop853_step` with the
-    system's ``stages``; None in a fixed-step variant, which takes no DOP853 step); RK4 the one RK4
-    step (`rotframe.numerics.rk4`); a splitting the model's own (`rotframe.problem.models.own_step`).
-    """
-    if method == DOP853:  # only the event locators' trials (the DOP853 loop steps on its own)
-        dop853_step(stages, (prob, fns, W), t, y, h, K, yn, yt)
-    elif method == RK4:
-        if body is None:
-            particle_rk4((prob, fns, W), t, y, h, K, yt, yn)
-        else:
-            body_rk4((prob, fns, W), t, y, h, K, yt, yn)
-    else:  # the model's own splitting, of order 2 or 4
-        own_step(body, method, t, y, h, yn, prob, fns, W)
 
 
 @jit_inline
@@ -152,7 +113,7 @@ def next_stop(S, t):
 
 
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
-SYSTEM = TRAJECTORY = STAGES = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
+SYSTEM = TRAJECTORY = STEPPER = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
 METHOD = DIM = 0
 EVENTS = False
 
@@ -161,12 +122,12 @@ def _event_trial(tctx, tau):
     """The template of a variant's event trial: event k's value after a re-step of length ``tau``.
 
     ``tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)``: the re-step is the variant's method from
-    ``(t, y)`` (`take_step` with the variant's ``STAGES``, ``BODY_FLAG`` and ``METHOD``; ``Kb[0]`` is
+    ``(t, y)`` (`take_step` with the variant's ``STEPPER``, ``BODY_FLAG`` and ``METHOD``; ``Kb[0]`` is
     f(t, y)), its state left in ``ybuf``. The trial of rotframe's one event locator
     (`rotframe.numerics.bisection.locator`) and of `_start_sign`.
     """
     k, t, y, Kb, ytb, ybuf, prob, fns, W = tctx
-    take_step(STAGES, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
+    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
     return call_event(fns[1], k, t + tau, ybuf, prob[2])
 
 
@@ -319,8 +280,8 @@ def _variant_kernel(model, method, events, D):
 
 
 def variant_loop(model, method, events, D=None):
-    """The loop of one variant, as Python: the model, ``method`` (a name of `METHOD_CODES`), ``events`` (and DOP853's
-    ``D``) constants of its code.
+    """The loop of one variant, as Python: the model, ``method`` (a name of `METHOD_CODES`), ``events`` and ``D``
+    constants of its code.
 
     numba prunes the branches of the other model, the other methods and the events before it types
     the function (a closure's variables are constants to it; the model reaches the steps as
@@ -330,29 +291,29 @@ def variant_loop(model, method, events, D=None):
     name, and its constants in numba's cache key).
 
     DOP853 runs the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`, `_dop853_loop`)
-    for the model's right-hand side, from stop to stop; ``D`` (default `STATE_LENGTH`) is the
-    length of its state. The fixed-step methods run `_fixed_step_loop`, which the GPU compiles too
-    (`rotframe.problem.gpu`).
+    for the model's right-hand side, from stop to stop. The fixed-step methods run
+    `_fixed_step_loop`, which the GPU compiles too (`rotframe.problem.gpu`). ``D`` (default
+    `STATE_LENGTH`) is the length of the state (a particle's is 10 where a force acts in inertial
+    axes), a constant of the steps' code too (`stepper`).
     """
     body = None if model == PARTICLE else True
     method = METHOD_CODES[method]
     D = STATE_LENGTH[model] if D is None else int(D)
-    suffix = "" if method != DOP853 or D == STATE_LENGTH[model] else str(D)
+    suffix = "" if D == STATE_LENGTH[model] else str(D)
     name = (f"advance_{'particle' if body is None else 'body'}{suffix}_{METHOD_NAMES[method]}"
             f"{'_events' if events else ''}")
     if method == DOP853:
         return _dop853_loop(name, body, events, D)
-    return _fixed_step_loop(name, body, method, events)
+    return _fixed_step_loop(name, body, method, events, D)
 
 
-def _watcher(kind, stages, body, method):
+def _watcher(kind, step, body, method):
     """The events' watcher of a variant (`_watch_events`) with its trial, locator and start rule, bound to them.
 
-    ``kind`` names the variant's copies; ``stages`` (DOP853's, None for a fixed-step method),
-    ``body`` and ``method`` are constants of its trial (`_event_trial`), so numba prunes the other
-    methods' steps from it.
+    ``kind`` names the variant's copies; ``step`` (the variant's `stepper`), ``body`` and ``method``
+    are constants of its trial (`_event_trial`), so numba prunes the other methods' steps from it.
     """
-    trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STAGES=stages, BODY_FLAG=body, METHOD=method))
+    trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STEPPER=step, BODY_FLAG=body, METHOD=method))
     start_sign = jit_inline(bound(_start_sign, f"start_sign_{kind}", TRIAL=trial))
     return jit_inline(bound(_watch_events, f"watch_{kind}", BODY_FLAG=body, TRIAL=trial, LOCATE=locator(kind, trial),
                             START_SIGN=start_sign))
@@ -369,7 +330,7 @@ def _dop853_loop(name, body, events, D):
     """
     system = particle_system if body is None else body_system
     kind = f"engine_{'particle' if body is None else 'body'}{D}"
-    stages = dop853_stages(kind, system, D)
+    stages = stepper(body, DOP853, D)
     watch = _watcher(kind, stages, body, DOP853) if events else None
     trajectory = dop853_trajectory(kind + ("_events" if events else ""), stages, store_rows, D, watch, aborted=raised)
     return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D))
@@ -425,15 +386,18 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
         save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, 0, status)
 
 
-def _fixed_step_loop(name, body, method, events):
+def _fixed_step_loop(name, body, method, events, D):
     """The loop of a fixed-step variant (RK4, the model's splittings): a step that divides each sample interval.
 
     A step ends on the next sample or the next stop, whichever is first; RK4's grid goes on from a
     stop. The template `_fixed_step_advance` reads the variant's constants as globals
-    (`rotframe.numerics.compiled.bound`); the GPU compiles this loop too (`rotframe.problem.gpu`).
+    (`rotframe.numerics.compiled.bound`), the length of the state ``D`` among them; the GPU compiles
+    this loop too (`rotframe.problem.gpu`).
     """
-    watch = _watcher(name, None, body, method) if events else None
-    return bound(_fixed_step_advance, name, BODY_FLAG=body, METHOD=method, EVENTS=bool(events), WATCH=watch)
+    step = stepper(body, method, D)
+    watch = _watcher(name, step, body, method) if events else None
+    return bound(_fixed_step_advance, name, STEPPER=step, BODY_FLAG=body, METHOD=method, EVENTS=bool(events),
+                 WATCH=watch, DIM=int(D))
 
 
 def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
@@ -442,7 +406,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
     # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
     # set for the block
     n = T.shape[0]
-    D = Y.shape[1]
+    D = DIM
     y, yt, yn, yev = V[0], V[1], V[2], V[3]
     ctx, wctx = contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
     for i in range(lo, hi):
@@ -478,7 +442,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 hh = hfix if on_grid else grid_next - t
                 sub += 1
                 landing = last
-            take_step(None, BODY_FLAG, METHOD, t, y, hh, K, yt, yn, prob, fns, W)
+            take_step(STEPPER, BODY_FLAG, METHOD, t, y, hh, K, yt, yn, prob, fns, W)
             steps += 1
             NSTEP[i] += 1
             NFEV[i] += 3 if METHOD == RK4 else 2
@@ -497,7 +461,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                         break
                     # the state at the terminal event: the step of that length from the step's start (the
                     # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                    take_step(None, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
+                    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
                     t = t + tau
                     for j in range(D):
                         y[j] = yev[j]
@@ -531,8 +495,8 @@ def variant(model, method, events, compiled=True, D=None):
     """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a name of `METHOD_CODES`) and
     ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
     when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`). ``D``, the
-    length of the state, is a constant of DOP853's loop (default the model's, `STATE_LENGTH`)."""
-    D = STATE_LENGTH[int(model)] if D is None or METHOD_CODES[method] != DOP853 else int(D)
+    length of the state, is a constant of the loop's code (default the model's, `STATE_LENGTH`)."""
+    D = STATE_LENGTH[int(model)] if D is None else int(D)
     key = (int(model), method, bool(events), D, bool(compiled))
     kernel = _VARIANTS.get(key)
     if kernel is None:
@@ -551,7 +515,12 @@ def variant(model, method, events, compiled=True, D=None):
 def scratch(D):
     """The loop's work arrays for states of D numbers: stages ``K`` (16, D) and ``Kb`` (13, D), state vectors
     ``V`` (7, D), the dense output's coefficients ``F`` (7, D) and the models' scratch ``W``."""
-    return np.empty((16, D)), np.empty((13, D)), np.empty((7, D)), np.empty((7, D)), np.zeros(SCRATCH)
+    block = np.zeros(43 * D + SCRATCH)
+    K = block[:16 * D].reshape(16, D)
+    Kb = block[16 * D:29 * D].reshape(13, D)
+    V = block[29 * D:36 * D].reshape(7, D)
+    F = block[36 * D:43 * D].reshape(7, D)
+    return K, Kb, V, F, block[43 * D:]
 
 
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,

@@ -117,7 +117,7 @@ def _kernel(module, method, events, D):
     from rotframe.problem.calls import direct_functions
     from rotframe.problem.signatures import PARTICLE
 
-    loop = device_function(engine.variant_loop(PARTICLE, method, events), _overrides(module))
+    loop = device_function(engine.variant_loop(PARTICLE, method, events, D), _overrides(module))
     done = _KERNELS[key] = cuda.jit(bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
                                            loop=loop, DIM=int(D), SCRATCH=models.SCRATCH,
                                            FNS=direct_functions()))

@@ -207,7 +207,7 @@ def euler_system(p, t, z, K, s):
 
 
 #: the one RK4 step (`rotframe.numerics.rk4`) for the rigid body
-_rk4_step = rk4_step("rigid", euler_system)
+_rk4_step = rk4_step("rigid", euler_system, 7)
 
 
 @njit(cache=True)

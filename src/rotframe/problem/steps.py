@@ -1,0 +1,68 @@
+"""One step of each of the engine's methods, for each model: the systems, the steppers, `take_step`.
+
+A model's right-hand side (`rotframe.problem.models.rhs`) is a *system* of rotframe's one DOP853
+loop (`rotframe.numerics.dop853_loop`) and its one RK4 step (`rotframe.numerics.rk4`): a
+compiled function ``f(ctx, t, z, K, s)`` writing ``K[s]``, with ``ctx = (prob, fns, W)``
+(`particle_system`, `body_system`). `stepper` compiles the method's step for a system and a
+length of state; `take_step` takes one step of any method with it: the engine's fixed-step
+loop steps with it, and its event locators re-step with it (`rotframe.problem.engine`).
+"""
+
+from __future__ import annotations
+
+import functools
+
+from rotframe.numerics.compiled import jit_inline
+from rotframe.numerics.dop853_loop import dop853_stages, dop853_step
+from rotframe.numerics.rk4 import rk4_step
+from rotframe.problem.models import DOP853, RK4, own_step, rhs
+
+__all__ = ["particle_system", "body_system", "stepper", "take_step"]
+
+
+@jit_inline
+def particle_system(ctx, t, z, K, s):
+    """A particle's right-hand side as the one DOP853 loop calls it: ``K[s] = f(t, z)``, ``ctx = (prob, fns, W)``."""
+    prob, fns, W = ctx
+    rhs(None, t, z, K[s], prob, fns, W)
+
+
+@jit_inline
+def body_system(ctx, t, z, K, s):
+    """A rigid body's right-hand side as the one DOP853 loop calls it (`particle_system`)."""
+    prob, fns, W = ctx
+    rhs(True, t, z, K[s], prob, fns, W)
+
+
+@functools.lru_cache(maxsize=None)
+def stepper(body, method, D):
+    """What `take_step` takes a step of ``method`` with, for the model (``body``) and states of ``D`` numbers.
+
+    DOP853: the one DOP853 loop's stages for the model's right-hand side
+    (`rotframe.numerics.dop853_loop.dop853_stages`); RK4: the one RK4 step
+    (`rotframe.numerics.rk4`); a splitting: None (the model's own step). ``D`` is a constant of
+    their code, so LLVM unrolls the loops over the state. Made once a process for each.
+    """
+    system = particle_system if body is None else body_system
+    kind = f"engine_{'particle' if body is None else 'body'}{D}"
+    if method == DOP853:
+        return dop853_stages(kind, system, D)
+    if method == RK4:
+        return rk4_step(kind, system, D)
+    return None
+
+
+@jit_inline
+def take_step(step, body, method, t, y, h, K, yt, yn, prob, fns, W):
+    """One step of ``method`` of length ``h`` from (t, y), K[0] = f(t, y): ``yn``.
+
+    ``step`` is the variant's `stepper`: DOP853's step is the one DOP853 loop's
+    (`rotframe.numerics.dop853_loop.dop853_step` with the system's stages), RK4's the one RK4
+    step (`rotframe.numerics.rk4`); a splitting is the model's own (`rotframe.problem.models.own_step`).
+    """
+    if method == DOP853:  # only the event locators' trials (the DOP853 loop steps on its own)
+        dop853_step(step, (prob, fns, W), t, y, h, K, yn, yt)
+    elif method == RK4:
+        step((prob, fns, W), t, y, h, K, yt, yn)
+    else:  # the model's own splitting, of order 2 or 4
+        own_step(body, method, t, y, h, yn, prob, fns, W)
