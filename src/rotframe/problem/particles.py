@@ -23,23 +23,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe.errors import IntegrationError, ScenarioError
+import time
+
+from rotframe.errors import IntegrationError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory
 from rotframe.problem import callables as uf
-from rotframe import method_registry as registry
-from rotframe.problem.arguments import (array_of, check_event, check_flag, check_inline, check_params, run_grid,
-                                        sequence_of_callables)
-from rotframe.problem.codegen import Driver, build_module
-from rotframe.problem.frame import frame_spec, origin_spec, stop_times
-from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.inlined import Inlining
-from rotframe.limits import check_memory, check_run
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.terms import (FRAME_TERMS, Force, StringConstraint, as_term, check_frame_terms, check_splitting,
-                                    model_constants, one_constraint)
+from rotframe.problem.particle_setup import function_roles, problem_tuple, run_state, set_up, start_states
+from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 
-__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks"]
+__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed", "trajectory_of"]
 
 #: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
@@ -60,71 +55,6 @@ class ProblemRun:
     frame_terms: tuple = FRAME_TERMS
 
 
-def _states(r0, v0):
-    r = np.atleast_2d(array_of(r0, "r0"))
-    v = np.atleast_2d(array_of(v0, "v0"))
-    if r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and 1 in (r.shape[0], v.shape[0]):
-        n = max(r.shape[0], v.shape[0])  # one start position with N velocities, or the other way round
-        r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
-    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
-        raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
-        raise ScenarioError("r0, v0: not finite")
-    return r, v
-
-
-def problem_tuple(M, p, frame, origin):
-    """The engine's `rotframe.problem.signatures.PROBLEM` tuple of a particle problem."""
-    from rotframe.problem.signatures import PARTICLE  # numba's types: imported by the runs that compile
-
-    return (PARTICLE, M, p, *frame.packed(), *origin.packed(derivative=False))
-
-
-def _bind(frame, origin, forces, events, compiled):
-    def prep(f):
-        return uf.compiled_for_glue(f) if compiled else uf.plain_function(f)
-
-    functions = {}
-    if frame.kind == "function":
-        functions["omega_fn"] = prep(frame.funcs[0])
-        if len(frame.funcs) > 1:
-            functions["omega_dot_fn"] = prep(frame.funcs[1])
-    if origin.kind == "function":
-        functions["origin_fn"] = prep(origin.funcs[0])
-    for k, f in enumerate(forces):
-        functions[f"force_{k}"] = prep(f.accel)
-        if f.potential is not None:
-            functions[f"potential_{k}"] = prep(f.potential)
-    for k, g in enumerate(events):
-        functions[f"event_{k}"] = prep(g)
-    return functions
-
-
-def _roles(frame, origin, forces, events, labels):
-    roles = []
-    if frame.kind == "function":
-        roles.append(("omega", frame.funcs[0]))
-        if len(frame.funcs) > 1:
-            roles.append(("omega_dot", frame.funcs[1]))
-    if origin.kind == "function":
-        roles.append(("origin_acceleration", origin.funcs[0]))
-    roles += [(labels[k], f.accel) for k, f in enumerate(forces)]
-    roles += [(f"{labels[k]}.potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
-    roles += [(f"events[{k}]", g) for k, g in enumerate(events)]
-    return roles
-
-
-def _check_functions(forces, events, params, r, v, t0, labels):
-    """Each force, potential and event once, in plain Python, at the start: shape, finiteness, raises."""
-    when = f"at t = {t0:g} s, r = {r.tolist()}, v = {v.tolist()}"
-    for k, f in enumerate(forces):
-        uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *f.params_for(params)), (3,), when=when)
-        if f.potential is not None:
-            uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
-    for k, g in enumerate(events):
-        uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
-
-
 def _blame(functions, params, t, y, dt, labels, frame_roles=()):
     """After a failed step: which of ``functions`` (`Force` terms or events, named by ``labels``), called
     at the last finite state ``y``, or of ``frame_roles`` (omega(t), a0(t)), raises or gives non-finite values.
@@ -143,26 +73,6 @@ def _blame(functions, params, t, y, dt, labels, frame_roles=()):
     return uf.blame_in_step(candidates, t, dt)
 
 
-def _scales(r, v, duration, rtol, atol, D):
-    """Absolute tolerances, one row per particle ((N, D)): each particle's from its own scales, so that its
-    steps, and its numbers, do not depend on the other particles of the ensemble."""
-    N = r.shape[0]
-    if atol is not None:
-        a = array_of(atol, "atol")
-        if a.ndim == 0:
-            a = np.full(6, float(a))
-        if a.shape != (6,) or not np.all(a > 0):
-            raise ScenarioError(f"atol={atol!r}: a positive number or 6 positive numbers (r then v)")
-        a = np.tile(a, (N, 1))
-    else:
-        sr = np.maximum(np.max(np.abs(r), axis=1), np.max(np.abs(v), axis=1) * duration)
-        sv = np.maximum(np.max(np.abs(v), axis=1), sr / duration)
-        still = sr == 0.0
-        sr[still], sv[still] = 1.0, 1.0 / duration
-        a = np.concatenate([np.repeat(rtol * sr[:, None], 3, axis=1), np.repeat(rtol * sv[:, None], 3, axis=1)],
-                           axis=1)
-    return np.ascontiguousarray(np.concatenate([a, np.full((N, D - 6), rtol)], axis=1))
-
 
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
@@ -178,94 +88,22 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         with ``frame_q`` (n, 4) where the attitude was integrated and ``energy`` (n, N) where
         it is conserved), ``diagnostics``, ``warnings``, ``notes``.
     """
-    import time
-
-    check_flag(jit, "jit")
-    check_inline(inline, jit)
-    on_gpu = _check_device(device, method, jit)
-    method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
-    if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
-        raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
-    frame_terms = check_frame_terms(frame_terms)
-    r, v = _states(r0, v0)
-    N = r.shape[0]
-    fixed = method not in ("dop853", "exact")
-    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed,
-                                                    what=f"method {method}", particles=N)
-    frame = frame_spec(omega, omega_dot)
-    origin = origin_spec(origin_acceleration)
-    for spec, what in ((frame, "omega"), (origin, "origin_acceleration")):
-        if spec.t_range[1] < duration or spec.t_range[0] > 0.0:
-            raise ScenarioError(f"{what}: defined for t in [{spec.t_range[0]:g}, {spec.t_range[1]:g}] s, "
-                                f"not over the run's [0, {duration:g}] s")
-    terms = [as_term(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
-    forces = [f for f in terms if isinstance(f, Force)]
-    labels = [f"forces[{k}]" for k, f in enumerate(terms) if isinstance(f, Force)]  # as the user numbered them
-    constraint = one_constraint(terms, r, v)
-    events = sequence_of_callables(events, "events")
-    for k, g in enumerate(events):
-        if not callable(g):
-            raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
-    params = check_params(params)
-    if method.startswith("rotation-splitting"):
-        check_splitting(method, forces, labels)
-    if method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
-        return _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress)
-    inertial = any(f.axes == "inertial" for f in forces)
-    D = 10 if inertial else 6
-    _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
-    if frame.kind == "function":
-        frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
-    roles = _roles(frame, origin, forces, events, labels)
-    for role, f in roles:
-        uf.check_compilable(role, f, jit)
-    splitting = method.startswith("rotation-splitting")
-    glue = particle_source(forces, events, params, splitting=splitting, origin=origin.kind == "function",
-                           omega=("function_dot" if len(frame.funcs) > 1 else "function") if frame.kind == "function"
-                           else "")
-    key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
-    cache_notes = [cache_note] if cache_note and jit else []
-    t0 = time.perf_counter()
-    try:
-        driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
-                                     compiled=jit, notes=cache_notes), compiled=jit)
-    except Exception as exc:
-        import numba
-
-        if isinstance(exc, numba.core.errors.NumbaError):
-            _compile_failure(exc, roles, params, r[0], v[0], frame,
-                             {labels[k] for k, f in enumerate(forces) if not f.takes_params})
-        raise
-    prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None,
-                                         frame_terms), flatten_params(params), frame, origin)
-    fns = driver.functions(prob)
-    slots = max_events if events else 1  # event records: none are kept without events
-    n = samples + 1
-    check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
-                              "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
-    stops = stop_times((frame, origin), duration)
-    check_run(steps=stops.size, particles=N, what="simulate (the frame's knots each end a step)")
-    y = np.zeros((N, D))
-    y[:, :3] = r
-    y[:, 3:6] = v
-    if D == 10:
-        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else array_of(frame_attitude, "frame_attitude")
-        if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
-            raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
-                                "numbers, not all 0")
-        if frame_attitude is None and frame.kind == "body":
-            q0 = np.asarray(omega.trajectory.q[0], dtype=float)
-        y[:, 6:] = q0 / np.linalg.norm(q0)
+    s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
+               origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
+               samples=samples, omega_dot=omega_dot, jit=jit, max_events=max_events, device=device,
+               frame_terms=frame_terms, inline=inline)
+    r, v = s.r, s.v
+    if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
+        return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
+                          progress)
+    method, duration, times, rtol, hfix, D, N = s.method, s.duration, s.times, s.rtol, s.hfix, s.D, r.shape[0]
+    frame, origin, forces, events, params, labels = s.frame, s.origin, s.forces, s.events, s.params, s.labels
+    driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
+    frame_terms, cache_notes, EDIR, ETERM, stops = s.frame_terms, s.cache_notes, s.EDIR, s.ETERM, s.stops
+    y, atol_arr = start_states(s, r, v, atol, frame_attitude, omega)
     y0_first = y[:1].copy()
-    atol_arr = _scales(r, v, duration, rtol, atol, D)
     OUT = np.full((n, N, D), np.nan)
-    state = dict(TC=np.zeros(N), H=np.zeros(N), IDX=np.zeros(N, np.int64), SUB=np.zeros(N, np.int64),
-                 ST=np.zeros(N, np.int64), EVT=np.full((N, slots), np.nan), EVY=np.zeros((N, slots, D)),
-                 EVK=np.zeros((N, slots), np.int64), EVN=np.zeros(N, np.int64),
-                 GPREV=np.zeros((N, max(len(events), 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
-    settings = [check_event(g, k) for k, g in enumerate(events)]
-    EDIR = np.array([float(d) for d, _ in settings], dtype=float)
-    ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
+    state = run_state(N, D, slots, len(events))
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     first = True
     if on_gpu:  # the same loop on the GPU: every particle at once, the arrays kept there between calls
@@ -327,31 +165,12 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     except KeyboardInterrupt:
         if gpu is not None:
             gpu.fetch()
-        traj = _trajectory(times, OUT, state, events, method, int(np.min(state["IDX"])), hfix)
+        traj = trajectory_of(times, OUT, state, events, method, int(np.min(state["IDX"])), hfix)
         raise RunInterrupted(traj) from None
     if gpu is not None:
         gpu.fetch()
-    traj = _trajectory(times, OUT, state, events, method, n, hfix)
-    if np.any(state["ST"] >= 3):
-        i = int(np.flatnonzero(state["ST"] >= 3)[0])
-        good = int(state["IDX"][i])
-        t_bad = float(state["TC"][i])
-        # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
-        code = int(state["ST"][i])
-        dt_failed = hfix if method != "dop853" else (10.0 if code in (3, 4) else 1.0) * float(state["H"][i])
-        if code == 5:
-            blame, raised = _blame(events, params, t_bad, y[i], dt_failed, [f"events[{k}]" for k in range(len(events))])
-        else:
-            blame, raised = _blame(forces, params, t_bad, y[i], dt_failed, labels,
-                                   _roles(frame, origin, [], [], []))
-        partial = _trajectory(times, OUT, state, events, method, good, hfix)
-        state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
-        if code == 6 or raised:  # a user function raised (compiled: the engine stopped at once)
-            raise uf.raised_during_run(f"simulate: particle {i}: a user function raised in the step from "
-                                       f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept",
-                                       t_bad, partial)
-        raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
-                               f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
+    traj = trajectory_of(times, OUT, state, events, method, n, hfix)
+    raise_if_failed(s, state, y, OUT)
     warnings, notes, diagnostics = [], list(frame.notes) + cache_notes + ([inlining.note] if inlining.note else []), {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
@@ -377,18 +196,31 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s, frame_terms)
 
 
-def _check_device(device, method, jit) -> bool:
-    """Whether the run is on the GPU (``device="gpu"``, `rotframe.problem.gpu`): checked, in one line each."""
-    from rotframe.particles.threads import check_device
-
-    if check_device(device, "device") != "gpu":
-        return False
-    if method is None:
-        raise ScenarioError(f"method: none given; device='gpu' runs {', '.join(registry.names('particles', gpu=True))} "
-                            "(the default, dop853, runs on the CPU)")
-    if not jit:
-        raise ScenarioError("jit=False: plain Python runs on the CPU; device='gpu' compiles the forces for the GPU")
-    return True
+def raise_if_failed(s, state, y, OUT):
+    """Where a particle of the run set up as ``s`` (`rotframe.problem.particle_setup.SetUp`) ended early (status 3 to
+    6): an error naming it, the time, the state and the function to blame, with the samples up to there."""
+    if not np.any(state["ST"] >= 3):
+        return
+    times, events, method, hfix = s.times, s.events, s.method, s.hfix
+    i = int(np.flatnonzero(state["ST"] >= 3)[0])
+    good = int(state["IDX"][i])
+    t_bad = float(state["TC"][i])
+    # the step that failed: RK4's fixed one, or DOP853's last try (10 times the step it fell back to)
+    code = int(state["ST"][i])
+    dt_failed = hfix if method != "dop853" else (10.0 if code in (3, 4) else 1.0) * float(state["H"][i])
+    if code == 5:
+        blame, raised = _blame(events, s.params, t_bad, y[i], dt_failed, [f"events[{k}]" for k in range(len(events))])
+    else:
+        blame, raised = _blame(s.forces, s.params, t_bad, y[i], dt_failed, s.labels,
+                               function_roles(s.frame, s.origin, [], [], []))
+    partial = trajectory_of(times, OUT, state, events, method, good, hfix)
+    state_text = f"r = {y[i, :3].tolist()}, v = {y[i, 3:6].tolist()}"
+    if code == 6 or raised:  # a user function raised (compiled: the engine stopped at once)
+        raise uf.raised_during_run(f"simulate: particle {i}: a user function raised in the step from "
+                                   f"t = {t_bad:.9g} s, {state_text}{blame}; samples up to there are kept",
+                                   t_bad, partial)
+    raise IntegrationError(f"simulate: particle {i}: {STATUS[code]}{blame} after t = {t_bad:.9g} s (method "
+                           f"{method}); samples up to there are kept", t_reached=t_bad, partial=partial)
 
 
 def advance_blocks(advance, N, args):
@@ -473,26 +305,10 @@ def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, ti
         where = f"a user function raised {what} after t = {t:.9g} s (the last state saved)"
     good = int(np.min(state["IDX"]))
     raise uf.raised_during_run(f"simulate: {where}; samples up to there are kept", float(times[max(good, 1) - 1]),
-                               _trajectory(times, OUT, state, events, method, good, hfix)) from None
+                               trajectory_of(times, OUT, state, events, method, good, hfix)) from None
 
 
-def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
-    """Name the function numba could not compile (``without_params``: the roles of the built-in terms, which take
-    no ``params``)."""
-    def sample_args(role):
-        own = () if role.split(".")[0] in without_params else params
-        if role.startswith("forces") and role.endswith("potential"):
-            return (0.0, r.copy(), *own)
-        if role.startswith(("forces", "events")):
-            return (0.0, r.copy(), v.copy(), *own)
-        return (0.0,)
-
-    found = uf.diagnose_compile(roles, sample_args)
-    reason = found or f"numba cannot compile the problem: {uf.numba_reason(exc)}"
-    raise uf.UserFunctionError(f"simulate: {reason}; pass jit=False to run it in plain Python (slow)") from None
-
-
-def _trajectory(times, OUT, state, events, method, n_kept, step=0.0):
+def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
     """The `Trajectory` of the first ``n_kept`` samples; ``step``: a fixed-step method's (``extras["step"]``)."""
     n_kept = max(int(n_kept), 1)
     r = OUT[:n_kept, :, :3].copy()

@@ -1,0 +1,287 @@
+"""A particle problem checked and built: what `rotframe.problem.particles.simulate_particles` does before its first step.
+
+`set_up` checks every argument (each bad one a one-line ScenarioError naming it), calls each
+of the user's functions once at the start, builds (or finds in the cache) the problem's glue
+(`rotframe.problem.codegen`) and the engine's data (`rotframe.problem.signatures.PROBLEM`), and
+returns it all as a `SetUp`. `start_states` and `run_state` make a run's arrays from it. A
+`simulate_particles` call sets up and runs once; a `rotframe.problem.prepared.PreparedProblem`
+sets up once and runs many times.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotframe import method_registry as registry
+from rotframe.errors import ScenarioError
+from rotframe.limits import check_memory, check_run
+from rotframe.problem import callables as uf
+from rotframe.problem.arguments import (array_of, check_event, check_flag, check_inline, check_params, run_grid,
+                                        sequence_of_callables)
+from rotframe.problem.codegen import Driver, build_module
+from rotframe.problem.frame import frame_spec, origin_spec, stop_times
+from rotframe.problem.glue import flatten_params, particle_source
+from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
+
+__all__ = ["SetUp", "set_up", "checked_states", "start_states", "run_state", "problem_tuple", "function_roles"]
+
+
+def checked_states(r0, v0):
+    """The start states ``r0``, ``v0`` as (N, 3) arrays: one of them may be a single state for all N; finite."""
+    r = np.atleast_2d(array_of(r0, "r0"))
+    v = np.atleast_2d(array_of(v0, "v0"))
+    if r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and 1 in (r.shape[0], v.shape[0]):
+        n = max(r.shape[0], v.shape[0])  # one start position with N velocities, or the other way round
+        r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
+    if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
+        raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
+    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
+        raise ScenarioError("r0, v0: not finite")
+    return r, v
+
+
+def problem_tuple(M, p, frame, origin):
+    """The engine's `rotframe.problem.signatures.PROBLEM` tuple of a particle problem."""
+    from rotframe.problem.signatures import PARTICLE  # numba's types: imported by the runs that compile
+
+    return (PARTICLE, M, p, *frame.packed(), *origin.packed(derivative=False))
+
+
+def _bind(frame, origin, forces, events, compiled):
+    def prep(f):
+        return uf.compiled_for_glue(f) if compiled else uf.plain_function(f)
+
+    functions = {}
+    if frame.kind == "function":
+        functions["omega_fn"] = prep(frame.funcs[0])
+        if len(frame.funcs) > 1:
+            functions["omega_dot_fn"] = prep(frame.funcs[1])
+    if origin.kind == "function":
+        functions["origin_fn"] = prep(origin.funcs[0])
+    for k, f in enumerate(forces):
+        functions[f"force_{k}"] = prep(f.accel)
+        if f.potential is not None:
+            functions[f"potential_{k}"] = prep(f.potential)
+    for k, g in enumerate(events):
+        functions[f"event_{k}"] = prep(g)
+    return functions
+
+
+def function_roles(frame, origin, forces, events, labels):
+    roles = []
+    if frame.kind == "function":
+        roles.append(("omega", frame.funcs[0]))
+        if len(frame.funcs) > 1:
+            roles.append(("omega_dot", frame.funcs[1]))
+    if origin.kind == "function":
+        roles.append(("origin_acceleration", origin.funcs[0]))
+    roles += [(labels[k], f.accel) for k, f in enumerate(forces)]
+    roles += [(f"{labels[k]}.potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
+    roles += [(f"events[{k}]", g) for k, g in enumerate(events)]
+    return roles
+
+
+def _check_functions(forces, events, params, r, v, t0, labels):
+    """Each force, potential and event once, in plain Python, at the start: shape, finiteness, raises."""
+    when = f"at t = {t0:g} s, r = {r.tolist()}, v = {v.tolist()}"
+    for k, f in enumerate(forces):
+        uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *f.params_for(params)), (3,), when=when)
+        if f.potential is not None:
+            uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
+    for k, g in enumerate(events):
+        uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
+
+def _scales(r, v, duration, rtol, atol, D):
+    """Absolute tolerances, one row per particle ((N, D)): each particle's from its own scales, so that its
+    steps, and its numbers, do not depend on the other particles of the ensemble."""
+    N = r.shape[0]
+    if atol is not None:
+        a = array_of(atol, "atol")
+        if a.ndim == 0:
+            a = np.full(6, float(a))
+        if a.shape != (6,) or not np.all(a > 0):
+            raise ScenarioError(f"atol={atol!r}: a positive number or 6 positive numbers (r then v)")
+        a = np.tile(a, (N, 1))
+    else:
+        sr = np.maximum(np.max(np.abs(r), axis=1), np.max(np.abs(v), axis=1) * duration)
+        sv = np.maximum(np.max(np.abs(v), axis=1), sr / duration)
+        still = sr == 0.0
+        sr[still], sv[still] = 1.0, 1.0 / duration
+        a = np.concatenate([np.repeat(rtol * sr[:, None], 3, axis=1), np.repeat(rtol * sv[:, None], 3, axis=1)],
+                           axis=1)
+    return np.ascontiguousarray(np.concatenate([a, np.full((N, D - 6), rtol)], axis=1))
+
+@dataclass
+class SetUp:
+    """A particle problem made ready to run (`set_up`): its checked settings, terms and events, the engine's driver,
+    the problem's data (`rotframe.problem.signatures.PROBLEM`) and its functions' addresses."""
+
+    #: the start states checked (N, 3)
+    r: np.ndarray
+    v: np.ndarray
+    method: str
+    duration: float
+    times: np.ndarray
+    rtol: float
+    hfix: float
+    D: int
+    frame: object
+    origin: object
+    terms: list
+    forces: list
+    labels: list
+    events: list
+    params: tuple
+    frame_terms: tuple
+    on_gpu: bool
+    #: what runs it (None for method exact, which compiles nothing)
+    driver: object = None
+    prob: tuple = None
+    fns: tuple = None
+    slots: int = 1
+    stops: np.ndarray = None
+    EDIR: np.ndarray = None
+    ETERM: np.ndarray = None
+    cache_notes: list = None
+    #: when the driver's build began (`time.perf_counter`): compile time counts from there
+    t0: float = 0.0
+
+
+def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples,
+           omega_dot, jit, max_events, device, frame_terms, inline=None):
+    """Check a particle problem and build what runs it, from the start states ``r0``, ``v0``: a `SetUp`.
+
+    Every argument as `simulate_particles` takes it, checked in its order; the start states are
+    checked too (the string's sphere, each function called once at particle 0's), and their
+    number sizes the work limits. For method ``exact`` nothing is built: the set-up is returned
+    checked, its driver None (the flow is the caller's, `rotframe.problem.exact`).
+    """
+    import time
+
+    check_flag(jit, "jit")
+    check_inline(inline, jit)
+    on_gpu = _check_device(device, method, jit)
+    method = registry.check(method, "particles", default="dop853", gpu=on_gpu)
+    if isinstance(max_events, bool) or not isinstance(max_events, (int, np.integer)) or max_events < 1:
+        raise ScenarioError(f"max_events={max_events!r}: a whole number >= 1 (event crossings kept per particle)")
+    frame_terms = check_frame_terms(frame_terms)
+    r, v = checked_states(r0, v0)
+    N = r.shape[0]
+    fixed = method not in ("dop853", "exact")
+    duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed,
+                                                    what=f"method {method}", particles=N)
+    frame = frame_spec(omega, omega_dot)
+    origin = origin_spec(origin_acceleration)
+    for spec, what in ((frame, "omega"), (origin, "origin_acceleration")):
+        if spec.t_range[1] < duration or spec.t_range[0] > 0.0:
+            raise ScenarioError(f"{what}: defined for t in [{spec.t_range[0]:g}, {spec.t_range[1]:g}] s, "
+                                f"not over the run's [0, {duration:g}] s")
+    terms = [as_term(f, k) for k, f in enumerate(sequence_of_callables(forces, "forces"))]
+    forces = [f for f in terms if isinstance(f, Force)]
+    labels = [f"forces[{k}]" for k, f in enumerate(terms) if isinstance(f, Force)]  # as the user numbered them
+    constraint = one_constraint(terms, r, v)
+    events = sequence_of_callables(events, "events")
+    for k, g in enumerate(events):
+        if not callable(g):
+            raise ScenarioError(f"events[{k}]: {g!r} is not callable (a function g(t, r, v, *params) -> float)")
+    params = check_params(params)
+    if method.startswith("rotation-splitting"):
+        check_splitting(method, forces, labels)
+    if method == "exact":  # the exact flow of a linear problem (the caller's): chosen from the terms, nothing compiled
+        return SetUp(r, v, method, duration, times, rtol, hfix, 6, frame, origin, terms, forces, labels, events, params,
+                     frame_terms, on_gpu)
+    inertial = any(f.axes == "inertial" for f in forces)
+    D = 10 if inertial else 6
+    _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
+    if frame.kind == "function":
+        frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
+    roles = function_roles(frame, origin, forces, events, labels)
+    for role, f in roles:
+        uf.check_compilable(role, f, jit)
+    splitting = method.startswith("rotation-splitting")
+    glue = particle_source(forces, events, params, splitting=splitting, origin=origin.kind == "function",
+                           omega=("function_dot" if len(frame.funcs) > 1 else "function") if frame.kind == "function"
+                           else "")
+    key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
+    cache_notes = [cache_note] if cache_note and jit else []
+    t0 = time.perf_counter()
+    try:
+        driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
+                                     compiled=jit, notes=cache_notes), compiled=jit)
+    except Exception as exc:
+        import numba
+
+        if isinstance(exc, numba.core.errors.NumbaError):
+            _compile_failure(exc, roles, params, r[0], v[0], frame,
+                             {labels[k] for k, f in enumerate(forces) if not f.takes_params})
+        raise
+    prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None,
+                                         frame_terms), flatten_params(params), frame, origin)
+    slots = max_events if events else 1  # event records: none are kept without events
+    n = samples + 1
+    check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
+                              "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
+    stops = stop_times((frame, origin), duration)
+    check_run(steps=stops.size, particles=N, what="simulate (the frame's knots each end a step)")
+    settings = [check_event(g, k) for k, g in enumerate(events)]
+    EDIR = np.array([float(d) for d, _ in settings], dtype=float)
+    ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
+    return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
+                 frame_terms, on_gpu, driver, prob, driver.functions(prob), slots, stops, EDIR, ETERM, cache_notes, t0)
+
+
+def start_states(s, r, v, atol, frame_attitude, omega):
+    """The engine's states ``y`` (N, D) of the set-up ``s`` from ``r``, ``v`` (N, 3) (and the frame's attitude where
+    a force acts in inertial axes), and the absolute tolerances (N, D) (`_scales`)."""
+    N, D = r.shape[0], s.D
+    y = np.zeros((N, D))
+    y[:, :3] = r
+    y[:, 3:6] = v
+    if D == 10:
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else array_of(frame_attitude, "frame_attitude")
+        if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
+            raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
+                                "numbers, not all 0")
+        if frame_attitude is None and s.frame.kind == "body":
+            q0 = np.asarray(omega.trajectory.q[0], dtype=float)
+        y[:, 6:] = q0 / np.linalg.norm(q0)
+    return y, _scales(r, v, s.duration, s.rtol, atol, D)
+
+
+def run_state(N, D, slots, n_events):
+    """The engine's per-particle arrays of a run (`rotframe.problem.engine.advance`), by name, at the start."""
+    return dict(TC=np.zeros(N), H=np.zeros(N), IDX=np.zeros(N, np.int64), SUB=np.zeros(N, np.int64),
+                ST=np.zeros(N, np.int64), EVT=np.full((N, slots), np.nan), EVY=np.zeros((N, slots, D)),
+                EVK=np.zeros((N, slots), np.int64), EVN=np.zeros(N, np.int64),
+                GPREV=np.zeros((N, max(n_events, 1))), NSTEP=np.zeros(N, np.int64), NFEV=np.zeros(N, np.int64))
+
+
+def _check_device(device, method, jit) -> bool:
+    """Whether the run is on the GPU (``device="gpu"``, `rotframe.problem.gpu`): checked, in one line each."""
+    from rotframe.particles.threads import check_device
+
+    if check_device(device, "device") != "gpu":
+        return False
+    if method is None:
+        raise ScenarioError(f"method: none given; device='gpu' runs {', '.join(registry.names('particles', gpu=True))} "
+                            "(the default, dop853, runs on the CPU)")
+    if not jit:
+        raise ScenarioError("jit=False: plain Python runs on the CPU; device='gpu' compiles the forces for the GPU")
+    return True
+
+def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
+    """Name the function numba could not compile (``without_params``: the roles of the built-in terms, which take
+    no ``params``)."""
+    def sample_args(role):
+        own = () if role.split(".")[0] in without_params else params
+        if role.startswith("forces") and role.endswith("potential"):
+            return (0.0, r.copy(), *own)
+        if role.startswith(("forces", "events")):
+            return (0.0, r.copy(), v.copy(), *own)
+        return (0.0,)
+
+    found = uf.diagnose_compile(roles, sample_args)
+    reason = found or f"numba cannot compile the problem: {uf.numba_reason(exc)}"
+    raise uf.UserFunctionError(f"simulate: {reason}; pass jit=False to run it in plain Python (slow)") from None

@@ -1,0 +1,118 @@
+"""Many runs of one particle problem from different start states, set up once.
+
+`rotframe.simulate` checks its arguments, calls each of your functions once, finds the
+problem's compiled glue, and after the run measures its energy and the frame's interpolation:
+some milliseconds a call, more than a short run's integration. A `PreparedProblem` does the
+set-up once (`rotframe.problem.particle_setup.set_up`, the same as ``simulate``'s) and loads the
+problem's inlined loop (`rotframe.problem.inlined`: your functions compiled into the engine's
+loop, cached on disk); each `PreparedProblem.run` then makes the run's arrays and makes one call
+of that loop. For optimisation loops, shooting, Monte Carlo over start states, and the scenes
+built on the engine: the particles' counterpart of the scenes'
+`rotframe.particles.prepared.PreparedRun`.
+
+A run gives the numbers of ``simulate`` with the same arguments, to the bit: the same loop, the
+same steps (a call's budget of steps never changes them: `rotframe.problem.engine`). What it
+leaves out is what ``simulate`` adds around the trajectory: the energy diagnostic, the frame's
+interpolation error, the progress bar, the GPU. A failed run raises as ``simulate`` does (the
+particle, the time, the state, the function to blame, the samples up to there).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["PreparedProblem"]
+
+#: a call's budget of steps per particle: the whole run in one call (the budget never changes the steps)
+_WHOLE_RUN = 2 ** 62
+
+
+class PreparedProblem:
+    """A particle problem of `rotframe.simulate`, set up once and run from many start states.
+
+    Parameters
+    ----------
+    r0, v0 : array_like
+        The first start states, (3,) or (N, 3) (m, m/s; the frame's axes): every check of
+        ``simulate`` is made on them (each function is called once at particle 0's).
+    omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples, omega_dot, atol, \
+frame_attitude, frame_terms
+        As `rotframe.simulate` takes them (SI floats here: the core takes no units).
+    inline : bool
+        True (default): the runs use the problem's inlined loop (`rotframe.problem.inlined`),
+        loaded from the disk cache or compiled here (seconds, once per problem ever); False:
+        the engine's loop, which calls your functions by address (nothing to compile).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rotframe import forces
+    >>> from rotframe.problem.prepared import PreparedProblem
+    >>> spin = PreparedProblem(r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], omega=[0.0, 0.0, 1.0], duration=1.0,
+    ...                        forces=[forces.spring(4.0, [0.0, 0.0, 0.0])], inline=False)
+    >>> [float(np.round(spin.run([x, 0.0, 0.0], [0.0, 0.0, 0.0]).r[-1, 0, 2], 12)) for x in (1.0, 2.0)]
+    [0.0, 0.0]
+    """
+
+    def __init__(self, *, r0, v0, omega, duration, forces=(), params=(), origin_acceleration=None, events=(),
+                 method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None, frame_attitude=None,
+                 frame_terms=None, inline=True):
+        from rotframe.problem.inlined import Inlining
+        from rotframe.problem.models import model_parts
+        from rotframe.problem.particle_setup import set_up
+
+        if not isinstance(inline, bool):
+            raise ScenarioError(f"inline={inline!r}: True (the problem's functions compiled into the loop) or False "
+                                "(called by address)")
+        s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
+                   origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
+                   samples=samples, omega_dot=omega_dot, jit=True, max_events=256, device=None,
+                   frame_terms=frame_terms, inline=inline)
+        if s.method == "exact":
+            raise ScenarioError("method='exact': the exact flow compiles nothing and has no set-up to keep; call "
+                                "rotframe.simulate")
+        self.setup = s
+        self._omega, self._atol, self._frame_attitude = omega, atol, frame_attitude
+        inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
+        inlining.start()
+        self._kernel = inlining.kernel
+        self.notes = [inlining.note] if inlining.note else []
+        #: the sample times (s), (samples + 1,)
+        self.times = s.times
+
+    def run(self, r0, v0):
+        """Integrate from the start states ``r0``, ``v0`` ((3,) or (N, 3)): a `rotframe.particles.trajectory.Trajectory`.
+
+        ``simulate``'s trajectory for the same arguments, to the bit. The states are checked as
+        ``simulate`` checks them (finite; on the string's sphere where there is one); the
+        functions are not called again in plain Python. Raises as ``simulate`` does where a
+        particle fails (`rotframe.problem.particles.raise_if_failed`).
+        """
+        from rotframe.problem.particle_setup import checked_states, run_state, start_states
+        from rotframe.problem.particles import advance_blocks, raise_if_failed, trajectory_of
+        from rotframe.problem.terms import one_constraint
+
+        s = self.setup
+        r, v = checked_states(r0, v0)
+        one_constraint(s.terms, r, v)
+        y, atol = start_states(s, r, v, self._atol, self._frame_attitude, self._omega)
+        N = r.shape[0]
+        OUT = np.full((s.times.size, N, s.D), np.nan)
+        state = run_state(N, s.D, s.slots, len(s.events))
+        if s.events:
+            s.driver.start_events(0.0, y, state["GPREV"], s.prob, s.fns)
+        args = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
+                state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"], _WHOLE_RUN,
+                s.method, s.rtol, atol, s.hfix, s.EDIR, s.ETERM, s.stops, s.prob, s.fns)
+        kernel = self._kernel
+        if N == 1:  # no thread to start
+            s.driver.advance(0, 1, *args, kernel=kernel)
+        else:
+            advance_blocks(lambda lo, hi, *a: s.driver.advance(lo, hi, *a, kernel=kernel), N, args)
+        raise_if_failed(s, state, y, OUT)
+        traj = trajectory_of(s.times, OUT, state, s.events, s.method, s.times.size, s.hfix)
+        if s.D == 10:
+            traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
+        return traj

@@ -1,0 +1,129 @@
+"""A particle problem set up once and run many times (`rotframe.problem.prepared.PreparedProblem`).
+
+The oracle is `simulate_particles` itself with the same arguments, whose physics the other suites check
+against closed forms, scipy and mpmath: what is checked here is that a prepared run is the same computation
+(the same set-up, loop and steps, so the same numbers to the bit), that each run starts from its own states,
+and that it refuses and fails as ``simulate`` does.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rotframe import forces
+from rotframe.errors import IntegrationError, ScenarioError
+from rotframe.problem.particles import Force, simulate_particles
+from rotframe.problem.prepared import PreparedProblem
+
+
+def pull(t, r, v, k):
+    return -k * r[0] + 0.1 * math.sin(t), -k * r[1], -k * r[2] - 0.05 * v[2]
+
+
+def inertial_push(t, r, v):
+    return 0.2, 0.0, 0.0  # in inertial axes: the frame's attitude is integrated with the particle
+
+
+def height(t, r, v, k):
+    return r[2]
+
+
+height.terminal = True
+height.direction = -1
+
+
+def omega_of(t):
+    return np.array([0.1 * math.sin(0.3 * t), 0.05, 0.4 + 0.02 * t])
+
+
+R0 = np.array([[1.0, 0.5, 2.0], [0.3, -0.2, 1.0]])
+V0 = np.array([[0.0, 0.4, 0.1], [0.2, 0.0, 0.0]])
+PROBLEMS = {
+    "dop853, a user force and a terminal event": dict(omega=[0.0, 0.1, 0.7], forces=[pull], params=(1.5,),
+                                                      events=[height], method="dop853", rtol=1e-9),
+    "rk4 in a frame given as a function": dict(omega=omega_of, forces=[pull], params=(0.8,), method="rk4", step=0.01),
+    "rotation-splitting4, a built-in spring": dict(omega=[0.0, 0.0, 0.9], forces=[forces.spring(2.0, [0, 0, 0])],
+                                                   method="rotation-splitting4", step=0.02),
+    "dop853, a force in inertial axes": dict(omega=[0.0, 0.0, 0.5], forces=[Force(inertial_push, axes="inertial")],
+                                             method="dop853", rtol=1e-8),
+}
+
+
+def same_trajectory(a, b):
+    assert np.array_equal(a.times, b.times)
+    assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v)
+    assert a.steps == b.steps
+    # each of simulate's calls (its pacer cuts the run into a few) evaluates f once at its start: a prepared run makes
+    # one call, so it may count fewer evaluations, never more
+    assert a.nfev <= b.nfev <= a.nfev + 16
+    assert np.array_equal(a.extras["status"], b.extras["status"])
+    assert sorted(a.event_times) == sorted(b.event_times)
+    for name in a.event_times:
+        for ta, tb in zip(a.event_times[name], b.event_times[name]):
+            assert np.array_equal(ta, tb)
+    if "frame_q" in b.extras:
+        assert np.array_equal(a.extras["frame_q"], b.extras["frame_q"])
+
+
+@pytest.mark.parametrize("inline", [False, True])
+@pytest.mark.parametrize("name", sorted(PROBLEMS))
+def test_a_prepared_run_is_simulate_to_the_bit(name, inline):
+    """Each run from new start states gives ``simulate``'s trajectory for those states, every array to the bit."""
+    kw = dict(PROBLEMS[name], duration=3.0, samples=30)
+    prepared = PreparedProblem(r0=R0, v0=V0, inline=inline, **kw)
+    for r0, v0 in ((R0, V0), (R0[::-1] * 1.1, V0[::-1]), (R0[0], V0[1])):
+        same_trajectory(prepared.run(r0, v0), simulate_particles(r0=r0, v0=v0, inline=inline, **kw).trajectory)
+
+
+def test_a_prepared_run_starts_from_its_own_states():
+    """Two runs of different states differ, and a run after them of the first states gives the first numbers."""
+    prepared = PreparedProblem(r0=R0, v0=V0, inline=False, **PROBLEMS["rk4 in a frame given as a function"],
+                               duration=2.0, samples=10)
+    first = prepared.run(R0, V0)
+    other = prepared.run(R0 * 0.5, V0)
+    assert not np.allclose(first.r[-1], other.r[-1])
+    assert np.array_equal(prepared.run(R0, V0).r, first.r)
+
+
+def test_a_failed_prepared_run_raises_as_simulate_does():
+    """A force that blows up ends the run with simulate's error: the particle, the time, the samples kept."""
+
+    def blow_up(t, r, v):
+        return 0.0, 0.0, 100.0 * r[2] * r[2] * r[2]  # z'' = 100 z^3 from z = 1: infinite within a second
+
+    kw = dict(omega=[0.0, 0.0, 0.1], forces=[blow_up], method="rk4", step=0.01, duration=3.0, samples=30)
+    prepared = PreparedProblem(r0=[1.0, 0.0, 1.0], v0=[0.0, 0.0, 0.0], inline=False, **kw)
+    with pytest.raises(IntegrationError) as ours:
+        prepared.run([1.0, 0.0, 1.0], [0.0, 0.0, 0.0])
+    with pytest.raises(IntegrationError) as theirs:
+        simulate_particles(r0=[1.0, 0.0, 1.0], v0=[0.0, 0.0, 0.0], inline=False, **kw)
+    assert str(ours.value) == str(theirs.value)
+    assert ours.value.t_reached == theirs.value.t_reached < 1.0
+    assert np.array_equal(ours.value.partial.r, theirs.value.partial.r)
+
+
+def test_each_run_is_checked_on_the_strings_sphere():
+    """A pendulum's states are checked at every run, as simulate checks them: off the sphere is one line."""
+    L, pivot = 2.0, np.array([0.0, 0.0, 2.0])
+    kw = dict(omega=[0.0, 0.0, 0.2], forces=[forces.gravity([0, 0, -9.81]), forces.pendulum(L, pivot)],
+              method="dop853", duration=1.0, samples=5)
+    prepared = PreparedProblem(r0=[0.5, 0.0, 2.0 - math.sqrt(L * L - 0.25)], v0=[0, 0, 0], inline=False, **kw)
+    with pytest.raises(ScenarioError, match="from the pivot of forces\\[1\\]"):
+        prepared.run([0.5, 0.0, 0.0], [0.0, 0.0, 0.0])
+    with pytest.raises(ScenarioError, match="r0, v0: not finite"):
+        prepared.run([np.nan, 0.0, 0.0], [0.0, 0.0, 0.0])
+
+
+def test_what_a_prepared_problem_refuses():
+    """Bad arguments are simulate's one-line errors; exact and a non-boolean inline are refused by name."""
+    base = dict(r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], omega=[0.0, 0.0, 1.0], duration=1.0,
+                forces=[forces.spring(1.0, [0, 0, 0])])
+    with pytest.raises(ScenarioError, match="method='exact'"):
+        PreparedProblem(method="exact", **base)
+    with pytest.raises(ScenarioError, match="inline='yes'"):
+        PreparedProblem(inline="yes", **base)
+    with pytest.raises(ScenarioError, match="duration=-1.0"):
+        PreparedProblem(**{**base, "duration": -1.0})
