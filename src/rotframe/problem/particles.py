@@ -319,7 +319,8 @@ def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
     traj = Trajectory(times[:n_kept].copy(), r, v, method, steps, nfev, complete,
                       float(times[n_kept - 1]))
     N = OUT.shape[1]
-    kept = np.arange(state["EVT"].shape[1])[None, :] < np.minimum(state["EVN"], state["EVT"].shape[1])[:, None]
+    if events:
+        kept = np.arange(state["EVT"].shape[1])[None, :] < np.minimum(state["EVN"], state["EVT"].shape[1])[:, None]
     for k, name in enumerate(_event_names(events)):
         # each particle's crossings of event k in time order (ties in the order located), split per particle
         i, j = np.nonzero(kept & (state["EVK"] == k))

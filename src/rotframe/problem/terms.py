@@ -137,17 +137,18 @@ def one_constraint(terms, r, v):
     if not found:
         return None
     k, c = found[0]
-    d = np.linalg.norm(r - np.asarray(c.pivot), axis=1)
-    bad = np.flatnonzero(np.abs(d - c.length) > 1e-9 * c.length)
-    if bad.size:
-        i = int(bad[0])
+    # array methods, not np.linalg.norm and np.flatnonzero: a prepared run checks its states at every run
+    rel = r - np.asarray(c.pivot)
+    d = np.sqrt((rel * rel).sum(axis=1))
+    bad = np.abs(d - c.length) > 1e-9 * c.length
+    if bad.any():
+        i = int(bad.argmax())
         raise ScenarioError(f"r0: particle {i} is {d[i]:.9g} m from the pivot of forces[{k}] (pendulum), not its "
                             f"length {c.length:.9g} m; start it on the string's sphere")
-    n = (r - np.asarray(c.pivot)) / c.length
-    radial = np.abs(np.sum(v * n, axis=1))
-    bad = np.flatnonzero(radial > 1e-9 * np.maximum(np.linalg.norm(v, axis=1), 1e-300))
-    if bad.size:
-        i = int(bad[0])
+    radial = np.abs((v * (rel / c.length)).sum(axis=1))
+    bad = radial > 1e-9 * np.maximum(np.sqrt((v * v).sum(axis=1)), 1e-300)
+    if bad.any():
+        i = int(bad.argmax())
         raise ScenarioError(f"v0: particle {i} moves along the string of forces[{k}] (pendulum) at "
                             f"{radial[i]:.3g} m/s; a taut string allows only velocities across it")
     return c
