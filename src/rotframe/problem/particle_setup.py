@@ -32,12 +32,13 @@ def checked_states(r0, v0):
     """The start states ``r0``, ``v0`` as (N, 3) arrays: one of them may be a single state for all N; finite."""
     r = np.atleast_2d(array_of(r0, "r0"))
     v = np.atleast_2d(array_of(v0, "v0"))
-    if r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and 1 in (r.shape[0], v.shape[0]):
+    if (r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and r.shape[0] != v.shape[0]
+            and 1 in (r.shape[0], v.shape[0])):
         n = max(r.shape[0], v.shape[0])  # one start position with N velocities, or the other way round
         r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
     if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
         raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
+    if not (np.isfinite(r).all() and np.isfinite(v).all()):  # array methods: a prepared run checks at every run
         raise ScenarioError("r0, v0: not finite")
     return r, v
 

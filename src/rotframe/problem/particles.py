@@ -199,7 +199,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
 def raise_if_failed(s, state, y, OUT):
     """Where a particle of the run set up as ``s`` (`rotframe.problem.particle_setup.SetUp`) ended early (status 3 to
     6): an error naming it, the time, the state and the function to blame, with the samples up to there."""
-    if not np.any(state["ST"] >= 3):
+    if not (state["ST"] >= 3).any():
         return
     times, events, method, hfix = s.times, s.events, s.method, s.hfix
     i = int(np.flatnonzero(state["ST"] >= 3)[0])
@@ -313,8 +313,8 @@ def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
     n_kept = max(int(n_kept), 1)
     r = OUT[:n_kept, :, :3].copy()
     v = OUT[:n_kept, :, 3:6].copy()
-    steps = int(np.max(state["NSTEP"])) if state["NSTEP"].size else 0
-    nfev = int(np.max(state["NFEV"])) if state["NFEV"].size else 0
+    steps = int(state["NSTEP"].max()) if state["NSTEP"].size else 0
+    nfev = int(state["NFEV"].max()) if state["NFEV"].size else 0
     complete = n_kept == times.size
     traj = Trajectory(times[:n_kept].copy(), r, v, method, steps, nfev, complete,
                       float(times[n_kept - 1]))

@@ -76,8 +76,35 @@ def user_force_rows(quick=False):
                      "per_eval_s": per_u, "builtin_per_eval_s": per_b, "ratio": per_u / per_b, "goal": 1.5,
                      "met": bool(per_u / per_b <= 1.5), "error": math.nan, "error_kind": "none",
                      "same_answer_rel": float(np.max(np.abs(a.r[-1] - b.r[-1]))) / scale, "note": note})
+    rows.append(_prepared_row(model, w, r0, v0, rtol, repeats))
     rows.extend(_cr3bp_rows(quick, repeats))
     return rows
+
+
+def _prepared_row(model, w, r0, v0, rtol, repeats):
+    """A short run (1 s of the same problem, DOP853) set up once and run again: what a run costs beyond its
+    integration, the user's problem (`rotframe.problem.prepared.PreparedProblem`) against the built-in terms (the
+    scenes' `rotframe.particles.prepared.PreparedRun`), with ``simulate``'s whole call beside them."""
+    from rotframe.particles.prepared import PreparedRun
+    from rotframe.problem.particles import simulate_particles
+    from rotframe.problem.prepared import PreparedProblem
+
+    kw = dict(omega=w, duration=1.0, forces=[_gravity_spring], params=(model.g[2], model.spring), rtol=rtol,
+              samples=10)
+    prepared = PreparedProblem(r0=r0, v0=v0, **kw)
+    builtin = PreparedRun(model, "dop853", 1.0, rtol=rtol, samples=10)
+    mine, theirs = prepared.run(r0, v0), builtin(r0, v0)
+    t_sim, _ = _best(lambda: simulate_particles(r0=r0, v0=v0, inline=True, **kw), repeats)
+    t_mine, _ = _best(lambda: prepared.run(r0, v0), repeats * 10)
+    t_theirs, _ = _best(lambda: builtin(r0, v0), repeats * 10)
+    scale = float(np.max(np.abs(theirs[0][-1])))
+    return {"scenario": "user-force", "kind": "user-force", "method": "dop853 prepared, 1 s", "setting": rtol,
+            "wall_s": t_mine, "builtin_wall_s": t_theirs, "simulate_wall_s": t_sim, "nfev": int(mine.nfev),
+            "builtin_nfev": int(builtin.nfev), "ratio": t_mine / t_theirs, "error": math.nan, "error_kind": "none",
+            "same_answer_rel": float(np.max(np.abs(mine.r[-1] - theirs[0][-1]))) / scale,
+            "note": "a 1 s run set up once and run again: the user's problem (PreparedProblem, inlined) against the "
+                    "built-in terms (the scenes' PreparedRun), the whole run each; simulate_wall_s is a whole "
+                    "rotframe.simulate call of it (checks, glue lookup, energy diagnostic)"}
 
 
 def _cr3bp_rows(quick, repeats):
