@@ -102,7 +102,7 @@ def test_a_failed_prepared_run_raises_as_simulate_does():
         simulate_particles(r0=[1.0, 0.0, 1.0], v0=[0.0, 0.0, 0.0], inline=False, **kw)
     assert str(ours.value) == str(theirs.value)
     assert ours.value.t_reached == theirs.value.t_reached < 1.0
-    assert np.array_equal(ours.value.partial.r, theirs.value.partial.r)
+    assert np.array_equal(ours.value.partial.r, theirs.value.partial.r, equal_nan=True)
 
 
 def test_each_run_is_checked_on_the_strings_sphere():
@@ -127,3 +127,26 @@ def test_what_a_prepared_problem_refuses():
         PreparedProblem(inline="yes", **base)
     with pytest.raises(ScenarioError, match="duration=-1.0"):
         PreparedProblem(**{**base, "duration": -1.0})
+
+
+def raise_late(t, r, v):
+    if t > 1.0:
+        raise ValueError("too late")
+    return -r[0], -r[1], -r[2]
+
+
+@pytest.mark.parametrize("inline", [False, True])
+def test_a_force_that_raises_is_named_as_simulate_names_it(inline):
+    """A force raising inside the compiled run: simulate's one-line error (the function, the step, the state) and
+    samples, whether the loop flagged it (by address) or the exception ended the call (inlined)."""
+    from rotframe.problem.callables import UserFunctionError
+
+    kw = dict(omega=[0.0, 0.0, 1.0], forces=[raise_late], duration=3.0, samples=30)
+    prepared = PreparedProblem(r0=R0, v0=V0, inline=inline, **kw)
+    with pytest.raises(UserFunctionError) as ours:
+        prepared.run(R0, V0)
+    with pytest.raises(UserFunctionError) as theirs:
+        simulate_particles(r0=R0, v0=V0, inline=inline, **kw)
+    assert str(ours.value) == str(theirs.value)
+    assert "raise_late" in str(ours.value) and "too late" in str(ours.value)
+    assert np.array_equal(ours.value.partial.r, theirs.value.partial.r, equal_nan=True)

@@ -71,6 +71,7 @@ def _bind(frame, origin, forces, events, compiled):
 
 
 def function_roles(frame, origin, forces, events, labels):
+    """The user's functions of a problem as ``(role, function)`` pairs, named as its errors name them."""
     roles = []
     if frame.kind == "function":
         roles.append(("omega", frame.funcs[0]))
@@ -93,6 +94,7 @@ def _check_functions(forces, events, params, r, v, t0, labels):
             uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
     for k, g in enumerate(events):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
+
 
 def _scales(r, v, duration, rtol, atol, D):
     """Absolute tolerances, one row per particle ((N, D)): each particle's from its own scales, so that its

@@ -34,7 +34,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import function_roles, problem_tuple, run_state, set_up, start_states
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 
-__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed", "trajectory_of"]
+__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed", "raised_later", "trajectory_of"]
 
 #: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
@@ -145,7 +145,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             except Exception as exc:
                 if gpu is not None:
                     gpu.fetch()
-                _raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
+                raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
                               params, method, hfix, times, OUT, state, events, labels)
             if first:
                 compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
@@ -273,7 +273,7 @@ def _again_on_the_cpu(particles, advance, y, state, saved, args):
         advance(int(i), int(i) + 1, *args)
 
 
-def _raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
+def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
     """A user function raised inside a compiled call: find the step, name the function, give time and state.
 
     The call is replayed from the state saved before it, one step per call, particle by particle

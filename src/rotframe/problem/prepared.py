@@ -11,7 +11,9 @@ built on the engine: the particles' counterpart of the scenes'
 `rotframe.particles.prepared.PreparedRun`.
 
 A run gives the numbers of ``simulate`` with the same arguments, to the bit: the same loop, the
-same steps (a call's budget of steps never changes them: `rotframe.problem.engine`). What it
+same steps (a call's budget of steps never changes them: `rotframe.problem.engine`); only its
+count of evaluations may be smaller, ``simulate``'s pacer cutting a run into calls that each
+evaluate f once more at their start. What it
 leaves out is what ``simulate`` adds around the trajectory: the energy diagnostic, the frame's
 interpolation error, the progress bar, the GPU. A failed run raises as ``simulate`` does (the
 particle, the time, the state, the function to blame, the samples up to there).
@@ -90,29 +92,47 @@ frame_attitude, frame_terms
         functions are not called again in plain Python. Raises as ``simulate`` does where a
         particle fails (`rotframe.problem.particles.raise_if_failed`).
         """
-        from rotframe.problem.particle_setup import checked_states, run_state, start_states
-        from rotframe.problem.particles import advance_blocks, raise_if_failed, trajectory_of
+        from rotframe.problem.particle_setup import checked_states
+        from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
         from rotframe.problem.terms import one_constraint
 
         s = self.setup
         r, v = checked_states(r0, v0)
         one_constraint(s.terms, r, v)
-        y, atol = start_states(s, r, v, self._atol, self._frame_attitude, self._omega)
+        y, state, atol = self._start(r, v)
         N = r.shape[0]
         OUT = np.full((s.times.size, N, s.D), np.nan)
-        state = run_state(N, s.D, s.slots, len(s.events))
-        if s.events:
-            s.driver.start_events(0.0, y, state["GPREV"], s.prob, s.fns)
-        args = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
-                state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"], _WHOLE_RUN,
-                s.method, s.rtol, atol, s.hfix, s.EDIR, s.ETERM, s.stops, s.prob, s.fns)
+        before = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
+                  state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
+        after = (s.method, s.rtol, atol, s.hfix, s.EDIR, s.ETERM, s.stops, s.prob, s.fns)
         kernel = self._kernel
-        if N == 1:  # no thread to start
-            s.driver.advance(0, 1, *args, kernel=kernel)
-        else:
-            advance_blocks(lambda lo, hi, *a: s.driver.advance(lo, hi, *a, kernel=kernel), N, args)
+
+        def advance(lo, hi, *args):
+            s.driver.advance(lo, hi, *args, kernel=kernel)
+
+        try:
+            if N == 1:  # no thread to start
+                advance(0, 1, *before, _WHOLE_RUN, *after)
+            else:
+                advance_blocks(advance, N, before + (_WHOLE_RUN,) + after)
+        except Exception as exc:  # a user function raised in the inlined loop: replayed from the start, as simulate
+            y0, saved, _ = self._start(r, v)  # replays a call (`raised_later`), to name the function and the step
+            saved["Y"] = y0
+            raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": _WHOLE_RUN}, s.forces,
+                         s.params, s.method, s.hfix, s.times, OUT, state, s.events, s.labels)
         raise_if_failed(s, state, y, OUT)
         traj = trajectory_of(s.times, OUT, state, s.events, s.method, s.times.size, s.hfix)
         if s.D == 10:
             traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
         return traj
+
+    def _start(self, r, v):
+        """The engine's states, per-particle arrays (their events' values at the start too) and tolerances of a run."""
+        from rotframe.problem.particle_setup import run_state, start_states
+
+        s = self.setup
+        y, atol = start_states(s, r, v, self._atol, self._frame_attitude, self._omega)
+        state = run_state(r.shape[0], s.D, s.slots, len(s.events))
+        if s.events:
+            s.driver.start_events(0.0, y, state["GPREV"], s.prob, s.fns)
+        return y, state, atol
