@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import os
 
 __all__ = ["BLOCK", "check_threads", "threads_scope", "threads_in_force", "resolve_threads", "DEVICES",
@@ -103,7 +104,7 @@ def check_threads(threads, what="threads") -> int | None:
         ok = False
     if not ok or int(threads) < 1:
         raise ScenarioError(f"{what}: {threads!r}; must be a whole number >= 1 (default: every core, "
-                            f"{os.cpu_count() or 1} here)")
+                            f"{cores()} here)")
     return int(threads)
 
 
@@ -127,5 +128,12 @@ def resolve_threads(threads=None) -> int:
     if threads is None:
         threads = _THREADS.get()
     if threads is None:
-        threads = os.cpu_count() or 1
+        threads = cores()
     return check_threads(threads)
+
+
+@functools.lru_cache(maxsize=1)
+def cores() -> int:
+    """The machine's cores (``os.cpu_count()``), read once a process: the call reads the system's files (some 40
+    microseconds), and every run asks."""
+    return os.cpu_count() or 1

@@ -48,13 +48,8 @@ def cache_dir(notes=None) -> Path | None:
     process (a later failure to write a driver is caught where it is written). None means no
     caching: the drivers compile in memory, once per process, and ``notes`` says why.
     """
-    env = os.environ.get("ROTFRAME_CACHE_DIR")
-    if env:
-        base = Path(env)
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        base = (Path(xdg) if xdg else Path.home() / ".cache") / "rotframe" / "problems"
-    fallback = Path(tempfile.gettempdir()) / f"rotframe-problems-{os.getuid() if hasattr(os, 'getuid') else 0}"
+    base, fallback = _folders(os.environ.get("ROTFRAME_CACHE_DIR"), os.environ.get("XDG_CACHE_HOME"),
+                              os.environ.get("HOME"))
     for folder in (base, fallback):
         if _writable(folder):
             return folder
@@ -62,6 +57,18 @@ def cache_dir(notes=None) -> Path | None:
         notes.append(f"the compiled-driver cache cannot be written ({base} nor {fallback}): the driver was "
                      "compiled in memory, not cached")
     return None
+
+
+@functools.lru_cache(maxsize=None)
+def _folders(env, xdg, home) -> tuple[Path, Path]:
+    """The configured cache folder and the temporary one, for the environment's values (``home``: HOME, which
+    `pathlib.Path.home` reads), made once for each: making the paths cost more than a short run's integration."""
+    if env:
+        base = Path(env)
+    else:
+        base = (Path(xdg) if xdg else Path.home() / ".cache") / "rotframe" / "problems"
+    fallback = Path(tempfile.gettempdir()) / f"rotframe-problems-{os.getuid() if hasattr(os, 'getuid') else 0}"
+    return base, fallback
 
 
 @functools.lru_cache(maxsize=None)
