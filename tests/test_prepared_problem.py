@@ -150,3 +150,21 @@ def test_a_force_that_raises_is_named_as_simulate_names_it(inline):
     assert str(ours.value) == str(theirs.value)
     assert "raise_late" in str(ours.value) and "too late" in str(ours.value)
     assert np.array_equal(ours.value.partial.r, theirs.value.partial.r, equal_nan=True)
+
+
+def test_more_particles_than_the_first_run_are_held_to_the_limits():
+    """A run of more particles than the set-up's is checked against the work limits, as simulate checks it."""
+    import dataclasses
+
+    from rotframe.limits import LimitError, applied, current
+
+    kw = dict(omega=[0.0, 0.0, 1.0], forces=[forces.spring(1.0, [0, 0, 0])], method="rk4", step=0.01, duration=1.0,
+              samples=10)
+    prepared = PreparedProblem(r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], inline=False, **kw)
+    many = np.tile([1.0, 0.0, 0.0], (50, 1))
+    with applied(dataclasses.replace(current(), max_steps=1000)):  # 100 steps a particle: 10 fit, 50 do not
+        prepared.run(many[:10], np.zeros((10, 3)))
+        with pytest.raises(LimitError, match="integration steps"):
+            prepared.run(many, np.zeros((50, 3)))
+        with pytest.raises(LimitError, match="integration steps"):
+            simulate_particles(r0=many, v0=np.zeros((50, 3)), inline=False, **kw)

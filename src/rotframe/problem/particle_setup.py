@@ -25,7 +25,7 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
-__all__ = ["SetUp", "set_up", "checked_states", "start_states", "run_state", "problem_tuple", "function_roles"]
+__all__ = ["SetUp", "set_up", "checked_states", "check_arrays", "start_states", "run_state", "problem_tuple", "function_roles"]
 
 
 def checked_states(r0, v0):
@@ -230,16 +230,22 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None,
                                          frame_terms), flatten_params(params), frame, origin)
     slots = max_events if events else 1  # event records: none are kept without events
-    n = samples + 1
-    check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
-                              "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
     stops = stop_times((frame, origin), duration)
-    check_run(steps=stops.size, particles=N, what="simulate (the frame's knots each end a step)")
+    check_arrays(N, times.size, D, slots, stops.size)
     settings = [check_event(g, k) for k, g in enumerate(events)]
     EDIR = np.array([float(d) for d, _ in settings], dtype=float)
     ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
     return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
                  frame_terms, on_gpu, driver, prob, driver.functions(prob), slots, stops, EDIR, ETERM, cache_notes, t0)
+
+
+def check_arrays(N, n, D, slots, knots):
+    """Refuse a run of N particles, n samples, states of D numbers and ``slots`` event records each whose arrays
+    exceed the memory limit, or whose frame's ``knots`` (each ends a step) or samples exceed the work limits
+    (`rotframe.limits`)."""
+    check_memory("simulate", {"samples (r, v and state at each sample)": 8.0 * n * N * D,
+                              "event slots": 8.0 * N * slots * (D + 2), "per-particle state": 8.0 * N * (3 * D + 16)})
+    check_run(steps=knots, samples=n, particles=N, what="simulate (the frame's knots each end a step)")
 
 
 def start_states(s, r, v, atol, frame_attitude, omega):

@@ -88,16 +88,22 @@ frame_attitude, frame_terms
         """Integrate from the start states ``r0``, ``v0`` ((3,) or (N, 3)): a `rotframe.particles.trajectory.Trajectory`.
 
         ``simulate``'s trajectory for the same arguments, to the bit. The states are checked as
-        ``simulate`` checks them (finite; on the string's sphere where there is one); the
+        ``simulate`` checks them (finite; on the string's sphere where there is one; more particles
+        than the first run's within the memory and work limits, `rotframe.limits`); the
         functions are not called again in plain Python. Raises as ``simulate`` does where a
         particle fails (`rotframe.problem.particles.raise_if_failed`).
         """
-        from rotframe.problem.particle_setup import checked_states
+        from rotframe.limits import check_run
+        from rotframe.problem.particle_setup import check_arrays, checked_states
         from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
         from rotframe.problem.terms import one_constraint
 
         s = self.setup
         r, v = checked_states(r0, v0)
+        if r.shape[0] > s.r.shape[0]:  # more particles than the set-up's: the limits checked for them
+            check_arrays(r.shape[0], s.times.size, s.D, s.slots, s.stops.size)
+            check_run(steps=s.duration / s.hfix if s.hfix else 0.0, particles=r.shape[0],
+                      what=f"method {s.method}")  # a fixed step's count, as simulate's grid checks it
         one_constraint(s.terms, r, v)
         y, state, atol = self._start(r, v)
         N = r.shape[0]
