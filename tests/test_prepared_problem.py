@@ -17,6 +17,7 @@ from rotframe import forces
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.problem.particles import Force, simulate_particles
 from rotframe.problem.prepared import PreparedProblem
+from raising_force import raise_after_one_second
 
 
 def pull(t, r, v, k):
@@ -129,26 +130,20 @@ def test_what_a_prepared_problem_refuses():
         PreparedProblem(**{**base, "duration": -1.0})
 
 
-def raise_late(t, r, v):
-    if t > 1.0:
-        raise ValueError("too late")
-    return -r[0], -r[1], -r[2]
-
-
 @pytest.mark.parametrize("inline", [False, True])
 def test_a_force_that_raises_is_named_as_simulate_names_it(inline):
     """A force raising inside the compiled run: simulate's one-line error (the function, the step, the state) and
     samples, whether the loop flagged it (by address) or the exception ended the call (inlined)."""
     from rotframe.problem.callables import UserFunctionError
 
-    kw = dict(omega=[0.0, 0.0, 1.0], forces=[raise_late], duration=3.0, samples=30)
+    kw = dict(omega=[0.0, 0.0, 1.0], forces=[raise_after_one_second], duration=3.0, samples=30)
     prepared = PreparedProblem(r0=R0, v0=V0, inline=inline, **kw)
     with pytest.raises(UserFunctionError) as ours:
         prepared.run(R0, V0)
     with pytest.raises(UserFunctionError) as theirs:
         simulate_particles(r0=R0, v0=V0, inline=inline, **kw)
     assert str(ours.value) == str(theirs.value)
-    assert "raise_late" in str(ours.value) and "too late" in str(ours.value)
+    assert "raise_after_one_second" in str(ours.value) and "too late" in str(ours.value)
     assert np.array_equal(ours.value.partial.r, theirs.value.partial.r, equal_nan=True)
 
 

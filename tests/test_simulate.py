@@ -30,6 +30,7 @@ from scipy.spatial.transform import Rotation
 
 import rotframe
 from rotframe.errors import IntegrationError, RotframeError, ScenarioError
+from raising_force import raise_after_one_second
 
 RTOL = 1e-12
 
@@ -441,12 +442,6 @@ def test_force_becomes_nan_later_keeps_partial():
     assert 0.9 <= part.times[-1] <= 1.0 + 1e-12
     assert np.all(np.isfinite(part.r)) and np.all(np.isfinite(part.v))
     assert part.r.shape == (part.times.size, 1, 3)
-
-
-def raise_after_one_second(t, r, v):
-    if t > 1.0:
-        raise ValueError("too late")
-    return -r[0], -r[1], -r[2]
 
 
 @pytest.mark.parametrize("inline", [False, True])
