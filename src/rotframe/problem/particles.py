@@ -31,7 +31,7 @@ from rotframe.problem import callables as uf
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.particle_setup import function_roles, problem_tuple, run_state, set_up, start_states
+from rotframe.problem.particle_setup import checked_atol, function_roles, problem_tuple, run_state, set_up, start_states
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed", "raised_later", "trajectory_of"]
@@ -100,7 +100,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     frame, origin, forces, events, params, labels = s.frame, s.origin, s.forces, s.events, s.params, s.labels
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
     frame_terms, cache_notes, EDIR, ETERM, stops = s.frame_terms, s.cache_notes, s.EDIR, s.ETERM, s.stops
-    y, atol_arr = start_states(s, r, v, atol, frame_attitude, omega)
+    y, atol_arr = start_states(s, r, v, checked_atol(atol), frame_attitude, omega)
     y0_first = y[:1].copy()
     OUT = np.full((n, N, D), np.nan)
     state = run_state(N, D, slots, len(events))

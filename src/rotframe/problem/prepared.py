@@ -27,9 +27,10 @@ from rotframe.errors import ScenarioError
 from rotframe.limits import check_run
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
-from rotframe.problem.particle_setup import check_arrays, checked_states, run_state, set_up, start_states
+from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_states, run_state, set_up,
+                                             start_states)
 from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
-from rotframe.problem.terms import one_constraint
+from rotframe.problem.terms import StringConstraint, check_on_string
 
 __all__ = ["PreparedProblem"]
 
@@ -80,7 +81,10 @@ frame_attitude, frame_terms
             raise ScenarioError("method='exact': the exact flow compiles nothing and has no set-up to keep; call "
                                 "rotframe.simulate")
         self.setup = s
-        self._omega, self._atol, self._frame_attitude = omega, atol, frame_attitude
+        self._omega, self._frame_attitude = omega, frame_attitude
+        self._atol = checked_atol(atol)  # checked once: each run takes it as it is
+        #: the string (`forces[k]`, the constraint) the start states are checked against at each run, or None
+        self._string = next(((k, f) for k, f in enumerate(s.terms) if isinstance(f, StringConstraint)), None)
         inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
         inlining.start()
         self._kernel = inlining.kernel
@@ -99,13 +103,14 @@ frame_attitude, frame_terms
         """
         s = self.setup
         r, v = checked_states(r0, v0)
-        if r.shape[0] > s.r.shape[0]:  # more particles than the set-up's: the limits checked for them
-            check_arrays(r.shape[0], s.times.size, s.D, s.slots, s.stops.size)
-            check_run(steps=s.duration / s.hfix if s.hfix else 0.0, particles=r.shape[0],
-                      what=f"method {s.method}")  # a fixed step's count, as simulate's grid checks it
-        one_constraint(s.terms, r, v)
-        y, state, atol = self._start(r, v)
         N = r.shape[0]
+        if N > s.r.shape[0]:  # more particles than the set-up's: the limits checked for them
+            check_arrays(N, s.times.size, s.D, s.slots, s.stops.size)
+            check_run(steps=s.duration / s.hfix if s.hfix else 0.0, particles=N,
+                      what=f"method {s.method}")  # a fixed step's count, as simulate's grid checks it
+        if self._string is not None:
+            check_on_string(*self._string, r, v)
+        y, state, atol = self._start(r, v)
         OUT = np.full((s.times.size, N, s.D), np.nan)
         before = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])

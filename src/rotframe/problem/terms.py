@@ -18,7 +18,7 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_splitting", "model_constants",
+__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_on_string", "check_splitting", "model_constants",
            "FRAME_TERMS", "check_frame_terms"]
 
 #: The frame's own terms, by the scenes' names for them (``-2 w x v``, ``-w x (w x r)``, ``-w' x r``): the ones a
@@ -136,22 +136,23 @@ def one_constraint(terms, r, v):
         raise ScenarioError(f"forces[{found[1][0]}]: a second pendulum; a particle hangs on one string")
     if not found:
         return None
-    k, c = found[0]
-    # array methods, not np.linalg.norm and np.flatnonzero: a prepared run checks its states at every run
-    rel = r - np.asarray(c.pivot)
-    d = np.sqrt((rel * rel).sum(axis=1))
-    bad = np.abs(d - c.length) > 1e-9 * c.length
-    if bad.any():
-        i = int(bad.argmax())
-        raise ScenarioError(f"r0: particle {i} is {d[i]:.9g} m from the pivot of forces[{k}] (pendulum), not its "
+    check_on_string(*found[0], r, v)
+    return found[0][1]
+
+
+def check_on_string(k, c, r, v):
+    """Refuse start states ``r``, ``v`` (N, 3; finite, C-ordered) off the sphere of the string ``c``, ``forces[k]``, or
+    moving along it, in one line naming the particle (`rotframe.problem.starts.start_defect`: compiled, as a
+    prepared run checks at every run)."""
+    from rotframe.problem.starts import ALONG_STRING, OFF_SPHERE, start_defect
+
+    kind, i, value = start_defect(r, v, *c.pivot, c.length)
+    if kind == OFF_SPHERE:
+        raise ScenarioError(f"r0: particle {i} is {value:.9g} m from the pivot of forces[{k}] (pendulum), not its "
                             f"length {c.length:.9g} m; start it on the string's sphere")
-    radial = np.abs((v * (rel / c.length)).sum(axis=1))
-    bad = radial > 1e-9 * np.maximum(np.sqrt((v * v).sum(axis=1)), 1e-300)
-    if bad.any():
-        i = int(bad.argmax())
+    if kind == ALONG_STRING:
         raise ScenarioError(f"v0: particle {i} moves along the string of forces[{k}] (pendulum) at "
-                            f"{radial[i]:.3g} m/s; a taut string allows only velocities across it")
-    return c
+                            f"{value:.3g} m/s; a taut string allows only velocities across it")
 
 
 def check_frame_terms(frame_terms) -> tuple:
