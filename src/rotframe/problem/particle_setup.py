@@ -23,10 +23,10 @@ from rotframe.problem.arguments import (array_of, check_event, check_flag, check
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
-from rotframe.problem.starts import NOT_FINITE, start_arrays, start_defect
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
-__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "check_arrays", "start_states", "run_state", "problem_tuple", "function_roles"]
+__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "check_arrays", "start_states", "run_state",
+           "problem_tuple", "function_roles"]
 
 
 def checked_states(r0, v0):
@@ -39,10 +39,9 @@ def checked_states(r0, v0):
         r, v = np.repeat(r, n // r.shape[0], axis=0), np.repeat(v, n // v.shape[0], axis=0)
     if r.ndim != 2 or r.shape[1] != 3 or v.shape != r.shape:
         raise ScenarioError(f"r0, v0: shapes {np.shape(r0)} and {np.shape(v0)}; expected both (3,) or both (N, 3)")
-    r, v = np.ascontiguousarray(r), np.ascontiguousarray(v)  # one compiled layout for the checks
-    if start_defect(r, v, 0.0, 0.0, 0.0, 0.0)[0] == NOT_FINITE:  # compiled: a prepared run checks at every run
+    if not (np.isfinite(r).all() and np.isfinite(v).all()):  # array methods: a prepared run checks at every run
         raise ScenarioError("r0, v0: not finite")
-    return r, v
+    return np.ascontiguousarray(r), np.ascontiguousarray(v)  # one layout for the string's compiled check
 
 
 def problem_tuple(M, p, frame, origin):
@@ -98,17 +97,38 @@ def _check_functions(forces, events, params, r, v, t0, labels):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
 
-def checked_atol(atol) -> np.ndarray:
-    """``atol=`` as `rotframe.problem.starts.start_arrays` takes it: six positive numbers (r then v; one number for
-    all six), or an empty array for the default (each particle's own scales); a one-line ScenarioError otherwise."""
+def checked_atol(atol) -> np.ndarray | None:
+    """``atol=`` as `_scales` takes it: six positive numbers (r then v; one number for all six), or None for the
+    default (each particle's own scales); a one-line ScenarioError otherwise. A prepared run checks it once."""
     if atol is None:
-        return np.empty(0)
+        return None
     a = array_of(atol, "atol")
     if a.ndim == 0:
         a = np.full(6, float(a))
     if a.shape != (6,) or not np.all(a > 0):
         raise ScenarioError(f"atol={atol!r}: a positive number or 6 positive numbers (r then v)")
     return a
+
+
+def _scales(r, v, duration, rtol, atol, D):
+    """Absolute tolerances, one row per particle ((N, D)): ``atol`` (`checked_atol`) where given, else each particle's
+    from its own scales, so that its steps, and its numbers, do not depend on the other particles of the ensemble."""
+    N = r.shape[0]
+    out = np.full((N, D), rtol)
+    if atol is not None:
+        out[:, :6] = atol
+        return out
+    # each particle's scales, in array methods (a prepared run makes them at every run: np.max and np.repeat cost more
+    # than the arithmetic); the same products, so the same numbers
+    ar = np.abs(r).max(axis=1)
+    av = np.abs(v).max(axis=1)
+    sr = np.maximum(ar, av * duration)
+    sv = np.maximum(av, sr / duration)
+    still = sr == 0.0
+    sr[still], sv[still] = 1.0, 1.0 / duration
+    out[:, :3] = (rtol * sr)[:, None]
+    out[:, 3:6] = (rtol * sv)[:, None]
+    return out
 
 
 @dataclass
@@ -238,10 +258,13 @@ def check_arrays(N, n, D, slots, knots):
 
 def start_states(s, r, v, atol, frame_attitude, omega):
     """The engine's states ``y`` (N, D) of the set-up ``s`` from ``r``, ``v`` (N, 3) (and the frame's attitude where
-    a force acts in inertial axes), and the absolute tolerances (N, D), ``atol`` as `checked_atol` gives it
-    (`rotframe.problem.starts.start_arrays`)."""
-    y, atol = start_arrays(r, v, s.D, s.duration, s.rtol, atol)
-    if s.D == 10:
+    a force acts in inertial axes), and the absolute tolerances (N, D) (`_scales`; ``atol`` as `checked_atol`
+    gives it)."""
+    N, D = r.shape[0], s.D
+    y = np.zeros((N, D))
+    y[:, :3] = r
+    y[:, 3:6] = v
+    if D == 10:
         q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else array_of(frame_attitude, "frame_attitude")
         if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
             raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
@@ -249,7 +272,7 @@ def start_states(s, r, v, atol, frame_attitude, omega):
         if frame_attitude is None and s.frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
-    return y, atol
+    return y, _scales(r, v, s.duration, s.rtol, atol, D)
 
 
 def run_state(N, D, slots, n_events):

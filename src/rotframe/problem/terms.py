@@ -142,11 +142,11 @@ def one_constraint(terms, r, v):
 
 def check_on_string(k, c, r, v):
     """Refuse start states ``r``, ``v`` (N, 3; finite, C-ordered) off the sphere of the string ``c``, ``forces[k]``, or
-    moving along it, in one line naming the particle (`rotframe.problem.starts.start_defect`: compiled, as a
+    moving along it, in one line naming the particle (`rotframe.problem.string_start.string_defect`: compiled, as a
     prepared run checks at every run)."""
-    from rotframe.problem.starts import ALONG_STRING, OFF_SPHERE, start_defect
+    from rotframe.problem.string_start import ALONG_STRING, OFF_SPHERE, string_defect
 
-    kind, i, value = start_defect(r, v, *c.pivot, c.length)
+    kind, i, value = string_defect(r, v, *c.pivot, c.length)
     if kind == OFF_SPHERE:
         raise ScenarioError(f"r0: particle {i} is {value:.9g} m from the pivot of forces[{k}] (pendulum), not its "
                             f"length {c.length:.9g} m; start it on the string's sphere")
