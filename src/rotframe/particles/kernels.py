@@ -21,6 +21,7 @@ import math
 from numba import njit
 
 from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
+from rotframe.numerics.rk4 import rk4_particle_step
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
@@ -249,43 +250,22 @@ def _rk4_steps(state, n, h, m, plan):
 
 
 @_inline
+def _stage_acceleration(ctx, t, state):
+    """The acceleration at an RK4 stage, ``ctx = (m, w, wd)``: the model and the plan's rates at the stage's time."""
+    m, w, wd = ctx
+    return _acceleration(state, m, w, wd)
+
+
+#: the one RK4 step of a particle (`rotframe.numerics.rk4.rk4_particle_step`) with the scenes' acceleration
+_rk4_particle_step = rk4_particle_step("scene", _stage_acceleration, _inline)
+
+
+@_inline
 def rk4_step(state, h, m, plan):
-    """One classical Runge-Kutta step (inlined into its callers); see `step_rk4`."""
-    x, y, z, vx, vy, vz = state
-    hh = 0.5 * h
-    h6 = h / 6.0
-    w1, wd1 = plan[0][0], plan[0][1]
-    w2, wd2 = plan[1][0], plan[1][1]
-    w4, wd4 = plan[2][0], plan[2][1]
-    a1x, a1y, a1z = _acceleration((x, y, z, vx, vy, vz), m, w1, wd1)
-    x2 = x + hh * vx
-    y2 = y + hh * vy
-    z2 = z + hh * vz
-    v2x = vx + hh * a1x
-    v2y = vy + hh * a1y
-    v2z = vz + hh * a1z
-    a2x, a2y, a2z = _acceleration((x2, y2, z2, v2x, v2y, v2z), m, w2, wd2)
-    x3 = x + hh * v2x
-    y3 = y + hh * v2y
-    z3 = z + hh * v2z
-    v3x = vx + hh * a2x
-    v3y = vy + hh * a2y
-    v3z = vz + hh * a2z
-    a3x, a3y, a3z = _acceleration((x3, y3, z3, v3x, v3y, v3z), m, w2, wd2)
-    x4 = x + h * v3x
-    y4 = y + h * v3y
-    z4 = z + h * v3z
-    v4x = vx + h * a3x
-    v4y = vy + h * a3y
-    v4z = vz + h * a3z
-    a4x, a4y, a4z = _acceleration((x4, y4, z4, v4x, v4y, v4z), m, w4, wd4)
-    x, y, z, vx, vy, vz = (x + h6 * (vx + 2.0 * v2x + 2.0 * v3x + v4x),
-                           y + h6 * (vy + 2.0 * v2y + 2.0 * v3y + v4y),
-                           z + h6 * (vz + 2.0 * v2z + 2.0 * v3z + v4z),
-                           vx + h6 * (a1x + 2.0 * a2x + 2.0 * a3x + a4x),
-                           vy + h6 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y),
-                           vz + h6 * (a1z + 2.0 * a2z + 2.0 * a3z + a4z))
-    return x, y, z, vx, vy, vz
+    """One classical Runge-Kutta step (inlined into its callers), the rates at t, t + h/2 and t + h from the
+    ``plan``: the one RK4 step of a particle (`rotframe.numerics.rk4.rk4_particle_step`); see `step_rk4`."""
+    a1 = _acceleration(state, m, plan[0][0], plan[0][1])
+    return _rk4_particle_step((m, plan[1][0], plan[1][1]), (m, plan[2][0], plan[2][1]), 0.0, state, h, a1)
 
 
 @_inline

@@ -6,18 +6,24 @@ compiled function ``f(ctx, t, z, K, s)`` writing ``K[s]``, with ``ctx = (prob, f
 (`particle_system`, `body_system`). `stepper` compiles the method's step for a system and a
 length of state; `take_step` takes one step of any method with it: the engine's fixed-step
 loop steps with it, and its event locators re-step with it (`rotframe.problem.engine`).
+
+A particle's RK4 step (6 numbers) is the one RK4 step of a particle, the scenes' too
+(`rotframe.numerics.rk4.rk4_particle_step`), with its stages in registers; it writes each stage's
+state to ``yt`` for the problem's functions, which take arrays (`particle_rk4`). A particle that
+carries the frame's attitude (10 numbers) and a body take the one RK4 step of a system
+(`rotframe.numerics.rk4.rk4_step`).
 """
 
 from __future__ import annotations
 
 import functools
 
-from rotframe.numerics.compiled import jit_inline
+from rotframe.numerics.compiled import jit_inline, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step
-from rotframe.numerics.rk4 import rk4_step
-from rotframe.problem.models import DOP853, RK4, own_step, rhs
+from rotframe.numerics.rk4 import rk4_particle_step, rk4_step
+from rotframe.problem.models import DOP853, RK4, own_step, particle_acceleration, rhs
 
-__all__ = ["particle_system", "body_system", "stepper", "take_step"]
+__all__ = ["particle_system", "body_system", "particle_rk4", "stepper", "take_step"]
 
 
 @jit_inline
@@ -34,13 +40,43 @@ def body_system(ctx, t, z, K, s):
     rhs(True, t, z, K[s], prob, fns, W)
 
 
+@jit_inline
+def _stage_acceleration(ctx, t, state):
+    """A particle's acceleration at an RK4 stage, ``ctx = (prob, fns, W, yt)``: the stage's ``state`` written to ``yt``,
+    the array the problem's functions take."""
+    prob, fns, W, yt = ctx
+    yt[0] = state[0]
+    yt[1] = state[1]
+    yt[2] = state[2]
+    yt[3] = state[3]
+    yt[4] = state[4]
+    yt[5] = state[5]
+    ax, ay, az, _, _, _ = particle_acceleration(t, yt, prob, fns, W)
+    return ax, ay, az
+
+
+#: the one RK4 step of a particle with the engine's acceleration
+_particle_step = rk4_particle_step("engine", _stage_acceleration, jit_llvm_inline)
+
+
+@jit_llvm_inline  # not numba's inlining: take_step passes each variant's step to the other method's branches too
+def particle_rk4(ctx, t, y, h, K, yt, yn):
+    """A particle's RK4 step (6 numbers) in the protocol of `rotframe.numerics.rk4.rk4_step`: from ``(t, y)``, with
+    ``K[0] = f(t, y)``, the state after ``h`` into ``yn``; ``yt`` the stages' states (the stages are in registers,
+    ``K[1:4]`` untouched)."""
+    prob, fns, W = ctx
+    stage = (prob, fns, W, yt)
+    yn[0], yn[1], yn[2], yn[3], yn[4], yn[5] = _particle_step(stage, stage, t, (y[0], y[1], y[2], y[3], y[4], y[5]),
+                                                              h, (K[0, 3], K[0, 4], K[0, 5]))
+
+
 @functools.lru_cache(maxsize=None)
 def stepper(body, method, D):
     """What `take_step` takes a step of ``method`` with, for the model (``body``) and states of ``D`` numbers.
 
     DOP853: the one DOP853 loop's stages for the model's right-hand side
     (`rotframe.numerics.dop853_loop.dop853_stages`); RK4: the one RK4 step
-    (`rotframe.numerics.rk4`); a splitting: None (the model's own step). ``D`` is a constant of
+    (`rotframe.numerics.rk4`; a particle's, `particle_rk4`, where the state is its 6 numbers); a splitting: None (the model's own step). ``D`` is a constant of
     their code, so LLVM unrolls the loops over the state. Made once a process for each.
     """
     system = particle_system if body is None else body_system
@@ -48,7 +84,7 @@ def stepper(body, method, D):
     if method == DOP853:
         return dop853_stages(kind, system, D)
     if method == RK4:
-        return rk4_step(kind, system, D)
+        return particle_rk4 if body is None and D == 6 else rk4_step(kind, system, D)
     return None
 
 
