@@ -103,12 +103,13 @@ def rk4_particle_step(name, accel, compile):
     with ``a1`` its acceleration, one step of length ``h``, the stages in registers.
     ``accel(ctx, t, state) -> (ax, ay, az)`` is called with ``ctx = mid`` at ``t + h/2`` and with
     ``ctx = end`` at ``t + h``: a scene passes the rates of its plan there; the engine passes
-    its problem both times. ``compile`` is the caller's inlining (numba's IR for the scenes'
-    kernels, LLVM's for the engine's), so the step's arithmetic is in each caller's loop.
+    its problem both times. ``compile`` is the caller's inlining (numba's, into each caller's
+    loop), so the step's arithmetic is in each caller's loop.
 
-    The engine's particle took 1.20 to 1.23 times the scene's time with its stages in arrays
-    (`rk4_step`), 1.06 to 1.10 with them in registers and the stage's state written to an array
-    for the user's force (a stand-alone model of the two loops on the Foucault model, one pinned
-    core, best of 9, 2026-11-29).
+    A stand-alone model of the engine's loop on the Foucault model took 1.20 to 1.23 times the
+    scene's time with its stages in arrays (`rk4_step`) and 1.06 to 1.10 with them in registers
+    and each stage's state written to an array for the user's force; the engine itself went from
+    1.21 to 1.29 to 1.11 to 1.13 (`tools/foucault_on_engine.py`; one pinned core, best of 9,
+    2026-11-29).
     """
     return compile(bound(_particle_step, f"rk4_particle_step_{name}", ACCEL=accel))

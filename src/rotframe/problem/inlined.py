@@ -31,7 +31,7 @@ fingerprinted) has its inlined loop compiled in memory too.
 
 What the inlined loop gains is the call by address (opaque to the compiler) and the parts of the
 model the problem lacks (the engine reads them from the problem's constants at every
-evaluation; the inlined loop holds them as constants, `rotframe.problem.models.particle_acceleration_of`).
+evaluation; the inlined loop holds them as constants, `rotframe.problem.models.particle_rhs_of`).
 It does not make the engine's loop as fast as the scenes' kernels, whose steps keep the state in
 registers (docs/architecture.md).
 
@@ -63,9 +63,9 @@ def _replacements(module, parts, where):
 
     Returns the dict that `_rebuilt` takes: each helper of `rotframe.problem.calls` -> its direct
     template bound to the glue's functions (`rotframe.problem.calls.direct_calls`, the GPU's too;
-    the engine's evaluator of a varying vector rebuilt on them), and a particle's acceleration
-    with the model's ``parts`` as constants (`rotframe.problem.models.particle_acceleration_of`; None
-    for a body).
+    the engine's evaluator of a varying vector rebuilt on them), and a particle's right-hand side
+    with the model's ``parts`` as constants (`rotframe.problem.models.particle_rhs_of`; None for a
+    body).
     """
     from rotframe.numerics.compiled import bound, jit_inline
     from rotframe.problem import calls, models
@@ -75,8 +75,7 @@ def _replacements(module, parts, where):
         made[helper] = jit_inline(bound(template, template.__name__,
                                         **{name: _rebuilt(f, made, where) for name, f in names.items()}))
     if parts is not None:
-        made[models.particle_acceleration] = _copy(models.particle_acceleration_of(parts), made, where,
-                                                   like=models.particle_acceleration)
+        made[models.particle_rhs] = _copy(models.particle_rhs_of(parts), made, where, like=models.particle_rhs)
     return made
 
 

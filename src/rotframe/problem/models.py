@@ -56,13 +56,12 @@ scene's own kernels: 39), with the same first compile (8.8 and 8.9 s, one pinned
 2026-11-29). The evaluators of a varying vector and the energy stay compiled apart, without
 reference counting (`rotframe.numerics.compiled.jit_uncounted`, see `rotframe.problem.engine`).
 
-A particle's acceleration is one template (`_particle_acceleration`) with two kinds of copy: the
-engine's own (`particle_acceleration`), which reads each part of the model (the frame's and the
-origin's kinds, the frame's terms, the string) from the problem's constants as it runs, and the
-copy a loop compiled for one problem takes (`particle_acceleration_of`, `rotframe.problem.inlined`),
-which holds them as constants, so that numba and LLVM drop the parts the problem lacks: the same
-arithmetic, in the same order, for the parts it has. The right-hand side (`particle_rhs`) and the
-particle's RK4 stages (`rotframe.problem.steps`) call it.
+A particle's right-hand side is one template (`_particle_rhs`) with two kinds of copy: the
+engine's own (`particle_rhs`), which reads each part of the model (the frame's and the origin's
+kinds, the frame's terms, the string) from the problem's constants as it runs, and the copy a
+loop compiled for one problem takes (`particle_rhs_of`, `rotframe.problem.inlined`), which holds
+them as constants, so that numba and LLVM drop the parts the problem lacks: the same arithmetic,
+in the same order, for the parts it has.
 
 Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
 vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is
@@ -227,15 +226,14 @@ def attitude_rate(y, dy, k, wx, wy, wz):
 
 
 #: a part of a particle's model read from its constants as the run goes (the engine's own loop, one for every problem),
-#: where a loop compiled for one problem holds it as a constant (`particle_acceleration_of`)
+#: where a loop compiled for one problem holds it as a constant (`particle_rhs_of`)
 AT_RUN_TIME = -1
-# the template's names of the model's parts (`_particle_acceleration`): read at run time in the engine's own copy
+# the template's names of the model's parts (`_particle_rhs`): read at run time in the engine's own copy
 FRAME_KIND = ORIGIN_KIND = CORIOLIS = CENTRIFUGAL = EULER = STRING = AT_RUN_TIME
 
 
-def _particle_acceleration(t, y, prob, fns, W):
-    """The template of a particle's acceleration (`particle_acceleration`, `particle_acceleration_of`) at the state
-    ``y``: ``(ax, ay, az, wx, wy, wz)``, with the frame's omega at ``t`` (the attitude's rate takes it).
+def _particle_rhs(t, y, dy, prob, fns, W):
+    """The template of a particle's right-hand side (`particle_rhs`, `particle_rhs_of`).
 
     Each part of the model (the frame's and the origin's kinds, the frame's terms, the string) is
     read from ``prob`` where its name in capitals is `AT_RUN_TIME`, else it is that constant.
@@ -277,26 +275,18 @@ def _particle_acceleration(t, y, prob, fns, W):
     az -= oz
     if (M[0] != 0.0) if STRING == AT_RUN_TIME else STRING:
         ax, ay, az = string_tension(ax, ay, az, x, yy, z, vx, vy, vz, M[1], M[2], M[3], M[4])
-    return ax, ay, az, wx, wy, wz
-
-
-#: a particle's acceleration in the engine's own loop: every part of the model read from ``prob``
-particle_acceleration = jit_llvm_inline(bound(_particle_acceleration, "particle_acceleration"))
-
-
-@jit_llvm_inline
-def particle_rhs(t, y, dy, prob, fns, W):
-    """A particle's right-hand side, ``y' = (v, a)`` into ``dy`` (`particle_acceleration`), and the attitude's rate
-    where ``y`` carries the frame's attitude (10 numbers: a force in inertial axes)."""
-    ax, ay, az, wx, wy, wz = particle_acceleration(t, y, prob, fns, W)
-    dy[0] = y[3]
-    dy[1] = y[4]
-    dy[2] = y[5]
+    dy[0] = vx
+    dy[1] = vy
+    dy[2] = vz
     dy[3] = ax
     dy[4] = ay
     dy[5] = az
     if y.shape[0] == 10:
         attitude_rate(y, dy, 6, wx, wy, wz)
+
+
+#: a particle's right-hand side in the engine's own loop: every part of the model read from ``prob``
+particle_rhs = jit_llvm_inline(bound(_particle_rhs, "particle_rhs"))
 
 
 def model_parts(prob) -> dict:
@@ -306,11 +296,10 @@ def model_parts(prob) -> dict:
             "CENTRIFUGAL": int(M[10] != 0.0), "EULER": int(M[11] != 0.0), "STRING": int(M[0] != 0.0)}
 
 
-def particle_acceleration_of(parts):
-    """A particle's acceleration with the model's ``parts`` (`model_parts`) as constants, as Python (to compile where a
-    loop is compiled for one problem, `rotframe.problem.inlined`): the other parts' code pruned."""
-    return bound(_particle_acceleration, "particle_acceleration_" + "_".join(str(parts[k]) for k in sorted(parts)),
-                 **parts)
+def particle_rhs_of(parts):
+    """A particle's right-hand side with the model's ``parts`` (`model_parts`) as constants, as Python (to compile
+    where a loop is compiled for one problem, `rotframe.problem.inlined`): the other parts' code pruned."""
+    return bound(_particle_rhs, "particle_rhs_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
 
 
 @jit_llvm_inline

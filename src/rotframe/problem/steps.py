@@ -21,7 +21,7 @@ import functools
 from rotframe.numerics.compiled import jit_inline, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step
 from rotframe.numerics.rk4 import rk4_particle_step, rk4_step
-from rotframe.problem.models import DOP853, RK4, own_step, particle_acceleration, rhs
+from rotframe.problem.models import DOP853, RK4, own_step, rhs
 
 __all__ = ["particle_system", "body_system", "particle_rk4", "stepper", "take_step"]
 
@@ -40,32 +40,33 @@ def body_system(ctx, t, z, K, s):
     rhs(True, t, z, K[s], prob, fns, W)
 
 
-@jit_inline
+@jit_llvm_inline  # compiled once: numba's inlining put it, and the right-hand side's call, in the step three times
 def _stage_acceleration(ctx, t, state):
-    """A particle's acceleration at an RK4 stage, ``ctx = (prob, fns, W, yt)``: the stage's ``state`` written to ``yt``,
-    the array the problem's functions take."""
-    prob, fns, W, yt = ctx
+    """A particle's acceleration at an RK4 stage, ``ctx = (prob, fns, W, yt, dy)``: the stage's ``state`` written to
+    ``yt``, the array the problem's functions take, and its rates to ``dy`` by the right-hand side (the one the DOP853
+    loop calls: no second copy to compile), read back at once (LLVM forwards the stores to the loads)."""
+    prob, fns, W, yt, dy = ctx
     yt[0] = state[0]
     yt[1] = state[1]
     yt[2] = state[2]
     yt[3] = state[3]
     yt[4] = state[4]
     yt[5] = state[5]
-    ax, ay, az, _, _, _ = particle_acceleration(t, yt, prob, fns, W)
-    return ax, ay, az
+    rhs(None, t, yt, dy, prob, fns, W)
+    return dy[3], dy[4], dy[5]
 
 
-#: the one RK4 step of a particle with the engine's acceleration
-_particle_step = rk4_particle_step("engine", _stage_acceleration, jit_llvm_inline)
+#: the one RK4 step of a particle with the engine's acceleration (inlined by numba into `particle_rk4`, its one caller)
+_particle_step = rk4_particle_step("engine", _stage_acceleration, jit_inline)
 
 
 @jit_llvm_inline  # not numba's inlining: take_step passes each variant's step to the other method's branches too
 def particle_rk4(ctx, t, y, h, K, yt, yn):
     """A particle's RK4 step (6 numbers) in the protocol of `rotframe.numerics.rk4.rk4_step`: from ``(t, y)``, with
-    ``K[0] = f(t, y)``, the state after ``h`` into ``yn``; ``yt`` the stages' states (the stages are in registers,
-    ``K[1:4]`` untouched)."""
+    ``K[0] = f(t, y)``, the state after ``h`` into ``yn``; ``yt`` the stages' states and ``K[1]`` their rates, each
+    read back at once (the stages are in registers)."""
     prob, fns, W = ctx
-    stage = (prob, fns, W, yt)
+    stage = (prob, fns, W, yt, K[1])
     yn[0], yn[1], yn[2], yn[3], yn[4], yn[5] = _particle_step(stage, stage, t, (y[0], y[1], y[2], y[3], y[4], y[5]),
                                                               h, (K[0, 3], K[0, 4], K[0, 5]))
 
@@ -76,8 +77,9 @@ def stepper(body, method, D):
 
     DOP853: the one DOP853 loop's stages for the model's right-hand side
     (`rotframe.numerics.dop853_loop.dop853_stages`); RK4: the one RK4 step
-    (`rotframe.numerics.rk4`; a particle's, `particle_rk4`, where the state is its 6 numbers); a splitting: None (the model's own step). ``D`` is a constant of
-    their code, so LLVM unrolls the loops over the state. Made once a process for each.
+    (`rotframe.numerics.rk4`; a particle's, `particle_rk4`, where the state is its 6 numbers); a
+    splitting: None (the model's own step). ``D`` is a constant of their code, so LLVM unrolls the
+    loops over the state. Made once a process for each.
     """
     system = particle_system if body is None else body_system
     kind = f"engine_{'particle' if body is None else 'body'}{D}"
