@@ -106,10 +106,9 @@ def rk4_particle_step(name, accel, compile):
     its problem both times. ``compile`` is the caller's inlining (numba's, into each caller's
     loop), so the step's arithmetic is in each caller's loop.
 
-    A stand-alone model of the engine's loop on the Foucault model took 1.20 to 1.23 times the
-    scene's time with its stages in arrays (`rk4_step`) and 1.06 to 1.10 with them in registers
-    and each stage's state written to an array for the user's force; the engine itself went from
-    1.21 to 1.29 to 1.11 to 1.13 (`tools/foucault_on_engine.py`; one pinned core, best of 9,
-    2026-11-29).
+    On the Foucault model the engine's particle took 1.21 to 1.29 times the scene's time with its
+    stages in arrays (`rk4_step`) and 1.11 to 1.13 with them in registers, each stage's state
+    written to an array for the user's force (`tools/foucault_on_engine.py`, prepared runs; one
+    pinned core, best of 9, 2026-11-29).
     """
     return compile(bound(_particle_step, f"rk4_particle_step_{name}", ACCEL=accel))
