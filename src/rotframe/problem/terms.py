@@ -18,8 +18,8 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_on_string", "check_splitting", "model_constants",
-           "FRAME_TERMS", "check_frame_terms"]
+__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_on_string", "check_splitting",
+           "model_constants", "FRAME_TERMS", "check_frame_terms"]
 
 #: The frame's own terms, by the scenes' names for them (``-2 w x v``, ``-w x (w x r)``, ``-w' x r``): the ones a
 #: run may choose with ``frame_terms`` (every one by default).
@@ -143,7 +143,7 @@ def one_constraint(terms, r, v):
 def check_on_string(k, c, r, v):
     """Refuse start states ``r``, ``v`` (N, 3; finite, C-ordered) off the sphere of the string ``c``, ``forces[k]``, or
     moving along it, in one line naming the particle (`rotframe.problem.string_start.string_defect`: compiled, as a
-    prepared run checks at every run)."""
+    prepared run checks at every run; imported at first use, as this module imports no numba)."""
     from rotframe.problem.string_start import ALONG_STRING, OFF_SPHERE, string_defect
 
     kind, i, value = string_defect(r, v, *c.pivot, c.length)
