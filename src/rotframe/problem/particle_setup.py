@@ -51,39 +51,32 @@ def problem_tuple(M, p, frame, origin):
     return (PARTICLE, M, p, *frame.packed(), *origin.packed(derivative=False))
 
 
-def _bind(frame, origin, forces, events, compiled):
-    def prep(f):
-        return uf.compiled_for_glue(f) if compiled else uf.plain_function(f)
-
-    functions = {}
+def _functions(frame, origin, forces, events, labels):
+    """The user's functions of a problem as ``(glue name, role, function)``: the name the glue binds it to
+    (`rotframe.problem.glue.particle_source`) and the role its errors name it by, in the roles' order."""
+    found = []
     if frame.kind == "function":
-        functions["omega_fn"] = prep(frame.funcs[0])
+        found.append(("omega_fn", "omega", frame.funcs[0]))
         if len(frame.funcs) > 1:
-            functions["omega_dot_fn"] = prep(frame.funcs[1])
+            found.append(("omega_dot_fn", "omega_dot", frame.funcs[1]))
     if origin.kind == "function":
-        functions["origin_fn"] = prep(origin.funcs[0])
-    for k, f in enumerate(forces):
-        functions[f"force_{k}"] = prep(f.accel)
-        if f.potential is not None:
-            functions[f"potential_{k}"] = prep(f.potential)
-    for k, g in enumerate(events):
-        functions[f"event_{k}"] = prep(g)
-    return functions
+        found.append(("origin_fn", "origin_acceleration", origin.funcs[0]))
+    found += [(f"force_{k}", labels[k], f.accel) for k, f in enumerate(forces)]
+    found += [(f"potential_{k}", f"{labels[k]}.potential", f.potential) for k, f in enumerate(forces)
+              if f.potential is not None]
+    found += [(f"event_{k}", f"events[{k}]", g) for k, g in enumerate(events)]
+    return found
+
+
+def _bind(frame, origin, forces, events, labels, compiled):
+    """The glue's names bound to the user's functions, compiled for it (or as plain Python)."""
+    prep = uf.compiled_for_glue if compiled else uf.plain_function
+    return {name: prep(f) for name, _, f in _functions(frame, origin, forces, events, labels)}
 
 
 def function_roles(frame, origin, forces, events, labels):
     """The user's functions of a problem as ``(role, function)`` pairs, named as its errors name them."""
-    roles = []
-    if frame.kind == "function":
-        roles.append(("omega", frame.funcs[0]))
-        if len(frame.funcs) > 1:
-            roles.append(("omega_dot", frame.funcs[1]))
-    if origin.kind == "function":
-        roles.append(("origin_acceleration", origin.funcs[0]))
-    roles += [(labels[k], f.accel) for k, f in enumerate(forces)]
-    roles += [(f"{labels[k]}.potential", f.potential) for k, f in enumerate(forces) if f.potential is not None]
-    roles += [(f"events[{k}]", g) for k, g in enumerate(events)]
-    return roles
+    return [(role, f) for _, role, f in _functions(frame, origin, forces, events, labels)]
 
 
 def _check_functions(forces, events, params, r, v, t0, labels):
@@ -226,7 +219,7 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
     try:
-        driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, jit), glue,
+        driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, labels, jit), glue,
                                      compiled=jit, notes=cache_notes), compiled=jit)
     except Exception as exc:
         import numba
@@ -295,6 +288,7 @@ def _check_device(device, method, jit) -> bool:
     if not jit:
         raise ScenarioError("jit=False: plain Python runs on the CPU; device='gpu' compiles the forces for the GPU")
     return True
+
 
 def _compile_failure(exc, roles, params, r, v, frame, without_params=()):
     """Name the function numba could not compile (``without_params``: the roles of the built-in terms, which take

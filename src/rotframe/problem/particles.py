@@ -19,11 +19,10 @@ attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
-
-import time
 
 from rotframe.errors import IntegrationError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory
@@ -31,10 +30,12 @@ from rotframe.problem import callables as uf
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.particle_setup import checked_atol, function_roles, problem_tuple, run_state, set_up, start_states
+from rotframe.problem.particle_setup import (checked_atol, function_roles, problem_tuple, run_state, set_up,
+                                             start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 
-__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed", "raised_later", "trajectory_of"]
+__all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
+           "raised_later", "trajectory_of"]
 
 #: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
@@ -71,7 +72,6 @@ def _blame(functions, params, t, y, dt, labels, frame_roles=()):
                   else (labels[k], f, at_state(params), where) for k, f in enumerate(functions)]
     candidates += [(role, f, lambda tp: (tp,), "") for role, f in frame_roles]
     return uf.blame_in_step(candidates, t, dt)
-
 
 
 def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
