@@ -163,3 +163,32 @@ def test_more_particles_than_the_first_run_are_held_to_the_limits():
             prepared.run(many, np.zeros((50, 3)))
         with pytest.raises(LimitError, match="integration steps"):
             simulate_particles(r0=many, v0=np.zeros((50, 3)), inline=False, **kw)
+
+
+@pytest.mark.parametrize("name", sorted(PROBLEMS))
+def test_runs_of_one_particle_after_another_each_start_afresh(name):
+    """A prepared problem keeps one particle's arrays from run to run (reset at each): every run is still simulate's
+    to the bit, whatever the run before left in them (a terminal event, a sample grid filled or not, events kept),
+    and a trajectory handed out is not changed by the runs after it."""
+    kw = dict(PROBLEMS[name], duration=3.0, samples=30)
+    prepared = PreparedProblem(r0=R0[0], v0=V0[0], inline=False, **kw)
+    starts = [(R0[0], V0[0]), (R0[1], V0[1]), (R0[0] * 3.0, -V0[1]), (R0[1], V0[0] * 0.0), (R0[0], V0[0])]
+    given = [(prepared.run(r0, v0), simulate_particles(r0=r0, v0=v0, inline=False, **kw).trajectory)
+             for r0, v0 in starts]
+    for ours, theirs in given:  # checked after every run is made: the later runs left the earlier ones alone
+        same_trajectory(ours, theirs)
+
+
+def test_runs_on_threads_at_once_are_each_their_own():
+    """Runs of one prepared problem called from several threads at once (one holds the kept arrays, the others make
+    their own) give each the numbers of that run made alone."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    kw = dict(PROBLEMS["dop853, a user force and a terminal event"], duration=3.0, samples=30)
+    prepared = PreparedProblem(r0=R0[0], v0=V0[0], inline=False, **kw)
+    starts = [(R0[k % 2] * (1.0 + 0.1 * k), V0[(k + 1) % 2]) for k in range(24)]
+    alone = [prepared.run(r0, v0) for r0, v0 in starts]
+    with ThreadPoolExecutor(4) as pool:
+        together = list(pool.map(lambda start: prepared.run(*start), starts))
+    for a, b in zip(alone, together):
+        same_trajectory(a, b)

@@ -29,7 +29,8 @@ from numba's cache; no problem ever compiles the loop again.
   derivatives jump there). No step crosses one: a step that would is cut to end on it, as
   DifferentialEquations.jl's ``tstops``, so each step integrates a smooth function and keeps its
   order; RK4's grid goes on from the knot. Without this, a finer table gave larger errors.
-* ``atol`` is (N, D), one row per particle (its own scales).
+* ``atol`` is (N, D), one row per particle; a row of NaN is filled with the particle's own
+  tolerances where the loop first takes it (`own_tolerances`).
 * Each particle is integrated alone, ``budget`` steps per call (DOP853's accepted ones), so
   results do not depend on the thread count and Python sees signals between calls. ``advance(lo, hi, ...)`` takes the
   particles ``lo:hi``; Python runs blocks of them on threads (the engine holds no GIL). numba's
@@ -171,6 +172,31 @@ def _start_sign(tctx, h):
         if not moved:
             break
     return g_near
+
+
+@jit_inline
+def own_tolerances(y, duration, rtol, atol):
+    """A particle's absolute tolerances from its start state ``y`` (r, v, ...) into ``atol`` (D,), where the DOP853 loop
+    first takes it (NaN until then: `rotframe.problem.particle_setup.tolerance_rows`): ``rtol s_r`` for r, ``rtol s_v``
+    for v, ``rtol`` for the rest (the frame's attitude); ``s_r = max(max|r|, max|v| duration)``, ``s_v = max(max|v|,
+    s_r / duration)``, 1 and 1 / duration at rest at the origin. Its own scales: its numbers do not depend on the
+    ensemble."""
+    ar = 0.0
+    av = 0.0
+    for j in range(3):
+        a = abs(y[j])
+        b = abs(y[3 + j])
+        ar = a if a > ar else ar
+        av = b if b > av else av
+    sr = av * duration
+    sr = ar if ar >= sr else sr
+    sv = sr / duration
+    sv = av if av >= sv else sv
+    if sr == 0.0:
+        sr = 1.0
+        sv = 1.0 / duration
+    for j in range(atol.shape[0]):
+        atol[j] = rtol * (sr if j < 3 else sv if j < 6 else 1.0)
 
 
 @jit_inline
@@ -348,6 +374,8 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
             continue
         atol_i = atol[i]
         t, h, idx = load_particle(i, Y, TC, H, IDX, y)
+        if atol_i[0] != atol_i[0]:  # NaN: the particle's own tolerances, from the state it starts from
+            own_tolerances(y, t_last - T[0], rtol, atol_i)
         W[RAISED] = 0.0
         SYSTEM(ctx, t, y, K, 0)
         NFEV[i] += 1
@@ -524,7 +552,7 @@ def scratch(D):
 
 
 def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, method, rtol,
-            atol, hfix, EDIR, ETERM, S, prob, fns, compiled=True, kernel=None):
+            atol, hfix, EDIR, ETERM, S, prob, fns, compiled=True, kernel=None, work=None):
     """Advance the particles ``lo:hi`` by at most ``budget`` steps each (module docstring); the state is in the arrays.
 
     ``T`` the sample times; ``Y`` (N, D) the states to go on from, ``TC``, ``H``, ``IDX``, ``SUB``,
@@ -532,15 +560,16 @@ def advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, N
     the samples; ``EVT``, ``EVY``, ``EVK``, ``EVN`` the event records; ``GPREV`` (N, NE) each
     event's last value; ``EDIR``, ``ETERM`` (NE,) the events' directions and terminal flags.
     ``method`` is the method's name (`METHOD_CODES`). Runs the problem's `variant` of the loop (``compiled=False``: as
-    plain Python) with work arrays of its own; or ``kernel``, the same variant with the problem's functions compiled
-    into it (`rotframe.problem.inlined.inlined_loop`), which takes tags where ``fns`` has addresses.
+    plain Python) with work arrays of its own (or ``work``, `scratch`'s, which a prepared run keeps); or ``kernel``, the
+    same variant with the problem's functions compiled into it (`rotframe.problem.inlined.inlined_loop`), which takes
+    tags where ``fns`` has addresses.
     """
     if kernel is None:
         kernel = variant(prob[0], method, EDIR.shape[0] > 0, compiled, Y.shape[1])
     else:
         fns = direct_functions()
     kernel(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol, atol, hfix,
-           EDIR, ETERM, S, prob, fns, *scratch(Y.shape[1]))
+           EDIR, ETERM, S, prob, fns, *(scratch(Y.shape[1]) if work is None else work))
 
 
 @_entry

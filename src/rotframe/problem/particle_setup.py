@@ -91,7 +91,7 @@ def _check_functions(forces, events, params, r, v, t0, labels):
 
 
 def checked_atol(atol) -> np.ndarray | None:
-    """``atol=`` as `_scales` takes it: six positive numbers (r then v; one number for all six), or None for the
+    """``atol=`` as `tolerance_rows` takes it: six positive numbers (r then v; one number for all six), or None for the
     default (each particle's own scales); a one-line ScenarioError otherwise. A prepared run checks it once."""
     if atol is None:
         return None
@@ -103,24 +103,16 @@ def checked_atol(atol) -> np.ndarray | None:
     return a
 
 
-def _scales(r, v, duration, rtol, atol, D):
-    """Absolute tolerances, one row per particle ((N, D)): ``atol`` (`checked_atol`) where given, else each particle's
-    from its own scales, so that its steps, and its numbers, do not depend on the other particles of the ensemble."""
-    N = r.shape[0]
+def tolerance_rows(N, D, rtol, atol):
+    """Absolute tolerances, one row per particle ((N, D)): ``atol`` (`checked_atol`) for r and v and ``rtol`` for the
+    rest of the state where given, else rows of NaN, which the engine's DOP853 loop fills with each particle's own
+    (`rotframe.problem.engine.own_tolerances`, from its start state: its steps, and its numbers, do not depend on the
+    other particles of the ensemble). The rule is compiled into the loop, not made here at every run: a prepared run
+    spent 6 us of numpy on it, where the whole of its own cost is some 20 us."""
+    if atol is None:
+        return np.full((N, D), np.nan)
     out = np.full((N, D), rtol)
-    if atol is not None:
-        out[:, :6] = atol
-        return out
-    # each particle's scales, in array methods (a prepared run makes them at every run: np.max and np.repeat cost more
-    # than the arithmetic); the same products, so the same numbers
-    ar = np.abs(r).max(axis=1)
-    av = np.abs(v).max(axis=1)
-    sr = np.maximum(ar, av * duration)
-    sv = np.maximum(av, sr / duration)
-    still = sr == 0.0
-    sr[still], sv[still] = 1.0, 1.0 / duration
-    out[:, :3] = (rtol * sr)[:, None]
-    out[:, 3:6] = (rtol * sv)[:, None]
+    out[:, :6] = atol
     return out
 
 
@@ -249,12 +241,14 @@ def check_arrays(N, n, D, slots, knots):
     check_run(steps=knots, samples=n, particles=N, what="simulate (the frame's knots each end a step)")
 
 
-def start_states(s, r, v, atol, frame_attitude, omega):
+def start_states(s, r, v, atol, frame_attitude, omega, y=None):
     """The engine's states ``y`` (N, D) of the set-up ``s`` from ``r``, ``v`` (N, 3) (and the frame's attitude where
-    a force acts in inertial axes), and the absolute tolerances (N, D) (`_scales`; ``atol`` as `checked_atol`
-    gives it)."""
+    a force acts in inertial axes), and the absolute tolerances (N, D) (`tolerance_rows`; ``atol`` as
+    `checked_atol` gives it). ``y``: an array to write the states into (its tolerances are then not made: None)."""
     N, D = r.shape[0], s.D
-    y = np.zeros((N, D))
+    made = y is None
+    if made:
+        y = np.zeros((N, D))
     y[:, :3] = r
     y[:, 3:6] = v
     if D == 10:
@@ -265,7 +259,7 @@ def start_states(s, r, v, atol, frame_attitude, omega):
         if frame_attitude is None and s.frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
-    return y, _scales(r, v, s.duration, s.rtol, atol, D)
+    return y, tolerance_rows(N, D, s.rtol, atol) if made else None
 
 
 def run_state(N, D, slots, n_events):

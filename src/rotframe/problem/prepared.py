@@ -5,8 +5,9 @@ problem's compiled glue, and after the run measures its energy and the frame's i
 some milliseconds a call, more than a short run's integration. A `PreparedProblem` does the
 set-up once (`rotframe.problem.particle_setup.set_up`, the same as ``simulate``'s) and loads the
 problem's inlined loop (`rotframe.problem.inlined`: your functions compiled into the engine's
-loop, cached on disk); each `PreparedProblem.run` then makes the run's arrays and makes one call
-of that loop. For optimisation loops, shooting, Monte Carlo over start states, and the scenes
+loop, cached on disk); each `PreparedProblem.run` then makes the run's arrays (one particle's it
+keeps from run to run and resets) and makes one call of that loop: some 15 us of its own a run,
+beside the scenes' 10. For optimisation loops, shooting, Monte Carlo over start states, and the scenes
 built on the engine: the particles' counterpart of the scenes'
 `rotframe.particles.prepared.PreparedRun`.
 
@@ -21,14 +22,17 @@ particle, the time, the state, the function to blame, the samples up to there).
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from rotframe.errors import ScenarioError
 from rotframe.limits import check_run
+from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
 from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_states, run_state, set_up,
-                                             start_states)
+                                             start_states, tolerance_rows)
 from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
@@ -88,6 +92,7 @@ frame_attitude, frame_terms
         inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
         inlining.start()
         self._kernel = inlining.kernel
+        self._kept = None  # a run's arrays, kept for the next (`_KeptArrays`)
         self.notes = [inlining.note] if inlining.note else []
         #: the sample times (s), (samples + 1,)
         self.times = s.times
@@ -110,23 +115,33 @@ frame_attitude, frame_terms
                       what=f"method {s.method}")  # a fixed step's count, as simulate's grid checks it
         if self._string is not None:
             check_on_string(*self._string, r, v)
-        y, state, atol = self._start(r, v)
-        OUT = np.full((s.times.size, N, s.D), np.nan)
+        if N == 1 and self._kept is None:
+            self._kept = _KeptArrays(s, self._atol)
+        kept = self._kept if N == 1 else None
+        if kept is not None and kept.lock.acquire(blocking=False):  # one call at a time uses them
+            try:
+                return self._run(r, v, *kept.reset())
+            finally:
+                kept.lock.release()
+        return self._run(r, v, *_fresh_arrays(s, N, self._atol))
+
+    def _run(self, r, v, y, state, atol, OUT, work):
+        """The run from ``r``, ``v`` with its arrays (`_KeptArrays` or `_fresh_arrays`): the states ``y``, the
+        per-particle ``state``, the tolerances, the samples and the loop's work arrays (None: made per block)."""
+        s = self.setup
+        self._start(r, v, y, state)
         before = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
         after = (s.method, s.rtol, atol, s.hfix, s.EDIR, s.ETERM, s.stops, s.prob, s.fns)
-        kernel = self._kernel
-
-        def advance(lo, hi, *args):
-            s.driver.advance(lo, hi, *args, kernel=kernel)
-
+        advance = self._advance
         try:
-            if N == 1:  # no thread to start
-                advance(0, 1, *before, _WHOLE_RUN, *after)
+            if work is not None:  # one particle: no thread to start, the kept work arrays
+                advance(0, 1, *before, _WHOLE_RUN, *after, work=work)
             else:
-                advance_blocks(advance, N, before + (_WHOLE_RUN,) + after)
+                advance_blocks(advance, r.shape[0], before + (_WHOLE_RUN,) + after)
         except Exception as exc:  # a user function raised in the inlined loop: replayed from the start, as simulate
-            y0, saved, _ = self._start(r, v)  # replays a call (`raised_later`), to name the function and the step
+            y0, saved, _, _, _ = _fresh_arrays(s, r.shape[0], self._atol)  # replays a call (`raised_later`)
+            self._start(r, v, y0, saved)
             saved["Y"] = y0
             raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": _WHOLE_RUN}, s.forces,
                          s.params, s.method, s.hfix, s.times, OUT, state, s.events, s.labels)
@@ -136,11 +151,55 @@ frame_attitude, frame_terms
             traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
         return traj
 
-    def _start(self, r, v):
-        """The engine's states, per-particle arrays (their events' values at the start too) and tolerances of a run."""
+    def _start(self, r, v, y, state):
+        """The engine's states of the start states ``r``, ``v`` into ``y``, and their events' values into the run's
+        ``state``."""
         s = self.setup
-        y, atol = start_states(s, r, v, self._atol, self._frame_attitude, self._omega)
-        state = run_state(r.shape[0], s.D, s.slots, len(s.events))
+        start_states(s, r, v, None, self._frame_attitude, self._omega, y)
         if s.events:
             s.driver.start_events(0.0, y, state["GPREV"], s.prob, s.fns)
-        return y, state, atol
+
+    def _advance(self, lo, hi, *args, work=None):
+        self.setup.driver.advance(lo, hi, *args, kernel=self._kernel, work=work)
+
+
+def _fresh_arrays(s, N, atol):
+    """A run's arrays made anew, as `PreparedProblem._run` takes them: ``(y, state, atol, OUT, work)``; ``work`` None
+    (the loop's work arrays made per block of particles). A run of many particles, or of one while another call holds
+    the kept ones (`_KeptArrays`)."""
+    return (np.zeros((N, s.D)), run_state(N, s.D, s.slots, len(s.events)), tolerance_rows(N, s.D, s.rtol, atol),
+            np.full((s.times.size, N, s.D), np.nan), None)
+
+
+class _KeptArrays:
+    """The arrays of a prepared run of one particle, made once in two blocks and reset by two copies at each run.
+
+    Sixteen arrays made anew took 5 us of a run's own 20 (numpy's cost per array, not per number),
+    as much as a short run's integration. Nothing of them leaves a run: its `Trajectory` holds
+    copies. A run that finds them in use (a call on another thread) makes its own
+    (`_fresh_arrays`); so does a run of many particles, whose blocks on threads each need work
+    arrays of their own, and whose integration outweighs the arrays.
+    """
+
+    def __init__(self, s, atol):
+        y, state, tolerances, OUT, _ = _fresh_arrays(s, 1, atol)
+        arrays = {"y": y, "atol": tolerances, "OUT": OUT, **state, **dict(zip("K Kb V F W".split(), scratch(s.D)))}
+        self.lock = threading.Lock()
+        self._blocks = []
+        views = {}
+        for numbers in (np.float64, np.int64):  # one block of each kind, the arrays views of it
+            group = {k: a for k, a in arrays.items() if a.dtype == numbers}
+            block = np.concatenate([a.ravel() for a in group.values()])
+            self._blocks.append((block, block.copy()))
+            at = 0
+            for k, a in group.items():
+                views[k] = block[at:at + a.size].reshape(a.shape)
+                at += a.size
+        self._views = (views["y"], {k: views[k] for k in state}, views["atol"], views["OUT"],
+                       tuple(views[k] for k in "K Kb V F W".split()))
+
+    def reset(self):
+        """The arrays as a fresh run finds them: ``(y, state, atol, OUT, work)``."""
+        for block, fresh in self._blocks:
+            block[:] = fresh
+        return self._views
