@@ -220,13 +220,11 @@ def save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status):
 
 
 @jit_inline
-def contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
-    """The data of a variant's loop: the system's ``ctx = (prob, fns, W)`` and the watcher's ``wctx``.
-
-    ``wctx`` (`_watch_events`): the events' arrays, the run's start, the locator's stages ``Kb`` and
-    states ``V[4:7]`` (the loops keep ``V[0:4]`` for their own).
-    """
-    return (prob, fns, W), (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6])
+def watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
+    """The data of a variant's watcher, ``wctx`` (`_watch_events`): the events' arrays, the run's start, the
+    locator's stages ``Kb`` and states ``V[4:7]`` (the loops keep ``V[0:4]`` for their own). A variant without
+    events passes 0 instead (``EVENTS``, a constant of its code): no tuple of twelve to build, type and pass on."""
+    return GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6]
 
 
 def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
@@ -359,7 +357,7 @@ def _dop853_loop(name, body, events, D):
     stages = stepper(body, DOP853, D)
     watch = _watcher(kind, stages, body, DOP853) if events else None
     trajectory = dop853_trajectory(kind + ("_events" if events else ""), stages, store_rows, D, watch, aborted=raised)
-    return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D))
+    return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D), EVENTS=bool(events))
 
 
 def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
@@ -368,7 +366,8 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
     n = T.shape[0]
     t_last = T[n - 1]
     y, yt, yn, tmp = V[0], V[1], V[2], V[3]
-    ctx, wctx = contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    ctx = (prob, fns, W)
+    wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
     for i in range(lo, hi):
         if ST[i] != 0:
             continue
@@ -436,7 +435,8 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
     n = T.shape[0]
     D = DIM
     y, yt, yn, yev = V[0], V[1], V[2], V[3]
-    ctx, wctx = contexts(prob, fns, W, GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V)
+    ctx = (prob, fns, W)
+    wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
     for i in range(lo, hi):
         if ST[i] != 0:
             continue
