@@ -104,3 +104,23 @@ def test_the_engines_codes_are_named_once_and_never_leave_it():
         source = inspect.getsource(module)
         assert "_CODES" not in source and "models import DOP853" not in source, module.__name__
     assert "take_step" in vars(steps) and "own_step" in vars(models)
+
+
+def test_the_scenes_loop_codes_stay_with_the_modules_that_compile_their_loops():
+    """The scenes' fixed-step loops branch on an integer per method (`rotframe.particles.kernels.loop_code`); only the
+    modules that compile those loops turn a name into it (the CPU's drivers, the GPU's kernel). Every other module,
+    the Python driver of a run among them, passes the method by name, and the bound driver it gets steps the method
+    it names: its code is the one `loop_code` gives."""
+    import pathlib
+
+    from rotframe.particles import drivers, kernels
+
+    src = pathlib.Path(kernels.__file__).parent.parent
+    users = sorted(str(p.relative_to(src)) for p in src.rglob("*.py") if "loop_code" in p.read_text())
+    assert users == ["particles/drivers.py", "particles/gpu.py", "particles/kernels.py"], users
+    for name in ("rotation-splitting", "rotation-splitting4", "rk4"):
+        for events in (False, True):
+            bound = drivers.fixed_step_driver(name, events)
+            assert bound.func is (drivers.run_fixed_events if events else drivers.run_fixed)
+            assert bound.args == (kernels.loop_code(name),)
+    assert len({kernels.loop_code(n) for n in ("rotation-splitting", "rotation-splitting4", "rk4")}) == 3

@@ -100,9 +100,8 @@ class KernelSetup:
         self.wt_arg = None if model.omega.is_constant else self.wt
         self.events = tuple(events)
         self.ev_tab = event_table(self.events) if self.events else None
-        from rotframe.particles.kernels import EVALS_PER_STEP, loop_code
+        from rotframe.particles.kernels import EVALS_PER_STEP
 
-        self.code = loop_code(info.name)  # the integer the compiled loops branch on (-1 for dop853)
         # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
@@ -145,7 +144,7 @@ class KernelSetup:
 
             # a kernel of its own with events (rotframe.particles.drivers): a run compiles only its own loops
             if self.info.step == "fixed":
-                kernel = drivers.run_fixed if self.ev_tab is None else drivers.run_fixed_events
+                kernel = drivers.fixed_step_driver(self.info.name, self.ev_tab is not None)
             else:
                 kernel = drivers.run_dop853 if self.ev_tab is None else drivers.run_dop853_events
         self._kernel = kernel
@@ -199,7 +198,7 @@ class KernelSetup:
         if self.fixed and r.shape[0] <= threads.BLOCK:
             # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
             k = self.sps if sps is None else sps
-            n_done, bad, nfev = kernel(self.code, r, v, alive, start, self.h, k, count, *self._model_args,
+            n_done, bad, nfev = kernel(r, v, alive, start, self.h, k, count, *self._model_args,
                                        out_r, out_v, *records, *self._family)
             return n_done, bad, nfev, k * n_done
         from rotframe.particles.blocks import run_blocks
@@ -210,7 +209,7 @@ class KernelSetup:
             k = self.sps if sps is None else sps
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
-                return kernel(self.code, r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                return kernel(r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
                               self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
                               max_events, self.rk4, self.sphere) + (k * count,)
 
@@ -250,7 +249,9 @@ class KernelSetup:
         types, so the run's own call only dispatches).
         """
         kernel = self.kernel()
-        # the dispatcher's compiled versions (a dict, O(1) to count; a wrapped kernel has none)
+        # the dispatcher's compiled versions (a dict, O(1) to count; a wrapped kernel has none), a fixed-step
+        # driver's behind its bound method (`rotframe.particles.drivers.fixed_step_driver`)
+        kernel = getattr(kernel, "func", kernel)
         overloads = getattr(kernel, "overloads", None)
         if overloads:
             return 0.0  # loaded or compiled before, in this process: the run's call only dispatches

@@ -18,6 +18,8 @@ handled between chunks without losing data.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -25,11 +27,18 @@ from rotframe.numerics.compiled import inlined
 from rotframe.particles.dop853_ensemble import run_particles
 from rotframe.particles.dop853_particles import particle_rhs, particle_trajectory, particle_trajectory_events, start_events
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
-from rotframe.particles.kernels import advance, free_step, make_plan, method_steps, rk4_step_of, sphere_step
+from rotframe.particles.kernels import advance, free_step, loop_code, make_plan, method_steps, rk4_step_of, sphere_step
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
-__all__ = ["run_fixed", "run_fixed_events", "run_dop853", "run_dop853_events"]
+__all__ = ["fixed_step_driver", "run_fixed", "run_fixed_events", "run_dop853", "run_dop853_events"]
+
+
+def fixed_step_driver(name, events):
+    """The compiled fixed-step driver of the method ``name`` (``events``: whether the run watches an event table),
+    called as `run_fixed` without its first argument: the integer its loops branch on stays with the modules that
+    compile them (`rotframe.particles.kernels.loop_code`). ``.func`` is the dispatcher."""
+    return functools.partial(run_fixed_events if events else run_fixed, loop_code(name))
 
 # inlined into run_fixed: a call per sample interval that passes arrays (the schedule, the output)
 # costs their reference counts, some 20 ns a particle and sample, as much as a few steps
