@@ -50,6 +50,8 @@ PROBLEMS = {
                                                    method="rotation-splitting4", step=0.02),
     "dop853, a force in inertial axes": dict(omega=[0.0, 0.0, 0.5], forces=[Force(inertial_push, axes="inertial")],
                                              method="dop853", rtol=1e-8),
+    "dop853, atol given": dict(omega=[0.0, 0.1, 0.7], forces=[pull], params=(1.5,), method="dop853", rtol=1e-9,
+                               atol=[1e-9, 1e-9, 1e-9, 1e-8, 1e-8, 1e-8]),
 }
 
 
