@@ -101,7 +101,8 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     ----------
     omega : 3-vector, (times, vectors), callable or rigid-body Result
         The frame's angular velocity relative to inertial space, rad/s, in its own axes: a
-        constant; a table (a C2 cubic spline through it); a function ``t -> (3,)`` (with
+        constant; a table (a C2 cubic spline through it; ``(times, vectors, "linear")``: the
+        straight lines between its knots, a ramp kept as a ramp); a function ``t -> (3,)`` (with
         ``omega_dot`` or derived); or a rigid-body ``Result`` (the frame of that tumbling body).
     r0, v0 : (3,) or (N, 3)
         Initial positions (m) and velocities (m/s) in the frame; N particles at once (one of

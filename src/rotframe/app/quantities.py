@@ -143,13 +143,15 @@ def to_si(value, unit: str, key: str):
 
 
 def vector_or_table_si(value, unit: str, key: str):
-    """A 3-vector or a table ``(times, vectors)`` in SI: times in s, vectors in ``unit``; other forms unchanged."""
+    """A 3-vector or a table ``(times, vectors[, how])`` in SI: times in s, vectors in ``unit``; other forms
+    unchanged."""
     from rotframe.problem.frame import is_table
 
     if callable(value) or hasattr(value, "trajectory"):
         return value  # a function (its return is checked: plain numbers) or a rigid-body Result
     if is_table(value):
-        return (to_si(value[0], "s", f"{key} (the table's times)"), to_si(value[1], unit, f"{key} (the table's vectors)"))
+        return (to_si(value[0], "s", f"{key} (the table's times)"), to_si(value[1], unit, f"{key} (the table's vectors)"),
+                *value[2:])
     return to_si(value, unit, key)
 
 

@@ -61,6 +61,7 @@ from rotframe.problem.calls import RAISED, call_event, direct_functions
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
+from rotframe.problem.stops import next_stop, short_of
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
@@ -94,23 +95,6 @@ def all_finite(y):
         if not math.isfinite(y[j]):
             return False
     return True
-
-
-@jit_inline
-def next_stop(S, t):
-    """The first stop time in the sorted S after t (inf if none): a knot where the right-hand side is not smooth."""
-    n = S.shape[0]
-    if n == 0 or S[n - 1] <= t:
-        return math.inf
-    lo = 0
-    hi = n - 1
-    while lo < hi:  # the first S[k] > t
-        mid = (lo + hi) // 2
-        if S[mid] > t:
-            hi = mid
-        else:
-            lo = mid + 1
-    return S[lo]
 
 
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
@@ -470,6 +454,9 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 hh = hfix if on_grid else grid_next - t
                 sub += 1
                 landing = last
+            t_new = target if landing else T[idx - 1] + sub * hfix
+            if METHOD == RK4 and next_stop(S, t) <= t_new:  # the step ends on a knot: its last stage just before it
+                hh = short_of(t, t_new)
             take_step(STEPPER, BODY_FLAG, METHOD, t, y, hh, K, yt, yn, prob, fns, W)
             steps += 1
             NSTEP[i] += 1
@@ -480,7 +467,6 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             if not all_finite(yn):
                 status = 3
                 break
-            t_new = target if landing else T[idx - 1] + sub * hfix
             if EVENTS:  # a constant of the variant: without events, none of this is compiled
                 stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
                 if stop_now:

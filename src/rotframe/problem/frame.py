@@ -15,7 +15,10 @@ kind        data
 ==========  =========================================================================
 constant    the vector omega; omega' = 0
 table       a C2 cubic spline through ``(times, vectors)`` (scipy's ``CubicSpline``,
-            not-a-knot): omega and omega' are the spline and its derivative
+            not-a-knot): omega and omega' are the spline and its derivative; or, given
+            as ``(times, vectors, "linear")``, the straight lines between the knots
+            (omega' the slope of each: a motor's ramp, which a spline would round
+            off and overshoot)
 function    a user function ``t -> (3,)``; omega' given (``omega_dot=``) or derived
             by a fourth-order central difference with a fixed step
             h = 2^-9 min(1 s, 1 / |omega(0)|) (error about h^4 |omega^(5)| / 30, some
@@ -40,7 +43,7 @@ from rotframe.errors import ScenarioError
 from rotframe.problem.callables import check_call, plain_function
 from rotframe.validation import check_vector3, refuse_units
 
-__all__ = ["FrameSpec", "frame_spec", "origin_spec", "stop_times", "is_table", "KINDS"]
+__all__ = ["FrameSpec", "frame_spec", "origin_spec", "stop_times", "is_table", "KINDS", "TABLE_INTERPOLATIONS"]
 
 KINDS = ("constant", "table", "function", "body")
 
@@ -216,8 +219,16 @@ def _quintic_basis_derivative(s):
             30 * s2 - 60 * s3 + 30 * s4, -12 * s2 + 28 * s3 - 15 * s4, 0.5 * (3 * s2 - 8 * s3 + 5 * s4))
 
 
+#: how a table ``(times, vectors, how)`` is interpolated between its knots (the default: "cubic")
+TABLE_INTERPOLATIONS = ("cubic", "linear")
+
+
 def _table(value, what):
-    times, vectors = value
+    times, vectors = value[0], value[1]
+    how = value[2] if len(value) == 3 else "cubic"
+    if how not in TABLE_INTERPOLATIONS:
+        raise ScenarioError(f"{what}: the table's interpolation {how!r}; allowed: "
+                            f"{', '.join(map(repr, TABLE_INTERPOLATIONS))}")
     refuse_units(times, f"{what} (the table's times)", ScenarioError)
     refuse_units(vectors, f"{what} (the table's vectors)", ScenarioError)
     try:
@@ -236,10 +247,15 @@ def _table(value, what):
         k = int(bad[0])
         raise ScenarioError(f"{what}: the table's times must increase; times[{k + 1}] = {times[k + 1]:g} s "
                             f"follows times[{k}] = {times[k]:g} s")
-    from scipy.interpolate import CubicSpline
+    if how == "linear":  # the cubic's form with two coefficients zero: v_i + slope_i (t - t_i) on each interval
+        coef = np.zeros((times.size - 1, 4, 3))
+        coef[:, 2] = np.diff(vectors, axis=0) / np.diff(times)[:, None]
+        coef[:, 3] = vectors[:-1]
+    else:
+        from scipy.interpolate import CubicSpline
 
-    spline = CubicSpline(times, vectors, axis=0, bc_type="not-a-knot" if times.size > 3 else "natural")
-    coef = np.ascontiguousarray(np.transpose(spline.c, (1, 0, 2)))  # (n - 1, 4, 3)
+        spline = CubicSpline(times, vectors, axis=0, bc_type="not-a-knot" if times.size > 3 else "natural")
+        coef = np.ascontiguousarray(np.transpose(spline.c, (1, 0, 2)))  # (n - 1, 4, 3)
     return FrameSpec("table", (np.ascontiguousarray(times), coef), t_range=(times[0], times[-1]),
                      is_constant=bool(np.all(vectors == vectors[0])))
 
@@ -278,8 +294,9 @@ def _body(result, what):
 
 
 def is_table(value) -> bool:
-    """``(times, vectors)``: a pair whose first entry is 1-D and whose second is a sequence of sequences (even ragged)."""
-    if not (isinstance(value, (tuple, list)) and len(value) == 2):
+    """``(times, vectors)``: a pair whose first entry is 1-D and whose second is a sequence of sequences (even ragged);
+    or ``(times, vectors, how)``, the same with its interpolation named (`TABLE_INTERPOLATIONS`)."""
+    if not (isinstance(value, (tuple, list)) and (len(value) == 2 or (len(value) == 3 and isinstance(value[2], str)))):
         return False
     try:
         first = np.ndim(value[0]) == 1

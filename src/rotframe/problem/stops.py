@@ -1,0 +1,52 @@
+"""Stops: the times inside a run where a problem's right-hand side is not smooth, and how a step meets them.
+
+A table's knots and a body frame's samples (`rotframe.problem.frame.stop_times`, the sorted ``S``
+of the engine's loops) are where an interpolant's higher derivatives jump, or, for a
+piecewise-linear table, omega' itself. No step of the engine crosses one
+(`rotframe.problem.engine`): DOP853's and RK4's steps are cut to end on it, as
+DifferentialEquations.jl's ``tstops``, so each integrates a smooth function and keeps its order.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rotframe.numerics.compiled import jit_inline
+
+__all__ = ["next_stop", "short_of"]
+
+
+@jit_inline
+def short_of(t, t_end):
+    """The length of a step from ``t`` whose end ``t + h`` falls just short of ``t_end`` (by one or two ulps).
+
+    For an RK4 step that ends on a stop: its last stage is f at ``t + h``, and at a knot itself a
+    table reads the next interval (`rotframe.problem.models.interval`). Where the rate turns there
+    (a piecewise-linear table: omega' jumps), f from the wrong side cost the step an error of order
+    h, at every knot. Just short of the knot, f is the step's own interval's; the state moves by
+    |v| ulp(t_end), far below any tolerance.
+    """
+    h = t_end - t
+    d = 2.220446049250313e-16 * abs(t_end) + 5e-324
+    while t + h >= t_end and h > d:
+        h -= d
+    return h
+
+
+@jit_inline
+def next_stop(S, t):
+    """The first stop time in the sorted S after t (inf if none): a knot where the right-hand side is not smooth."""
+    n = S.shape[0]
+    if n == 0 or S[n - 1] <= t:
+        return math.inf
+    lo = 0
+    hi = n - 1
+    while lo < hi:  # the first S[k] > t
+        mid = (lo + hi) // 2
+        if S[mid] > t:
+            hi = mid
+        else:
+            lo = mid + 1
+    return S[lo]
+
+
