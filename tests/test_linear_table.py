@@ -88,3 +88,35 @@ def test_the_public_door_converts_a_linear_table_and_refuses_another_form():
     np.testing.assert_allclose(res.trajectory.r[:, 0], plain.r[:, 0], rtol=1e-12, atol=1e-12)
     with pytest.raises(ScenarioError, match="interpolation 'spline'; allowed: 'cubic', 'linear'"):
         rotframe.simulate(omega=table("spline"), r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], duration=9.0)
+
+
+def test_the_exact_flow_in_a_turning_frame_is_the_inertial_line():
+    """``method="exact"``: a particle under the frame's terms alone in a frame turning about one axis at a
+    piecewise-linear rate (here a tilted axis, not a coordinate one) is the inertial line turned back, to round-off."""
+    axis = np.array([0.3, -0.4, 0.866])
+    axis = axis / np.linalg.norm(axis)
+    r0, v0 = np.array([1.0, -0.5, 0.2]), np.array([0.3, 0.8, -0.1])
+    run = simulate_particles(omega=(KNOTS, RATES[:, None] * axis, "linear"), r0=r0, v0=v0, duration=9.0, samples=90,
+                             method="exact").trajectory
+    # the oracle about z, turned: the same motion in axes where the rotation axis is z
+    e3 = axis
+    e1 = np.cross([0.0, 1.0, 0.0], e3)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(e3, e1)
+    R = np.array([e1, e2, e3])  # rows: the axes of the z frame in the given frame's components
+    expected = seen_from_the_frame(R @ r0, R @ v0, run.times) @ R
+    assert np.max(np.abs(run.r[:, 0] - expected)) < 1e-13 * np.max(np.abs(expected))
+
+
+@pytest.mark.parametrize("change, names", [
+    (dict(forces=[rotframe.forces.gravity([0.0, 0.0, -9.8])]), "forces[0]"),
+    (dict(frame_terms=("coriolis", "centrifugal")), "frame_terms="),
+    (dict(omega=(KNOTS, np.column_stack([RATES, 0.0 * RATES, 0.0 * RATES + 0.1]), "linear")), "off the axis"),
+    (dict(omega=table()), "(times, vectors, 'linear')"),
+])
+def test_what_the_exact_flow_of_a_turning_frame_refuses(change, names):
+    kw = dict(omega=table("linear"), r0=[1.0, -0.5, 0.2], v0=[0.3, 0.8, -0.1], duration=9.0, method="exact")
+    kw.update(change)
+    with pytest.raises(ScenarioError) as refused:
+        rotframe.simulate(**kw)
+    assert names in str(refused.value) and "use dop853" in str(refused.value) and "\n" not in str(refused.value)

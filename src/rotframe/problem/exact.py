@@ -14,9 +14,14 @@ The engine chooses it from the terms, as the scenes choose it from theirs:
   ``C -= 2 [w x]``, centrifugal ``K -= [w x]^2`` (Euler's is zero in a steady frame);
 - a constant acceleration of the origin ``b -= a0``.
 
+A particle under the frame's terms alone (all three of them) in a frame that turns about a fixed
+axis at a piecewise-linear rate (``omega=(times, vectors, "linear")``, every vector along one axis)
+moves on the inertial straight line too, turned into the frame by the rate's exact integral: the
+scenes' turntable flow (`rotframe.particles.model.OmegaSchedule.table`).
+
 Anything else is refused by name, in one line: a force of your own or a nonlinear built-in
-term (no linear form), the pendulum's string, a frame whose omega is not constant, an origin
-whose acceleration is not, events (the exact flow locates only the scenes' own), the GPU. The
+term (no linear form), the pendulum's string, a frame whose omega is not constant (but that one),
+an origin whose acceleration is not, events (the exact flow locates only the scenes' own), the GPU. The
 frame's part is the scenes' model of the frame's terms
 (`rotframe.particles.model.ParticleModel.linear_matrices` and ``is_force_free``), the forces' parts
 added after it in the scenes' order, so a scene's model and the same terms given here have the
@@ -69,9 +74,12 @@ def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearP
     refusal = "method='exact' takes terms linear in (r, v) with constant coefficients in a steady frame"
     if events:
         raise ScenarioError(f"events[0]: {refusal}, and locates no events of your own; use dop853")
+    if frame.kind == "table" and frame.interpolation == "linear":
+        return _turning_frame(terms, frame, origin, frame_terms)
     if frame.kind != "constant":
-        raise ScenarioError(f"omega: {refusal}; this frame's omega is a {frame.kind}, not a constant vector; use "
-                            "dop853")
+        raise ScenarioError(f"omega: {refusal}; this frame's omega is a {frame.kind}, not a constant vector (a "
+                            "piecewise-linear table, (times, vectors, 'linear'), takes a particle under the frame's "
+                            "terms alone); use dop853")
     if origin.kind not in ("zero", "constant"):
         raise ScenarioError(f"origin_acceleration: {refusal}; a0 is a {origin.kind}, not a constant; use dop853")
     # the frame's terms are the scenes' model of them (its matrices, and whether it is force-free), then the
@@ -96,3 +104,33 @@ def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearP
         b -= np.asarray(origin.data[0], dtype=float)
     force_free = not terms and origin.kind == "zero" and frame_model.is_force_free
     return LinearProblem(names + list(frame_terms), frame_model.omega, K, C, b, force_free)
+
+
+def _turning_frame(terms, frame, origin, frame_terms) -> LinearProblem:
+    """A particle under the frame's terms alone in a frame turning about a fixed axis at a piecewise-linear rate: the
+    inertial straight line turned into the frame (`rotframe.particles.linear.free_flow_matrices`), or a one-line
+    ScenarioError naming what keeps the flow from being that."""
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+
+    refusal = ("method='exact' in a frame whose rate varies takes a particle under the frame's terms alone, the frame "
+               "turning about one axis at a piecewise-linear rate")
+    if terms:
+        raise ScenarioError(f"forces[0]: {refusal}; use dop853")
+    if origin.kind != "zero":
+        raise ScenarioError(f"origin_acceleration: {refusal}, its origin at rest; use dop853")
+    nodes = frame.nodes
+    k = int(np.argmax(np.linalg.norm(nodes, axis=1)))
+    axis = nodes[k] / np.linalg.norm(nodes[k]) if np.any(nodes[k]) else np.array([0.0, 0.0, 1.0])
+    rates = nodes @ axis
+    off_axis = np.linalg.norm(nodes - rates[:, None] * axis, axis=1)
+    if np.any(off_axis > 1e-12 * max(1.0, float(np.max(np.abs(rates))))):
+        j = int(np.argmax(off_axis))
+        raise ScenarioError(f"omega: {refusal}; the table's vector at t = {frame.data[0][j]:g} s is off the axis "
+                            f"{axis.tolist()}; use dop853")
+    model = ParticleModel(tuple(frame_terms), omega=OmegaSchedule.table(axis, frame.data[0], rates))
+    if not model.is_force_free:
+        raise ScenarioError(f"frame_terms={tuple(frame_terms)}: {refusal}, and all three of the frame's terms "
+                            "(coriolis, centrifugal, euler) acting; use dop853")
+    problem = LinearProblem(frame_terms, model.omega, np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3), True)
+    problem.is_linear = False  # its coefficients vary: the flow is the closed form, never a matrix exponential
+    return problem

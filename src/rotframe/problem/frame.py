@@ -75,6 +75,10 @@ class FrameSpec:
     #: for ``body``: the order in h (sample interval) of a trajectory's error from the interpolant
     #: (6 for the quintic Hermite of a free body, 4 where omega'' comes from differences: a torque)
     order: int = 0
+    #: for ``table``: how it is interpolated between its knots (`TABLE_INTERPOLATIONS`)
+    interpolation: str = ""
+    #: for a ``"linear"`` table: its knots' vectors (n, 3), as given
+    nodes: np.ndarray | None = None
 
     def coarsened(self):
         """The same body frame from every other sample (None for another kind, or too few samples).
@@ -257,7 +261,8 @@ def _table(value, what):
         spline = CubicSpline(times, vectors, axis=0, bc_type="not-a-knot" if times.size > 3 else "natural")
         coef = np.ascontiguousarray(np.transpose(spline.c, (1, 0, 2)))  # (n - 1, 4, 3)
     return FrameSpec("table", (np.ascontiguousarray(times), coef), t_range=(times[0], times[-1]),
-                     is_constant=bool(np.all(vectors == vectors[0])))
+                     is_constant=bool(np.all(vectors == vectors[0])), interpolation=how,
+                     nodes=vectors.copy() if how == "linear" else None)
 
 
 def _body(result, what):

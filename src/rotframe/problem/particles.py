@@ -362,7 +362,9 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     forces = [f for f in terms if isinstance(f, Force)]
     diagnostics = {}
     notes = list(frame.notes) + ["method exact: the flow of r'' = K r + C v + b (the terms' linear forms and the "
-                                 "frame's), to round-off"]
+                                 "frame's), to round-off" if model.is_linear else
+                                 "method exact: the inertial straight line turned into the frame by the exact "
+                                 "integral of its piecewise-linear rate, to round-off"]
 
     def energies(rotating):
         n, N = traj.r.shape[:2]
