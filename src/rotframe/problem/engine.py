@@ -57,11 +57,12 @@ from rotframe.numerics.bisection import MAX_HALVINGS, locator
 from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
+from rotframe.numerics.step_control import start_short_of
 from rotframe.problem.calls import RAISED, call_event, direct_functions
 from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, particle_energy, rhs
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
-from rotframe.problem.stops import next_stop, short_of
+from rotframe.problem.stops import next_stop
 
 __all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
 
@@ -455,9 +456,10 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 sub += 1
                 landing = last
             t_new = target if landing else T[idx - 1] + sub * hfix
+            t_stages = t
             if METHOD == RK4 and next_stop(S, t) <= t_new:  # the step ends on a knot: its last stage just before it
-                hh = short_of(t, t_new)
-            take_step(STEPPER, BODY_FLAG, METHOD, t, y, hh, K, yt, yn, prob, fns, W)
+                t_stages = start_short_of(t, hh, t_new)
+            take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
             steps += 1
             NSTEP[i] += 1
             NFEV[i] += 3 if METHOD == RK4 else 2

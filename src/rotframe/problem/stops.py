@@ -4,7 +4,9 @@ A table's knots and a body frame's samples (`rotframe.problem.frame.stop_times`,
 of the engine's loops) are where an interpolant's higher derivatives jump, or, for a
 piecewise-linear table, omega' itself. No step of the engine crosses one
 (`rotframe.problem.engine`): DOP853's and RK4's steps are cut to end on it, as
-DifferentialEquations.jl's ``tstops``, so each integrates a smooth function and keeps its order.
+DifferentialEquations.jl's ``tstops``, so each integrates a smooth function and keeps its order;
+an RK4 step that ends on one reads f on its own side of it
+(`rotframe.numerics.step_control.start_short_of`).
 """
 
 from __future__ import annotations
@@ -13,24 +15,7 @@ import math
 
 from rotframe.numerics.compiled import jit_inline
 
-__all__ = ["next_stop", "short_of"]
-
-
-@jit_inline
-def short_of(t, t_end):
-    """The length of a step from ``t`` whose end ``t + h`` falls just short of ``t_end`` (by one or two ulps).
-
-    For an RK4 step that ends on a stop: its last stage is f at ``t + h``, and at a knot itself a
-    table reads the next interval (`rotframe.problem.models.interval`). Where the rate turns there
-    (a piecewise-linear table: omega' jumps), f from the wrong side cost the step an error of order
-    h, at every knot. Just short of the knot, f is the step's own interval's; the state moves by
-    |v| ulp(t_end), far below any tolerance.
-    """
-    h = t_end - t
-    d = 2.220446049250313e-16 * abs(t_end) + 5e-324
-    while t + h >= t_end and h > d:
-        h -= d
-    return h
+__all__ = ["next_stop"]
 
 
 @jit_inline
