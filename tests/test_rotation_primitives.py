@@ -101,6 +101,8 @@ class _Err(RotframeError, ValueError):
 
 def test_check_vector3_accepts_and_refuses():
     assert check_vector3([1, 2, 3], "r0").dtype == np.float64
+    with pytest.raises(_Err, match=r"^w = '\[1, \[2, 3\]\]' is not numbers; it must be 3 numbers$"):
+        check_vector3([1, [2, 3]], "w", _Err)  # ragged: numpy's own test of complexity cannot read it
     assert check_vector3(np.zeros((4, 2, 3)), "r", stack=True).shape == (4, 2, 3)
     assert np.isnan(check_vector3([np.nan, 0, 0], "r", finite=False)[0])
     with pytest.raises(_Err, match=r"^f: omega = \[1\.0, 2\.0\] has shape \(2,\); it must be \(\.\.\., 3\)$"):

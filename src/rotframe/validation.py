@@ -142,7 +142,8 @@ def check_vector3(value, name: str, error_cls: type[Exception] = ValueError, *, 
     """
     where = f"{caller}: " if caller else ""
     units = f" ({unit})" if unit else ""
-    if np.iscomplexobj(value):  # before the conversion, which would drop the imaginary part with a warning
+    if _has_complex(value):  # before the conversion, which would drop the imaginary part with a warning (a ragged
+        # list too, which numpy's own test of complexity cannot read: it is refused below, as not numbers)
         raise error_cls(f"{where}{name} = {value!r} is complex; it must be real{units}")
     try:
         a = np.asarray(value, dtype=np.float64)

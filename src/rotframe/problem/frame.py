@@ -230,7 +230,7 @@ TABLE_INTERPOLATIONS = ("cubic", "linear")
 def _table(value, what):
     times, vectors = value[0], value[1]
     how = value[2] if len(value) == 3 else "cubic"
-    if how not in TABLE_INTERPOLATIONS:
+    if not isinstance(how, str) or how not in TABLE_INTERPOLATIONS:
         raise ScenarioError(f"{what}: the table's interpolation {how!r}; allowed: "
                             f"{', '.join(map(repr, TABLE_INTERPOLATIONS))}")
     refuse_units(times, f"{what} (the table's times)", ScenarioError)
@@ -301,7 +301,7 @@ def _body(result, what):
 def is_table(value) -> bool:
     """``(times, vectors)``: a pair whose first entry is 1-D and whose second is a sequence of sequences (even ragged);
     or ``(times, vectors, how)``, the same with its interpolation named (`TABLE_INTERPOLATIONS`)."""
-    if not (isinstance(value, (tuple, list)) and (len(value) == 2 or (len(value) == 3 and isinstance(value[2], str)))):
+    if not (isinstance(value, (tuple, list)) and len(value) in (2, 3)):
         return False
     try:
         first = np.ndim(value[0]) == 1
