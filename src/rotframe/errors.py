@@ -9,6 +9,8 @@ code 2 with one line of text. [`IntegrationError`][rotframe.errors.IntegrationEr
 
 from __future__ import annotations
 
+import re
+
 __all__ = [
     "RotframeError",
     "NotARotationError",
@@ -25,7 +27,10 @@ MAX_MESSAGE = 600
 
 
 def readable(message: str, limit: int = MAX_MESSAGE) -> str:
-    """``message`` on one readable line: at most ``limit`` characters, the middle cut out and counted."""
+    """``message`` on one readable line: its line breaks (a numpy array's repr echoed back spans lines) made single
+    spaces, and at most ``limit`` characters, the middle cut out and counted."""
+    if "\n" in message:
+        message = re.sub(r"\s*\n\s*", " ", message.strip())
     if len(message) <= limit:
         return message
     head, tail = message[:limit * 2 // 3], message[-(limit // 4):]

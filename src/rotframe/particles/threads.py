@@ -70,7 +70,7 @@ def check_device(device, what="device") -> str | None:
         return None
     from rotframe.errors import ScenarioError
 
-    if device not in DEVICES:
+    if not isinstance(device, str) or device not in DEVICES:  # an array's `in` would ask its truth value
         raise ScenarioError(f"{what}: {device!r}; allowed: {', '.join(DEVICES)}")
     if device == "gpu":
         require_gpu(what)
