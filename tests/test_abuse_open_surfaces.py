@@ -81,6 +81,8 @@ SIMULATE = {
     "duration a 2-D array (its repr spans lines)": (dict(duration=np.zeros((2, 2))), "duration"),
     "rtol a 2-D array (its repr spans lines)": (dict(rtol=np.zeros((2, 2))), "rtol"),
     "device an array": (dict(device=np.zeros(2)), "device"),
+    "frame_attitude all zero, where no force reads it": (dict(frame_attitude=[0, 0, 0, 0]), "frame_attitude"),
+    "frame_attitude ragged, where no force reads it": (dict(frame_attitude=[0, [0], 0, 1]), "frame_attitude"),
     "device an empty array": (dict(device=np.array([])), "device"),
     "omega a table with NaN": (dict(omega=([0, 1, 2], [[0, 0, 1], [0, np.nan, 0], [0, 0, 1]])), "omega"),
     "omega a table of text": (dict(omega=(["a", "b"], [[0, 0, 1], [0, 0, 1]])), "omega"),
@@ -380,3 +382,16 @@ def test_a_signal_inside_a_slow_compiled_call_is_answered_in_a_second(tmp_path, 
             proc.kill()
     assert out.startswith("interrupted True"), (out, err)  # the first line was read above
     assert answered < 3.0
+
+
+def test_a_frame_attitude_nothing_reads_is_flagged():
+    """``frame_attitude`` is read only where a force acts in inertial axes: given without one, the run says so."""
+    unread = rotframe.simulate(**{**BASE, "frame_attitude": [0.0, 0.0, 0.0, 1.0]})
+    assert any(w.startswith("frame_attitude is not used") for w in unread.warnings), unread.warnings
+
+    def push(t, r, v):
+        return 0.1, 0.0, 0.0
+
+    read = rotframe.simulate(**{**BASE, "frame_attitude": [0.0, 0.0, 0.0, 1.0],
+                                "forces": [rotframe.Force(push, axes="inertial")]})
+    assert not any("frame_attitude" in w for w in read.warnings), read.warnings

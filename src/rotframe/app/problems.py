@@ -217,6 +217,9 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
     # a setting the caller gave that the method does not read is flagged, as in the scenes' runs (the registry's rule)
     given = {key: value for key, value in (("step", step), ("rtol", rtol), ("atol", atol)) if value is not None}
     run.warnings[:0] = registry.unread_settings(run.trajectory.method, given)
+    if frame_attitude is not None and "frame_q" not in run.trajectory.extras:  # read only with an inertial force
+        run.warnings.insert(0, "frame_attitude is not used: no force acts in inertial axes "
+                               "(rotframe.Force(..., axes='inertial')), so nothing reads the frame's attitude")
     return _particle_result(run, forces, origin_acceleration, duration, time.perf_counter() - t0)
 
 

@@ -25,7 +25,7 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
-__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "check_arrays", "start_states", "run_state",
+__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitude", "check_arrays", "start_states", "run_state",
            "problem_tuple", "function_roles"]
 
 
@@ -88,6 +88,16 @@ def _check_functions(forces, events, params, r, v, t0, labels):
             uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
     for k, g in enumerate(events):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
+
+
+def checked_attitude(frame_attitude) -> np.ndarray:
+    """``frame_attitude=`` as four numbers (a scalar-last quaternion, x, y, z, w), finite and not all 0; a one-line
+    ScenarioError otherwise. Checked wherever it is given, read only where a force acts in inertial axes."""
+    q0 = array_of(frame_attitude, "frame_attitude")
+    if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
+        raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
+                            "numbers, not all 0")
+    return q0
 
 
 def checked_atol(atol) -> np.ndarray | None:
@@ -252,10 +262,7 @@ def start_states(s, r, v, atol, frame_attitude, omega, y=None):
     y[:, :3] = r
     y[:, 3:6] = v
     if D == 10:
-        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else array_of(frame_attitude, "frame_attitude")
-        if q0.shape != (4,) or not np.all(np.isfinite(q0)) or not np.any(q0):
-            raise ScenarioError(f"frame_attitude: {q0.tolist()}; a scalar-last quaternion (x, y, z, w), 4 finite "
-                                "numbers, not all 0")
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else checked_attitude(frame_attitude)
         if frame_attitude is None and s.frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)

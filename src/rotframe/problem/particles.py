@@ -30,8 +30,8 @@ from rotframe.problem import callables as uf
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.particle_setup import (checked_atol, function_roles, problem_tuple, run_state, set_up,
-                                             start_states)
+from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
+                                             set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
@@ -93,6 +93,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                samples=samples, omega_dot=omega_dot, jit=jit, max_events=max_events, device=device,
                frame_terms=frame_terms, inline=inline)
     r, v = s.r, s.v
+    if frame_attitude is not None:
+        checked_attitude(frame_attitude)  # a bad one is refused even where no force reads it
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress)

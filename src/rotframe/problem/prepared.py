@@ -31,8 +31,8 @@ from rotframe.limits import check_run
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
-from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_states, run_state, set_up,
-                                             start_states, tolerance_rows)
+from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, run_state,
+                                             set_up, start_states, tolerance_rows)
 from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
@@ -86,6 +86,8 @@ frame_attitude, frame_terms
                                 "rotframe.simulate")
         self.setup = s
         self._omega, self._frame_attitude = omega, frame_attitude
+        if frame_attitude is not None:
+            checked_attitude(frame_attitude)  # refused even where no force reads it, as simulate refuses it
         self._atol = checked_atol(atol)  # checked once: each run takes it as it is
         #: the string (`forces[k]`, the constraint) the start states are checked against at each run, or None
         self._string = next(((k, f) for k, f in enumerate(s.terms) if isinstance(f, StringConstraint)), None)
