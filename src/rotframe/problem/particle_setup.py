@@ -25,8 +25,8 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
-__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitude", "check_arrays", "start_states", "run_state",
-           "problem_tuple", "function_roles"]
+__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitude", "check_arrays", "start_states",
+           "run_state", "problem_tuple", "function_roles"]
 
 
 def checked_states(r0, v0):
