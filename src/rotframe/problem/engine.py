@@ -457,7 +457,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 landing = last
             t_new = target if landing else T[idx - 1] + sub * hfix
             t_stages = t
-            if METHOD == RK4 and next_stop(S, t) <= t_new:  # the step ends on a knot: its last stage just before it
+            if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
                 t_stages = start_short_of(t, hh, t_new)
             take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
             steps += 1

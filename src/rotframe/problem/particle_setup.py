@@ -26,7 +26,7 @@ from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
 __all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitude", "check_arrays", "start_states",
-           "run_state", "problem_tuple", "function_roles"]
+           "fill_states", "run_state", "problem_tuple", "function_roles"]
 
 
 def checked_states(r0, v0):
@@ -251,22 +251,25 @@ def check_arrays(N, n, D, slots, knots):
     check_run(steps=knots, samples=n, particles=N, what="simulate (the frame's knots each end a step)")
 
 
-def start_states(s, r, v, atol, frame_attitude, omega, y=None):
-    """The engine's states ``y`` (N, D) of the set-up ``s`` from ``r``, ``v`` (N, 3) (and the frame's attitude where
-    a force acts in inertial axes), and the absolute tolerances (N, D) (`tolerance_rows`; ``atol`` as
-    `checked_atol` gives it). ``y``: an array to write the states into (its tolerances are then not made: None)."""
-    N, D = r.shape[0], s.D
-    made = y is None
-    if made:
-        y = np.zeros((N, D))
+def start_states(s, r, v, atol, attitude, omega):
+    """The engine's states ``y`` (N, D) of the set-up ``s`` from ``r``, ``v`` (N, 3) (`fill_states`), and the
+    absolute tolerances (N, D) (`tolerance_rows`; ``atol`` as `checked_atol` gives it)."""
+    y = np.zeros((r.shape[0], s.D))
+    fill_states(s, r, v, attitude, omega, y)
+    return y, tolerance_rows(r.shape[0], s.D, s.rtol, atol)
+
+
+def fill_states(s, r, v, attitude, omega, y):
+    """The engine's states of the set-up ``s`` from ``r``, ``v`` (N, 3) into ``y`` (N, D): with the frame's attitude
+    where a force acts in inertial axes (``attitude`` as `checked_attitude` gives it; None: the identity, or a body
+    frame's first)."""
     y[:, :3] = r
     y[:, 3:6] = v
-    if D == 10:
-        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if frame_attitude is None else checked_attitude(frame_attitude)
-        if frame_attitude is None and s.frame.kind == "body":
+    if s.D == 10:
+        q0 = np.array([0.0, 0.0, 0.0, 1.0]) if attitude is None else attitude
+        if attitude is None and s.frame.kind == "body":
             q0 = np.asarray(omega.trajectory.q[0], dtype=float)
         y[:, 6:] = q0 / np.linalg.norm(q0)
-    return y, tolerance_rows(N, D, s.rtol, atol) if made else None
 
 
 def run_state(N, D, slots, n_events):

@@ -93,8 +93,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                samples=samples, omega_dot=omega_dot, jit=jit, max_events=max_events, device=device,
                frame_terms=frame_terms, inline=inline)
     r, v = s.r, s.v
-    if frame_attitude is not None:
-        checked_attitude(frame_attitude)  # a bad one is refused even where no force reads it
+    attitude = None if frame_attitude is None else checked_attitude(frame_attitude)  # refused even where unread
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress)
@@ -102,7 +101,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     frame, origin, forces, events, params, labels = s.frame, s.origin, s.forces, s.events, s.params, s.labels
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
     frame_terms, cache_notes, EDIR, ETERM, stops = s.frame_terms, s.cache_notes, s.EDIR, s.ETERM, s.stops
-    y, atol_arr = start_states(s, r, v, checked_atol(atol), frame_attitude, omega)
+    y, atol_arr = start_states(s, r, v, checked_atol(atol), attitude, omega)
     y0_first = y[:1].copy()
     OUT = np.full((n, N, D), np.nan)
     state = run_state(N, D, slots, len(events))

@@ -31,8 +31,8 @@ from rotframe.limits import check_run
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
-from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, run_state,
-                                             set_up, start_states, tolerance_rows)
+from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, fill_states,
+                                             run_state, set_up, tolerance_rows)
 from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
@@ -85,9 +85,9 @@ frame_attitude, frame_terms
             raise ScenarioError("method='exact': the exact flow compiles nothing and has no set-up to keep; call "
                                 "rotframe.simulate")
         self.setup = s
-        self._omega, self._frame_attitude = omega, frame_attitude
-        if frame_attitude is not None:
-            checked_attitude(frame_attitude)  # refused even where no force reads it, as simulate refuses it
+        self._omega = omega
+        #: the frame's attitude, checked once (refused even where no force reads it, as simulate refuses it)
+        self._attitude = None if frame_attitude is None else checked_attitude(frame_attitude)
         self._atol = checked_atol(atol)  # checked once: each run takes it as it is
         #: the string (`forces[k]`, the constraint) the start states are checked against at each run, or None
         self._string = next(((k, f) for k, f in enumerate(s.terms) if isinstance(f, StringConstraint)), None)
@@ -157,7 +157,7 @@ frame_attitude, frame_terms
         """The engine's states of the start states ``r``, ``v`` into ``y``, and their events' values into the run's
         ``state``."""
         s = self.setup
-        start_states(s, r, v, None, self._frame_attitude, self._omega, y)
+        fill_states(s, r, v, self._attitude, self._omega, y)
         if s.events:
             s.driver.start_events(0.0, y, state["GPREV"], s.prob, s.fns)
 
@@ -173,6 +173,10 @@ def _fresh_arrays(s, N, atol):
             np.full((s.times.size, N, s.D), np.nan), None)
 
 
+#: the loop's work arrays, by `rotframe.problem.engine.scratch`'s names
+_WORK = ("K", "Kb", "V", "F", "W")
+
+
 class _KeptArrays:
     """The arrays of a prepared run of one particle, made once in two blocks and reset by two copies at each run.
 
@@ -185,7 +189,7 @@ class _KeptArrays:
 
     def __init__(self, s, atol):
         y, state, tolerances, OUT, _ = _fresh_arrays(s, 1, atol)
-        arrays = {"y": y, "atol": tolerances, "OUT": OUT, **state, **dict(zip("K Kb V F W".split(), scratch(s.D)))}
+        arrays = {"y": y, "atol": tolerances, "OUT": OUT, **state, **dict(zip(_WORK, scratch(s.D)))}
         self.lock = threading.Lock()
         self._blocks = []
         views = {}
@@ -198,7 +202,7 @@ class _KeptArrays:
                 views[k] = block[at:at + a.size].reshape(a.shape)
                 at += a.size
         self._views = (views["y"], {k: views[k] for k in state}, views["atol"], views["OUT"],
-                       tuple(views[k] for k in "K Kb V F W".split()))
+                       tuple(views[k] for k in _WORK))
 
     def reset(self):
         """The arrays as a fresh run finds them: ``(y, state, atol, OUT, work)``."""

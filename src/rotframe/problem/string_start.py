@@ -6,8 +6,9 @@ path. In numpy's array calls on a few numbers (the distance from the pivot, the 
 string) it took 8 of a prepared run's 48 us, where the scene's `rotframe.particles.prepared.PreparedRun`
 takes 13 us in all (the Foucault model over 1 s; one pinned core, best of 2000, 2026-11-29).
 Compiled, it is one call of about a microsecond. It compiles in 0.25 s, once (cached on disk),
-for a problem with a string alone: the checks every run makes (finite numbers, the scales of
-the tolerances) stay in numpy, whose calls cost less than a first compile.
+for a problem with a string alone: the other check every run makes (finite numbers) stays in
+numpy, whose calls cost less than a first compile (a particle's default tolerances are made by
+the engine's loop itself, `rotframe.problem.engine.own_tolerances`).
 """
 
 from __future__ import annotations
