@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Issue 26's and 32's checks on a lent GPU machine, in one call (see docs/guide/bench.md):
-#   the machine, the GPU kernel's register limits (tools/gpu_variants.py), your own problems on the GPU against
-#   the CPU (tools/gpu_user_check.py), the GPU bench (rotframe bench gpu, with the user-force rows) and the CPU
-#   ensemble bench on every core.
+#   the machine, the GPU bench (rotframe bench gpu, with the user-force rows), your own problems on the GPU against
+#   the CPU (tools/gpu_user_check.py), the GPU kernel's register limits (tools/gpu_variants.py; VARIANTS=0 skips
+#   them) and the CPU ensemble bench on every core (CPU=0 skips it). The most wanted first: a run cut short by its
+#   limit still leaves what it finished in $OUT.
 # Run from the repository root; results land in $OUT (default /tmp/rotframe-device).
 set -u
 OUT=${OUT:-/tmp/rotframe-device}
@@ -28,16 +29,18 @@ except Exception as e:
     print("cupy:", type(e).__name__, e)
 PY
 t0=$(date +%s)
-timeout ${VARIANTS_TIMEOUT:-120} $PY tools/gpu_variants.py 2>&1 | tee "$OUT/variants.txt" | grep -v Warning
-echo "gpu variants: in $(( $(date +%s) - t0 )) s"
+timeout ${GPU_TIMEOUT:-300} $PY -m rotframe bench gpu ${GPU_ARGS:-} --json > "$OUT/gpu.json" 2> "$OUT/gpu.err"
+echo "bench gpu: rc=$? in $(( $(date +%s) - t0 )) s"; tail -c 3000 "$OUT/gpu.err"
+$PY tools/gpu_table.py "$OUT/gpu.json" | tee "$OUT/gpu.md"
 t0=$(date +%s)
 # your own problem on the GPU against the CPU (rotframe.simulate(device="gpu")): exits 1 unless they agree to 1e-9
 timeout ${USER_TIMEOUT:-240} $PY tools/gpu_user_check.py ${USER_PARTICLES:-4096} 2>&1 | tee "$OUT/user_check.txt" | grep -v Warning
 echo "gpu user check: rc=${PIPESTATUS[0]} in $(( $(date +%s) - t0 )) s"
-t0=$(date +%s)
-timeout ${GPU_TIMEOUT:-300} $PY -m rotframe bench gpu ${GPU_ARGS:-} --json > "$OUT/gpu.json" 2> "$OUT/gpu.err"
-echo "bench gpu: rc=$? in $(( $(date +%s) - t0 )) s"; tail -c 3000 "$OUT/gpu.err"
-$PY tools/gpu_table.py "$OUT/gpu.json" | tee "$OUT/gpu.md"
+if [ "${VARIANTS:-1}" = 1 ]; then
+  t0=$(date +%s)
+  timeout ${VARIANTS_TIMEOUT:-120} $PY tools/gpu_variants.py 2>&1 | tee "$OUT/variants.txt" | grep -v Warning
+  echo "gpu variants: in $(( $(date +%s) - t0 )) s"
+fi
 if [ "${CPU:-1}" = 1 ]; then
   t0=$(date +%s)
   timeout ${CPU_TIMEOUT:-240} $PY -m rotframe bench ensemble --json > "$OUT/ensemble.json" 2> "$OUT/ensemble.err"
