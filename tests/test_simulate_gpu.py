@@ -17,7 +17,6 @@ import textwrap
 import types
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import rotframe
@@ -108,3 +107,41 @@ def test_the_gpu_kernel_is_the_engine_loop_with_the_problems_calls_made_direct()
     direct = calls.direct_calls(types.ModuleType("glue"), None)
     assert set(direct) == replaced
     assert direct[calls.call_terms][1]["TERMS"] is stubs.no_terms
+
+
+def test_a_function_inlined_by_numba_on_the_cpu_is_inlined_by_numba_on_the_gpu(monkeypatch):
+    """`take_step` types only the branch of its variant's method where numba inlines it (``inline="always"``).
+
+    Compiled for a GPU as a function of its own, it typed every branch with one method's step and
+    failed at the first launch on an H200, which the simulator (Python) never showed. Here the
+    GPU's options are read off `device_function` with numba's CUDA ``jit`` recording them.
+    """
+    from numba import cuda
+
+    from rotframe.problem import steps
+
+    seen = {}
+
+    def recording_jit(*args, **options):
+        def made(fn):
+            seen[fn.__name__] = options
+            return fn
+        return made
+
+    monkeypatch.setattr(cuda, "jit", recording_jit)
+    monkeypatch.setattr(gpu, "inline_options", lambda: {"forceinline": True})  # a real GPU's numba-cuda
+    gpu.device_function(steps.take_step, {})
+    gpu.device_function(steps.particle_rk4, {})
+    assert seen["take_step"] == {"device": True, "forceinline": True, "inline": "always"}
+    assert seen["particle_rk4"] == {"device": True, "forceinline": True}  # LLVM's inlining only, as on the CPU
+    assert steps.take_step.targetoptions["inline"] == "always"  # what the rule reads: jit_inline's option
+
+
+@pytest.mark.skipif(os.environ.get("NUMBA_ENABLE_CUDASIM") == "1" or "NVIDIA" not in
+                    getattr(__import__("numba").cuda, "implementation", ""),
+                    reason="needs NVIDIA's numba-cuda and a CUDA toolkit's libnvvm (no GPU): tools/gpu_ptx_check.py")
+def test_every_gpu_kernel_compiles_for_a_hopper_gpu():
+    res = subprocess.run([sys.executable, str(ROOT / "tools" / "gpu_ptx_check.py")], capture_output=True, text=True,
+                         timeout=1200, cwd=ROOT)
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    assert res.stdout.rstrip().endswith("0 failed")

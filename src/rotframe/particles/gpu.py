@@ -88,6 +88,13 @@ def device_function(kernel, made=None):
     to the GPU versions to use instead, and receives what is made: a tree of its own, for
     a caller that replaces some functions of it (`rotframe.problem.gpu`: the calls by address
     become direct calls of a problem's functions). Default: the process-wide tree.
+
+    A function that numba inlines into its callers on the CPU (``inline="always"``,
+    `rotframe.numerics.compiled.jit_inline`) is inlined the same way on the GPU: a caller may
+    rely on it to drop the branches that its constants rule out before they are typed
+    (`rotframe.problem.steps.take_step` gets one method's step and types only that method's
+    branch). Compiled on its own, every branch is typed, and a branch with another method's step
+    fails to compile on a real GPU. The simulator runs Python and never types them.
     """
     from numba import cuda
     from numba.core.dispatcher import Dispatcher
@@ -107,7 +114,10 @@ def device_function(kernel, made=None):
     clone = types.FunctionType(fn.__code__, names, fn.__name__, fn.__defaults__, fn.__closure__)
     clone.__qualname__ = fn.__qualname__
     clone.__module__ = fn.__module__
-    done = made[kernel] = cuda.jit(device=True, **inline_options())(clone)
+    options = inline_options()
+    if options and isinstance(kernel, Dispatcher) and kernel.targetoptions.get("inline") == "always":
+        options = {**options, "inline": "always"}  # numba's IR inlining, as on the CPU
+    done = made[kernel] = cuda.jit(device=True, **options)(clone)
     return done
 
 
