@@ -46,7 +46,7 @@ import numpy as np
 from rotframe import method_registry as registry
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.chunked import KernelSetup, run_chunked, sample_times, steps_per_sample
-from rotframe.particles.trajectory import Event, RunInterrupted, Trajectory
+from rotframe.particles.trajectory import Event, RunInterrupted, Trajectory, per_particle
 
 if TYPE_CHECKING:  # names used only in annotations
     from collections.abc import Callable, Sequence
@@ -340,9 +340,9 @@ def integrate_exact(model, r0, v0, duration, samples, events, progress, ordered=
         tau, state = locate_crossings(M, out[k, :, p].T, np.full(len(k), dt), g[k, p], g[k + 1, p], col,
                                       ev.value, times[k])
         order = np.argsort(p, kind="stable")  # group the crossings by particle, in time order
-        splits = np.cumsum(np.bincount(p, minlength=n))[:-1]
-        traj.event_times[ev.name] = np.split((times[k] + tau)[order], splits)
-        traj.event_states[ev.name] = np.split(state[:6].T[order], splits)
+        counts = np.bincount(p, minlength=n)
+        traj.event_times[ev.name] = per_particle((times[k] + tau)[order], counts)
+        traj.event_states[ev.name] = per_particle(state[:6].T[order], counts)
         if ev.terminal:  # a stopped particle keeps its event state in the later samples
             after = np.arange(samples + 1)[:, None] > k[None, :]  # (samples + 1, crossings)
             traj.r[:, p] = np.where(after[:, :, None], state[0:3].T[None], traj.r[:, p])

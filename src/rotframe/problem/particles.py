@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.errors import IntegrationError
-from rotframe.particles.trajectory import RunInterrupted, Trajectory
+from rotframe.particles.trajectory import RunInterrupted, Trajectory, per_particle
 from rotframe.problem import callables as uf
 from rotframe.problem.frame_error import frame_interpolation
 from rotframe.problem.inlined import Inlining
@@ -327,9 +327,9 @@ def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
         i, j = np.nonzero(kept & (state["EVK"] == k))
         order = np.lexsort((state["EVT"][i, j], i))
         i, j = i[order], j[order]
-        cuts = np.cumsum(np.bincount(i, minlength=N))[:-1]
-        traj.event_times[name] = np.split(state["EVT"][i, j], cuts)
-        traj.event_states[name] = np.split(state["EVY"][i, j, :6], cuts)
+        counts = np.bincount(i, minlength=N)
+        traj.event_times[name] = per_particle(state["EVT"][i, j], counts)
+        traj.event_states[name] = per_particle(state["EVY"][i, j, :6], counts)
     traj.extras["status"] = state["ST"].copy()
     if step:
         traj.extras["step"] = step
