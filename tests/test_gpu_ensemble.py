@@ -211,6 +211,20 @@ def test_bench_gpu_on_the_simulator_does_the_same_work_as_the_hand_written_kerne
         "rotframe kernel alone (GpuLaunch)", "hand-written numba CUDA kernel alone"}
 
 
+def test_bench_gpu_hands_over_its_rows_after_every_case():
+    """A lent machine's run cut short keeps the cases it finished (`tools/device_check.sh` writes them)."""
+    code = ("from rotframe.app.bench.gpu import gpu_rows\n"
+            "seen = []\n"
+            "rows = gpu_rows(True, each=lambda rows: seen.append([r['method'] for r in rows]))\n"
+            "print(len(seen), [len(s) for s in seen], seen[-1] == [r['method'] for r in rows])\n")
+    res = _simulated(["-c", code])
+    assert res.returncode == 0, res.stderr[-3000:]
+    line = res.stdout.strip().splitlines()[-1]
+    assert line.startswith("4 ") and line.endswith(" True"), line
+    sizes = [int(x) for x in line[line.index("[") + 1:line.index("]")].split(",")]
+    assert sizes == sorted(sizes) and sizes[0] > 0 and len(set(sizes)) == 4  # each case adds its rows
+
+
 @pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
 def test_bench_gpu_without_a_gpu_exits_2_in_one_line(capsys):
     assert cli.main(["bench", "gpu"]) == 2

@@ -29,7 +29,17 @@ except Exception as e:
     print("cupy:", type(e).__name__, e)
 PY
 t0=$(date +%s)
-timeout ${GPU_TIMEOUT:-300} $PY -m rotframe bench gpu ${GPU_ARGS:-} --json > "$OUT/gpu.json" 2> "$OUT/gpu.err"
+# rotframe bench gpu --json, its rows written after every case: a run cut by its limit keeps the cases it finished
+timeout ${GPU_TIMEOUT:-300} $PY - "$OUT/gpu.json" <<'PY' 2> "$OUT/gpu.err"
+import json, math, sys
+from rotframe.app.bench.gpu import gpu_rows
+def write(rows):
+    clean = [{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in r.items()} for r in rows]
+    with open(sys.argv[1], "w") as f:
+        json.dump(clean, f, default=str)
+    print(f"bench gpu: {len(rows)} rows written", file=sys.stderr, flush=True)
+gpu_rows(False, each=write)
+PY
 echo "bench gpu: rc=$? in $(( $(date +%s) - t0 )) s"; tail -c 3000 "$OUT/gpu.err"
 $PY tools/gpu_table.py "$OUT/gpu.json" | tee "$OUT/gpu.md"
 t0=$(date +%s)

@@ -47,8 +47,12 @@ CEILING_GOAL = 0.5
 JAX_GOAL = 10.0
 
 
-def gpu_rows(quick):
-    """The rows of ``rotframe bench gpu`` (see the module docstring); ScenarioError without a GPU."""
+def gpu_rows(quick, each=None):
+    """The rows of ``rotframe bench gpu`` (see the module docstring); ScenarioError without a GPU.
+
+    ``each`` (optional) is called with the rows so far after every case, so that a run cut short
+    (a lent machine's minutes) keeps the cases it finished (`tools/device_check.sh`).
+    """
     from numba import config
 
     from rotframe.errors import ScenarioError
@@ -66,9 +70,10 @@ def gpu_rows(quick):
     rows = []
     for method, rk4 in (("rotation-splitting", False), ("rk4", True)):
         for event in (True, False):
-            rows += _case(method, rk4, event, n, steps, quick or simulator)
-    for r in rows:
-        r.update(gpu=name, simulator=simulator)
+            for r in _case(method, rk4, event, n, steps, quick or simulator):
+                rows.append({**r, "gpu": name, "simulator": simulator})
+            if each is not None:
+                each(rows)
     return rows
 
 
