@@ -15,21 +15,13 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-class _HostArray(np.ndarray):
-    """A host array in place of a device array."""
-
-    def copy_to_host(self, host=None):
-        if host is None:
-            return np.array(self)
-        host[...] = self
-        return host
-
-    def copy_to_device(self, host):
-        self[...] = host
+from gpu_ptx_check import HostArray  # noqa: E402 -- a tool beside this one
 
 
 class _Done:
@@ -50,7 +42,7 @@ def main(n=2**20) -> int:
     from rotframe.app.bench import gpu as bench_gpu
 
     problem_gpu._kernel = lambda *args: _Done()
-    cuda.to_device = lambda a, *args, **kw: np.array(a).view(_HostArray)
+    cuda.to_device = lambda a, *args, **kw: np.array(a).view(HostArray)
     cuda.is_available = lambda: True
     cuda.synchronize = lambda: None
     threads.gpu_available = lambda: True

@@ -80,7 +80,7 @@ class _Failures(list):
         self.compiled = []
 
 
-class _HostArray(np.ndarray):
+class HostArray(np.ndarray):
     """A host array in place of a device array (what a run does with its arrays after the launch)."""
 
     def copy_to_host(self, host=None):
@@ -128,8 +128,8 @@ def _intercept(failures, current):
     dispatcher.get_current_device = Device
     cuda.is_available = lambda: True
     threads.gpu_available = lambda: True
-    cuda.to_device = lambda a, *args, **kw: np.array(a).view(_HostArray)
-    cuda.device_array = lambda shape, *args, **kw: np.zeros(shape).view(_HostArray)
+    cuda.to_device = lambda a, *args, **kw: np.array(a).view(HostArray)
+    cuda.device_array = lambda shape, *args, **kw: np.zeros(shape).view(HostArray)
 
 
 def _cases():
