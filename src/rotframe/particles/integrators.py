@@ -45,7 +45,7 @@ import numpy as np
 
 from rotframe import method_registry as registry
 from rotframe.errors import IntegrationError, ScenarioError
-from rotframe.particles.chunked import KernelSetup, run_chunked, sample_times, steps_per_sample
+from rotframe.particles.chunked import KernelSetup, run_chunked, sample_times
 from rotframe.particles.trajectory import Event, RunInterrupted, Trajectory, per_particle
 
 if TYPE_CHECKING:  # names used only in annotations
