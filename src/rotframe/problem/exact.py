@@ -50,15 +50,17 @@ class LinearProblem:
     is_force_free : bool
         Only the frame's Coriolis and centrifugal terms act: the inertial straight line, turned
         into the frame, is the flow (exact at every sample however long the run).
+    is_linear : bool
+        False where the coefficients vary (a frame turning at a piecewise-linear rate): the flow
+        is then the force-free particle's closed form, never a matrix exponential.
     """
 
-    is_linear = True
-
-    def __init__(self, terms, omega, K, C, b, force_free):
+    def __init__(self, terms, omega, K, C, b, force_free, linear=True):
         self.terms = tuple(terms)
         self.omega = omega
         self._matrices = (K, C, b)
         self.is_force_free = bool(force_free)
+        self.is_linear = bool(linear)
 
     def linear_matrices(self):
         """``(K, C, b)`` of ``r'' = K r + C v + b``."""
@@ -131,6 +133,4 @@ def _turning_frame(terms, frame, origin, frame_terms) -> LinearProblem:
     if not model.is_force_free:
         raise ScenarioError(f"frame_terms={tuple(frame_terms)}: {refusal}, and all three of the frame's terms "
                             "(coriolis, centrifugal, euler) acting; use dop853")
-    problem = LinearProblem(frame_terms, model.omega, np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3), True)
-    problem.is_linear = False  # its coefficients vary: the flow is the closed form, never a matrix exponential
-    return problem
+    return LinearProblem(frame_terms, model.omega, np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3), True, linear=False)
