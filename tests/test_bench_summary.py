@@ -222,24 +222,35 @@ def test_the_work_bound_is_the_fewest_evaluations_at_the_level_times_our_cost():
     assert row["bound_ratio"] == pytest.approx(b["bound_ratio"]) and "the bound is x" in row["note"]
 
 
-def test_the_problem_start_up_rows_time_three_runs_against_their_goals(monkeypatch):
-    """The first problem ever (both caches empty), a new problem and a changed force, each against its goal."""
+def test_the_problem_start_up_rows_time_four_runs_against_their_goals(monkeypatch):
+    """The first problem ever (both caches empty) short and long, a new problem and a changed force, each against its
+    goal; the note says which tier ran each."""
     from rotframe.app.bench import problem_startup
 
     calls = []
+    plain = "... short enough for its plain-Python remake ..."
+    switched = "... remake ran the first 8 steps, then the loop compiled ..."
 
-    def child(env, k1, k2):
-        calls.append((env["NUMBA_CACHE_DIR"], env["ROTFRAME_CACHE_DIR"], k1, k2))
-        return {"first": 0.4 if len(calls) == 2 else 4.0, "changed": 0.25}
+    def child(env, runs):
+        calls.append((env["NUMBA_CACHE_DIR"], env["ROTFRAME_CACHE_DIR"], runs))
+        answers = {1: [{"wall": 0.4, "tier": plain}], 2: [{"wall": 4.5, "tier": switched}],
+                   3: [{"wall": 0.3, "tier": ""}, {"wall": 0.25, "tier": ""}]}
+        return answers[len(calls)]
 
     monkeypatch.setattr(problem_startup, "_child", child)
     peer = [{"run": "diffrax", "setting": "first solve in a process"}]
     monkeypatch.setattr(problem_startup, "diffrax_startup_rows", lambda constants: peer)
     rows = problem_startup.problem_startup_rows()
-    assert rows[3:] == peer  # diffrax's rows follow rotframe's (tests/test_bench_diffrax_startup.py)
-    rows = rows[:3]
-    assert [r["setting"] for r in rows] == ["first problem ever", "new problem", "changed force"]
-    assert [r["wall_s"] for r in rows] == [4.0, 0.4, 0.25]
-    assert [r["goal_met"] for r in rows] == [False, True, True]
-    assert calls[0][:2] == calls[1][:2]  # the second process finds what the first one cached
-    assert len({c for call in calls for c in call[2:]}) == 4  # a new force every time: nothing found by chance
+    assert rows[4:] == peer  # diffrax's rows follow rotframe's (tests/test_bench_diffrax_startup.py)
+    rows = rows[:4]
+    assert [r["setting"] for r in rows] == ["first problem ever", "first problem ever, long", "new problem",
+                                            "changed force"]
+    assert [r["wall_s"] for r in rows] == [0.4, 4.5, 0.3, 0.25]
+    assert [r["goal_met"] for r in rows] == [True, False, True, True]
+    assert "plain-Python remake" in rows[0]["note"] and "compiled" in rows[1]["note"]
+    assert "loaded from numba's cache" in rows[2]["note"]
+    assert calls[0][:2] != calls[1][:2]  # both first runs find every cache empty
+    assert calls[1][:2] == calls[2][:2]  # the new problem finds what the long first run cached
+    assert [span for call in calls for _, span in call[2]] == [problem_startup.SHORT_S, problem_startup.LONG_S,
+                                                               problem_startup.SHORT_S, problem_startup.SHORT_S]
+    assert len({k for call in calls for k, _ in call[2]}) == 4  # a new force every time: nothing found by chance

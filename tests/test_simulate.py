@@ -506,6 +506,53 @@ def test_uncompilable_force_one_line_then_plain_python():
     assert np.max(np.abs(res.trajectory.r[:, 0] - expected)) < 1e-6
 
 
+def _pull_star(t, r, v, *p):
+    return -p[0] * r[0], -p[0] * r[1], -p[1] * r[2]
+
+
+def _pull(t, r, v, k, kz):
+    return -k * r[0], -k * r[1], -kz * r[2]
+
+
+def _crossing_star(t, r, v, *p):
+    return r[0] - 0.5 * p[0] / 2.0
+
+
+def test_functions_of_star_args_run_compiled_as_their_spelled_out_twins():
+    """A force, an event and a torque written with *params give the numbers of the same functions with their
+    parameters spelled out, compiled (numba's inliner refuses *args with no message: they compile on their own)."""
+    kw = dict(omega=[0.0, 0.0, 0.5], r0=R0, v0=V0, duration=3.0, params=(2.0, 0.5), samples=6)
+    star = rotframe.simulate(forces=[_pull_star], events=[_crossing_star], **kw)
+    spelled = rotframe.simulate(forces=[_pull], events=[lambda t, r, v, k, kz: r[0] - 0.5 * k / 2.0], **kw)
+    assert not star.warnings
+    np.testing.assert_array_equal(star.trajectory.r, spelled.trajectory.r)
+    [a], [b] = star.trajectory.event_times.values(), spelled.trajectory.event_times.values()
+    assert a[0].size >= 1
+    np.testing.assert_array_equal(a[0], b[0])
+
+    def torque_star(t, L, q, *p):
+        return p[0] * L[1], 0.0, 0.0
+
+    def torque(t, L, q, c):
+        return c * L[1], 0.0, 0.0
+
+    body = dict(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.1], q0=[0, 0, 0, 1], duration=2.0, samples=4, params=(0.3,))
+    np.testing.assert_array_equal(rotframe.simulate_body(torque=torque_star, **body).trajectory.L,
+                                  rotframe.simulate_body(torque=torque, **body).trajectory.L)
+
+
+def test_functions_of_keywords_are_refused_in_one_line():
+    def pull(t, r, v, **options):
+        return -r[0], -r[1], -r[2]
+
+    with pytest.raises(RotframeError) as info:
+        rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=R0, v0=V0, duration=1.0, forces=[pull], samples=4)
+    msg = _one_line(info.value)
+    assert "forces[0]" in msg and "**keywords" in msg and "jit=False" in msg
+    res = rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=R0, v0=V0, duration=1.0, forces=[pull], samples=4, jit=False)
+    assert np.all(np.isfinite(res.trajectory.r))
+
+
 def test_bad_method_and_arguments_name_the_key():
     with pytest.raises(ScenarioError, match="method"):
         rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=1.0, method="euler")

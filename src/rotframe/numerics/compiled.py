@@ -28,7 +28,7 @@ from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["jit_kernel", "jit_internal", "jit_uncounted", "jit_llvm_inline", "jit_inline", "inlined", "uncounted", "bound",
-           "CompiledOnlyDispatcher", "source_fingerprint", "global_names"]
+           "CompiledOnlyDispatcher", "source_fingerprint", "global_names", "load_cached"]
 
 #: The package's folder: a kernel defined in a file below it is cached with `source_fingerprint` as its stamp.
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -206,6 +206,29 @@ def inlined(kernel):
     For a kernel whose callers are few and large: a first run compiles one function less.
     """
     return njit(inline="always", error_model="numpy", nogil=True)(kernel.py_func)
+
+
+def load_cached(dispatcher, signature) -> bool:
+    """Whether ``dispatcher`` was found in numba's disk cache for ``signature`` (then it is loaded), never compiling.
+
+    numba's `Dispatcher.compile` loads from the cache or compiles; this is its first half alone
+    (numba's own calls), so that a caller can tell a loop it may load from one it would have to
+    compile: a long run's inlined loop (`rotframe.problem.inlined`), the engine's loop before a
+    first run (`rotframe.problem.tiers`). Any failure reads as "not in the cache".
+    """
+    from numba.core.compiler_lock import global_compiler_lock
+
+    try:
+        with global_compiler_lock:
+            cres = dispatcher._cache.load_overload(signature, dispatcher.targetctx)
+            if cres is None:
+                return False
+            dispatcher._cache_hits[signature] += 1  # numba's count of loads, as its own compile keeps it
+            dispatcher.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            dispatcher.add_overload(cres)
+    except Exception:  # noqa: BLE001 -- numba's internals changed, or a damaged entry: compile instead, if at all
+        return False
+    return True
 
 
 def global_names(code) -> set:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import enum
 import hashlib
+import inspect
 import re
 import types
 
@@ -84,8 +85,12 @@ def compiled_for_glue(f):
     """
     import numba
 
-    return numba.njit(plain_function(f), error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True,
-                      inline="always")
+    py = plain_function(f)
+    # numba's inliner cannot take a function of *args (it fails with no message): such a function is compiled on
+    # its own, as numba can (**keywords are refused before: `check_compilable`)
+    starred = bool(getattr(py, "__code__", None) and py.__code__.co_flags & inspect.CO_VARARGS)
+    return numba.njit(py, error_model="numpy", no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                      inline="never" if starred else "always")
 
 
 def reads_argument(f, index: int) -> bool:
@@ -276,6 +281,9 @@ def check_compilable(role: str, f, jit: bool) -> None:
         kind = type(target).__module__ + "." + type(target).__qualname__
         raise UserFunctionError(f"{role}: a {kind} ({display_name(f)}) is not a function numba can compile; write "
                                 "it as a def (bound values go in params=, or a closure), or pass jit=False")
+    if jit and target.__code__.co_flags & inspect.CO_VARKEYWORDS:
+        raise UserFunctionError(f"{role} ({display_name(f)}) takes **keywords, which numba cannot compile; drop "
+                                "them (its parameters come from params=, by position), or pass jit=False")
 
 
 def check_call(role: str, f, args, shape, *, when: str) -> np.ndarray:

@@ -507,18 +507,25 @@ METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4
 _VARIANTS: dict = {}
 
 
-def variant(model, method, events, compiled=True, D=None):
+def variant(model, method, events, compiled=True, D=None, load_only=False):
     """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a name of `METHOD_CODES`) and
     ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
     when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`). ``D``, the
-    length of the state, is a constant of the loop's code (default the model's, `STATE_LENGTH`)."""
+    length of the state, is a constant of the loop's code (default the model's, `STATE_LENGTH`). With
+    ``load_only``: None where the loop would have to compile (neither made in this process nor in the cache), what
+    tells a run to begin in the plain tier (`rotframe.problem.tiers`)."""
+    from rotframe.numerics.compiled import load_cached
+
     D = STATE_LENGTH[int(model)] if D is None else int(D)
     key = (int(model), method, bool(events), D, bool(compiled))
     kernel = _VARIANTS.get(key)
     if kernel is None:
         kernel = _variant_kernel(*key[:4])
         if compiled:
-            kernel.compile(VARIANT_SIGNATURE)
+            if not load_cached(kernel, VARIANT_SIGNATURE):
+                if load_only:
+                    return None
+                kernel.compile(VARIANT_SIGNATURE)
             kernel.disable_compile()
         else:
             from rotframe.numerics.plain import plain

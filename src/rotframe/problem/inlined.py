@@ -166,27 +166,6 @@ def _dispatcher(module, model, method, events, D, parts):
     return njit(**dict(engine.ENTRY_OPTIONS, cache=where[0] is not None))(loop)
 
 
-def _loaded(dispatcher, signature) -> bool:
-    """Whether ``dispatcher`` was found in numba's disk cache for ``signature`` (then it is loaded), never compiling.
-
-    numba's `Dispatcher.compile` loads from the cache or compiles; this is its first half alone
-    (numba's own calls), so that a run loads an inlined loop whenever one is there but compiles
-    one only where the run is long enough to repay it. Any failure reads as "not in the cache".
-    """
-    from numba.core.compiler_lock import global_compiler_lock
-
-    try:
-        with global_compiler_lock:
-            cres = dispatcher._cache.load_overload(signature, dispatcher.targetctx)
-            if cres is None:
-                return False
-            dispatcher.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
-            dispatcher.add_overload(cres)
-    except Exception:  # noqa: BLE001 -- numba's internals changed, or a damaged entry: compile instead, if at all
-        return False
-    return True
-
-
 def _key(module, model, method, events, D, parts):
     parts = None if parts is None else tuple(sorted(parts.items()))
     return module.__name__, int(model), method, bool(events), int(D), parts
@@ -200,6 +179,7 @@ def inlined_loop(module, model, method, events, D, parts=None, compile=True):
     With ``compile=False``, only loaded: None where it is neither in this process nor in the cache.
     It takes the engine's arguments, with `rotframe.problem.calls.direct_functions` for the addresses.
     """
+    from rotframe.numerics.compiled import load_cached
     from rotframe.problem import engine
 
     key = _key(module, model, method, events, D, parts)
@@ -207,7 +187,7 @@ def inlined_loop(module, model, method, events, D, parts=None, compile=True):
     if kernel is not None:
         return kernel
     kernel = _dispatcher(module, model, method, events, D, parts)
-    if not _loaded(kernel, engine.VARIANT_SIGNATURE):
+    if not load_cached(kernel, engine.VARIANT_SIGNATURE):
         if not compile:
             return None
         kernel.compile(engine.VARIANT_SIGNATURE)

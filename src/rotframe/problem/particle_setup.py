@@ -160,6 +160,8 @@ class SetUp:
     cache_notes: list = None
     #: when the driver's build began (`time.perf_counter`): compile time counts from there
     t0: float = 0.0
+    #: makes the same problem's driver as plain Python (`rotframe.problem.tiers`); None for a plain run
+    plain_driver: object = None
 
 
 def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples,
@@ -238,8 +240,13 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     settings = [check_event(g, k) for k, g in enumerate(events)]
     EDIR = np.array([float(d) for d, _ in settings], dtype=float)
     ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
+    def plain_driver():
+        return Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, labels, False), glue,
+                                   compiled=False), compiled=False)
+
     return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
-                 frame_terms, on_gpu, driver, prob, driver.functions(prob), slots, stops, EDIR, ETERM, cache_notes, t0)
+                 frame_terms, on_gpu, driver, prob, driver.functions(prob), slots, stops, EDIR, ETERM, cache_notes, t0,
+                 plain_driver if jit else None)
 
 
 def check_arrays(N, n, D, slots, knots):

@@ -33,6 +33,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
+from rotframe.problem.tiers import Tier
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
            "raised_later", "trajectory_of"]
@@ -118,21 +119,27 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
 
     inlining = Inlining(driver.module, prob[0], method, events, D, model_parts(prob),
                         inline if jit and not on_gpu else False)
+    # a first run whose loop is not compiled yet begins as the loop's plain-Python remake (`rotframe.problem.tiers`)
+    tier = Tier(driver, fns, s.plain_driver if gpu is None and inline is not True else None,
+                (prob[0], method, bool(events), D), prob, N)
 
-    def advance(*args):  # the engine's loop, or the inlined one once the run has switched to it
-        driver.advance(*args, kernel=inlining.kernel)
+    def advance(*args):  # the plain tier's loop, the engine's, or the inlined one once the run has switched to it
+        if tier.plain:
+            tier.driver.advance(*args)
+        else:
+            driver.advance(*args, kernel=inlining.kernel)
 
     try:
         inlining.start()
         if events:
-            driver.start_events(0.0, y, state["GPREV"], prob, fns)
+            tier.driver.start_events(0.0, y, state["GPREV"], prob, tier.fns)
         before = (times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
-        after = (method, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, fns)
         while True:
+            after = (method, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, tier.fns)
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
-            budget = pacer.start()
+            budget = tier.budget(pacer.start())
             try:
                 if gpu is not None:
                     gpu(0, N, *before, budget, *after)
@@ -151,12 +158,15 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             if first:
                 compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
                 first = False
-            pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
-            inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
-                                float(np.sum(duration - state["TC"][state["ST"] == 0])))
+            if not tier.plain:  # the plain tier's calls are counted in steps, and say nothing of the compiled pace
+                pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
+                inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
+                                    float(np.sum(duration - state["TC"][state["ST"] == 0])))
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
+            # in the plain tier: where the run goes on, compiled from here once it is seen to be long
+            tier.after_call(state["NFEV"], state["NSTEP"], state["TC"], ST, duration)
             if np.any(ST >= 3):
                 break
             if np.all(ST != 0):
@@ -172,18 +182,19 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
         gpu.fetch()
     traj = trajectory_of(times, OUT, state, events, method, n, hfix)
     raise_if_failed(s, state, y, OUT)
-    warnings, notes, diagnostics = [], list(frame.notes) + cache_notes + ([inlining.note] if inlining.note else []), {}
+    notes = list(frame.notes) + cache_notes + [note for note in (tier.note, inlining.note) if note]
+    warnings, diagnostics = [], {}
     if not jit:
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
 
-    def energies(rotating):
-        return driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, fns, driver.potential(),
-                               rotating)
+    def energies(rotating):  # by the loop that ran the run's end: a run ended in the plain tier compiles nothing
+        return tier.driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, tier.fns,
+                                    tier.driver.potential(), rotating)
 
     _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)
     try:
-        frame_interpolation(driver.advance, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
+        frame_interpolation(tier.driver.advance, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
                             warnings, notes, lambda spec: problem_tuple(prob[1], prob[2], spec, origin))
     except KeyboardInterrupt:
         raise RunInterrupted(traj) from None
@@ -192,7 +203,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     dropped = int(np.sum(np.maximum(state["EVN"] - max_events, 0)))
     if dropped:
         warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
-    compile_s += inlining.seconds_mid_run  # an inlined loop made after the first call: compile time too
+    compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
     traj.extras["compile_s"] = compile_s
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s, frame_terms)
 

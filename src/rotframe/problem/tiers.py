@@ -1,0 +1,152 @@
+"""A first run of a loop not compiled yet: begun by the loop's plain-Python remake, compiled only if it runs on.
+
+The engine's loops are compiled once, then loaded from numba's cache in a fraction of a second
+(`rotframe.problem.engine`). The first run on a fresh install, with every cache empty, waits for
+that compile: 4 to 5 s for the DOP853 particle loop on the 2-core reference machine, where the
+run itself, a projectile or a few orbits, takes a few thousand right-hand sides. The loop's
+plain-Python remake (`rotframe.numerics.plain`: the same functions, run by Python instead of
+compiled) needs nothing compiled and takes some 30 us a right-hand side, so it answers such a
+run in a few hundredths of a second. A run whose loop is neither made in this process nor in
+numba's cache (`loop_is_compiled`) therefore begins in the *plain tier*:
+
+* it runs calls of `PLAIN_STEPS` steps per particle as plain Python;
+* after each, it projects the run's right-hand sides (summed over the particles): each running
+  particle's so far, times the run's span over the span it has covered. Where the projection
+  exceeds `PLAIN_FEVS`, the loop is compiled, as the run would have compiled it at its start, and the run goes on compiled from where it is (the loop keeps
+  everything a step needs in its arrays, as between any two calls);
+* a run that ends first never compiles the loop; the next run's loop is then still cold, and it
+  begins in the plain tier too.
+
+A long run is seen as long after its first plain call, a few milliseconds (DOP853's first steps
+are its shortest, so the projection errs long, and a run near the line compiles). The problem's
+own functions are compiled before either tier runs, as always: a function numba cannot compile
+is refused at once, whatever the run's length.
+
+**The numbers.** The remake runs the loop's own code, statement for statement, in float64: its
+arithmetic is IEEE's, in the same order, so its numbers are the compiled loop's to the bit where
+the problem's functions give the same numbers in Python as compiled. The built-in terms and plain
+arithmetic do (`tests/test_tiers.py` checks every method, events, a varying frame and forces in
+inertial axes). A user function calling numpy's vectorised functions on scalars may not: numpy
+may round a transcendental differently from the C library numba calls, by an ulp. The switch
+is decided on counts of steps and simulated time, not on the clock, so a run begins and switches
+the same way every time its loop is cold. Each run says in its notes which tier ran it.
+
+Only runs on the CPU of at most `PLAIN_PARTICLES` particles, with ``inline`` not True, begin
+in the plain tier: a large ensemble's first call alone would be too long as Python.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+__all__ = ["Tier", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+
+#: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
+#: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
+#: against 4 to 5 s to compile its loop
+PLAIN_FEVS = 20_000
+#: the steps per particle of each call in the plain tier (a count, not a time: the same run switches at the same step)
+PLAIN_STEPS = 8
+#: the most particles a run may have to begin in the plain tier (a first call of PLAIN_STEPS DOP853 steps each: some
+#: 3,300 right-hand sides, 0.1 s)
+PLAIN_PARTICLES = 32
+
+
+def loop_is_compiled(variant) -> bool:
+    """Whether the engine's loop of ``variant`` (`rotframe.problem.engine.variant`'s arguments) is made in this process
+    or in numba's disk cache (then it is loaded): whether a run may begin compiled without compiling it."""
+    from rotframe.problem import engine
+
+    return engine.variant(*variant, load_only=True) is not None
+
+
+def projected_fevs(NFEV, TC, ST, span) -> float:
+    """The run's right-hand sides at its end, projected from each particle's so far (``NFEV``) over the span it has
+    covered (``TC``, from 0): a running particle's (``ST`` 0) scaled by ``span / TC`` (infinite before it has moved),
+    an ended one's as counted."""
+    total = 0.0
+    for nf, t, status in zip(NFEV, TC, ST):
+        if status != 0:
+            total += float(nf)
+        else:
+            total += float(nf) * span / t if t > 0.0 else math.inf
+    return total
+
+
+class Tier:
+    """Which loop runs a particle run's calls: the compiled engine's, or its plain remake first (module docstring).
+
+    Parameters
+    ----------
+    driver : rotframe.problem.codegen.Driver
+        The run's compiled driver.
+    fns : tuple
+        Its functions' addresses (`rotframe.problem.codegen.Driver.functions`).
+    plain : callable or None
+        Makes the run's plain driver (the same problem as plain Python), where the run may begin in the plain
+        tier (on the CPU, ``inline`` not True); None where it may not.
+    variant : tuple
+        The engine's variant of the run, ``(model, method, events, D)`` (`rotframe.problem.engine.variant`).
+    prob : tuple
+        The problem's data (`rotframe.problem.signatures.PROBLEM`).
+    particles : int
+        The run's particles (at most `PLAIN_PARTICLES` to begin in the plain tier).
+    """
+
+    def __init__(self, driver, fns, plain, variant, prob, particles):
+        self.driver = driver
+        self.fns = fns
+        self.variant = variant
+        #: whether the calls run as plain Python now
+        self.plain = (plain is not None and particles <= PLAIN_PARTICLES
+                      and not loop_is_compiled(variant))
+        self._compiled = (driver, fns)
+        #: the seconds the compile took where the run switched to it after its first call: compile time, not
+        #: integration
+        self.seconds_mid_run = 0.0
+        self._plain_steps = 0
+        self._switched_at = None  # the steps (all particles) the plain tier ran before the switch
+        if self.plain:
+            self.driver = plain()
+            self.fns = self.driver.functions(prob)
+
+    def budget(self, paced: int) -> int:
+        """The steps per particle of the next call: ``paced`` (the run's `rotframe.problem.pacing.Pacer`) where
+        compiled, `PLAIN_STEPS` in the plain tier."""
+        return PLAIN_STEPS if self.plain else paced
+
+    def after_call(self, NFEV, NSTEP, TC, ST, span) -> bool:
+        """After a call in the plain tier, with the run's right-hand sides ``NFEV``, steps ``NSTEP``, times ``TC`` and
+        statuses ``ST`` so far (per particle) and its ``span`` (s): where the run goes on and its right-hand sides,
+        projected or counted, exceed `PLAIN_FEVS`, compile the loop and switch to it. Returns whether it switched."""
+        if not self.plain:
+            return False
+        self._plain_steps = int(np.sum(NSTEP))
+        if np.any(ST >= 3) or not np.any(ST == 0) or projected_fevs(NFEV, TC, ST, span) <= PLAIN_FEVS:
+            return False
+        from rotframe.problem import engine
+
+        t0 = time.perf_counter()
+        engine.variant(*self.variant)  # the compile the run would have begun with
+        self.seconds_mid_run = time.perf_counter() - t0
+        self.driver, self.fns = self._compiled
+        self.plain = False
+        self._switched_at = self._plain_steps
+        return True
+
+    @property
+    def note(self):
+        """What the run's notes say of its tier (None where it ran compiled from the start)."""
+        method = self.variant[1]
+        if self.plain:
+            return (f"the engine's {method} loop was not compiled yet (a first run): this run was short enough for "
+                    f"its plain-Python remake, which ran all {self._plain_steps} steps (all particles; the same code and "
+                    "numbers; rotframe.problem.tiers); a longer run compiles the loop, once")
+        if self._switched_at is not None:
+            return (f"the engine's {method} loop was not compiled yet (a first run): its plain-Python remake ran the "
+                    f"first {self._switched_at} steps, then the loop compiled ({self.seconds_mid_run:.2g} s, once) and "
+                    "ran the rest (the same code and numbers; rotframe.problem.tiers)")
+        return None

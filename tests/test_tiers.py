@@ -1,0 +1,226 @@
+"""The plain tier of a first run (rotframe.problem.tiers): the same numbers as the compiled loop, to the bit.
+
+A run whose loop is not compiled yet begins as the loop's plain-Python remake, and compiles the
+loop where its first calls project more than `PLAIN_FEVS` right-hand sides. Each case is run three
+ways and must agree to the bit in every sample and every event record:
+
+* compiled from the start (this process has the loops, or compiles them);
+* in the plain tier from start to end (``loop_is_compiled`` says no, the budget
+  never reached);
+* in the plain tier for its first calls, then compiled (the budget set low).
+
+The oracle is the compiled loop, which the other tests check against closed forms and other
+integrators: these tests say the tier changes nothing, not that the physics is right. A
+planted difference between the remake and the loop (a different step control, a dropped term)
+fails them: `test_a_planted_difference_is_seen` plants one.
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import rotframe.forces as rf
+from rotframe.problem import engine, tiers
+from rotframe.problem.particles import simulate_particles
+from rotframe.problem.terms import Force
+
+
+def spring(t, r, v):
+    return -1.3 * r[0], -1.3 * r[1], -1.3 * r[2]
+
+
+def kick(t, r, v, k):
+    return -k * r[0] * abs(r[0]), -k * r[1], -k * math.sin(r[2])
+
+
+def ground(t, r, v):
+    return r[2] + 40.0
+
+
+ground.terminal = True
+ground.direction = -1
+
+
+def crossing(t, r, v):
+    return r[0]
+
+
+def crossing_k(t, r, v, k):
+    return r[0] - 0.01 * k
+
+
+def omega_of_t(t):
+    return np.array([0.01 * math.sin(0.3 * t), 0.0, 0.5 + 0.02 * t])
+
+
+def inertial_push(t, r, v):
+    return 0.05, 0.0, -0.02 * t
+
+
+R0 = np.array([[1.0, 0.0, 0.5], [0.3, -0.4, 1.0], [-0.2, 0.7, 0.0]])
+V0 = np.array([[0.0, 1.0, 0.2], [0.5, 0.1, -0.3], [0.0, -0.2, 0.4]])
+
+CASES = {
+    "dop853, user and built-in forces, two events": dict(
+        method="dop853", omega=[0.0, 0.1, 0.5], forces=[spring, rf.gravity((0.0, 0.0, -9.81)), rf.drag(linear=0.1, quadratic=0.02)],
+        events=[ground, crossing], duration=6.0, samples=40),
+    "rk4, user force with params, events": dict(
+        method="rk4", omega=[0.0, 0.0, 0.7], forces=[kick, rf.gravity((0.0, -1.0, 0.0))], params=(0.8,), events=[crossing_k],
+        duration=4.0, samples=20, step=0.01),
+    "rotation-splitting4, user kick and drag's flow": dict(
+        method="rotation-splitting4", omega=[0.0, 0.0, 0.9], forces=[spring, rf.drag(linear=0.3)], duration=5.0,
+        samples=25, step=0.02),
+    "rotation-splitting, user kick, event": dict(
+        method="rotation-splitting", omega=[0.1, 0.0, 0.6], forces=[spring, rf.central_gravity(2.0, (0.0, 0.0, -3.0))],
+        events=[crossing], duration=4.0, samples=16, step=0.01),
+    "dop853, a frame turning by a function, an accelerating origin": dict(
+        method="dop853", omega=omega_of_t, forces=[spring], origin_acceleration=lambda t: np.array([0.0, 0.1 * t, 0.0]),
+        duration=5.0, samples=30),
+    "dop853, a table frame, a force in inertial axes": dict(
+        method="dop853", omega=(np.linspace(0.0, 5.0, 11), np.column_stack([np.zeros(11), np.zeros(11),
+                                                                            0.4 + 0.05 * np.linspace(0.0, 5.0, 11)])),
+        forces=[spring, Force(inertial_push, axes="inertial")], duration=5.0, samples=30),
+    "dop853, a pendulum and gravity with its potential": dict(
+        method="dop853", omega=[0.0, 0.0, 0.3], forces=[rf.pendulum(2.0), rf.gravity((0.0, 0.0, -9.81))], duration=4.0, samples=20,
+        r0=np.array([[1.2, 0.0, -1.6]]), v0=np.array([[0.0, 0.3, 0.0]])),
+    "rk4, altitude gravity and a spring": dict(
+        method="rk4", omega=[0.0, 0.0, 0.2], forces=[rf.altitude_gravity(9.81, 100.0), rf.spring(2.0)],
+        duration=3.0, samples=12, step=0.01),
+}
+
+
+def _run(case, tier_mode, monkeypatch, budget=None):
+    """The case's run: ``compiled`` (the loop as this process has it), ``plain`` (the plain tier throughout),
+    ``switch`` (the plain tier for its first calls, then compiled)."""
+    kw = dict(case)
+    kw.setdefault("r0", R0)
+    kw.setdefault("v0", V0)
+    with monkeypatch.context() as m:
+        if tier_mode == "compiled":  # never the plain tier, whether or not this process has compiled the loop yet
+            m.setattr(tiers, "PLAIN_PARTICLES", 0)
+        else:
+            m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+            m.setattr(tiers, "PLAIN_FEVS", 10**12 if tier_mode == "plain" else budget)
+        return simulate_particles(**kw)
+
+
+def _same(a, b):
+    ta, tb = a.trajectory, b.trajectory
+    np.testing.assert_array_equal(ta.times, tb.times)
+    np.testing.assert_array_equal(ta.r, tb.r)
+    np.testing.assert_array_equal(ta.v, tb.v)
+    assert ta.event_times.keys() == tb.event_times.keys()
+    for name in ta.event_times:
+        for x, y in zip(ta.event_times[name], tb.event_times[name]):
+            np.testing.assert_array_equal(x, y)
+        for x, y in zip(ta.event_states[name], tb.event_states[name]):
+            np.testing.assert_array_equal(x, y)
+    assert ta.steps == tb.steps  # not nfev: each call begins with f at its start, and the tiers cut calls apart
+    assert a.diagnostics.keys() == b.diagnostics.keys()
+    for key in a.diagnostics:
+        assert a.diagnostics[key] == b.diagnostics[key], key
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_plain_tier_and_the_switch_give_the_compiled_numbers(name, monkeypatch):
+    case = CASES[name]
+    compiled = _run(case, "compiled", monkeypatch)
+    assert not any("plain-Python remake" in n for n in compiled.notes)
+    assert np.all(compiled.trajectory.extras["status"] >= 1)
+    plain = _run(case, "plain", monkeypatch)
+    assert any("short enough for its plain-Python remake" in n for n in plain.notes), plain.notes
+    _same(plain, compiled)
+    # switched after the first plain call (the budget a single right-hand side): the rest compiled
+    switched = _run(case, "switch", monkeypatch, budget=1)
+    assert any("remake ran the first" in n and "then the loop compiled" in n for n in switched.notes), switched.notes
+    assert 0 < switched.trajectory.steps
+    _same(switched, compiled)
+
+
+def test_a_planted_difference_is_seen(monkeypatch):
+    """The comparison above sees a remake that differs from the loop: Hairer's safety factor planted 1 % smaller in
+    the plain tier alone changes its steps and numbers."""
+    from rotframe.numerics import plain as plain_module, step_control
+
+    case = CASES["dop853, user and built-in forces, two events"]
+    compiled = _run(case, "compiled", monkeypatch)
+    with monkeypatch.context() as m:
+        m.setattr(plain_module, "_PLAIN", {})  # the remakes made anew, reading the planted constant
+        m.setattr(plain_module, "_SPACES", {})
+        m.setattr(engine, "_VARIANTS", {key: k for key, k in engine._VARIANTS.items() if key[-1]})
+        m.setattr(step_control, "SAFE", step_control.SAFE * 0.99)  # read by the plain remake, frozen in the loop
+        plain = _run(case, "plain", monkeypatch)
+    with pytest.raises(AssertionError):
+        _same(plain, compiled)
+
+
+def test_large_ensembles_and_inline_runs_begin_compiled(monkeypatch):
+    """More particles than PLAIN_PARTICLES, or inline=True, never begin in the plain tier."""
+    case = dict(CASES["rk4, user force with params, events"])
+    with monkeypatch.context() as m:
+        m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+        n = tiers.PLAIN_PARTICLES + 1
+        many = simulate_particles(**dict(case, r0=np.tile(R0[0], (n, 1)), v0=np.tile(V0[0], (n, 1))))
+        assert not any("plain-Python" in note for note in many.notes)
+        inlined = simulate_particles(**dict(case, r0=R0, v0=V0, inline=True))
+        assert not any("plain-Python" in note for note in inlined.notes)
+
+
+def test_a_user_function_that_raises_in_the_plain_tier_is_named(monkeypatch):
+    from rotframe.problem.callables import UserFunctionError
+
+    def breaks(t, r, v):
+        if t > 1.0:
+            raise ValueError("broken at t > 1")
+        return -r[0], -r[1], -r[2]
+
+    with monkeypatch.context() as m:
+        m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+        with pytest.raises(UserFunctionError) as info:
+            simulate_particles(omega=[0.0, 0.0, 0.5], r0=R0[:1], v0=V0[:1], duration=3.0, forces=[breaks], samples=30,
+                               method="rk4", step=0.01)
+    assert "broken at t > 1" in str(info.value) and "particle 0" in str(info.value)
+    assert info.value.partial is not None and 0.9 <= info.value.t_reached <= 1.0 + 1e-9
+
+
+_CHILD = r"""
+import json, sys
+from rotframe.problem import engine
+from rotframe.problem.particles import simulate_particles
+
+def spring(t, r, v):
+    return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
+
+run = simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=float(sys.argv[1]),
+                         forces=[spring], samples=10)
+print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
+                  "compiled": engine.variant(0, "dop853", False, load_only=True) is not None}))
+"""
+
+
+def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
+    """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
+    one switches and compiles it; the next short one, in another process, finds it in the cache and runs compiled.
+    The final states agree to the bit."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
+
+    def child(duration):
+        out = subprocess.run([sys.executable, "-c", _CHILD, repr(duration)], env=env, capture_output=True, text=True,
+                             timeout=600)
+        assert out.returncode == 0, out.stderr[-2000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    short = child(10.0)
+    assert any("short enough for its plain-Python remake" in n for n in short["notes"]), short["notes"]
+    assert not short["compiled"]
+    long = child(400.0)
+    assert any("then the loop compiled" in n for n in long["notes"]), long["notes"]
+    again = child(10.0)
+    assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
+    assert again["compiled"]
+    assert again["r"] == short["r"]
