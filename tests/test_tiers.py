@@ -142,6 +142,54 @@ def test_plain_tier_and_the_switch_give_the_compiled_numbers(name, monkeypatch):
     _same(switched, compiled)
 
 
+def _torque(t, L, q, c):
+    return -c * L[0], c * q[2], 0.1 * math.sin(t)
+
+
+def _gravity_torque(t, L, q, c):  # of the attitude alone: the splittings' kick
+    return c * q[0] * q[3], -c * q[1], 0.0
+
+
+from rotframe.problem.body import Torque  # noqa: E402 -- the body cases' marker, beside them
+
+BODIES = {
+    "a free body, dop853": dict(method="dop853", duration=300.0),
+    "a torque, dop853": dict(method="dop853", torque=_torque, params=(0.2,)),
+    "a torque, rk4": dict(method="rk4", torque=_torque, params=(0.2,), step=0.005),
+    "a torque of the attitude, lie-poisson4": dict(method="lie-poisson4", torque=Torque(_gravity_torque,
+                                                                                       attitude_only=True),
+                                                   params=(0.3,), step=0.01),
+}
+
+
+def _body(case, tier_mode, monkeypatch, budget=None):
+    from rotframe.problem.body import simulate_rigid_body
+
+    kw = dict(dict(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.2], q0=[0.0, 0.0, 0.0, 1.0], duration=6.0, samples=24),
+              **case)
+    with monkeypatch.context() as m:
+        if tier_mode == "compiled":
+            m.setattr(tiers, "PLAIN_PARTICLES", 0)
+        else:
+            m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+            m.setattr(tiers, "PLAIN_FEVS", 10**12 if tier_mode == "plain" else budget)
+        return simulate_rigid_body(**kw)
+
+
+@pytest.mark.parametrize("name", list(BODIES))
+def test_a_body_in_the_plain_tier_and_switched_gives_the_compiled_numbers(name, monkeypatch):
+    compiled = _body(BODIES[name], "compiled", monkeypatch)
+    plain = _body(BODIES[name], "plain", monkeypatch)
+    switched = _body(BODIES[name], "switch", monkeypatch, budget=1)
+    assert not any("plain-Python remake" in n for n in compiled.notes)
+    assert any("short enough for its plain-Python remake" in n for n in plain.notes), plain.notes
+    assert any("then the loop compiled" in n for n in switched.notes), switched.notes
+    for run in (plain, switched):
+        np.testing.assert_array_equal(run.trajectory.L, compiled.trajectory.L)
+        np.testing.assert_array_equal(run.trajectory.q, compiled.trajectory.q)
+        assert run.diagnostics == compiled.diagnostics
+
+
 def test_a_planted_difference_is_seen(monkeypatch):
     """The comparison above sees a remake that differs from the loop: Hairer's safety factor planted 1 % smaller in
     the plain tier alone changes its steps and numbers."""

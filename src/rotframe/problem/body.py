@@ -27,6 +27,7 @@ from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
+from rotframe.problem.tiers import Tier
 from rotframe import method_registry as registry
 from rotframe.problem.arguments import check_flag, check_inline, check_params, run_grid
 from rotframe.problem.particles import STATUS
@@ -184,26 +185,35 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
     # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
     inlining = Inlining(driver.module, BODY, method, False, 7, None, inline if jit else False)
 
+    def plain_driver():  # the same body as plain Python, for a first run whose loop is not compiled yet
+        plain = {name: uf.plain_function(f) for name, f in functions.items()}
+        return Driver(build_module("body", key, plain, glue, compiled=False), compiled=False)
+
+    tier = Tier(driver, fns, plain_driver if jit and inline is not True else None, (BODY, method, False, 7), prob, 1)
+
     def call(budget):
-        driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                       st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob, fns,
-                       kernel=inlining.kernel)
+        tier.driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
+                            st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob,
+                            tier.fns, kernel=None if tier.plain else inlining.kernel)
 
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     try:
         inlining.start()
         while True:
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
-            budget = pacer.start()
+            budget = tier.budget(pacer.start())
             try:
                 call(budget)
             except Exception as exc:
                 _torque_raised(exc, call, saved, y, TC, H, st, torque, budget)
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
-            pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
-            inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
-                                float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
+            if tier.plain:  # compiled from here where the run is seen to be long (`rotframe.problem.tiers`)
+                tier.after_call(st["NFEV"], st["NSTEP"], TC, st["ST"], duration)
+            else:
+                pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
+                inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
+                                    float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
             if progress is not None:
                 progress(float(st["IDX"][0]) / n)
             if st["ST"][0] != 0:
@@ -229,9 +239,9 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
                                        t_bad, partial)
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
-    compile_s += inlining.seconds_mid_run  # an inlined loop made after the first call: compile time too
+    compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
     run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
-    run.notes.extend(cache_notes + ([inlining.note] if inlining.note else []))
+    run.notes.extend(cache_notes + [note for note in (tier.note, inlining.note) if note])
     return run
 
 

@@ -31,8 +31,9 @@ may round a transcendental differently from the C library numba calls, by an ulp
 is decided on counts of steps and simulated time, not on the clock, so a run begins and switches
 the same way every time its loop is cold. Each run says in its notes which tier ran it.
 
-Only runs on the CPU of at most `PLAIN_PARTICLES` particles, with ``inline`` not True, begin
-in the plain tier: a large ensemble's first call alone would be too long as Python.
+Only runs on the CPU of at most `PLAIN_PARTICLES` particles (or one rigid body:
+`rotframe.problem.body`), with ``inline`` not True, begin in the plain tier: a large ensemble's
+first call alone would be too long as Python.
 """
 
 from __future__ import annotations
@@ -143,7 +144,7 @@ class Tier:
         method = self.variant[1]
         if self.plain:
             return (f"the engine's {method} loop was not compiled yet (a first run): this run was short enough for "
-                    f"its plain-Python remake, which ran all {self._plain_steps} steps (all particles; the same code and "
+                    f"its plain-Python remake, which ran all {self._plain_steps} steps (the same code and "
                     "numbers; rotframe.problem.tiers); a longer run compiles the loop, once")
         if self._switched_at is not None:
             return (f"the engine's {method} loop was not compiled yet (a first run): its plain-Python remake ran the "
