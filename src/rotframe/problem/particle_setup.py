@@ -240,7 +240,8 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     settings = [check_event(g, k) for k, g in enumerate(events)]
     EDIR = np.array([float(d) for d, _ in settings], dtype=float)
     ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
-    def plain_driver():
+
+    def plain_driver():  # the same problem as plain Python, for a first run whose loop is not compiled yet
         return Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, labels, False), glue,
                                    compiled=False), compiled=False)
 
