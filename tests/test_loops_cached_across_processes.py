@@ -38,6 +38,8 @@ if case == "rigid":  # the rigid body's DOP853 loop, an entry point called from 
     from rotframe.rigid.adaptive import rigid_dop853
     rigid_dop853([1.0, 2.0, 3.0], [0.1, 1.0, 0.1], [0.0, 0.0, 0.0, 1.0], np.linspace(0.0, 1.0, 5))
 elif case == "problem":  # your own problem's DOP853 variant with events, and a body's
+    import rotframe.problem.tiers
+    rotframe.problem.tiers.PLAIN_PARTICLES = 0  # compiled from the first run: no plain tier, the compile is the test
     def ground(t, r, v):
         return r[2] + 1.0
     ground.terminal = True

@@ -20,6 +20,16 @@ from rotframe.problem.prepared import PreparedProblem
 from raising_force import raise_after_one_second
 
 
+@pytest.fixture(autouse=True)
+def _compiled_from_the_start(monkeypatch):
+    """simulate's runs here begin compiled, whatever the caches hold: these tests compare its counts of right-hand
+    sides with a prepared run's, and each call begins with one, where the plain tier's calls are shorter
+    (`rotframe.problem.tiers`; its numbers are the compiled loop's to the bit: tests/test_tiers.py)."""
+    from rotframe.problem import tiers
+
+    monkeypatch.setattr(tiers, "PLAIN_PARTICLES", 0)
+
+
 def pull(t, r, v, k):
     return -k * r[0] + 0.1 * math.sin(t), -k * r[1], -k * r[2] - 0.05 * v[2]
 

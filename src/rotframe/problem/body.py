@@ -27,7 +27,7 @@ from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.tiers import Tier
+from rotframe.problem.tiers import PlainTierFailed, Tier, quiet_as_compiled
 from rotframe import method_registry as registry
 from rotframe.problem.arguments import check_flag, check_inline, check_params, run_grid
 from rotframe.problem.particles import STATUS
@@ -102,9 +102,19 @@ def _inertia(inertia):
     return np.ascontiguousarray(I)
 
 
-def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
-                        samples=None, jit=True, progress=None, inline=None) -> BodyRun:
-    """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`."""
+def simulate_rigid_body(**kwargs) -> BodyRun:
+    """Integrate a rigid body under the user's torque; see `rotframe.simulate_body`.
+
+    A run begun in the plain tier that fails runs again compiled from its start (`rotframe.problem.tiers`).
+    """
+    try:
+        return _simulate_rigid_body(**kwargs)
+    except PlainTierFailed:
+        return _simulate_rigid_body(**kwargs, plain_tier=False)
+
+
+def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                         samples=None, jit=True, progress=None, inline=None, plain_tier=True) -> BodyRun:
     import time
 
     attitude_only = bool(getattr(torque, "attitude_only", False))
@@ -189,7 +199,8 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
         plain = {name: uf.plain_function(f) for name, f in functions.items()}
         return Driver(build_module("body", key, plain, glue, compiled=False), compiled=False)
 
-    tier = Tier(driver, fns, plain_driver if jit and inline is not True else None, (BODY, method, False, 7), prob, 1)
+    tier = Tier(driver, fns, plain_driver if jit and inline is not True and plain_tier else None,
+                (BODY, method, False, 7), prob, 1)
 
     def call(budget):
         tier.driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
@@ -203,9 +214,17 @@ def simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), me
             saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
             budget = tier.budget(pacer.start())
             try:
-                call(budget)
+                if tier.plain:
+                    with quiet_as_compiled():
+                        call(budget)
+                else:
+                    call(budget)
             except Exception as exc:
+                if tier.plain:
+                    raise PlainTierFailed from None
                 _torque_raised(exc, call, saved, y, TC, H, st, torque, budget)
+            if tier.plain and st["ST"][0] >= 3:
+                raise PlainTierFailed
             if compile_s is None:
                 compile_s = time.perf_counter() - t0
             if tier.plain:  # compiled from here where the run is seen to be long (`rotframe.problem.tiers`)

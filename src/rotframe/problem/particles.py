@@ -33,7 +33,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
-from rotframe.problem.tiers import Tier
+from rotframe.problem.tiers import PlainTierFailed, Tier, quiet_as_compiled
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
            "raised_later", "trajectory_of"]
@@ -75,10 +75,23 @@ def _blame(functions, params, t, y, dt, labels, frame_roles=()):
     return uf.blame_in_step(candidates, t, dt)
 
 
-def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
-                       method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
-                       frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
-                       frame_terms=None, inline=None) -> ProblemRun:
+def simulate_particles(**kwargs) -> ProblemRun:
+    """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
+
+    A run begun in the plain tier that fails (a user function raised, a state not finite) runs
+    again compiled from its start (`rotframe.problem.tiers`): a failure is met and reported as the
+    compiled loop meets it, whatever the caches held.
+    """
+    try:
+        return _simulate_particles(**kwargs)
+    except PlainTierFailed:
+        return _simulate_particles(**kwargs, plain_tier=False)
+
+
+def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
+                        method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
+                        frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
+                        frame_terms=None, inline=None, plain_tier=True) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -120,7 +133,7 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
     inlining = Inlining(driver.module, prob[0], method, events, D, model_parts(prob),
                         inline if jit and not on_gpu else False)
     # a first run whose loop is not compiled yet begins as the loop's plain-Python remake (`rotframe.problem.tiers`)
-    tier = Tier(driver, fns, s.plain_driver if gpu is None and inline is not True else None,
+    tier = Tier(driver, fns, s.plain_driver if gpu is None and inline is not True and plain_tier else None,
                 (prob[0], method, bool(events), D), prob, N)
 
     def advance(*args):  # the plain tier's loop, the engine's, or the inlined one once the run has switched to it
@@ -148,13 +161,19 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
                         _again_on_the_cpu(gpu.ended, advance, y, state, saved, before + (budget,) + after)
                         if np.all(state["ST"][gpu.ended] == 0):  # it did not raise there: the GPU goes on from it
                             gpu.resume()
+                elif tier.plain:
+                    with quiet_as_compiled():
+                        advance_blocks(advance, N, before + (budget,) + after)
                 else:
                     advance_blocks(advance, N, before + (budget,) + after)
             except Exception as exc:
+                if tier.plain:
+                    raise PlainTierFailed from None
                 if gpu is not None:
                     gpu.fetch()
                 raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
-                              params, method, hfix, times, OUT, state, events, labels)
+                             params, method, hfix, times, OUT, state, events, labels,
+                             function_roles(frame, origin, [], [], []))
             if first:
                 compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
                 first = False
@@ -165,6 +184,8 @@ def simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
+            if tier.plain and np.any(ST >= 3):
+                raise PlainTierFailed
             # in the plain tier: where the run goes on, compiled from here once it is seen to be long
             tier.after_call(state["NFEV"], state["NSTEP"], state["TC"], ST, duration)
             if np.any(ST >= 3):
@@ -285,12 +306,14 @@ def _again_on_the_cpu(particles, advance, y, state, saved, args):
         advance(int(i), int(i) + 1, *args)
 
 
-def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels):
-    """A user function raised inside a compiled call: find the step, name the function, give time and state.
+def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels,
+                 frame_roles=()):
+    """A user function raised inside a call: find the step, name the function, give time and state.
 
     The call is replayed from the state saved before it, one step per call, particle by particle
-    (the drivers are deterministic), up to the step where the exception comes again; the force that
-    raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
+    (the drivers are deterministic), up to the step where the exception comes again; the force, the
+    event function or the frame's function (``frame_roles``, `rotframe.problem.particle_setup.function_roles`)
+    that raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
     ``.partial`` keep the samples up to that step).
     """
     _restore(y, state, saved)
@@ -303,7 +326,9 @@ def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, tim
                 advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
-                blame = _blame(forces, params, t, yi, dt, labels)[0]
+                # a force or an event function (a plain run's, where either raises as Python)
+                blame = _blame(list(forces) + list(events), params, t, yi, dt,
+                               list(labels) + [f"events[{k}]" for k in range(len(events))], frame_roles)[0]
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
                 state["TC"][i] = t

@@ -15,7 +15,11 @@ numba's cache (`loop_is_compiled`) therefore begins in the *plain tier*:
   exceeds `PLAIN_FEVS`, the loop is compiled, as the run would have compiled it at its start, and the run goes on compiled from where it is (the loop keeps
   everything a step needs in its arrays, as between any two calls);
 * a run that ends first never compiles the loop; the next run's loop is then still cold, and it
-  begins in the plain tier too.
+  begins in the plain tier too;
+* a run that fails in the plain tier (a function raised, a state not finite) runs again compiled
+  from its start (`PlainTierFailed`): Python raises where the compiled loop goes on with inf or
+  NaN (a division by zero), so a failure is met and reported as compiled, whatever the caches
+  held. numpy's warnings are off in a plain call (`quiet_as_compiled`), as compiled.
 
 A long run is seen as long after its first plain call, a few milliseconds (DOP853's first steps
 are its shortest, so the projection errs long, and a run near the line compiles). The problem's
@@ -38,12 +42,14 @@ first call alone would be too long as Python.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
+import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "quiet_as_compiled", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -54,6 +60,20 @@ PLAIN_STEPS = 8
 #: the most particles a run may have to begin in the plain tier (a first call of PLAIN_STEPS DOP853 steps each: some
 #: 3,300 right-hand sides, 0.1 s)
 PLAIN_PARTICLES = 32
+
+
+class PlainTierFailed(Exception):
+    """A run in the plain tier failed (a function raised, a state not finite): it runs again compiled from its start,
+    so that the failure is met and reported as the compiled loop meets it (Python raises on a division by zero or a
+    square root of a negative number where the compiled loop goes on with inf or NaN)."""
+
+
+@contextlib.contextmanager
+def quiet_as_compiled():
+    """numpy's RuntimeWarnings off for a plain call, as the compiled loop gives none (an overflow is an inf)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
 
 
 def loop_is_compiled(variant) -> bool:
