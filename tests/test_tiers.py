@@ -272,3 +272,29 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["compiled"]
     assert again["r"] == short["r"]
+
+
+def _blows_up(t, r, v):
+    return -r[0], -r[1], 1.0 / (r[2] - r[2]) if t > 0.5 else 0.0  # Python raises; compiled, an inf
+
+
+def test_a_run_that_fails_in_the_plain_tier_fails_as_compiled(monkeypatch):
+    """Python raises ZeroDivisionError where the compiled loop goes on with inf: the plain tier hands the failing run
+    to the compiled loop from its start, so the error and its samples are the compiled run's."""
+    from rotframe.errors import RotframeError
+
+    kw = dict(omega=[0.0, 0.0, 0.5], r0=R0[:1], v0=V0[:1], duration=2.0, forces=[_blows_up], samples=20)
+    errors = {}
+    for mode in ("compiled", "plain"):
+        with monkeypatch.context() as m:
+            if mode == "compiled":
+                m.setattr(tiers, "PLAIN_PARTICLES", 0)
+            else:
+                m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+            with pytest.raises(RotframeError) as info:
+                simulate_particles(**kw)
+            errors[mode] = info.value
+    assert type(errors["plain"]) is type(errors["compiled"])
+    assert str(errors["plain"]) == str(errors["compiled"])
+    assert "ZeroDivisionError" not in str(errors["plain"])
+    np.testing.assert_array_equal(errors["plain"].partial.r, errors["compiled"].partial.r)
