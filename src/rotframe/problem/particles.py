@@ -33,7 +33,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
-from rotframe.problem.tiers import PlainTierFailed, Tier, quiet_as_compiled
+from rotframe.problem.tiers import PlainTierFailed, Tier
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
            "raised_later", "trajectory_of"]
@@ -112,7 +112,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress)
     method, duration, times, rtol, hfix, D, N = s.method, s.duration, s.times, s.rtol, s.hfix, s.D, r.shape[0]
-    frame, origin, forces, events, params, labels = s.frame, s.origin, s.forces, s.events, s.params, s.labels
+    frame, origin, forces, events = s.frame, s.origin, s.forces, s.events
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
     frame_terms, cache_notes, EDIR, ETERM, stops = s.frame_terms, s.cache_notes, s.EDIR, s.ETERM, s.stops
     y, atol_arr = start_states(s, r, v, checked_atol(atol), attitude, omega)
@@ -137,10 +137,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                 (prob[0], method, bool(events), D), prob, N)
 
     def advance(*args):  # the plain tier's loop, the engine's, or the inlined one once the run has switched to it
-        if tier.plain:
-            tier.driver.advance(*args)
-        else:
-            driver.advance(*args, kernel=inlining.kernel)
+        tier.driver.advance(*args, kernel=None if tier.plain else inlining.kernel)
 
     try:
         inlining.start()
@@ -153,6 +150,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
             saved = {key: state[key].copy() for key in _REPLAYED}
             saved["Y"] = y.copy()
             budget = tier.budget(pacer.start())
+            t_call = time.perf_counter()
             try:
                 if gpu is not None:
                     gpu(0, N, *before, budget, *after)
@@ -161,21 +159,18 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                         _again_on_the_cpu(gpu.ended, advance, y, state, saved, before + (budget,) + after)
                         if np.all(state["ST"][gpu.ended] == 0):  # it did not raise there: the GPU goes on from it
                             gpu.resume()
-                elif tier.plain:
-                    with quiet_as_compiled():
-                        advance_blocks(advance, N, before + (budget,) + after)
                 else:
-                    advance_blocks(advance, N, before + (budget,) + after)
+                    with tier.quiet():
+                        advance_blocks(advance, N, before + (budget,) + after)
             except Exception as exc:
-                if tier.plain:
+                if tier.plain:  # met again compiled, from the start (`simulate_particles`)
                     raise PlainTierFailed from None
                 if gpu is not None:
                     gpu.fetch()
-                raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, forces,
-                             params, method, hfix, times, OUT, state, events, labels,
-                             function_roles(frame, origin, [], [], []))
-            if first:
-                compile_s = time.perf_counter() - t0  # the glue's compile and the first call (the engine's load)
+                raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, s, OUT,
+                             state)
+            if first:  # the glue's compile and the first call (the engine's load); begun plain, the glue's alone
+                compile_s = (t_call if tier.began_plain else time.perf_counter()) - t0
                 first = False
             if not tier.plain:  # the plain tier's calls are counted in steps, and say nothing of the compiled pace
                 pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
@@ -184,9 +179,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
-            if tier.plain and np.any(ST >= 3):
-                raise PlainTierFailed
-            # in the plain tier: where the run goes on, compiled from here once it is seen to be long
+            # in the plain tier: a failure met again compiled; where the run goes on, compiled from here once long
             tier.after_call(state["NFEV"], state["NSTEP"], state["TC"], ST, duration)
             if np.any(ST >= 3):
                 break
@@ -306,16 +299,16 @@ def _again_on_the_cpu(particles, advance, y, state, saved, args):
         advance(int(i), int(i) + 1, *args)
 
 
-def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, times, OUT, state, events, labels,
-                 frame_roles=()):
+def raised_later(exc, advance, y, saved, args, s, OUT, state):
     """A user function raised inside a call: find the step, name the function, give time and state.
 
     The call is replayed from the state saved before it, one step per call, particle by particle
     (the drivers are deterministic), up to the step where the exception comes again; the force, the
-    event function or the frame's function (``frame_roles``, `rotframe.problem.particle_setup.function_roles`)
-    that raises there in plain Python is named. Raises `UserFunctionError` (``.t_reached`` and
-    ``.partial`` keep the samples up to that step).
+    event function or the frame's function of the run set up as ``s``
+    (`rotframe.problem.particle_setup.SetUp`) that raises there in plain Python is named. Raises
+    `UserFunctionError` (``.t_reached`` and ``.partial`` keep the samples up to that step).
     """
+    times, events, method, hfix = s.times, s.events, s.method, s.hfix
     _restore(y, state, saved)
     what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
     where = ""
@@ -326,9 +319,10 @@ def raised_later(exc, advance, y, saved, args, forces, params, method, hfix, tim
                 advance(int(i), int(i) + 1, *args["before"], 1, *args["after"])
             except Exception:  # the user's function raised again: this step
                 dt = hfix if method != "dop853" else float(state["H"][i])
-                # a force or an event function (a plain run's, where either raises as Python)
-                blame = _blame(list(forces) + list(events), params, t, yi, dt,
-                               list(labels) + [f"events[{k}]" for k in range(len(events))], frame_roles)[0]
+                # a force, an event function or the frame's (a plain run's, where each raises as Python)
+                blame = _blame(list(s.forces) + list(events), s.params, t, yi, dt,
+                               list(s.labels) + [f"events[{k}]" for k in range(len(events))],
+                               function_roles(s.frame, s.origin, [], [], []))[0]
                 where = (f"particle {i}: a user function raised {what} in the step from t = {t:.9g} s, "
                          f"r = {yi[:3].tolist()}, v = {yi[3:6].tolist()}" + blame)
                 state["TC"][i] = t

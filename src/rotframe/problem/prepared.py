@@ -32,7 +32,7 @@ from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
 from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, fill_states,
-                                             function_roles, run_state, set_up, tolerance_rows)
+                                             run_state, set_up, tolerance_rows)
 from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
@@ -145,9 +145,8 @@ frame_attitude, frame_terms
             y0, saved, _, _, _ = _fresh_arrays(s, r.shape[0], self._atol)  # replays a call (`raised_later`)
             self._start(r, v, y0, saved)
             saved["Y"] = y0
-            raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": _WHOLE_RUN}, s.forces,
-                         s.params, s.method, s.hfix, s.times, OUT, state, s.events, s.labels,
-                         function_roles(s.frame, s.origin, [], [], []))
+            raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": _WHOLE_RUN}, s, OUT,
+                         state)
         raise_if_failed(s, state, y, OUT)
         traj = trajectory_of(s.times, OUT, state, s.events, s.method, s.times.size, s.hfix)
         if s.D == 10:

@@ -19,7 +19,7 @@ numba's cache (`loop_is_compiled`) therefore begins in the *plain tier*:
 * a run that fails in the plain tier (a function raised, a state not finite) runs again compiled
   from its start (`PlainTierFailed`): Python raises where the compiled loop goes on with inf or
   NaN (a division by zero), so a failure is met and reported as compiled, whatever the caches
-  held. numpy's warnings are off in a plain call (`quiet_as_compiled`), as compiled.
+  held. numpy's warnings are off in a plain call (`Tier.quiet`), as compiled.
 
 A long run is seen as long after its first plain call, a few milliseconds (DOP853's first steps
 are its shortest, so the projection errs long, and a run near the line compiles). The problem's
@@ -49,7 +49,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "quiet_as_compiled", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -66,14 +66,6 @@ class PlainTierFailed(Exception):
     """A run in the plain tier failed (a function raised, a state not finite): it runs again compiled from its start,
     so that the failure is met and reported as the compiled loop meets it (Python raises on a division by zero or a
     square root of a negative number where the compiled loop goes on with inf or NaN)."""
-
-
-@contextlib.contextmanager
-def quiet_as_compiled():
-    """numpy's RuntimeWarnings off for a plain call, as the compiled loop gives none (an overflow is an inf)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        yield
 
 
 def loop_is_compiled(variant) -> bool:
@@ -124,6 +116,8 @@ class Tier:
         #: whether the calls run as plain Python now
         self.plain = (plain is not None and particles <= PLAIN_PARTICLES
                       and not loop_is_compiled(variant))
+        #: whether the run began in the plain tier (its first call then integrates: no compile to count)
+        self.began_plain = self.plain
         self._compiled = (driver, fns)
         #: the seconds the compile took where the run switched to it after its first call: compile time, not
         #: integration
@@ -139,14 +133,28 @@ class Tier:
         compiled, `PLAIN_STEPS` in the plain tier."""
         return PLAIN_STEPS if self.plain else paced
 
+    @contextlib.contextmanager
+    def quiet(self):
+        """The context of a call: numpy's RuntimeWarnings off in the plain tier, as the compiled loop gives none (an
+        overflow is an inf); nothing where compiled."""
+        if not self.plain:
+            yield
+            return
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            yield
+
     def after_call(self, NFEV, NSTEP, TC, ST, span) -> bool:
         """After a call in the plain tier, with the run's right-hand sides ``NFEV``, steps ``NSTEP``, times ``TC`` and
-        statuses ``ST`` so far (per particle) and its ``span`` (s): where the run goes on and its right-hand sides,
-        projected or counted, exceed `PLAIN_FEVS`, compile the loop and switch to it. Returns whether it switched."""
+        statuses ``ST`` so far (per particle) and its ``span`` (s): `PlainTierFailed` where a particle failed; where
+        the run goes on and its projected right-hand sides exceed `PLAIN_FEVS`, compile the loop and switch to it.
+        Returns whether it switched."""
         if not self.plain:
             return False
+        if np.any(ST >= 3):
+            raise PlainTierFailed
         self._plain_steps = int(np.sum(NSTEP))
-        if np.any(ST >= 3) or not np.any(ST == 0) or projected_fevs(NFEV, TC, ST, span) <= PLAIN_FEVS:
+        if not np.any(ST == 0) or projected_fevs(NFEV, TC, ST, span) <= PLAIN_FEVS:
             return False
         from rotframe.problem import engine
 
