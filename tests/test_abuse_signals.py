@@ -64,8 +64,11 @@ def readable(path):
 PHASES = [
     # (module, attribute, nth call, scenario and options, partial recording expected)
     ("rotframe.scenes", "get", 1, ["run", "tower-drop"], False),                        # loading the scene
-    ("rotframe.particles.drivers", "run_fixed", 1, ["run", "turntable", "--method", "splitting"], True),  # compiling
-    ("rotframe.particles.drivers", "run_fixed", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
+    ("rotframe.particles.drivers", "run_fixed_events", 1, ["run", "tower-drop", "--method", "splitting"], True),  # compiling
+    ("rotframe.particles.drivers", "run_fixed_events", 3, ["run", "tower-drop", "--method", "splitting", "--set", "step=1e-7"], True),
+    # the scenes on the engine: its loop's calls (the first may compile it), and one in the middle of a long run
+    ("rotframe.problem.particles", "advance_blocks", 1, ["run", "turntable", "--method", "splitting"], True),
+    ("rotframe.problem.particles", "advance_blocks", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
     ("scipy.linalg", "expm", 20, ["run", "inertial-oscillation", "--set", "samples=100000"], True),  # exact
     ("rotframe.rigid.dynamics", "free_body_closed_form", 3, ["run", "free-top", "--set", "samples=20000"], True),   # rigid exact
     ("rotframe.app.runner", "summarize", 1, ["run", "tower-drop"], True),                     # analysis

@@ -119,8 +119,8 @@ def test_sigterm_leaves_a_readable_partial_recording(tmp_path):
                     cwd=tmp_path).returncode == 0
     from signs import start, wait_for
 
-    # the sign: the second compiled call (the first after loading the kernel), so the run is integrating
-    proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.call", 2, "run", "turntable",
+    # the sign: the engine's second call of its loop (the first may run in the plain tier), so the run is integrating
+    proc, sign = start(tmp_path, "rotframe.problem.particles", "advance_blocks", 2, "run", "turntable",
                        "--set", "duration=400", "--set", "step=1e-6", "--method", "splitting")
     wait_for(sign, proc)
     proc.send_signal(signal.SIGTERM)

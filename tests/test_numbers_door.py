@@ -50,6 +50,30 @@ def test_the_python_api_refuses_a_tiny_step_with_a_rotframe_error(key, value):
         rotframe.run("turntable", method=method, **{key: value})
 
 
+@pytest.mark.parametrize("body", [False, True])
+def test_your_own_problem_refuses_a_step_count_beyond_any_integer_by_the_limit(body):
+    """A fixed step so far below the run's length that the count overflows an integer is over the work limit (one
+    line naming the steps), never an OverflowError: the count is a float until it is checked."""
+    from rotframe.limits import LimitError
+
+    kw = dict(duration=1e300, method="rk4", step=1e-300)
+    with pytest.raises(LimitError, match="integration steps"):
+        if body:
+            rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[1.0, 0.0, 0.0], q0=[0.0, 0.0, 0.0, 1.0], **kw)
+        else:
+            rotframe.simulate(omega=[0.0, 0.0, 1.0], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], **kw)
+
+
+@pytest.mark.parametrize("method", ["dop853", "exact"])
+def test_too_many_samples_of_a_method_without_a_fixed_step_name_the_samples(method):
+    """A sample is no step: an adaptive or exact run over the sample limit is refused for its samples."""
+    from rotframe.limits import LimitError
+
+    with pytest.raises(LimitError, match="output samples"):
+        rotframe.simulate(omega=[0.0, 0.0, 1.0], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=1.0,
+                          method=method, samples=10**12)
+
+
 def test_a_scenario_file_in_a_file_refuses_a_subnormal_step(tmp_path, capsys):
     path = tmp_path / "tiny.toml"
     path.write_text('scene = "turntable"\n[run]\nmethod = "rk4"\nstep = 1e-310\n', encoding="utf-8")

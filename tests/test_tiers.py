@@ -190,6 +190,30 @@ def test_a_body_in_the_plain_tier_and_switched_gives_the_compiled_numbers(name, 
         assert run.diagnostics == compiled.diagnostics
 
 
+@pytest.fixture(autouse=True)
+def _fresh_ledger(monkeypatch):
+    """Each test begins with no plain-tier work spent in the process (`tiers.plain_fevs_spent`)."""
+    monkeypatch.setattr(tiers, "_SPENT", {})
+
+
+def test_short_runs_of_one_loop_compile_it_once_they_have_spent_the_budget(monkeypatch):
+    """A run that ends plain leaves its loop cold, but its right-hand sides count: the runs after it begin plain
+    until the loop's runs together would pass PLAIN_FEVS, and that run compiles the loop; the numbers are the
+    same in every run."""
+    case = dict(CASES["rk4, user force with params, events"], r0=R0[0], v0=V0[0])
+    compiled = _run(case, "compiled", monkeypatch)
+    fevs = compiled.trajectory.nfev
+    with monkeypatch.context() as m:
+        m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+        m.setattr(tiers, "PLAIN_FEVS", int(3.5 * fevs))  # three runs fit, the fourth would pass it
+        runs = [simulate_particles(**case) for _ in range(4)]
+    for run in runs[:3]:
+        assert any("short enough for its plain-Python remake" in n for n in run.notes), run.notes
+    assert any("then the loop compiled" in n for n in runs[3].notes), runs[3].notes
+    for run in runs:
+        _same(run, compiled)
+
+
 def test_a_planted_difference_is_seen(monkeypatch):
     """The comparison above sees a remake that differs from the loop: Hairer's safety factor planted 1 % smaller in
     the plain tier alone changes its steps and numbers."""

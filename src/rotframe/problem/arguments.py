@@ -103,15 +103,18 @@ def run_grid(duration, samples, rtol, step, *, fixed, what, particles=1):
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ScenarioError(f"samples={samples!r}: a whole number >= 1")
     samples = int(samples)
-    steps, hfix = samples, 0.0
+    # an adaptive run's steps are checked at its pace as it goes (`rotframe.limits.check_pace`); the exact flow takes
+    # none: only a fixed step's count is known before the run (a sample is no step, and its own limit names it)
+    steps, hfix = 0.0, 0.0
     if fixed:
         step = duration / samples / 20 if step is None else number(step, "step", "s")
         if not (math.isfinite(step) and step > 0) or step < 1e-300:
             raise ScenarioError(f"step={step!r}: must be finite and > 0 (s)")
-        per = max(1, math.ceil((duration / samples) / step - 1e-9))
-        hfix = (duration / samples) / per
-        steps = per * samples
+        per = (duration / samples) / step  # in floats: a step far below the sample interval gives a count no
+        steps = float(samples) * math.ceil(per - 1e-9) if per < 1e300 else math.inf  # integer holds
     limits.check_run(steps=steps, samples=samples + 1, particles=particles, what=what)
+    if fixed:
+        hfix = (duration / samples) / max(1, math.ceil(per - 1e-9))
     return duration, samples, np.linspace(0.0, duration, samples + 1), rtol, hfix
 
 

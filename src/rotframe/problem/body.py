@@ -180,6 +180,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
     OUT = np.full((n, 1, 7), np.nan)
+    OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
     Iinv = np.ascontiguousarray(np.linalg.inv(I))
     sL = max(float(np.max(np.abs(L))), 1e-300)
     atol = np.array([[rtol * sL] * 3 + [rtol] * 4])  # one row per body (the stepping's per-particle atol)

@@ -10,6 +10,7 @@ sets up once and runs many times.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +32,14 @@ __all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitud
 
 def checked_states(r0, v0):
     """The start states ``r0``, ``v0`` as (N, 3) arrays: one of them may be a single state for all N; finite."""
+    if (type(r0) is np.ndarray and type(v0) is np.ndarray and r0.dtype == np.float64 and v0.dtype == np.float64
+            and r0.shape == v0.shape and 1 <= r0.ndim <= 2 and r0.shape[-1] == 3 and r0.flags.c_contiguous
+            and v0.flags.c_contiguous):  # what a prepared run's caller passes: its checks alone, in a microsecond
+        r, v = r0.reshape(-1, 3), v0.reshape(-1, 3)
+        if not (all(map(math.isfinite, r0.tolist() + v0.tolist())) if r0.ndim == 1 else
+                np.isfinite(r).all() and np.isfinite(v).all()):
+            raise ScenarioError("r0, v0: not finite")
+        return r, v
     r = np.atleast_2d(array_of(r0, "r0"))
     v = np.atleast_2d(array_of(v0, "v0"))
     if (r.ndim == 2 and v.ndim == 2 and r.shape[1] == 3 and v.shape[1] == 3 and r.shape[0] != v.shape[0]

@@ -36,7 +36,7 @@ from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
 from rotframe.problem.tiers import PlainTierFailed, Tier
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
-           "raised_later", "trajectory_of"]
+           "raised_later", "trajectory_of", "exact_model"]
 
 #: what a particle's status code (`rotframe.problem.engine`) says when it ends a run early
 STATUS = {3: "the state became non-finite", 4: "the step size collapsed below round-off of t",
@@ -118,6 +118,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     y, atol_arr = start_states(s, r, v, checked_atol(atol), attitude, omega)
     y0_first = y[:1].copy()
     OUT = np.full((n, N, D), np.nan)
+    OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
     state = run_state(N, D, slots, len(events))
     pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     first = True
@@ -381,13 +382,20 @@ def _event_names(events):
     return names
 
 
+def exact_model(terms, frame, origin, events, frame_terms):
+    """The linear problem (`rotframe.problem.exact.LinearProblem`) the exact flow runs, its terms named by their
+    place in ``forces``; a ScenarioError naming what has no exact flow."""
+    from rotframe.problem.exact import linear_problem
+
+    return linear_problem(terms, [f"forces[{k}]" for k in range(len(terms))], frame, origin, events, frame_terms)
+
+
 def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress) -> ProblemRun:
     """``method="exact"``: the exact flow of the run's linear problem (`rotframe.problem.exact`), the scenes' own
     (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
     from rotframe.particles.integrators import integrate_exact
-    from rotframe.problem.exact import linear_problem
 
-    model = linear_problem(terms, [f"forces[{k}]" for k in range(len(terms))], frame, origin, events, frame_terms)
+    model = exact_model(terms, frame, origin, events, frame_terms)
     traj = integrate_exact(model, r, v, duration, samples, (), progress, ordered=True)  # per particle, as the engine
     traj.extras["compile_s"] = 0.0
     forces = [f for f in terms if isinstance(f, Force)]

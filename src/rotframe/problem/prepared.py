@@ -26,14 +26,15 @@ import threading
 
 import numpy as np
 
-from rotframe.errors import ScenarioError
+from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.limits import check_run
+from rotframe.particles.trajectory import Trajectory
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
 from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, fill_states,
                                              run_state, set_up, tolerance_rows)
-from rotframe.problem.particles import advance_blocks, raise_if_failed, raised_later, trajectory_of
+from rotframe.problem.particles import advance_blocks, exact_model, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
 __all__ = ["PreparedProblem"]
@@ -81,9 +82,6 @@ frame_attitude, frame_terms
                    origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                    samples=samples, omega_dot=omega_dot, jit=True, max_events=256, device=None,
                    frame_terms=frame_terms, inline=inline)
-        if s.method == "exact":
-            raise ScenarioError("method='exact': the exact flow compiles nothing and has no set-up to keep; call "
-                                "rotframe.simulate")
         self.setup = s
         self._omega = omega
         #: the frame's attitude, checked once (refused even where no force reads it, as simulate refuses it)
@@ -91,13 +89,18 @@ frame_attitude, frame_terms
         self._atol = checked_atol(atol)  # checked once: each run takes it as it is
         #: the string (`forces[k]`, the constraint) the start states are checked against at each run, or None
         self._string = next(((k, f) for k, f in enumerate(s.terms) if isinstance(f, StringConstraint)), None)
+        #: the sample times (s), (samples + 1,)
+        self.times = s.times
+        self.notes = []
+        #: the exact flow's matrices for the sample grid (`_ExactFlow`), where the method is ``exact``
+        self._exact = _ExactFlow(s) if s.method == "exact" else None
+        if self._exact is not None:
+            return
         inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
         inlining.start()
         self._kernel = inlining.kernel
         self._kept = None  # a run's arrays, kept for the next (`_KeptArrays`)
         self.notes = [inlining.note] if inlining.note else []
-        #: the sample times (s), (samples + 1,)
-        self.times = s.times
 
     def run(self, r0, v0):
         """Integrate from the start states ``r0``, ``v0`` ((3,) or (N, 3)): a `rotframe.particles.trajectory.Trajectory`.
@@ -109,6 +112,8 @@ frame_attitude, frame_terms
         particle fails (`rotframe.problem.particles.raise_if_failed`).
         """
         s = self.setup
+        if self._exact is not None:
+            return self._exact.run(r0, v0, s.times)
         r, v = checked_states(r0, v0)
         N = r.shape[0]
         if N > s.r.shape[0]:  # more particles than the set-up's: the limits checked for them
@@ -132,6 +137,7 @@ frame_attitude, frame_terms
         per-particle ``state``, the tolerances, the samples and the loop's work arrays (None: made per block)."""
         s = self.setup
         self._start(r, v, y, state)
+        OUT[0] = y  # the start, as the loop writes it: a particle the run never reached keeps it (as simulate)
         before = (s.times, y, state["TC"], state["H"], state["IDX"], state["SUB"], state["ST"], OUT, state["EVT"],
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
         after = (s.method, s.rtol, atol, s.hfix, s.EDIR, s.ETERM, s.stops, s.prob, s.fns)
@@ -163,6 +169,46 @@ frame_attitude, frame_terms
 
     def _advance(self, lo, hi, *args, work=None):
         self.setup.driver.advance(lo, hi, *args, kernel=self._kernel, work=work)
+
+
+class _ExactFlow:
+    """``method="exact"`` prepared: the exact flow's matrices for the run's sample grid, made once (the scenes'
+    `rotframe.particles.linear.ExactFlow` of the problem's `rotframe.problem.particles.exact_model`); each run
+    multiplies them into its start states in one compiled loop (`rotframe.particles.exact_kernel.apply_flow`), a few
+    microseconds. ``simulate``'s numbers to round-off, not to the bit: the products are grouped otherwise."""
+
+    def __init__(self, s):
+        from rotframe.particles.exact_kernel import apply_flow
+        from rotframe.particles.linear import ExactFlow
+
+        model = exact_model(s.terms, s.frame, s.origin, s.events, s.frame_terms)
+        with np.errstate(all="ignore"):  # an overflow (an unstable problem run far) is caught per run
+            phi = ExactFlow(model, s.times).matrices()  # (samples + 1, 7, 7)
+        self._phi_t = np.ascontiguousarray(np.transpose(phi[:, 0:6, :], (0, 2, 1)))  # (samples + 1, 7, 6)
+        self._apply = apply_flow
+        apply_flow(self._phi_t[:1], np.zeros((1, 3)), np.zeros((1, 3)))  # load or compile the kernel now
+        self._times = s.times.copy()
+        self._times.flags.writeable = False  # shared by every run's Trajectory, as its sample times
+
+    def run(self, r0, v0, times):
+        """The `Trajectory` from the start states ``r0``, ``v0`` (as ``simulate`` takes them); IntegrationError at a
+        non-finite state."""
+        if (type(r0) is np.ndarray and type(v0) is np.ndarray and r0.dtype == np.float64 and v0.dtype == np.float64
+                and r0.shape == v0.shape and 1 <= r0.ndim <= 2 and r0.shape[-1] == 3 and r0.flags.c_contiguous
+                and v0.flags.c_contiguous):  # the states as a run takes them: their finiteness is the flow's sample 0
+            r, v = (r0[None], v0[None]) if r0.ndim == 1 else (r0, v0)
+        else:
+            r, v = checked_states(r0, v0)
+        rs, vs, k_bad = self._apply(self._phi_t, r, v)
+        if k_bad == 0:  # sample 0 is the start itself (the flow's identity): the start is not finite
+            checked_states(r0, v0)
+        if k_bad >= 0:
+            good = max(int(k_bad), 1)
+            partial = Trajectory(times[:good].copy(), rs[:good], vs[:good], "exact", 0, 0, False,
+                                 float(times[good - 1]))
+            raise IntegrationError(f"simulate: the exact flow gave a non-finite state at t = {times[k_bad]:.9g} s; "
+                                   "samples up to there are kept", t_reached=float(times[good - 1]), partial=partial)
+        return Trajectory(self._times, rs, vs, "exact", 0, 0, True, float(times[-1]))
 
 
 def _fresh_arrays(s, N, atol):

@@ -15,7 +15,10 @@ numba's cache (`loop_is_compiled`) therefore begins in the *plain tier*:
   exceeds `PLAIN_FEVS`, the loop is compiled, as the run would have compiled it at its start, and the run goes on compiled from where it is (the loop keeps
   everything a step needs in its arrays, as between any two calls);
 * a run that ends first never compiles the loop; the next run's loop is then still cold, and it
-  begins in the plain tier too;
+  begins in the plain tier too. The right-hand sides of the runs of a loop that ended plain count
+  against the same `PLAIN_FEVS` in the process (`plain_fevs_spent`): many short runs of one problem
+  (a sweep, a loop over start states, the bench's repeats) compile the loop once they have spent
+  that much Python, as one long run does, instead of staying plain for ever;
 * a run that fails in the plain tier (a function raised, a state not finite) runs again compiled
   from its start (`PlainTierFailed`): Python raises where the compiled loop goes on with inf or
   NaN (a division by zero), so a failure is met and reported as compiled, whatever the caches
@@ -49,7 +52,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "loop_is_compiled", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -60,6 +63,16 @@ PLAIN_STEPS = 8
 #: the most particles a run may have to begin in the plain tier (a first call of PLAIN_STEPS DOP853 steps each: some
 #: 3,300 right-hand sides, 0.1 s)
 PLAIN_PARTICLES = 32
+
+
+#: the right-hand sides the plain tier has spent in this process on the runs of each loop variant that ended plain
+_SPENT = {}
+
+
+def plain_fevs_spent(variant) -> float:
+    """The right-hand sides the runs of ``variant``'s loop (`rotframe.problem.engine.variant`'s arguments) that
+    ended in the plain tier have spent in this process: they count against `PLAIN_FEVS` with a run's own."""
+    return _SPENT.get(tuple(variant), 0.0)
 
 
 class PlainTierFailed(Exception):
@@ -147,14 +160,19 @@ class Tier:
     def after_call(self, NFEV, NSTEP, TC, ST, span) -> bool:
         """After a call in the plain tier, with the run's right-hand sides ``NFEV``, steps ``NSTEP``, times ``TC`` and
         statuses ``ST`` so far (per particle) and its ``span`` (s): `PlainTierFailed` where a particle failed; where
-        the run goes on and its projected right-hand sides exceed `PLAIN_FEVS`, compile the loop and switch to it.
-        Returns whether it switched."""
+        the run goes on and its projected right-hand sides, with those the loop's earlier runs spent plain in this
+        process (`plain_fevs_spent`), exceed `PLAIN_FEVS`, compile the loop and switch to it. Returns whether it
+        switched."""
         if not self.plain:
             return False
         if np.any(ST >= 3):
             raise PlainTierFailed
         self._plain_steps = int(np.sum(NSTEP))
-        if not np.any(ST == 0) or projected_fevs(NFEV, TC, ST, span) <= PLAIN_FEVS:
+        if not np.any(ST == 0):  # the run ended plain: its right-hand sides count against the next runs'
+            key = tuple(self.variant)
+            _SPENT[key] = _SPENT.get(key, 0.0) + float(np.sum(NFEV))
+            return False
+        if plain_fevs_spent(self.variant) + projected_fevs(NFEV, TC, ST, span) <= PLAIN_FEVS:
             return False
         from rotframe.problem import engine
 

@@ -8,6 +8,12 @@ turntable spins up) Euler forces. Oracle (docs/physics/rotating-frames.md,
 `rotframe.analytic.turntable_inertial_line`): the inertial
 line mapped into the rotating frame, r_rot(t) = R_z(-theta(t)) (r0 + v_in t),
 theta(t) = integral of w.
+
+Built on the engine of your own problems (`rotframe.problem.particles.simulate_particles`), as
+``inertial-oscillation``, ``cr3bp`` and ``tumbling-ball`` are: the scene chooses its frame (a
+constant spin, or the rate's two knots joined linearly, which is the spin-up exactly), its terms
+(the frame's, by name: ``frame_terms``) and its theory; the engine runs the method (the exact
+flow of a force-free particle by default: the inertial line turned by the rate's exact integral).
 """
 
 from __future__ import annotations
@@ -17,11 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe import analytic
+from rotframe import analytic, method_registry
+from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.numerics.vectors import norm3
-from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, method_rel_error, particle_methods, reject_subnormal, rel_drift,
-                                  run_particles, run_setting, with_parameters)
+from rotframe.particles.model import OmegaSchedule
+from rotframe.scenes.base import (SceneResult, guarded, method_rel_error, particle_methods, reject_subnormal,
+                                  rel_drift, run_setting, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -46,40 +53,68 @@ METHODS = particle_methods()
 DEFAULT_METHOD = "exact (the puck is force-free: a straight line in inertial space)"
 
 Z = np.array([0.0, 0.0, 1.0])
+#: the turntable's terms: the frame's alone (nothing else acts on a frictionless puck)
+FRAME_TERMS = ("coriolis", "centrifugal", "euler")
 
 
 def _setup(p, terms):
+    """``(omega, frame, frame_terms, r0, v0, T)``: the spin as a schedule (the oracle's exact angle) and as the
+    engine's frame (a constant vector, or the rate's two knots joined linearly), the frame's terms that act."""
+    others = [t for t in terms if t not in FRAME_TERMS]
+    if others:
+        raise ScenarioError(f"model: {others[0]!r} is not a term of this scene; the puck feels the frame's terms "
+                            f"alone ({', '.join(FRAME_TERMS)})")
     w0, alpha, T = p.omega0, p.alpha, p.duration
     omega = OmegaSchedule.ramp(Z, w0, alpha, T)
-    terms = [t for t in terms if not (t == "euler" and alpha == 0.0)]
-    model = ParticleModel(tuple(terms), omega=omega)
+    frame_terms = tuple(t for t in terms if not (t == "euler" and alpha == 0.0))
+    # a steady spin is a constant omega; a spin-up is w(t) = w0 + alpha t, exactly the line through its two knots
+    frame = w0 * Z if alpha == 0.0 else (np.array([0.0, T]), np.array([w0 * Z, (w0 + alpha * T) * Z]), "linear")
     r0 = np.array([p.start_radius, 0.0, 0.0])
     v0 = np.array([-p.speed, 0.0, 0.0])
-    return model, omega, r0, v0, T
+    return omega, frame, frame_terms, r0, v0, T
 
 
 #: A run whose distance from the exact line exceeds this fraction of the motion's size has diverged.
 DIVERGED = 0.1
 
 
+def left_out(frame_terms, alpha) -> list:
+    """The frame's terms that act on the puck but the model leaves out (Coriolis, centrifugal, and Euler's while the
+    table spins up). With none the puck moves on the inertial straight line, the scene's oracle; a model that
+    leaves one out is the motion without it, which leaves the line."""
+    acting = {"coriolis", "centrifugal"} | ({"euler"} if alpha != 0.0 else set())
+    return sorted(acting - set(frame_terms))
+
+
+def _default_method(frame_terms, alpha):
+    """The exact flow where it exists: the puck under every term of the frame moves on the inertial straight line
+    (exact for any spin-up), and a steady frame's terms are linear with constant coefficients; with a term of a
+    spinning-up frame left out there is none, and the fourth-order splitting at the scenario's step runs instead."""
+    return "exact" if alpha == 0.0 or not left_out(frame_terms, alpha) else "rotation-splitting4"
+
+
 @with_parameters(TurntableParameters)
 def simulate(p, terms, method, run, progress):
-    from rotframe.errors import IntegrationError
     from rotframe.particles.advice import remedy
-    from rotframe.particles.integrators import METHODS, canonical_method
+    from rotframe.problem.particles import simulate_particles  # the engine's front door: imported by a run
 
     reject_subnormal(p)
-    model, omega, r0, v0, T = _setup(p, terms)
-    # the puck is force-free: its exact flow is the least costly way to the answer (the bench); with a
-    # term left out there is none, and the fourth-order splitting at the scenario's step runs instead
-    method = method or ("exact" if model.has_exact_flow else "rotation-splitting4")
+    omega, frame, frame_terms, r0, v0, T = _setup(p, terms)
+    method = particle_methods().canonical(method) if method else _default_method(frame_terms, p.alpha)
 
-    def finish(traj):
+    def finish(res):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(res, "trajectory", res)
         oracle = inertial_line(omega, r0, v0, traj.times)
-        return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"oracle": oracle, "omega": omega})
+        return SceneResult(traj, list(frame_terms), traj.method, traj.steps, traj.nfev,
+                           extras={"oracle": oracle, "omega": omega,
+                                   "notes": list(getattr(res, "notes", [])),  # the engine's, passed on
+                                   "warnings": list(getattr(res, "warnings", []))})
 
-    result = run_particles(model, r0, v0, T, method, run, progress, finish)
+    result = guarded(finish, simulate_particles, omega=frame, r0=r0, v0=v0, duration=T, method=method,
+                     frame_terms=frame_terms, rtol=run_setting(run, "rtol"), step=run.get("step"),
+                     samples=int(run_setting(run, "samples")), progress=progress)
+    if left_out(frame_terms, p.alpha):  # the line is not this model's motion: leaving it is no failure
+        return result
     # a numerical instability that stays finite is still a failure: stop where the path left the exact line
     traj = result.trajectory
     err = _oracle_error(result)
@@ -91,7 +126,7 @@ def simulate(p, terms, method, run, progress):
         raise IntegrationError(f"the {traj.method} run diverged: {err[bad[0]]:.3g} m from the exact inertial line "
                                f"at t = {traj.times[bad[0]]:.6g} s, more than {DIVERGED:g} of the motion's size "
                                f"{size[bad[0]]:.3g} m; "
-                               + remedy(METHODS[canonical_method(traj.method)].step, step=traj.extras.get("step"),
+                               + remedy(method_registry.get(traj.method).step, step=traj.extras.get("step"),
                                         rtol=run_setting(run, "rtol")),
                                t_reached=float(traj.times[good - 1]), partial=partial)
     return result
@@ -142,16 +177,26 @@ def analyse(p, result):
     notes = []
     if p.alpha != 0 and p.omega0 * (p.omega0 + p.alpha * T) < 0:
         notes.append("the spin reverses during the run: turns counts the net angle (the two senses cancel)")
+    theory = {"position_error_m": 0.0, "turns": (p.omega0 * T + 0.5 * p.alpha * T**2) / (2 * math.pi)}
+    theory_notes = {"position_error_m": "exact: the inertial straight line seen from the turntable",
+                    "turns": "exact: (omega0 T + alpha T^2 / 2) / 2 pi"}
+    tolerance = {"position_error_m": tol, "turns": 1e-12 * max(abs(turns), 1.0)}
+    missing = left_out(result.terms, p.alpha)
+    if missing:  # the model is not the whole motion: the line is no theory of it
+        for table in (theory, theory_notes, tolerance):
+            del table["position_error_m"]
+        notes.append(f"position_error_m: the model leaves out the frame's {', '.join(missing)}, so the puck does "
+                     "not move on the inertial straight line; it measures how far the model's motion leaves it "
+                     "(no theory)")
     return {
         "metrics": {"position_error_m": float(err[-1]), "turns": turns},
-        "theory": {"position_error_m": 0.0,
-                   "turns": (p.omega0 * T + 0.5 * p.alpha * T**2) / (2 * math.pi)},
-        "theory_notes": {"position_error_m": "exact: the inertial straight line seen from the turntable",
-                         "turns": "exact: (omega0 T + alpha T^2 / 2) / 2 pi"},
-        "tolerance": {"position_error_m": tol, "turns": 1e-12 * max(abs(turns), 1.0)},
+        "theory": theory,
+        "theory_notes": theory_notes,
+        "tolerance": tolerance,
         "diagnostics": {"max_position_error_m": float(np.max(err)),
                         "inertial_speed_rel_drift": rel_drift(_inertial_speed(result))},
-        "notes": notes,
+        "notes": notes + result.extras.get("notes", []),
+        "warnings": result.extras.get("warnings", []),
     }
 
 
