@@ -64,8 +64,10 @@ def readable(path):
 PHASES = [
     # (module, attribute, nth call, scenario and options, partial recording expected)
     ("rotframe.scenes", "get", 1, ["run", "tower-drop"], False),                        # loading the scene
-    ("rotframe.particles.drivers", "run_fixed_events", 1, ["run", "tower-drop", "--method", "splitting"], True),  # compiling
-    ("rotframe.particles.drivers", "run_fixed_events", 3, ["run", "tower-drop", "--method", "splitting", "--set", "step=1e-7"], True),
+    ("rotframe.particles.drivers", "run_fixed", 1, ["run", "foucault", "--method", "splitting",
+                                                    "--set", "duration=60"], True),  # compiling
+    ("rotframe.particles.drivers", "run_fixed", 3, ["run", "foucault", "--method", "splitting", "--set", "step=1e-6",
+                                                    "--set", "duration=600"], True),
     # the scenes on the engine: its loop's calls (the first may compile it), and one in the middle of a long run
     ("rotframe.problem.particles", "advance_blocks", 1, ["run", "turntable", "--method", "splitting"], True),
     ("rotframe.problem.particles", "advance_blocks", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
@@ -116,17 +118,24 @@ def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
     assert json.loads(again.stdout)["rows"] == 6
 
 
-def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path):
-    # one sample interval of 5.7e9 steps (tens of seconds: the compiled splitting watching the ground event
-    # did the former 5.7e8 within the 5 s wait): the kernel is called in pieces, so SIGINT is seen within the loop
+@pytest.mark.parametrize("target,attr,nth,argv", [
+    # the scenes' kernels: 1e9 steps, more than CALL_EVALS (1.6e7) in each sample interval, called in pieces
+    ("rotframe.particles.chunked", "KernelSetup.one_sample_in_pieces", 1,
+     ["foucault", "--set", "step=1e-8", "--set", "duration=10"]),
+    # the engine (the tower drop): 5.7e8 steps in one sample interval, its loop called in paced pieces
+    ("rotframe.problem.particles", "advance_blocks", 2, ["tower-drop", "--set", "step=1e-8"]),
+])
+def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path, target, attr, nth, argv):
+    # a single sample interval of many steps (tens of seconds of compiled splitting): the loop is called in pieces,
+    # so SIGINT is seen within it
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
-    warm = subprocess.run([sys.executable, "-m", "rotframe", "run", "tower-drop", "--method", "splitting",
-                           "--set", "step=1e-3", "--no-record"], cwd=tmp_path, env=env, capture_output=True)
+    warm = subprocess.run([sys.executable, "-m", "rotframe", "run", argv[0], "--method", "splitting",
+                           "--set", "step=1e-2", "--no-record"], cwd=tmp_path, env=env, capture_output=True)
     assert warm.returncode == 0
     from signs import start, wait_for
 
-    proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.one_sample_in_pieces", 1, "run",
-                       "tower-drop", "--method", "splitting", "--set", "step=1e-8", "--set", "samples=1", "--no-record")
+    proc, sign = start(tmp_path, target, attr, nth, "run", *argv, "--method", "splitting", "--set", "samples=1",
+                       "--no-record")
     wait_for(sign, proc)  # the long compiled loop has begun
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=60)  # not a timing assertion: a bound so that a hang fails the test

@@ -57,7 +57,7 @@ _LAZY = {
     "IntegrationError": "rotframe.errors",
     "RotframeWarning": "rotframe.errors",
 }
-_SUBMODULES = ("analytic", "app", "earth", "errors", "forces", "frames", "limits", "method_registry", "numerics",
+_SUBMODULES = ("analytic", "app", "earth", "errors", "events", "forces", "frames", "limits", "method_registry", "numerics",
                "particles", "problem", "rigid", "scenes", "validation")
 
 #: Where the modules of the first, flat layout live now: ``rotframe.inertia`` and

@@ -56,12 +56,6 @@ import math
 import numpy as np
 
 from rotframe.errors import ScenarioError
-# the terms' arithmetic, written once (imported by name, so a GPU compile rebinds them to its own versions)
-from rotframe.particles.accelerations import air_density as _air_density
-from rotframe.particles.accelerations import altitude_gravity as _altitude_gravity
-from rotframe.particles.accelerations import central_gravity as _central_gravity
-from rotframe.particles.accelerations import drag_rate as _drag_rate
-from rotframe.particles.accelerations import spring_pull as _spring_pull
 from rotframe.problem.particles import Force, StringConstraint
 from rotframe.validation import check_vector3
 
@@ -75,6 +69,22 @@ _ZERO3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 def _diagonal(a, b, c):
     """The rows of diag(a, b, c), for a term's linear form (`Force.linear`)."""
     return ((a, 0.0, 0.0), (0.0, b, 0.0), (0.0, 0.0, c))
+
+
+def _arithmetic():
+    """Bind the terms' arithmetic, written once (`rotframe.particles.accelerations`), as this module's globals.
+
+    A factory whose function calls it runs this first. They are module globals, read by name, so
+    a GPU compile rebinds them to its own versions, and imported only here because they are
+    compiled functions: numba's import (0.1 s) is not paid by a run of uniform gravity alone,
+    whose exact flow compiles nothing.
+    """
+    global _air_density, _altitude_gravity, _central_gravity, _drag_rate, _spring_pull
+    from rotframe.particles.accelerations import air_density as _air_density
+    from rotframe.particles.accelerations import altitude_gravity as _altitude_gravity
+    from rotframe.particles.accelerations import central_gravity as _central_gravity
+    from rotframe.particles.accelerations import drag_rate as _drag_rate
+    from rotframe.particles.accelerations import spring_pull as _spring_pull
 
 
 def _finite(name, **values):
@@ -117,6 +127,7 @@ def altitude_gravity(g0, radius) -> Force:
 
     ``U = -g0 R^2 / (R + z)``. The scenes' term ``altitude-gravity`` (g0 in m/s^2, R in m).
     """
+    _arithmetic()
     _finite("altitude_gravity", g0=g0, radius=radius)
     g0, R = float(g0), float(radius)
     if not R > 0:
@@ -137,6 +148,7 @@ def central_gravity(gm, centre) -> Force:
     The scenes' term ``central-gravity`` is this one with ``c = (0, 0, -R)``, Earth's centre
     below a local frame on its surface (GM in m^3/s^2, c in m).
     """
+    _arithmetic()
     _finite("central_gravity", gm=gm)
     GM = float(gm)
     cx, cy, cz = _vector("central_gravity", "centre", centre)
@@ -168,6 +180,7 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
     >>> round(ax, 12), round(ay, 12)                    # -k2 |v| v with |v| = 5 m/s
     (-0.15, -0.2)
     """
+    _arithmetic()
     _finite("drag", linear=linear, quadratic=quadratic, scale_height=scale_height)
     k1, k2, H = float(linear), float(quadratic), float(scale_height)
     if k1 < 0 or k2 < 0 or H < 0:
@@ -193,6 +206,7 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
     With ``horizontal=True`` only x and y are pulled back, ``a = -k (x - x_a, y - y_a, 0)``:
     the scenes' term ``spring``, the small-angle pendulum (``k = g / L``).
     """
+    _arithmetic()
     _finite("spring", k=k)
     k = float(k)
     ax_, ay_, az_ = _vector("spring", "anchor", anchor)

@@ -21,7 +21,8 @@ scenes' turntable flow (`rotframe.particles.model.OmegaSchedule.table`).
 
 Anything else is refused by name, in one line: a force of your own or a nonlinear built-in
 term (no linear form), the pendulum's string, a frame whose omega is not constant (but that one),
-an origin whose acceleration is not, events (the exact flow locates only the scenes' own), the GPU. The
+an origin whose acceleration is not, an event of your own (the exact flow locates the built-in crossings of a
+coordinate, `rotframe.events.crossing`, as the scenes' own), the GPU. The
 frame's part is the scenes' model of the frame's terms
 (`rotframe.particles.model.ParticleModel.linear_matrices` and ``is_force_free``), the forces' parts
 added after it in the scenes' order, so a scene's model and the same terms given here have the
@@ -35,7 +36,7 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem.terms import Force, StringConstraint
 
-__all__ = ["LinearProblem", "linear_problem"]
+__all__ = ["LinearProblem", "linear_problem", "event_row"]
 
 
 class LinearProblem:
@@ -68,14 +69,32 @@ class LinearProblem:
         return K.copy(), C.copy(), b.copy()
 
 
+def event_row(g, name):
+    """The scenes' event row (`rotframe.particles.trajectory.Event`, named ``name``) of a built-in crossing
+    (`rotframe.events.crossing`: its ``crossing`` attribute), which the exact flow locates; None for another
+    function."""
+    from rotframe.particles.trajectory import Event
+    from rotframe.problem.callables import plain_function
+
+    g = plain_function(g)
+    what = getattr(g, "crossing", None)
+    if what is None:
+        return None
+    of, component, value = what
+    return Event(name, of, int(component), float(value), int(getattr(g, "direction", 0)),
+                 bool(getattr(g, "terminal", False)))
+
+
 def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearProblem:
     """The linear problem of the run's ``terms`` (`Force` or `StringConstraint`, named by ``labels``), or a one-line
     ScenarioError naming what the exact flow cannot take."""
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     refusal = "method='exact' takes terms linear in (r, v) with constant coefficients in a steady frame"
-    if events:
-        raise ScenarioError(f"events[0]: {refusal}, and locates no events of your own; use dop853")
+    for k, g in enumerate(events):
+        if event_row(g, "") is None:
+            raise ScenarioError(f"events[{k}]: {refusal}, and locates the crossings of a coordinate "
+                                "(rotframe.events.crossing), no event function of your own; use dop853")
     if frame.kind == "table" and frame.interpolation == "linear":
         return _turning_frame(terms, frame, origin, frame_terms)
     if frame.kind != "constant":

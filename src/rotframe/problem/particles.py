@@ -395,8 +395,11 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
     from rotframe.particles.integrators import integrate_exact
 
+    from rotframe.problem.exact import event_row
+
     model = exact_model(terms, frame, origin, events, frame_terms)
-    traj = integrate_exact(model, r, v, duration, samples, (), progress, ordered=True)  # per particle, as the engine
+    rows = [event_row(g, name) for g, name in zip(events, _event_names(events))]  # built-in crossings: the flow's own
+    traj = integrate_exact(model, r, v, duration, samples, rows, progress, ordered=True)  # per particle, as the engine
     traj.extras["compile_s"] = 0.0
     forces = [f for f in terms if isinstance(f, Force)]
     diagnostics = {}

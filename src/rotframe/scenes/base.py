@@ -161,6 +161,67 @@ def run_particles(model, r0, v0, duration, method, run, progress, finish, events
                    progress=progress)
 
 
+def engine_terms(model):
+    """A scene's model (`rotframe.particles.model.ParticleModel`, its terms by name) as the engine takes it:
+    ``(omega, forces, frame_terms)``.
+
+    Each named term becomes the built-in term of `rotframe.forces` that the scene's term is (the same arithmetic,
+    `rotframe.particles.accelerations`), the frame's terms the engine's ``frame_terms``, and a steady rotation its
+    vector. A term the engine does not have yet (``curvature``) or a rotation that varies is a ScenarioError naming it:
+    a scene with one keeps its own kernels.
+    """
+    from rotframe import forces as rf
+    from rotframe.problem.terms import FRAME_TERMS
+
+    if not model.omega.is_constant:
+        raise ScenarioError("model: a rotation rate that varies is not passed to the engine as a scene's model; "
+                            "give the engine its frame")
+    terms = []
+    for t in model.terms:
+        if t == "gravity":
+            terms.append(rf.gravity(model.g))
+        elif t == "altitude-gravity":
+            terms.append(rf.altitude_gravity(model.g0, model.radius))
+        elif t == "central-gravity":
+            terms.append(rf.central_gravity(model.gm, (0.0, 0.0, -model.radius)))
+        elif t == "spring":
+            terms.append(rf.spring(model.spring, horizontal=True))
+        elif t == "pendulum":
+            terms.append(rf.pendulum(model.pendulum_length, model.pivot))
+        elif t in ("linear-drag", "quadratic-drag"):
+            if not any(getattr(f, "flow", None) for f in terms):  # both laws in one term, as the scenes sum them
+                terms.append(rf.drag(linear=model.k_linear if model.has("linear-drag") else 0.0,
+                                     quadratic=model.k_quadratic if model.has("quadratic-drag") else 0.0,
+                                     scale_height=model.scale_height))
+        elif t not in FRAME_TERMS:
+            raise ScenarioError(f"model: the term {t!r} is not on the engine yet")
+    return model.omega.vector(0.0), terms, tuple(t for t in model.terms if t in FRAME_TERMS)
+
+
+def engine_remarks(res) -> dict:
+    """``{"notes", "warnings"}`` of an engine's run (a `ProblemRun`; a partial trajectory has none) that a scene
+    passes on: what the engine says of the run (its method, its tier, its caches), not of the diagnostics the scene
+    does not report (a note that begins with the name of one of the engine's own, ``energy_rel_drift: ...``)."""
+    own = tuple(f"{key}:" for key in getattr(res, "diagnostics", {}))
+    return {"notes": [n for n in getattr(res, "notes", []) if not n.startswith(own)],
+            "warnings": list(getattr(res, "warnings", []))}
+
+
+def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=()):
+    """Integrate a particle scene's model on the engine (`rotframe.problem.particles.simulate_particles`) with the
+    run settings (``step``, ``rtol``, ``samples``), as `run_particles` does on the scenes' kernels.
+
+    ``finish(result)`` builds the scene's result from the engine's run (a `ProblemRun`, or the trajectory up to an
+    early stop: `guarded`); its ``notes`` and ``warnings`` are the engine's.
+    """
+    from rotframe.problem.particles import simulate_particles  # the engine's front door: imported by a run
+
+    omega, forces, frame_terms = engine_terms(model)
+    return guarded(finish, simulate_particles, omega=omega, r0=r0, v0=v0, duration=duration, method=method,
+                   forces=forces, frame_terms=frame_terms, events=list(events), rtol=run_setting(run, "rtol"),
+                   step=run.get("step"), samples=int(run_setting(run, "samples")), progress=progress)
+
+
 def guarded(finish, func, *args, **kwargs):
     """Run ``func`` and build the scene's result with ``finish(trajectory)``, even when the run stops early.
 

@@ -24,9 +24,9 @@ from rotframe import analytic
 from rotframe.numerics.linefit import line_fit
 from rotframe.numerics.vectors import norm3
 from rotframe.errors import ScenarioError
-from rotframe.scenes.base import (guarded, run_setting, SceneResult, earth_model_constants, method_rel_error,
-                                  particle_methods, reject_subnormal, rel_drift, samples_for, unresolved_note,
-                                  with_parameters)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, engine_remarks, guarded, method_rel_error,
+                                  particle_methods, reject_subnormal, rel_drift, run_setting, samples_for,
+                                  unresolved_note, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,8 +81,7 @@ def simulate(p, terms, method, run, progress):
         traj = getattr(res, "trajectory", res)
         return SceneResult(traj, list(frame_terms), traj.method, traj.steps, traj.nfev,
                            extras={"Omega": Omega, "resolved": resolved, "period": period,
-                                   "notes": list(getattr(res, "notes", [])),  # the engine's, passed on
-                                   "warnings": list(getattr(res, "warnings", []))})
+                                   **engine_remarks(res)})  # the engine's notes and warnings, passed on
 
     return guarded(finish, simulate_particles, omega=f_plane, r0=r0, v0=v0, duration=p.duration, method=method,
                    frame_terms=frame_terms, rtol=run_setting(run, "rtol"), step=run.get("step"), samples=samples,

@@ -20,11 +20,12 @@ import numpy as np
 from rotframe import analytic
 # astropy's values, read when the scene is imported (before the run's clock starts): every run needs them
 from rotframe.earth import GM_EARTH, R_EARTH
+from rotframe.events import crossing
 from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
-                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
-                                  scene_parameters, UNDERFLOW, with_parameters)
+from rotframe.scenes.base import (SceneResult, engine_remarks, earth_model_constants, jacobi_energy, landing,
+                                  method_rel_error, particle_methods, reject_subnormal, rel_drift, resolve_terms,
+                                  run_on_engine, scene_parameters, UNDERFLOW, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -72,17 +73,22 @@ def fall_duration(h, drag, g):
     return float(out) if np.ndim(out) == 0 else out
 
 
+#: the ground on the engine: the same crossing as `GROUND` (which the sweeps' ensembles run on the scenes' kernels)
+GROUND_EVENT = crossing(2, 0.0, direction=-1, terminal=True, name="ground")
+
+
 @with_parameters(TowerDropParameters)
 def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     model, r0, v0, duration, g = build(p, terms)
-    method = method or default_method(model)
+    method = particle_methods().canonical(method) if method else default_method(model)
 
-    def finish(traj):
+    def finish(res):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(res, "trajectory", res)
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g})
+                           extras={"model": model, "g": g, **engine_remarks(res)})  # the engine's, passed on
 
-    return run_particles(model, r0, v0, duration, method, run, progress, finish, events=[GROUND])
+    return run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=[GROUND_EVENT])
 
 
 @with_parameters(TowerDropParameters)
@@ -158,7 +164,8 @@ def analyse(p, result):
             tolerance[key] = (acc + method_rel) * abs(theory[key]) + floor.get(
                 key, 1e-13 * abs(theory["east_deflection_m"]))
     return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
-            "diagnostics": diagnostics, "notes": notes}
+            "diagnostics": diagnostics, "notes": notes + result.extras.get("notes", []),
+            "warnings": result.extras.get("warnings", [])}
 
 
 @with_parameters(TowerDropParameters, position=1)

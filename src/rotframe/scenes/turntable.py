@@ -27,8 +27,8 @@ from rotframe import analytic, method_registry
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.numerics.vectors import norm3
 from rotframe.particles.model import OmegaSchedule
-from rotframe.scenes.base import (SceneResult, guarded, method_rel_error, particle_methods, reject_subnormal,
-                                  rel_drift, run_setting, with_parameters)
+from rotframe.scenes.base import (SceneResult, engine_remarks, guarded, method_rel_error, particle_methods,
+                                  reject_subnormal, rel_drift, run_setting, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -107,8 +107,7 @@ def simulate(p, terms, method, run, progress):
         oracle = inertial_line(omega, r0, v0, traj.times)
         return SceneResult(traj, list(frame_terms), traj.method, traj.steps, traj.nfev,
                            extras={"oracle": oracle, "omega": omega,
-                                   "notes": list(getattr(res, "notes", [])),  # the engine's, passed on
-                                   "warnings": list(getattr(res, "warnings", []))})
+                                   **engine_remarks(res)})  # the engine's notes and warnings, passed on
 
     result = guarded(finish, simulate_particles, omega=frame, r0=r0, v0=v0, duration=T, method=method,
                      frame_terms=frame_terms, rtol=run_setting(run, "rtol"), step=run.get("step"),

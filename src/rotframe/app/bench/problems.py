@@ -126,15 +126,16 @@ def _with_prepared(runs, quick):
     return out
 
 
-def _engine_runner(omega, frame_terms, r0, v0, t_end, invariant_fn):
+def _engine_runner(problem, r0, v0, t_end, invariant_fn):
     """A runner of a scene built on the engine (`rotframe.problem`): ``rotframe.simulate``'s core for a whole run,
-    `rotframe.problem.prepared.PreparedProblem` (set up once, untimed) for the prepared methods."""
+    `rotframe.problem.prepared.PreparedProblem` (set up once, untimed) for the prepared methods. ``problem``: the
+    engine's arguments of the scene's model (``omega``, ``forces``, ``frame_terms``)."""
     from rotframe.problem.particles import simulate_particles
     from rotframe.problem.prepared import PreparedProblem
 
     prepared = {}
     times = np.array([0.0, t_end])
-    problem = {"omega": omega, "frame_terms": frame_terms, "duration": t_end, "samples": 1}
+    problem = dict(problem, duration=t_end, samples=1)
 
     def settings(method, setting):
         return {"rtol": setting} if method == "dop853" else {"step": setting} if setting is not None else {}
@@ -197,8 +198,9 @@ def _turntable(quick):
 
     return [Problem("turntable", "4 s, 0.9 turns", T, y0, python_rhs(spec),
                     lambda y: float(np.linalg.norm(y[:3] - r_end)), "analytic: final position error (m)",
-                    inertial_speed, runs, _engine_runner(frame, ("coriolis", "centrifugal", "euler"), r0, v0, T,
-                                                         inertial_speed), spec=spec)]
+                    inertial_speed, runs, _engine_runner({"omega": frame, "frame_terms": ("coriolis", "centrifugal",
+                                                                                          "euler")},
+                                                         r0, v0, T, inertial_speed), spec=spec)]
 
 
 def _tower_drop(quick):
@@ -224,10 +226,15 @@ def _tower_drop(quick):
     steps = _ladder(quick, [1e-1, 1e-2, 1e-3, 1e-4], [1e-2])
     runs = _with_prepared({"exact": [None], "rotation-splitting": steps, "rk4": steps,
                            "dop853": _ladder(quick, [1e-4, 1e-6, 1e-8, 1e-10, 1e-12], [1e-8])}, quick)
+    # the scene on the engine: its model as the engine takes it (rotframe.forces' gravity, the frame's Coriolis term)
+    from rotframe.scenes.base import engine_terms
+
+    omega, forces, frame_terms = engine_terms(model)
     return [Problem("tower-drop", "5 s fall", T, np.concatenate([r0, v0]), python_rhs(spec),
                     lambda y: float(np.linalg.norm(y[:3] - r_exact)),
                     "analytic (closed form, gravity + Coriolis): final position error (m)", energy, runs,
-                    _particle_runner(model, r0, v0, T, energy), spec=spec)]
+                    _engine_runner({"omega": omega, "forces": forces, "frame_terms": frame_terms}, r0, v0, T, energy),
+                    spec=spec)]
 
 
 def _foucault(quick):

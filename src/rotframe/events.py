@@ -1,0 +1,91 @@
+"""The built-in events, as the same kind of object as your own (``rotframe.events``).
+
+An event of ``rotframe.simulate`` is a function ``g(t, r, v, *params) -> float`` whose zero
+crossings are located (``terminal`` and ``direction`` attributes as in
+``scipy.integrate.solve_ivp``). A factory here returns such a function, compiled and located
+like yours by every method, that also says what it is, as a built-in force carries its linear
+form (`rotframe.forces`): the exact flow of a linear problem (``method="exact"``) locates it on
+the flow itself, by the scenes' Newton iteration on ``exp(M t)`` (`rotframe.particles.linear`),
+where it locates no function of your own::
+
+    import rotframe
+    from rotframe import events, forces
+
+    ground = events.crossing(2, 0.0, direction=-1, terminal=True, name="ground")
+    res = rotframe.simulate(omega=[0.0, 4.6e-5, 5.7e-5], r0=[0, 0, 100.0], v0=[0, 0, 0], duration=6.0,
+                            forces=[forces.gravity([0, 0, -9.81])], events=[ground], method="exact")
+    res.trajectory.event_times["ground"]         # the landing, to round-off
+
+=============================================  =====================================
+factory                                        the event function
+=============================================  =====================================
+``crossing(component, value, of="r")``         ``r[component] - value`` (``of="v"``: ``v[component] - value``)
+=============================================  =====================================
+
+The scenes' ground (``tower-drop``) is ``crossing(2, 0.0, direction=-1, terminal=True, name="ground")``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rotframe.errors import ScenarioError
+
+__all__ = ["crossing"]
+
+
+def crossing(component, value=0.0, *, of="r", direction=0, terminal=False, name=None):
+    """An event where one coordinate of the state crosses ``value``: ``g = r[component] - value``.
+
+    Parameters
+    ----------
+    component : int
+        0, 1 or 2: the axis of the frame (x, y, z).
+    value : float
+        The level crossed (m for ``of="r"``, m/s for ``of="v"``).
+    of : {"r", "v"}
+        The position's coordinate, or the velocity's (``v[component] - value``: an apex where ``v_z``
+        crosses 0).
+    direction : {-1, 0, 1}
+        Falling crossings only, both, or rising only.
+    terminal : bool
+        The particle stops at its first crossing (samples after it keep the state there).
+    name : str, optional
+        The event's name in ``Result.trajectory.event_times`` (default ``"x_crossing"``, ``"vz_crossing"``...).
+
+    Returns
+    -------
+    function
+        ``g(t, r, v)`` with the attributes ``terminal``, ``direction`` and ``crossing``, the triple
+        ``(of, component, value)`` the exact flow reads.
+
+    Examples
+    --------
+    >>> ground = crossing(2, 0.0, direction=-1, terminal=True, name="ground")
+    >>> ground(0.0, [0.0, 0.0, 3.5], [0.0, 0.0, -1.0]), ground.__name__, ground.crossing
+    (3.5, 'ground', ('r', 2, 0.0))
+    """
+    if isinstance(component, bool) or component not in (0, 1, 2):
+        raise ScenarioError(f"crossing: component={component!r}; allowed 0, 1, 2 (x, y, z of the frame)")
+    if of not in ("r", "v"):
+        raise ScenarioError(f"crossing: of={of!r}; allowed 'r' (a position's coordinate) or 'v' (a velocity's)")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ScenarioError(f"crossing: value={value!r}; a finite number ({'m' if of == 'r' else 'm/s'})")
+    if isinstance(direction, bool) or direction not in (-1, 0, 1):
+        raise ScenarioError(f"crossing: direction={direction!r}; allowed -1 (falling), 0 (both), 1 (rising)")
+    if not isinstance(terminal, bool):
+        raise ScenarioError(f"crossing: terminal={terminal!r}; True or False")
+    if name is not None and not (isinstance(name, str) and name.isidentifier()):
+        raise ScenarioError(f"crossing: name={name!r}; a name of letters, digits and _ (not starting with a digit)")
+    k, c = int(component), float(value)
+    if of == "r":
+        def event(t, r, v):
+            return r[k] - c
+    else:
+        def event(t, r, v):
+            return v[k] - c
+    event.__name__ = event.__qualname__ = name or f"{'' if of == 'r' else 'v'}{'xyz'[k]}_crossing"
+    event.terminal = terminal
+    event.direction = int(direction)
+    event.crossing = (of, k, c)
+    return event
