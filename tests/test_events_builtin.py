@@ -139,3 +139,59 @@ def test_the_tower_drop_on_the_engine_lands_where_the_scenes_kernels_do(method, 
     east = abs(r_ref[-1, 0])
     assert abs(res.metrics["east_deflection_m"] - r_ref[-1, 0]) < tol * params.height + 1e-12 * east
     assert abs(res.metrics["north_deflection_m"] - r_ref[-1, 1]) < tol * params.height + 1e-12 * east
+
+
+R_BALL = 6.371e6
+
+
+def _altitude_by_hand(t, r, v):
+    dz = r[2] + R_BALL
+    return math.sqrt(r[0] * r[0] + r[1] * r[1] + dz * dz) - R_BALL - 0.0
+
+
+_altitude_by_hand.terminal = True
+_altitude_by_hand.direction = -1
+
+
+@pytest.mark.parametrize("method", ["dop853", "rk4"])
+def test_a_built_in_altitude_is_a_users_event_to_the_bit(method):
+    ground = events.altitude(R_BALL, direction=-1, terminal=True, name="ground")
+    settings = {"step": 0.05} if method == "rk4" else {}
+    kw = dict(omega=W, r0=[0.0, 0.0, 0.0], v0=[800.0, 0.0, 800.0], duration=200.0, samples=20,
+              forces=[forces.gravity(G)], method=method, **settings)
+    ours = simulate_particles(events=[ground], **kw).trajectory
+    theirs = simulate_particles(events=[_altitude_by_hand], **kw).trajectory
+    np.testing.assert_array_equal(ours.r, theirs.r)
+    np.testing.assert_array_equal(ours.event_times["ground"][0], theirs.event_times["_altitude_by_hand"][0])
+    # beyond the flat ground's landing (z = 0 at 2 v_z / g): the round Earth falls away under the shell
+    (t_hit,), = ours.event_times["ground"]
+    assert t_hit > 2 * 800.0 / 9.81
+
+
+@pytest.mark.parametrize("method,sets,terms,tol", [
+    (None, {}, (), 1e-9),                                                    # exact, the default
+    (None, {"drag": 1e-5}, (), 1e-7),                                        # dop853 with drag in thin air
+    (None, {}, ("curvature", "central-gravity"), 1e-7),                      # dop853, the curved ground's altitude
+    ("rk4", {"step": 0.05}, ("curvature",), 1e-7),
+])
+def test_the_projectile_on_the_engine_lands_where_the_scenes_kernels_do(method, sets, terms, tol, tmp_path):
+    """Range, lateral deflection and flight time of the scene on the engine against the scenes' kernels running
+    the same model and ground (`integrate_particles`), each within its method's error of the other."""
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.scenes import projectile
+    from rotframe.scenes.base import landing
+
+    scn = tmp_path / "p.toml"
+    scn.write_text('scene = "projectile"\nname = "p"\nmodel = ' + str(["gravity", "coriolis", *terms]).replace("'", '"')
+                   + "\n")
+    step = sets.pop("step", None)
+    res = rotframe.run(str(scn), method=method, **({"step": step} if step else {}), **sets)
+    params = projectile.PARAMETERS(**{k: v for k, v in res.params.items()
+                                      if k in projectile.PARAMETERS.__dataclass_fields__})
+    model, r0, v0, ground, duration, _ = projectile.build(params, ["gravity", "coriolis", *terms])
+    ref = integrate_particles(model, r0, v0, duration, method=res.method, step=step, samples=50, events=[ground])
+    t_ref, r_ref, _, landed = landing(ref)
+    rng, lateral = projectile.ground_track(params, r_ref, model)
+    assert landed and abs(res.metrics["flight_time_s"] - t_ref[-1]) < tol * t_ref[-1]
+    assert abs(res.metrics["range_m"] - rng[-1]) < tol * abs(rng[-1])
+    assert abs(res.metrics["lateral_deflection_m"] - lateral[-1]) < tol * abs(rng[-1])

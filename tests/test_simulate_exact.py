@@ -174,7 +174,7 @@ def _wind(t, r, v):
     ({"omega": lambda t: (0.0, 0.0, 0.1 * t)}, ["omega", "function", "constant"]),
     ({"omega": ([0.0, 1.0, 2.0], [[0, 0, 0.1], [0, 0, 0.2], [0, 0, 0.3]])}, ["omega", "table"]),
     ({"origin_acceleration": lambda t: (0.0, 0.0, t)}, ["origin_acceleration", "function"]),
-    ({"events": [lambda t, r, v: r[2]]}, ["events[0]", "no event function of your own", "rotframe.events.crossing"]),
+    ({"events": [lambda t, r, v: r[2]]}, ["events[0]", "no other event function", "rotframe.events.crossing"]),
     ({"device": "gpu"}, ["gpu"]),  # no GPU here: refused for that; where one is, the registry refuses exact
 ])
 def test_what_the_exact_flow_cannot_take_is_refused_by_name(kwargs, words):

@@ -20,9 +20,13 @@ where it locates no function of your own::
 factory                                        the event function
 =============================================  =====================================
 ``crossing(component, value, of="r")``         ``r[component] - value`` (``of="v"``: ``v[component] - value``)
+``altitude(radius, value)``                    ``|r - c| - radius - value``, ``c = (0, 0, -radius)``
 =============================================  =====================================
 
-The scenes' ground (``tower-drop``) is ``crossing(2, 0.0, direction=-1, terminal=True, name="ground")``.
+The scenes' ground is ``crossing(2, 0.0, direction=-1, terminal=True, name="ground")`` on flat
+ground (``tower-drop``, ``projectile``), ``altitude(R, 0.0, direction=-1, terminal=True,
+name="ground")`` on the curved Earth (``projectile`` with its ``curvature`` term), whose surface
+is a nonlinear function of the state: the exact flow takes no problem with it.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ import math
 
 from rotframe.errors import ScenarioError
 
-__all__ = ["crossing"]
+__all__ = ["crossing", "altitude"]
 
 
 def crossing(component, value=0.0, *, of="r", direction=0, terminal=False, name=None):
@@ -65,18 +69,13 @@ def crossing(component, value=0.0, *, of="r", direction=0, terminal=False, name=
     >>> ground(0.0, [0.0, 0.0, 3.5], [0.0, 0.0, -1.0]), ground.__name__, ground.crossing
     (3.5, 'ground', ('r', 2, 0.0))
     """
+    _check_kind("crossing", direction, terminal, name)
     if isinstance(component, bool) or component not in (0, 1, 2):
         raise ScenarioError(f"crossing: component={component!r}; allowed 0, 1, 2 (x, y, z of the frame)")
     if of not in ("r", "v"):
         raise ScenarioError(f"crossing: of={of!r}; allowed 'r' (a position's coordinate) or 'v' (a velocity's)")
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ScenarioError(f"crossing: value={value!r}; a finite number ({'m' if of == 'r' else 'm/s'})")
-    if isinstance(direction, bool) or direction not in (-1, 0, 1):
-        raise ScenarioError(f"crossing: direction={direction!r}; allowed -1 (falling), 0 (both), 1 (rising)")
-    if not isinstance(terminal, bool):
-        raise ScenarioError(f"crossing: terminal={terminal!r}; True or False")
-    if name is not None and not (isinstance(name, str) and name.isidentifier()):
-        raise ScenarioError(f"crossing: name={name!r}; a name of letters, digits and _ (not starting with a digit)")
     k, c = int(component), float(value)
     if of == "r":
         def event(t, r, v):
@@ -89,3 +88,59 @@ def crossing(component, value=0.0, *, of="r", direction=0, terminal=False, name=
     event.direction = int(direction)
     event.crossing = (of, k, c)
     return event
+
+
+def altitude(radius, value=0.0, *, direction=0, terminal=False, name=None):
+    """An event where the height above a sphere crosses ``value``: ``g = |r - c| - radius - value``.
+
+    The sphere of ``radius`` R centred at ``c = (0, 0, -R)`` touches the frame's origin: the ground
+    of a local frame on a round Earth (the scenes' event kind ``altitude``, the same arithmetic:
+    `rotframe.particles.events`). Its value is a nonlinear function of the state, so the exact flow
+    takes no problem with it; every other method locates it as an event of yours.
+
+    Parameters
+    ----------
+    radius : float
+        R (m), > 0.
+    value : float
+        The height crossed (m).
+    direction, terminal, name
+        As for `crossing` (default name ``"altitude"``).
+
+    Returns
+    -------
+    function
+        ``g(t, r, v)`` with the attributes ``terminal`` and ``direction``.
+
+    Examples
+    --------
+    >>> ground = altitude(6.371e6, direction=-1, terminal=True, name="ground")
+    >>> round(ground(0.0, [0.0, 0.0, 100.0], [0.0, 0.0, 0.0]), 9), ground.__name__
+    (100.0, 'ground')
+    """
+    _check_kind("altitude", direction, terminal, name)
+    for key, x in (("radius", radius), ("value", value)):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+            raise ScenarioError(f"altitude: {key}={x!r}; a finite number (m)")
+    if not radius > 0:
+        raise ScenarioError(f"altitude: radius={radius!r}; must be > 0 (m)")
+    R, c = float(radius), float(value)
+
+    def event(t, r, v):
+        dz = r[2] + R
+        return math.sqrt(r[0] * r[0] + r[1] * r[1] + dz * dz) - R - c
+
+    event.__name__ = event.__qualname__ = name or "altitude"
+    event.terminal = terminal
+    event.direction = int(direction)
+    return event
+
+
+def _check_kind(factory, direction, terminal, name):
+    """One-line errors for an event's ``direction``, ``terminal`` and ``name``, naming the ``factory``."""
+    if isinstance(direction, bool) or direction not in (-1, 0, 1):
+        raise ScenarioError(f"{factory}: direction={direction!r}; allowed -1 (falling), 0 (both), 1 (rising)")
+    if not isinstance(terminal, bool):
+        raise ScenarioError(f"{factory}: terminal={terminal!r}; True or False")
+    if name is not None and not (isinstance(name, str) and name.isidentifier()):
+        raise ScenarioError(f"{factory}: name={name!r}; a name of letters, digits and _ (not starting with a digit)")

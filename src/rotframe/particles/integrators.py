@@ -168,12 +168,17 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
         setup = _setup(model, info, duration, samples, step, rtol, atol, events, r0.shape[0])
         return run_chunked(setup, model, r0, v0, progress, max_events, records, owned=True)
     _check_work(info, duration, step, samples, r0.shape[0], model)
+    check_exact(model)
+    return integrate_exact(model, r0, v0, duration, samples, events, progress)
+
+
+def check_exact(model: ParticleModel) -> None:
+    """A one-line ScenarioError where ``method="exact"`` cannot run the scene's ``model`` (no exact flow), naming why."""
     if not model.has_exact_flow:
         why = "; ".join(model.nonlinear_reasons())
         raise ScenarioError(f"method: 'exact' needs a linear model with constant coefficients ({why}) "
                             "or a force-free one (only coriolis, centrifugal and euler); "
                             "use rotation-splitting, rotation-splitting4, rk4 or dop853")
-    return integrate_exact(model, r0, v0, duration, samples, events, progress)
 
 
 # ---------------------------------------------------------------------------

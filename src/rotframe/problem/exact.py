@@ -93,8 +93,8 @@ def linear_problem(terms, labels, frame, origin, events, frame_terms) -> LinearP
     refusal = "method='exact' takes terms linear in (r, v) with constant coefficients in a steady frame"
     for k, g in enumerate(events):
         if event_row(g, "") is None:
-            raise ScenarioError(f"events[{k}]: {refusal}, and locates the crossings of a coordinate "
-                                "(rotframe.events.crossing), no event function of your own; use dop853")
+            raise ScenarioError(f"events[{k}]: {refusal}, and locates the crossings of a coordinate alone "
+                                "(rotframe.events.crossing), no other event function; use dop853")
     if frame.kind == "table" and frame.interpolation == "linear":
         return _turning_frame(terms, frame, origin, frame_terms)
     if frame.kind != "constant":

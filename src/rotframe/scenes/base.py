@@ -167,8 +167,8 @@ def engine_terms(model):
 
     Each named term becomes the built-in term of `rotframe.forces` that the scene's term is (the same arithmetic,
     `rotframe.particles.accelerations`), the frame's terms the engine's ``frame_terms``, and a steady rotation its
-    vector. A term the engine does not have yet (``curvature``) or a rotation that varies is a ScenarioError naming it:
-    a scene with one keeps its own kernels.
+    vector. ``curvature`` is no force: it makes the ground a sphere, which is the scene's event
+    (`rotframe.events.altitude`). A rotation that varies is a ScenarioError: a scene gives the engine its frame.
     """
     from rotframe import forces as rf
     from rotframe.problem.terms import FRAME_TERMS
@@ -193,7 +193,7 @@ def engine_terms(model):
                 terms.append(rf.drag(linear=model.k_linear if model.has("linear-drag") else 0.0,
                                      quadratic=model.k_quadratic if model.has("quadratic-drag") else 0.0,
                                      scale_height=model.scale_height))
-        elif t not in FRAME_TERMS:
+        elif t not in FRAME_TERMS and t != "curvature":  # the curved ground is the scene's event
             raise ScenarioError(f"model: the term {t!r} is not on the engine yet")
     return model.omega.vector(0.0), terms, tuple(t for t in model.terms if t in FRAME_TERMS)
 

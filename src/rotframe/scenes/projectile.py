@@ -24,11 +24,11 @@ import numpy as np
 from rotframe import analytic
 # astropy's values, read when the scene is imported (before the run's clock starts): every run needs them
 from rotframe.earth import R_EARTH
-from rotframe.particles.integrators import Event, default_method
+from rotframe.particles.integrators import Event, check_exact, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (run_setting, SceneResult, earth_model_constants, jacobi_energy, landing, method_rel_error,
-                                  particle_methods, reject_subnormal, rel_drift, resolve_terms, run_particles,
-                                  samples_for, UNDERFLOW, with_parameters)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, engine_remarks, jacobi_energy, landing,
+                                  method_rel_error, particle_methods, reject_subnormal, rel_drift, resolve_terms,
+                                  run_on_engine, run_setting, samples_for, UNDERFLOW, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -78,24 +78,39 @@ def build(p, terms):
     return model, np.zeros(3), v0, ground, 3.0 * flight + min(10.0, 3.0 * flight), g
 
 
+def ground_event(ground):
+    """The engine's ground of the scene's event row ``ground`` (`build`): the flat ground's crossing of z = 0, or the
+    curved Earth's altitude 0 (the ``curvature`` term), falling, terminal (`rotframe.events`)."""
+    from rotframe import events
+
+    if ground.kind == "altitude":
+        return events.altitude(R_EARTH, ground.value, direction=-1, terminal=True, name="ground")
+    return events.crossing(ground.component, ground.value, direction=-1, terminal=True, name="ground")
+
+
 @with_parameters(ProjectileParameters)
 def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     model, r0, v0, ground, duration, g = build(p, terms)
     # the exact flow where it exists (round-off accurate, nothing to compile); DOP853 at the scenario's rtol once
     # central gravity, curvature or drag make the model nonlinear
-    method = method or run.get("method") or default_method(model, [ground], otherwise="dop853")
+    method = particle_methods().canonical(method or run.get("method") or default_method(model, [ground],
+                                                                                         otherwise="dop853"))
+    if method == "exact":
+        check_exact(model)  # the scenes' one-line reason (the curved ground is no term of the engine's)
 
     # the apex is read from the samples: at least 32 of them per (vacuum) flight, or it is null
     flight = 2 * p.speed * math.sin(math.radians(p.elevation)) / g
     samples, resolved = samples_for(duration, flight, run_setting(run, "samples"))
 
-    def finish(traj):
+    def finish(res):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(res, "trajectory", res)
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g, "apex_resolved": resolved, "flight": flight})
+                           extras={"model": model, "g": g, "apex_resolved": resolved, "flight": flight,
+                                   **engine_remarks(res)})  # the engine's notes and warnings, passed on
 
-    return run_particles(model, r0, v0, duration, method, dict(run, samples=samples), progress, finish,
-                         events=[ground])
+    return run_on_engine(model, r0, v0, duration, method, dict(run, samples=samples), progress, finish,
+                         events=[ground_event(ground)])
 
 
 def apex_height(times, r):
@@ -216,7 +231,8 @@ def analyse(p, result):
     tolerance = {k: acc + method_rel * (theory[k] if k == "flight_time_s" else size)
                  for k, acc in accuracy.items() if acc is not None}
     return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
-            "diagnostics": diagnostics, "notes": notes}
+            "diagnostics": diagnostics, "notes": notes + result.extras.get("notes", []),
+            "warnings": result.extras.get("warnings", [])}
 
 
 @with_parameters(ProjectileParameters, position=1)
