@@ -88,7 +88,11 @@ def test_a_prepared_run_is_simulate_to_the_bit(name, inline):
     kw = dict(PROBLEMS[name], duration=3.0, samples=30)
     prepared = PreparedProblem(r0=R0, v0=V0, inline=inline, **kw)
     for r0, v0 in ((R0, V0), (R0[::-1] * 1.1, V0[::-1]), (R0[0], V0[1])):
-        same_trajectory(prepared.run(r0, v0), simulate_particles(r0=r0, v0=v0, inline=inline, **kw).trajectory)
+        want = simulate_particles(r0=r0, v0=v0, inline=inline, **kw).trajectory
+        same_trajectory(prepared.run(r0, v0), want)
+        r, v = prepared.states(r0, v0)  # the samples as arrays
+        np.testing.assert_array_equal(r, want.r)
+        np.testing.assert_array_equal(v, want.v)
 
 
 def test_a_prepared_run_starts_from_its_own_states():
@@ -150,6 +154,9 @@ def test_a_prepared_exact_flow_is_simulates_to_round_off(frame):
         np.testing.assert_allclose(got.v, want.v, rtol=0, atol=1e-12 * np.max(np.abs(want.v)))
         np.testing.assert_array_equal(got.times, want.times)
         assert got.method == "exact" and got.complete
+        rs, vs = prepared.states(r, v)  # the same samples as arrays, without the Trajectory
+        np.testing.assert_array_equal(rs, got.r)
+        np.testing.assert_array_equal(vs, got.v)
     with pytest.raises(ScenarioError, match="forces\\[0\\]"):
         PreparedProblem(r0=r0[0], v0=v0[0], **dict(kw, forces=[forces.drag(quadratic=0.1)]))
 
