@@ -233,3 +233,17 @@ def test_runs_on_threads_at_once_are_each_their_own():
         together = list(pool.map(lambda start: prepared.run(*start), starts))
     for a, b in zip(alone, together):
         same_trajectory(a, b)
+
+
+def test_a_prepared_exact_flow_refuses_events_and_holds_more_particles_to_the_limits():
+    """The kept matrices give samples alone: a crossing is refused by name (simulate's exact run locates it), never
+    dropped in silence; more particles than the set-up's are held to the sample limit before any work."""
+    from rotframe import events
+    from rotframe.limits import LimitError
+
+    kw = dict(omega=[0.0, 0.0, 1.0], duration=1.0, method="exact", forces=[forces.gravity([0, 0, -9.81])])
+    with pytest.raises(ScenarioError, match="events: a prepared exact flow"):
+        PreparedProblem(r0=[0.0, 0.0, 1.0], v0=[0.0, 0.0, 0.0], events=[events.crossing(2)], **kw)
+    prepared = PreparedProblem(r0=[0.0, 0.0, 1.0], v0=[0.0, 0.0, 0.0], samples=1000, **kw)
+    with pytest.raises(LimitError, match="output samples"):
+        prepared.states(np.zeros((10**5, 3)), np.zeros((10**5, 3)))

@@ -26,15 +26,25 @@ from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
-__all__ = ["SetUp", "set_up", "checked_states", "checked_atol", "checked_attitude", "check_arrays", "start_states",
+__all__ = ["SetUp", "set_up", "checked_states", "plain_states", "checked_atol", "checked_attitude", "check_arrays", "start_states",
            "fill_states", "run_state", "problem_tuple", "function_roles"]
+
+
+#: float64, the dtype a run's arrays have (numpy keeps one object for it: compared by identity, in 30 ns)
+_F64 = np.dtype(np.float64)
+
+
+def plain_states(r0, v0) -> bool:
+    """Whether ``r0``, ``v0`` are already what a run takes: float64 arrays of one shape, (3,) or (N, 3), C-ordered
+    (what a prepared run's caller passes; their checks then take a microsecond, not five)."""
+    return (type(r0) is np.ndarray and type(v0) is np.ndarray and r0.dtype is _F64 and v0.dtype is _F64
+            and r0.shape == v0.shape and r0.shape[-1:] == (3,) and r0.ndim <= 2 and r0.flags.c_contiguous
+            and v0.flags.c_contiguous)
 
 
 def checked_states(r0, v0):
     """The start states ``r0``, ``v0`` as (N, 3) arrays: one of them may be a single state for all N; finite."""
-    if (type(r0) is np.ndarray and type(v0) is np.ndarray and r0.dtype == np.float64 and v0.dtype == np.float64
-            and r0.shape == v0.shape and 1 <= r0.ndim <= 2 and r0.shape[-1] == 3 and r0.flags.c_contiguous
-            and v0.flags.c_contiguous):  # what a prepared run's caller passes: its checks alone, in a microsecond
+    if plain_states(r0, v0):
         r, v = r0.reshape(-1, 3), v0.reshape(-1, 3)
         if not (all(map(math.isfinite, r0.tolist() + v0.tolist())) if r0.ndim == 1 else
                 np.isfinite(r).all() and np.isfinite(v).all()):

@@ -394,7 +394,6 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     """``method="exact"``: the exact flow of the run's linear problem (`rotframe.problem.exact`), the scenes' own
     (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
     from rotframe.particles.integrators import integrate_exact
-
     from rotframe.problem.exact import event_row
 
     model = exact_model(terms, frame, origin, events, frame_terms)

@@ -33,7 +33,7 @@ from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import model_parts
 from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, fill_states,
-                                             run_state, set_up, tolerance_rows)
+                                             plain_states, run_state, set_up, tolerance_rows)
 from rotframe.problem.particles import advance_blocks, exact_model, raise_if_failed, raised_later, trajectory_of
 from rotframe.problem.terms import StringConstraint, check_on_string
 
@@ -94,7 +94,8 @@ frame_attitude, frame_terms
         self.notes = []
         #: the exact flow's matrices for the sample grid (`_ExactFlow`), where the method is ``exact``
         self._exact = _ExactFlow(s) if s.method == "exact" else None
-        if self._exact is not None:
+        if self._exact is not None:  # its calls bound here: a run of a few microseconds pays no second dispatch
+            self.states, self.run = self._exact.states, self._exact.run
             return
         inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
         inlining.start()
@@ -107,9 +108,7 @@ frame_attitude, frame_terms
         as ``traj.r`` and ``traj.v``, without the `Trajectory` around them. For ``method="exact"`` the least a run
         costs (the kept matrices times the start states, some 1.6 us for one particle); the other methods run
         `run`."""
-        if self._exact is not None:
-            return self._exact.states(r0, v0)
-        traj = self.run(r0, v0)
+        traj = self.run(r0, v0)  # (the exact flow's own `states` is bound in its place)
         return traj.r, traj.v
 
     def run(self, r0, v0):
@@ -122,8 +121,6 @@ frame_attitude, frame_terms
         particle fails (`rotframe.problem.particles.raise_if_failed`).
         """
         s = self.setup
-        if self._exact is not None:
-            return self._exact.run(r0, v0)
         r, v = checked_states(r0, v0)
         N = r.shape[0]
         if N > s.r.shape[0]:  # more particles than the set-up's: the limits checked for them
@@ -191,6 +188,10 @@ class _ExactFlow:
         from rotframe.particles.exact_kernel import apply_flow
         from rotframe.particles.linear import ExactFlow
 
+        if s.events:  # the kept matrices give samples alone: a crossing is located by simulate's exact run
+            raise ScenarioError("events: a prepared exact flow keeps the flow's matrices for the samples and locates "
+                                "no event; call rotframe.simulate (method='exact' locates a crossing) or prepare "
+                                "dop853")
         model = exact_model(s.terms, s.frame, s.origin, s.events, s.frame_terms)
         with np.errstate(all="ignore"):  # an overflow (an unstable problem run far) is caught per run
             phi = ExactFlow(model, s.times).matrices()  # (samples + 1, 7, 7)
@@ -199,6 +200,7 @@ class _ExactFlow:
         apply_flow(self._phi_t[:1], np.zeros((1, 3)), np.zeros((1, 3)))  # load or compile the kernel now
         self._times = s.times.copy()
         self._times.flags.writeable = False  # shared by every run's Trajectory, as its sample times
+        self._particles = s.r.shape[0]  # the set-up's, whose samples simulate's checks held to the limits
 
     def run(self, r0, v0):
         """The `Trajectory` from the start states ``r0``, ``v0`` (as ``simulate`` takes them)."""
@@ -208,12 +210,12 @@ class _ExactFlow:
     def states(self, r0, v0):
         """``(r, v)`` samples from the start states ``r0``, ``v0``; IntegrationError at a non-finite state."""
         times = self._times
-        if (type(r0) is np.ndarray and type(v0) is np.ndarray and r0.dtype == np.float64 and v0.dtype == np.float64
-                and r0.shape == v0.shape and 1 <= r0.ndim <= 2 and r0.shape[-1] == 3 and r0.flags.c_contiguous
-                and v0.flags.c_contiguous):  # the states as a run takes them: their finiteness is the flow's sample 0
+        if plain_states(r0, v0):  # the states as a run takes them: their finiteness is the flow's sample 0
             r, v = (r0[None], v0[None]) if r0.ndim == 1 else (r0, v0)
         else:
             r, v = checked_states(r0, v0)
+        if r.shape[0] > self._particles:  # more particles than the set-up's: their samples within the limits
+            check_run(samples=times.size, particles=r.shape[0], what="method exact")
         rs, vs, k_bad = self._apply(self._phi_t, r, v)
         if k_bad == 0:  # sample 0 is the start itself (the flow's identity): the start is not finite
             checked_states(r0, v0)

@@ -53,13 +53,14 @@ METHODS = particle_methods()
 DEFAULT_METHOD = "exact (the puck is force-free: a straight line in inertial space)"
 
 Z = np.array([0.0, 0.0, 1.0])
-#: the turntable's terms: the frame's alone (nothing else acts on a frictionless puck)
-FRAME_TERMS = ("coriolis", "centrifugal", "euler")
 
 
 def _setup(p, terms):
     """``(omega, frame, frame_terms, r0, v0, T)``: the spin as a schedule (the oracle's exact angle) and as the
-    engine's frame (a constant vector, or the rate's two knots joined linearly), the frame's terms that act."""
+    engine's frame (a constant vector, or the rate's two knots joined linearly), the frame's terms that act (the
+    frame's alone: nothing else acts on a frictionless puck)."""
+    from rotframe.problem.terms import FRAME_TERMS  # imported by a run, not by listing or describing the scene
+
     others = [t for t in terms if t not in FRAME_TERMS]
     if others:
         raise ScenarioError(f"model: {others[0]!r} is not a term of this scene; the puck feels the frame's terms "
