@@ -94,6 +94,21 @@ def test_a_crossing_of_the_velocity_and_a_rising_one():
     assert math.isclose(t_up, (20.0 - math.sqrt(400.0 - 2 * 9.81 * 10.0)) / 9.81, rel_tol=1e-13)
 
 
+@pytest.mark.parametrize("of,component,value,direction", [("r", 2, 10.0, 1), ("r", 0, -3.0, 0), ("v", 2, 5.0, -1),
+                                                          ("v", 0, -8.0, 0)])
+def test_a_crossings_function_and_the_row_the_exact_flow_reads_are_one_event(of, component, value, direction):
+    """The function every other method calls and the triple the exact flow locates say the same: DOP853 at rtol
+    1e-12 finds the exact flow's crossings to its tolerance (a function that disagreed with its ``crossing`` would
+    put them elsewhere, or find none)."""
+    ev = events.crossing(component, value, of=of, direction=direction, name="c")
+    kw = dict(omega=[0.0, 0.1, 0.3], r0=[0.0, 1.0, 0.0], v0=[-10.0, 0.0, 20.0], duration=4.0, samples=8,
+              forces=[forces.gravity(G)], events=[ev])
+    exact = simulate_particles(method="exact", **kw).trajectory.event_times["c"][0]
+    dop = simulate_particles(method="dop853", rtol=1e-12, **kw).trajectory.event_times["c"][0]
+    assert len(exact) >= 1 and len(exact) == len(dop)
+    np.testing.assert_allclose(dop, exact, rtol=0, atol=1e-9)
+
+
 def test_the_exact_flow_refuses_an_event_of_your_own_by_name():
     with pytest.raises(ScenarioError, match=r"events\[1\].*rotframe.events.crossing"):
         simulate_particles(omega=W, r0=[0, 0, H], v0=[0, 0, 0], duration=6.0, forces=[forces.gravity(G)],
@@ -151,6 +166,23 @@ def _altitude_by_hand(t, r, v):
 
 _altitude_by_hand.terminal = True
 _altitude_by_hand.direction = -1
+
+
+def _above_a_kilometre(t, r, v):
+    dz = r[2] + R_BALL
+    return math.sqrt(r[0] * r[0] + r[1] * r[1] + dz * dz) - R_BALL - 1000.0
+
+
+def test_an_altitude_of_its_own_value_is_crossed_going_up_and_down():
+    """``value`` is the height crossed: a shell passing 1 km on the way up and on the way down, as a user's function
+    of that height says, to the bit."""
+    up_and_down = events.altitude(R_BALL, 1000.0, name="km")
+    kw = dict(omega=W, r0=[0.0, 0.0, 0.0], v0=[300.0, 0.0, 300.0], duration=60.0, samples=12,
+              forces=[forces.gravity(G)], method="dop853")
+    ours = simulate_particles(events=[up_and_down], **kw).trajectory
+    theirs = simulate_particles(events=[_above_a_kilometre], **kw).trajectory
+    np.testing.assert_array_equal(ours.event_times["km"][0], theirs.event_times["_above_a_kilometre"][0])
+    assert len(ours.event_times["km"][0]) == 2  # up through 1 km and down again (apex 4.6 km)
 
 
 @pytest.mark.parametrize("method", ["dop853", "rk4"])
