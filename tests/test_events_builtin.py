@@ -227,3 +227,51 @@ def test_the_projectile_on_the_engine_lands_where_the_scenes_kernels_do(method, 
     assert landed and abs(res.metrics["flight_time_s"] - t_ref[-1]) < tol * t_ref[-1]
     assert abs(res.metrics["range_m"] - rng[-1]) < tol * abs(rng[-1])
     assert abs(res.metrics["lateral_deflection_m"] - lateral[-1]) < tol * abs(rng[-1])
+
+
+# a scene's model as the engine's terms (scenes.base.engine_terms): every named term mapped to its built-in factory
+
+_W_SITE = np.array([0.0, 4.6e-5, 5.7e-5])
+
+
+@pytest.mark.parametrize("terms,kw,r0,v0,T", [
+    (("altitude-gravity", "coriolis", "centrifugal"), dict(g0=9.81, radius=6.371e6), [0, 0, 2.0e4], [300.0, 0, 50.0],
+     60.0),
+    (("central-gravity", "coriolis"), dict(gm=3.986e14, radius=6.371e6), [0, 0, 1.0e5], [1500.0, 200.0, 500.0], 100.0),
+    (("gravity", "linear-drag", "quadratic-drag", "coriolis"), dict(g=np.array([0, 0, -9.81]), k_linear=0.02,
+                                                                    k_quadratic=3e-4, scale_height=8000.0),
+     [0, 0, 100.0], [80.0, 10.0, 60.0], 20.0),
+    (("spring", "coriolis"), dict(spring=0.15), [3.0, 0, 0], [0, 0.1, 0], 60.0),
+    (("gravity", "pendulum", "coriolis", "euler"), dict(g=np.array([0, 0, -9.81]), pendulum_length=10.0,
+                                                        pivot=np.array([0, 0, 10.0])),
+     [1.0, 0, 10.0 - math.sqrt(99.0)], [0, 0, 0], 30.0),
+])
+def test_a_scenes_model_on_the_engine_is_the_same_motion(terms, kw, r0, v0, T):
+    """The model run by the scenes' kernels and its `engine_terms` run by the engine, both DOP853 at rtol 1e-12: the
+    same motion to the tolerance (a term mapped to the wrong factory or constant would part them far more)."""
+    from rotframe.particles.integrators import integrate_particles
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.scenes.base import engine_terms
+
+    model = ParticleModel(terms, omega=OmegaSchedule.constant(_W_SITE), **kw)
+    omega, fs, frame_terms = engine_terms(model)
+    assert frame_terms == tuple(t for t in terms if t in ("coriolis", "centrifugal", "euler"))
+    ref = integrate_particles(model, np.array(r0, float), np.array(v0, float), T, method="dop853", rtol=1e-12,
+                              samples=10)
+    ours = simulate_particles(omega=omega, r0=r0, v0=v0, duration=T, forces=fs, frame_terms=frame_terms,
+                              method="dop853", rtol=1e-12, samples=10).trajectory
+    scale = np.max(np.abs(ref.r))
+    assert np.max(np.abs(ours.r - ref.r)) < 1e-9 * scale
+    assert np.max(np.abs(ours.v - ref.v)) < 1e-9 * np.max(np.abs(ref.v))
+
+
+def test_a_term_the_engine_lacks_and_a_varying_rate_are_refused_by_name():
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.scenes.base import engine_terms
+
+    ramp = ParticleModel(("coriolis",), omega=OmegaSchedule.ramp([0, 0, 1.0], 1.0, 0.2, 4.0))
+    with pytest.raises(ScenarioError, match="varies"):
+        engine_terms(ramp)
+    curved = ParticleModel(("gravity", "coriolis", "curvature"), omega=OmegaSchedule.constant(_W_SITE),
+                           g=np.array([0, 0, -9.81]), radius=6.371e6)
+    assert [f.name for f in engine_terms(curved)[1]] == ["gravity"]  # the curved ground is the scene's event
