@@ -19,8 +19,11 @@ from numba.core.dispatcher import Dispatcher
 
 __all__ = ["plain"]
 
-_SPACES: dict[int, dict] = {}  # id of a globals dict (a module's, or a bound copy's) -> its plain remake
-_PLAIN: dict[int, types.FunctionType] = {}
+# the remakes, by the id of what they remake, each beside that object itself: held, it keeps its id, which another
+# object (a later problem's glue, a loop bound to other functions) would otherwise reuse once it was freed, and
+# be given this one's remake (found: a run's events called another problem's functions)
+_SPACES: dict[int, tuple[dict, dict]] = {}  # id of a globals dict (a module's, or a bound copy's) -> (it, its remake)
+_PLAIN: dict[int, tuple[types.FunctionType, types.FunctionType]] = {}  # id of a function -> (it, its remake)
 
 
 def _space(py) -> dict:
@@ -30,10 +33,10 @@ def _space(py) -> dict:
     `rotframe.numerics.compiled.bound`).
     """
     original = py.__globals__
-    space = _SPACES.get(id(original))
-    if space is None:
+    held, space = _SPACES.get(id(original), (None, None))
+    if held is not original:
         space = dict(original)
-        _SPACES[id(original)] = space  # before the remakes: a module's functions call each other
+        _SPACES[id(original)] = (original, space)  # before the remakes: a module's functions call each other
         for name, value in original.items():
             if isinstance(value, Dispatcher):
                 space[name] = plain(value)
@@ -46,9 +49,9 @@ def plain(f):
     if override is not None:
         return override
     py = getattr(f, "py_func", f)
-    made = _PLAIN.get(id(py))
-    if made is None:
+    held, made = _PLAIN.get(id(py), (None, None))
+    if held is not py:
         made = types.FunctionType(py.__code__, _space(py), py.__name__, py.__defaults__, py.__closure__)
         made.__doc__ = py.__doc__
-        _PLAIN[id(py)] = made
+        _PLAIN[id(py)] = (py, made)
     return made
