@@ -42,9 +42,10 @@ def test_the_scene_on_the_engine_agrees_with_the_scenes_kernels(method):
     assert np.max(np.abs(traj.r[:, 0] - scene.r[:, 0])) < tol * radius
 
 
-def test_a_term_that_is_not_the_frames_is_refused(tmp_path):
+@pytest.mark.parametrize("scene", ["inertial-oscillation", "turntable"])  # the two scenes of the frame's terms alone
+def test_a_term_that_is_not_the_frames_is_refused(tmp_path, scene):
     scn = tmp_path / "io.toml"
-    scn.write_text('scene = "inertial-oscillation"\nname = "io"\nmodel = ["coriolis", "gravity"]\n')
+    scn.write_text(f'scene = "{scene}"\nname = "io"\nmodel = ["coriolis", "gravity"]\n')
     with pytest.raises(ScenarioError) as info:
         rotframe.run(str(scn))
     assert "'gravity'" in str(info.value) and "coriolis, centrifugal, euler" in str(info.value)

@@ -20,7 +20,6 @@ import pytest
 
 import rotframe
 from rotframe import method_registry
-from rotframe.errors import ScenarioError
 
 W0, ALPHA, T = 1.0, 0.2, 4.0
 R0, SPEED = 2.0, 1.0
@@ -91,10 +90,3 @@ def test_a_steady_table_and_a_term_left_out(tmp_path):
     assert "position_error_m" not in res.theory and not res.warnings  # and no theory to miss
     assert any("leaves out the frame's coriolis," in note for note in res.notes), res.notes
 
-
-def test_a_term_that_is_not_the_frames_is_refused(tmp_path):
-    scn = tmp_path / "tt.toml"
-    scn.write_text('scene = "turntable"\nname = "tt"\nmodel = ["coriolis", "centrifugal", "euler", "gravity"]\n')
-    with pytest.raises(ScenarioError) as info:
-        rotframe.run(str(scn))
-    assert "'gravity'" in str(info.value) and "coriolis, centrifugal, euler" in str(info.value)

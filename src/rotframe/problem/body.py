@@ -27,7 +27,7 @@ from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
-from rotframe.problem.tiers import PlainTierFailed, Tier
+from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
 from rotframe import method_registry as registry
 from rotframe.problem.arguments import check_flag, check_inline, check_params, run_grid
 from rotframe.problem.particles import STATUS
@@ -107,10 +107,7 @@ def simulate_rigid_body(**kwargs) -> BodyRun:
 
     A run begun in the plain tier that fails runs again compiled from its start (`rotframe.problem.tiers`).
     """
-    try:
-        return _simulate_rigid_body(**kwargs)
-    except PlainTierFailed:
-        return _simulate_rigid_body(**kwargs, plain_tier=False)
+    return run_falling_back(_simulate_rigid_body, kwargs)
 
 
 def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,

@@ -33,7 +33,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
-from rotframe.problem.tiers import PlainTierFailed, Tier
+from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
            "raised_later", "trajectory_of", "exact_model"]
@@ -82,10 +82,7 @@ def simulate_particles(**kwargs) -> ProblemRun:
     again compiled from its start (`rotframe.problem.tiers`): a failure is met and reported as the
     compiled loop meets it, whatever the caches held.
     """
-    try:
-        return _simulate_particles(**kwargs)
-    except PlainTierFailed:
-        return _simulate_particles(**kwargs, plain_tier=False)
+    return run_falling_back(_simulate_particles, kwargs)
 
 
 def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),

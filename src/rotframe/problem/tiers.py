@@ -52,7 +52,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -79,6 +79,15 @@ class PlainTierFailed(Exception):
     """A run in the plain tier failed (a function raised, a state not finite): it runs again compiled from its start,
     so that the failure is met and reported as the compiled loop meets it (Python raises on a division by zero or a
     square root of a negative number where the compiled loop goes on with inf or NaN)."""
+
+
+def run_falling_back(run, kwargs):
+    """``run(**kwargs)`` (a particle or body run that may begin in the plain tier); where it fails there
+    (`PlainTierFailed`), ``run(**kwargs, plain_tier=False)``: the same run compiled from its start."""
+    try:
+        return run(**kwargs)
+    except PlainTierFailed:
+        return run(**kwargs, plain_tier=False)
 
 
 def loop_is_compiled(variant) -> bool:

@@ -140,8 +140,10 @@ def _engine_runner(problem, r0, v0, t_end, invariant_fn):
     def settings(method, setting):
         return {"rtol": setting} if method == "dop853" else {"step": setting} if setting is not None else {}
 
-    def states(traj):
-        return np.concatenate([traj.r[:, 0], traj.v[:, 0]], axis=1)
+    def final(out, at=times):  # the final state and the invariant's path (after the timing, where timed)
+        r, v, nfev = (*out, 0) if isinstance(out, tuple) else (out.r, out.v, out.nfev)
+        Y = np.concatenate([r[:, 0], v[:, 0]], axis=1)
+        return Y[-1], nfev, lambda: invariant_fn(at, Y)
 
     def prepared_call(method, setting):
         base = method.removesuffix(PREPARED)
@@ -150,14 +152,9 @@ def _engine_runner(problem, r0, v0, t_end, invariant_fn):
             pr = prepared[(base, setting)] = PreparedProblem(r0=r0, v0=v0, method=base, **problem,
                                                              **settings(base, setting))
 
-        def finish(out):  # the final state and the invariant's path, after the timing
-            r, v, nfev = (*out, 0) if isinstance(out, tuple) else (out.r, out.v, out.nfev)
-            Y = np.concatenate([r[:, 0], v[:, 0]], axis=1)
-            return Y[-1], nfev, lambda: invariant_fn(times, Y)
-
         # the exact flow's samples as arrays (`PreparedProblem.states`, as the scenes' PreparedRun gives them); the
         # integrators' Trajectory, whose count of evaluations the bench reports
-        return (lambda: pr.states(r0, v0)) if base == "exact" else (lambda: pr.run(r0, v0)), finish
+        return (lambda: pr.states(r0, v0)) if base == "exact" else (lambda: pr.run(r0, v0)), final
 
     def run(method, setting):
         if method.endswith(PREPARED):
@@ -167,8 +164,7 @@ def _engine_runner(problem, r0, v0, t_end, invariant_fn):
         # the start-up table measures) would leave the loop to compile in a timed repeat
         traj = simulate_particles(r0=r0, v0=v0, method=method, plain_tier=False, **problem,
                                   **settings(method, setting)).trajectory
-        Y = states(traj)
-        return Y[-1], traj.nfev, lambda: invariant_fn(traj.times, Y)
+        return final(traj, traj.times)
 
     run.prepared_call = prepared_call
     return run
