@@ -26,7 +26,7 @@ LAYERS = {
     "errors": 0, "limits": 0, "validation": 0, "frames": 0, "files": 0, "method_registry": 0,
     "numerics": 1,
     "particles": 2, "rigid": 2,
-    "earth": 3, "analytic": 3, "problem": 3, "forces": 3, "events": 3,
+    "earth": 3, "analytic": 3, "problem": 3, "forces": 3, "events": 3, "torques": 3,
     "scenes": 4,
     "app": 5, "__main__": 5,
 }

@@ -79,11 +79,14 @@ def test_the_particle_glue_renders_and_lints(splitting, omega):
     assert lines[0].startswith("   1  ") and len(lines) == len(source.splitlines())
 
 
-def test_the_body_glue_renders_and_lints():
-    source = glue.body_source(PARAMS)
+@pytest.mark.parametrize("takes_params", [(True,), (False, True, False)])
+def test_the_body_glue_renders_and_lints(takes_params):
+    source = glue.body_source(takes_params, PARAMS)
     text = codegen._HEADER_COMPILED.format(cache=False) + source
     compile(text, "<glue>", "exec")
-    assert _undefined_names(text, {"torque_fn"}) == set()
+    assert _undefined_names(text, {f"torque_{k}" for k in range(len(takes_params))}) == set()
+    calls = [line.strip() for line in source.splitlines() if "torque_" in line]
+    assert calls == [f"a = torque_{k}(t, L, q{', P0, P1, P2' if takes else ''})" for k, takes in enumerate(takes_params)]
 
 
 def test_params_flatten_into_one_array_in_order():

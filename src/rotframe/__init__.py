@@ -58,7 +58,7 @@ _LAZY = {
     "RotframeWarning": "rotframe.errors",
 }
 _SUBMODULES = ("analytic", "app", "earth", "errors", "events", "forces", "frames", "limits", "method_registry", "numerics",
-               "particles", "problem", "rigid", "scenes", "validation")
+               "particles", "problem", "rigid", "scenes", "torques", "validation")
 
 #: Where the modules of the first, flat layout live now: ``rotframe.inertia`` and
 #: ``from rotframe import integrators`` keep working (``import rotframe.inertia`` does not).

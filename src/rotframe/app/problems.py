@@ -77,8 +77,8 @@ def _progress(progress, label):
 def _describe(f):
     from rotframe.problem.callables import display_name
 
-    name = getattr(f, "name", "")  # a built-in term (rotframe.forces) or a named Force
-    return name if isinstance(name, str) and name else display_name(getattr(f, "accel", f))
+    name = getattr(f, "name", "")  # a built-in term (rotframe.forces, rotframe.torques) or a named Force or Torque
+    return name if isinstance(name, str) and name else display_name(getattr(f, "accel", getattr(f, "func", f)))
 
 
 def _result(scn, scene, scene_result, summary):
@@ -259,12 +259,14 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
         Angular momentum in body axes, kg m^2/s.
     q0 : (4,)
         Attitude, a scalar-last unit quaternion rotating body components into space components.
-    torque : callable, optional
-        ``tau(t, L, q, *params) -> (3,)``, N m, body axes, compiled with numba as the forces are.
+    torque : callable, Torque, or a list of them, optional
+        ``tau(t, L, q, *params) -> (3,)``, N m, body axes, compiled with numba as the forces are; a
+        list is summed in order, so the built-in torques of `rotframe.torques` (gravity on a heavy
+        top, a torque fixed in the body or in space) compose with your own.
     method : {"dop853", "rk4", "lie-poisson", "lie-poisson4", "exact"}, optional
-        Any case. The Lie-Poisson splittings (principal axes, ``step``) take a torque of
-        ``(t, q)`` alone, marked ``rotframe.Torque(f, attitude_only=True)``, as a kick; ``exact``
-        takes none. Other torques with a splitting are refused by name.
+        Any case. The Lie-Poisson splittings (principal axes, ``step``) take torques of
+        ``(t, q)`` alone, marked ``rotframe.Torque(f, attitude_only=True)`` (the built-in ones are), as
+        a kick; ``exact`` takes none. Other torques with a splitting are refused by name.
     inline : bool, optional
         Whether the run goes on in a loop compiled with the torque in it, as `rotframe.simulate`'s
         ``inline`` (the same numbers to the bit; by default decided by the run's pace).
@@ -298,12 +300,15 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
         if progress is True:
             bar.close()
     simulate_s = time.perf_counter() - t0
-    terms = ["euler equations"] + ([f"torque {_describe(torque)}"] if torque is not None else [])
+    from rotframe.problem.body import torque_terms
+
+    torques = [term for _, term in torque_terms(torque)]
+    terms = ["euler equations"] + [f"torque {_describe(term)}" for term in torques]
     timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
     summary = _summary("simulate_body", {"duration": float(duration)}, terms, run.method, run.steps,
                        run.diagnostics, run.warnings, run.notes, timing, run.complete, run.t_reached)
     scn = ProblemScenario("simulate_body", "simulate_body", "Your own rigid body (rotframe.simulate_body)",
-                          "Euler's equations" + (" with a torque" if torque is not None else ", torque-free"))
+                          "Euler's equations" + (" with a torque" if torques else ", torque-free"))
     from rotframe.scenes.base import SceneResult
 
     scene_result = SceneResult(run, terms, run.method, run.steps, run.nfev,

@@ -1,10 +1,11 @@
-"""A rigid body of the user's own: any inertia tensor, a torque of the user's, DOP853 or RK4.
+"""A rigid body of the user's own: any inertia tensor, torques of the user's and built-in ones, DOP853 or RK4.
 
-`simulate_rigid_body` is the numerical core of ``rotframe.simulate_body``. The torque
+`simulate_rigid_body` is the numerical core of ``rotframe.simulate_body``. A torque
 is a function ``tau(t, L, q, *params) -> (3,)`` in body axes (N m), compiled with numba into
 a driver generated for it (`rotframe.problem.codegen`, cached on disk), as the forces of
-a particle problem are. A torque-free body may also take ``exact``, the closed-form flow of
-``rotframe.rigid.free_body_exact`` (principal axes).
+a particle problem are; ``torque=`` takes one, or a list of them summed in order, the built-in
+torques of `rotframe.torques` among them (the same kind of object, `Torque`). A torque-free body
+may also take ``exact``, the closed-form flow of ``rotframe.rigid.free_body_exact`` (principal axes).
 
 The splitting methods of the built-in scenes (``lie-poisson``, ``rotation-splitting``...)
 compose the free body's exact flow with a torque's flow, which exists in closed form only
@@ -41,7 +42,7 @@ KICK_METHODS = ("lie-poisson", "lie-poisson4")
 
 @dataclass(frozen=True)
 class Torque:
-    """A user torque with what rotframe should know about it.
+    """A torque with what rotframe should know about it: a user's, or a built-in one (`rotframe.torques`).
 
     Attributes
     ----------
@@ -51,10 +52,21 @@ class Torque:
         True when ``tau`` depends on ``t`` and ``q`` alone (gravity gradient, a field fixed in
         space, a thruster's schedule), not on ``L``: its flow at fixed attitude is a kick, and
         the Lie-Poisson splittings take it.
+    name : str, optional
+        For messages and the run's list of terms (the built-in torques give theirs).
+    takes_params : bool
+        Whether ``func`` takes the run's ``params`` after ``(t, L, q)`` (default True). The built-in
+        torques do not: their constants are their own.
     """
 
     func: object
     attitude_only: bool = False
+    name: str = ""
+    takes_params: bool = True
+
+    def params_for(self, params) -> tuple:
+        """The ``params`` ``func`` is called with: the run's, or none (`takes_params`)."""
+        return tuple(params) if self.takes_params else ()
 
     def __call__(self, *args):
         return self.func(*args)
@@ -110,20 +122,44 @@ def simulate_rigid_body(**kwargs) -> BodyRun:
     return run_falling_back(_simulate_rigid_body, kwargs)
 
 
+def torque_terms(torque) -> list:
+    """``torque=`` as a list of ``(label, Torque)``: one callable or `Torque` (labelled ``torque``), or a list or
+    tuple of them summed in order (``torque[k]``); None or an empty list: none. A one-line ScenarioError for an
+    entry that is not callable."""
+    if torque is None:
+        return []
+    single = not isinstance(torque, (list, tuple))
+    entries = [torque] if single else list(torque)
+    terms = []
+    for k, f in enumerate(entries):
+        label = "torque" if single else f"torque[{k}]"
+        term = f if isinstance(f, Torque) else Torque(f, attitude_only=bool(getattr(f, "attitude_only", False)))
+        if not callable(term.func):
+            raise ScenarioError(f"{label}: {term.func!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
+        terms.append((label, term))
+    return terms
+
+
+def _describe_torques(terms) -> str:
+    """The torques for a message: ``torque=name`` or ``torque[k]=name, ...``."""
+    return ", ".join(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms)
+
+
 def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
                          samples=None, jit=True, progress=None, inline=None, plain_tier=True) -> BodyRun:
     import time
 
-    attitude_only = bool(getattr(torque, "attitude_only", False))
-    if isinstance(torque, Torque):
-        torque = torque.func
-    name = registry.check(method, "bodies", default="dop853",
-                          nor=f"torque={uf.display_name(torque)}" if torque is not None else "")
-    if torque is not None and name == "exact":
-        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: the exact flow is the "
+    terms = torque_terms(torque)
+    attitude_only = all(term.attitude_only for _, term in terms)
+    named = _describe_torques(terms)
+    name = registry.check(method, "bodies", default="dop853", nor=named)
+    if terms and name == "exact":
+        raise ScenarioError(f"method={method!r} cannot take {named}: the exact flow is the "
                             "free body's; use dop853, rk4, or a Lie-Poisson splitting for a torque of (t, q) alone")
-    if torque is not None and name in KICK_METHODS and not attitude_only:
-        raise ScenarioError(f"method={method!r} cannot take torque={uf.display_name(torque)}: it splits the torque as a "
+    if terms and name in KICK_METHODS and not attitude_only:
+        late = next(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms
+                    if not term.attitude_only)
+        raise ScenarioError(f"method={method!r} cannot take {late}: it splits the torque as a "
                             "kick at fixed attitude, exact only for a torque of (t, q) alone; mark such a torque "
                             "rotframe.Torque(f, attitude_only=True), or use dop853 or rk4")
     method = name
@@ -146,22 +182,21 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     q = q / nq
     fixed = method not in ("exact", "dop853")
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
-    if torque is not None and not callable(torque):
-        raise ScenarioError(f"torque: {torque!r} is not callable (a function tau(t, L, q, *params) -> (3,))")
     check_flag(jit, "jit")
     check_inline(inline, jit)
-    if torque is not None:
-        uf.check_compilable("torque", torque, jit)
+    for label, term in terms:
+        uf.check_compilable(label, term.func, jit)
     params = check_params(params)
     if method == "exact":
         return _exact(I, L, q, times)
-    if torque is not None:
-        uf.check_call("torque", torque, (0.0, L.copy(), q.copy(), *params), (3,),
-                      when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")
-        fn = uf.compiled_for_glue(torque) if jit else uf.plain_function(torque)
-        functions = {"torque_fn": fn}
-        glue = body_source(params)
-        key, cache_note = uf.cache_key([("torque", torque)], "")
+    if terms:
+        for label, term in terms:
+            uf.check_call(label, term.func, (0.0, L.copy(), q.copy(), *term.params_for(params)), (3,),
+                          when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")
+        functions = {f"torque_{k}": uf.compiled_for_glue(term.func) if jit else uf.plain_function(term.func)
+                     for k, (_, term) in enumerate(terms)}
+        glue = body_source([term.takes_params for _, term in terms], params)
+        key, cache_note = uf.cache_key([(label, term.func) for label, term in terms], "")
     else:
         functions, glue, key, cache_note = {}, "", "free", None
     cache_notes = [cache_note] if cache_note and jit else []
@@ -172,7 +207,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
         import numba
 
         if isinstance(exc, numba.core.errors.NumbaError):
-            _compile_failed(exc, torque, L, q, params)
+            _compile_failed(exc, terms, L, q, params)
         raise
     y = np.concatenate([L, q])[None, :].copy()
     n = samples + 1
@@ -218,7 +253,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
             except Exception as exc:
                 if tier.plain:  # met again compiled, from the start (`simulate_rigid_body`)
                     raise PlainTierFailed from None
-                _torque_raised(exc, call, saved, y, TC, H, st, torque, budget)
+                _torque_raised(exc, call, saved, y, TC, H, st, terms, budget)
             if compile_s is None:  # the glue's compile and the first call; begun plain, the glue's alone
                 compile_s = (t_call if tier.began_plain else time.perf_counter()) - t0
             if tier.plain:  # a failure met again compiled; compiled from here where the run is seen to be long
@@ -234,18 +269,22 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
             pacer.check(st["NSTEP"], TC)
     except KeyboardInterrupt:
         k = max(int(st["IDX"][0]), 1)
-        raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, torque, compile_s or 0.0,
+        raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, terms, compile_s or 0.0,
                                   [], jit)) from None
     k = int(st["IDX"][0])
     if st["ST"][0] >= 3:
-        partial = _run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, torque, compile_s, [], jit)
+        partial = _run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, terms, compile_s, [], jit)
         t_bad = float(TC[0])
         blame = ""
-        if torque is not None:  # a torque that turns non-finite at a time: probe it inside the failed step
+        if terms:  # a torque that turns non-finite at a time: probe each inside the failed step
             dt = hfix if method != "dop853" else (1.0 if int(st["ST"][0]) == 6 else 10.0) * float(H[0])
             L_last, q_last = y[0, :3].copy(), y[0, 3:].copy()
-            blame, _ = uf.blame_in_step([("torque", torque, lambda tp: (tp, *uf.read_only_args((L_last, q_last)),
-                                                                         *params), "")], t_bad, dt)
+
+            def at_state(own):
+                return lambda tp: (tp, *uf.read_only_args((L_last, q_last)), *own)
+
+            blame, _ = uf.blame_in_step([(label, term.func, at_state(term.params_for(params)), "")
+                                         for label, term in terms], t_bad, dt)
         if int(st["ST"][0]) == 6:  # the torque raised (compiled: the engine stopped at that step)
             raise uf.raised_during_run(f"simulate_body: {blame[2:] or 'the torque raised'} in the step from "
                                        f"t = {t_bad:.9g} s, L = {y[0, :3].tolist()}, q = {y[0, 3:].tolist()}",
@@ -253,13 +292,15 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
-    run = _run(times, OUT[:, 0], method, st, I, True, params, torque, compile_s, [], jit)
+    run = _run(times, OUT[:, 0], method, st, I, True, params, terms, compile_s, [], jit)
     run.notes.extend(cache_notes + [note for note in (tier.note, inlining.note) if note])
     return run
 
 
-def _compile_failed(exc, torque, L, q, params):
-    reason = uf.diagnose_compile([("torque", torque)], lambda role: (0.0, L.copy(), q.copy(), *params))
+def _compile_failed(exc, terms, L, q, params):
+    own = {label: term.params_for(params) for label, term in terms}
+    reason = uf.diagnose_compile([(label, term.func) for label, term in terms],
+                                 lambda role: (0.0, L.copy(), q.copy(), *own[role]))
     raise uf.UserFunctionError(f"simulate_body: {reason or uf.numba_reason(exc)}; pass jit=False to run it in plain "
                                "Python (slow)") from None
 
@@ -271,7 +312,7 @@ def _restore(saved, y, TC, H, st):
         st[key][...] = a
 
 
-def _torque_raised(exc, call, saved, y, TC, H, st, torque, budget):
+def _torque_raised(exc, call, saved, y, TC, H, st, terms, budget):
     """The torque raised inside a compiled call: replay the call one step at a time to give the time and state."""
     _restore(saved, y, TC, H, st)
     what = f"{type(exc).__name__}: {exc}".replace("\n", " ")
@@ -285,11 +326,11 @@ def _torque_raised(exc, call, saved, y, TC, H, st, torque, budget):
             break
         if st["ST"][0] != 0:
             break
-    name = uf.display_name(torque) if torque is not None else "?"
-    raise uf.UserFunctionError(f"simulate_body: torque ({name}) raised {what} {where}") from None
+    names = ", ".join(f"{label} ({term.name or uf.display_name(term.func)})" for label, term in terms) or "torque (?)"
+    raise uf.UserFunctionError(f"simulate_body: {names} raised {what} {where}") from None
 
 
-def _run(times, Y, method, st, I, complete, params, torque, compile_s, warnings, jit):
+def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, jit):
     L = Y[:, :3].copy()
     q = Y[:, 3:7].copy()
     norms = np.linalg.norm(q, axis=1)
@@ -297,16 +338,15 @@ def _run(times, Y, method, st, I, complete, params, torque, compile_s, warnings,
     q /= norms[:, None]
     notes = []
     torque_samples = None
-    if torque is None:
+    if not terms:
         w = L @ np.linalg.inv(I).T
         E = 0.5 * np.einsum("ij,ij->i", L, w)
         Lm = np.linalg.norm(L, axis=1)
         diagnostics["energy_rel_drift"] = float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] else 0.0
         diagnostics["momentum_rel_drift"] = float(np.max(np.abs(Lm - Lm[0])) / Lm[0]) if Lm[0] else 0.0
     else:
-        f = uf.plain_function(torque)
-        torque_samples = np.array([np.asarray(f(t, *uf.read_only_args((L[i], q[i])), *params), float)
-                                   for i, t in enumerate(times)])
+        plain = [(uf.plain_function(term.func), term.params_for(params)) for _, term in terms]
+        torque_samples = np.array([_summed(plain, t, L[i], q[i]) for i, t in enumerate(times)])
         notes.append("a torque acts: energy and |L| are not conserved, and not reported")
     warnings = list(warnings)
     if not jit:
@@ -325,4 +365,13 @@ def _exact(I, L, q, times):
                             "moments, or use dop853")
     Ls, qs = free_body_closed_form(np.diag(I).copy(), L, q, times)  # the reference path: the same bits on every machine
     st = {"NSTEP": np.zeros(1, np.int64), "NFEV": np.zeros(1, np.int64)}
-    return _run(times, np.concatenate([Ls, qs], axis=1), "exact", st, I, True, (), None, 0.0, [], True)
+    return _run(times, np.concatenate([Ls, qs], axis=1), "exact", st, I, True, (), [], 0.0, [], True)
+
+
+def _summed(plain, t, L, q):
+    """The torques' sum at one sample, in their order (as the glue sums them), from their plain functions."""
+    total = None
+    for f, own in plain:
+        tau = np.asarray(f(t, *uf.read_only_args((L, q)), *own), float)
+        total = tau if total is None else total + tau
+    return total

@@ -117,11 +117,17 @@ def particle_source(forces, events, params, *, splitting: bool, omega: str, orig
     return "".join(src)
 
 
-def body_source(params) -> str:
-    """The glue of a body under the user's torque (bound ``torque_fn``): ``terms``."""
-    return ("\n@jit(TERMS_SIG)\ndef terms(t, y, p, out):\n" + params_source(params)
-            + f"    a = torque_fn(t, readonly(y[0:3]), readonly(y[3:7]){_args(params)})\n"
-            + "    out[0] = a[0]\n    out[1] = a[1]\n    out[2] = a[2]\n")
+def body_source(takes_params, params) -> str:
+    """The glue of a body under its torques (bound ``torque_0``, ``torque_1``...; ``takes_params[k]``: whether
+    torque k takes the run's ``params``): ``terms``, their sum in order (one torque: its value)."""
+    src = ["\n@jit(TERMS_SIG)\ndef terms(t, y, p, out):\n", params_source(params),
+           "    L = readonly(y[0:3])\n    q = readonly(y[3:7])\n"]
+    for k, takes in enumerate(takes_params):
+        src.append(f"    a = torque_{k}(t, L, q{_args(params) if takes else ''})\n")
+        src.append("    tx = a[0]\n    ty = a[1]\n    tz = a[2]\n" if k == 0 else
+                   "    tx += a[0]\n    ty += a[1]\n    tz += a[2]\n")
+    src.append("    out[0] = tx\n    out[1] = ty\n    out[2] = tz\n")
+    return "".join(src)
 
 
 def render(source: str) -> str:
