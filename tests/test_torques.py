@@ -27,15 +27,15 @@ from rotframe.rigid.kernels import body_torque
 TOP = dict(inertia=[0.02, 0.02, 0.01], L0=[0.0, 0.0, 0.01 * 40.0],
            q0=Rotation.from_euler("x", 20.0, degrees=True).as_quat().tolist())
 MASS, LENGTH, G = 0.5, 0.04, 9.81
-MGL = MASS * LENGTH * G
+MGL = MASS * G * LENGTH  # as rotframe.rigid.checks.heavy_top_mgl multiplies
 
 
 def _mine_gravity(t, L, q):  # your own torque, the built-in's arithmetic (the scenes' body_torque)
-    return body_torque(q[0], q[1], q[2], q[3], MASS * LENGTH * G, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    return body_torque(q[0], q[1], q[2], q[3], MASS * G * LENGTH, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def _mine_both(t, L, q):  # gravity and a torque fixed in space, summed as the glue sums a list
-    a = body_torque(q[0], q[1], q[2], q[3], MASS * LENGTH * G, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    a = body_torque(q[0], q[1], q[2], q[3], MASS * G * LENGTH, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     b = body_torque(q[0], q[1], q[2], q[3], 0.0, 0.0, 0.0, 0.0, 0.01, -0.02, 0.003)
     return a[0] + b[0], a[1] + b[1], a[2] + b[2]
 

@@ -79,7 +79,7 @@ def gravity(mass, length, g) -> Torque:
     ``tau = l e3 x (-m g z_b) = m g l (z_b[1], -z_b[0], 0)`` in body axes, with ``z_b`` space's
     vertical (gravity along -z of space). ``mass`` in kg, ``length`` in m (negative: the centre of
     mass below the pivot), ``g`` in m/s^2 (> 0). The heavy-top scene's torque, with ``m g l``
-    multiplied as it does (``mass * length * g``).
+    multiplied as its splitting does (`rotframe.rigid.checks.heavy_top_mgl`: ``mass * g * length``).
 
     Examples
     --------
@@ -98,7 +98,7 @@ def gravity(mass, length, g) -> Torque:
         raise ScenarioError(f"gravity: mass={mass!r} must be > 0 (kg)")
     if not gv > 0:
         raise ScenarioError(f"gravity: g={g!r} must be > 0 (m/s^2, along -z of space)")
-    mgl = m * l * gv
+    mgl = m * gv * l
 
     def gravity(t, L, q):
         return _body_torque(q[0], q[1], q[2], q[3], mgl, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)

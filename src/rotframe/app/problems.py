@@ -263,10 +263,11 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
         ``tau(t, L, q, *params) -> (3,)``, N m, body axes, compiled with numba as the forces are; a
         list is summed in order, so the built-in torques of `rotframe.torques` (gravity on a heavy
         top, a torque fixed in the body or in space) compose with your own.
-    method : {"dop853", "rk4", "lie-poisson", "lie-poisson4", "exact"}, optional
-        Any case. The Lie-Poisson splittings (principal axes, ``step``) take torques of
-        ``(t, q)`` alone, marked ``rotframe.Torque(f, attitude_only=True)`` (the built-in ones are), as
-        a kick; ``exact`` takes none. Other torques with a splitting are refused by name.
+    method : {"dop853", "rk4", "lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "top-splitting", "top-splitting4", "top-splitting6", "top-splitting8", "exact"}, optional
+        Any case. The splittings (principal axes, ``step``; the rigid scenes' own step, a symmetric
+        body's free flow exactly; ``top-splitting`` a symmetric body only) take torques of ``(t, q)``
+        alone, marked ``rotframe.Torque(f, attitude_only=True)`` (the built-in ones are), as a kick;
+        ``exact`` takes none. Other torques with a splitting are refused by name.
     inline : bool, optional
         Whether the run goes on in a loop compiled with the torque in it, as `rotframe.simulate`'s
         ``inline`` (the same numbers to the bit; by default decided by the run's pace).

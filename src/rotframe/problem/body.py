@@ -26,6 +26,7 @@ from rotframe.problem import callables as uf
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
+from rotframe.problem.models import body_constants
 from rotframe.problem.signatures import BODY
 from rotframe.problem.pacing import Pacer
 from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
@@ -36,8 +37,10 @@ from rotframe.validation import refuse_units
 
 __all__ = ["simulate_rigid_body", "BodyRun", "Torque"]
 
-#: Lie-Poisson splittings: the torque as a kick at fixed attitude (a torque of (t, q) alone)
-KICK_METHODS = ("lie-poisson", "lie-poisson4")
+#: the splittings (the rigid scenes' own step, `rotframe.problem.models.lie_poisson_strang`): principal axes, the torque
+#: as a kick at fixed attitude (a torque of (t, q) alone); the top-splittings need a symmetric body
+KICK_METHODS = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "top-splitting", "top-splitting4",
+                "top-splitting6", "top-splitting8")
 
 
 @dataclass(frozen=True)
@@ -167,6 +170,10 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     if method in KICK_METHODS and np.any(I != np.diag(np.diag(I))):
         raise ScenarioError(f"method={method!r} turns about the principal axes: give the 3 principal moments (a "
                             "diagonal inertia), or use dop853 or rk4")
+    inv_principal, symmetry = _free_step_constants(I)
+    if method.startswith("top-splitting") and symmetry < 0:
+        raise ScenarioError(f"method={method!r} takes the free flow of a symmetric body: two of the principal moments "
+                            f"{np.diag(I).tolist()} must be equal; use a lie-poisson splitting, dop853 or rk4")
     refuse_units(L0, "L0", ScenarioError)
     refuse_units(q0, "q0", ScenarioError)
     try:
@@ -213,7 +220,6 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     n = samples + 1
     OUT = np.full((n, 1, 7), np.nan)
     OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
-    Iinv = np.ascontiguousarray(np.linalg.inv(I))
     sL = max(float(np.max(np.abs(L))), 1e-300)
     atol = np.array([[rtol * sL] * 3 + [rtol] * 4])  # one row per body (the stepping's per-particle atol)
     st = {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")}
@@ -222,7 +228,8 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     GPREV = np.zeros((1, 1))
     EDIR, ETERM = np.zeros(0), np.zeros(0, dtype=bool)
     compile_s = None
-    prob = (BODY, np.ascontiguousarray(Iinv.ravel()), flatten_params(params), 0, np.zeros(1), np.zeros((1, 1, 3)), 0,
+    prob = (BODY, body_constants(I, inv_principal, symmetry, bool(terms)), flatten_params(params), 0, np.zeros(1),
+            np.zeros((1, 1, 3)), 0,
             np.zeros(1), np.zeros((1, 1, 3)))
     fns = driver.functions(prob)
     # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
@@ -297,6 +304,18 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     return run
 
 
+def _free_step_constants(I):
+    """``(inv_principal (4,), symmetry axis or -1)`` of the splittings' free step (`rotframe.rigid.kernels.free_step`),
+    as the rigid scenes compute them (`rotframe.rigid.checks.check_inertia`); zeros and -1 off principal axes."""
+    from rotframe.rigid.checks import check_inertia, symmetry_axis
+
+    if np.any(I != np.diag(np.diag(I))):
+        return np.zeros(4), -1
+    moments, inv_principal = check_inertia(np.diag(I).copy())
+    symmetry = symmetry_axis(moments)
+    return inv_principal, -1 if symmetry is None else symmetry
+
+
 def _compile_failed(exc, terms, L, q, params):
     own = {label: term.params_for(params) for label, term in terms}
     reason = uf.diagnose_compile([(label, term.func) for label, term in terms],
@@ -335,7 +354,8 @@ def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, 
     q = Y[:, 3:7].copy()
     norms = np.linalg.norm(q, axis=1)
     diagnostics = {"quaternion_norm_drift": float(np.max(np.abs(norms - 1.0)))}
-    q /= norms[:, None]
+    if method not in KICK_METHODS and method != "exact":  # the splittings normalise each step's, as the scenes do
+        q /= norms[:, None]
     notes = []
     torque_samples = None
     if not terms:

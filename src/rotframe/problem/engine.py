@@ -18,7 +18,8 @@ from numba's cache; no problem ever compiles the loop again.
   inside a step from Hairer's dense output of order 7, the events watched after each accepted
   step (`_watch_events`), a budget of accepted steps per call (`_dop853_loop`).
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
-  ``SPLITTING`` and ``SPLITTING4``): a fixed step that divides each sample interval.
+  ``SPLITTING`` and its compositions ``SPLITTING4``, ``SPLITTING6``, ``SPLITTING8``): a fixed step that
+  divides each sample interval.
 * Events: a sign change of g over a step (with its direction) is bisected on the step's
   length, each trial a re-step from the step's start by the same method, to round-off in
   time on the method's own discrete trajectory (as the built-in ground event,
@@ -59,7 +60,8 @@ from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINI
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
 from rotframe.numerics.step_control import start_short_of
 from rotframe.problem.calls import RAISED, call_event, direct_functions
-from rotframe.problem.models import DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, particle_energy, rhs
+from rotframe.problem.models import (DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8, particle_energy,
+                                     rhs)
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
 from rotframe.problem.stops import next_stop
@@ -501,9 +503,12 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
 #: equations, `rotframe.problem.models`): a particle's rotation splittings and a body's Lie-Poisson splittings are the
 #: model's own splitting of order 2 and 4
 METHOD_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4,
-                "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4}
+                "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4, "lie-poisson6": SPLITTING6,
+                "lie-poisson8": SPLITTING8, "top-splitting": SPLITTING, "top-splitting4": SPLITTING4,
+                "top-splitting6": SPLITTING6, "top-splitting8": SPLITTING8}
 #: the variants' names of the codes
-METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4"}
+METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4", SPLITTING6: "splitting6",
+                SPLITTING8: "splitting8"}
 _VARIANTS: dict = {}
 
 

@@ -23,7 +23,9 @@ momentum in body axes and the attitude (body to space, scalar last)::
 
     L' = L x omega + tau(t, L, q),   omega = I^-1 L,   q' = q (omega, 0) / 2
 
-``M`` = ``I^-1`` by rows (9 numbers).
+``M`` (`body_constants`) = ``I^-1`` by rows (9 numbers), then what the splittings' free step takes
+(`rotframe.rigid.kernels.free_step`): the principal inverses and ``1/I_s - 1/I_p`` (4), the symmetry
+axis (-1: none), and 1 where torques act (the kicks; 0: none).
 
 **Vectors of time** (`vector_of_time`): omega and omega' of the frame, a0 of its origin, by
 kind: ``ZERO``; ``CONSTANT`` (``C[0, 0]``); ``TABLE``, a C2 cubic spline (``T`` the knots,
@@ -33,13 +35,15 @@ user's ``omega(t)`` with omega' from the fourth-order central difference of step
 (`rotframe.problem.frame.derivative_step`) or ``FUNCTION_DOT``, with the user's omega'.
 The numpy twins used for analysis are in `rotframe.problem.frame`.
 
-**Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING`` and ``SPLITTING4``):
-a particle's rotation splitting (docs/physics/splitting.md: drift, kick, the Coriolis rotation,
-a drag term's exact flow; with a pendulum's string, the same on the string's sphere, `sphere_strang`:
-the great-circle flow for the drift, the Coriolis rotation about the string) and a body's
-Lie-Poisson splitting (McLachlan 1993; Dullweber, Leimkuhler & McLachlan 1997: exact rotations about the principal axes, the torque a kick at
-fixed attitude), each of order 2, and Yoshida's triple jump of it, order 4
-(`rotframe.numerics.composition`).
+**Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING``, ``SPLITTING4``,
+``SPLITTING6``, ``SPLITTING8``): a particle's rotation splitting (docs/physics/splitting.md: drift,
+kick, the Coriolis rotation, a drag term's exact flow; with a pendulum's string, the same on the
+string's sphere, `sphere_strang`: the great-circle flow for the drift, the Coriolis rotation about
+the string) and a body's splitting, the rigid scenes' own step (`rotframe.rigid.kernels.free_step`:
+the free flow exactly for a symmetric body, else the Lie-Poisson splitting, McLachlan 1993;
+Dullweber, Leimkuhler & McLachlan 1997: exact rotations about the principal axes; the torques a kick
+at fixed attitude), each of order 2, Yoshida's triple jump of it, order 4, and Kahan & Li's
+compositions of orders 6 and 8 (`rotframe.numerics.composition`).
 
 The string's tension, the air's density and the splitting kick's frame terms (centrifugal, Euler, for
 any vector omega) are `rotframe.particles.accelerations`' (each term's arithmetic written once, for
@@ -73,20 +77,25 @@ from __future__ import annotations
 import math
 
 from rotframe.numerics.compiled import bound, jit_inline, jit_llvm_inline, jit_uncounted
-from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
+from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER, composition_weights
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
 from rotframe.particles.accelerations import air_density, centrifugal, euler, string_tension
 from rotframe.particles.forces import drag_flow
+from rotframe.rigid.kernels import free_step
 from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
-           "SPLITTING4", "SCRATCH", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
+           "SPLITTING4", "SPLITTING6", "SPLITTING8", "SCRATCH", "BODY_CONSTANTS", "body_constants", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
 
 #: kinds of a vector of time
 ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
 #: method codes of the compiled loop (the names are `rotframe.method_registry`'s; no code leaves this package)
-DOP853, RK4, SPLITTING, SPLITTING4 = range(4)
+DOP853, RK4, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8 = range(6)
+#: Kahan & Li's fractions of the order-2 step in the compositions of orders 6 and 8 (`rotframe.numerics.composition`,
+#: the scenes' own), constants of the compiled step
+KAHAN_LI6_STEPS = tuple(float(w) for w in composition_weights(6))
+KAHAN_LI8_STEPS = tuple(float(w) for w in composition_weights(8))
 #: the length of the scratch ``W`` (its last slot: `rotframe.problem.calls.RAISED`)
 SCRATCH = 7
 
@@ -433,33 +442,6 @@ def sphere_strang(t, h, yn, prob, fns, W):
 
 
 @jit_llvm_inline
-def turn_about_axis(k, a, yn):
-    """The exact flow of H_k = L_k^2 / (2 I_k) for an angle a = h L_k / I_k: L turns by -a about body
-    axis k, the attitude by +a about it (q <- q (e_k sin(a/2), cos(a/2)))."""
-    c = math.cos(a)
-    s = math.sin(a)
-    i = (k + 1) % 3
-    j = (k + 2) % 3
-    li = yn[i]
-    lj = yn[j]
-    yn[i] = c * li + s * lj
-    yn[j] = -s * li + c * lj
-    hc = math.cos(0.5 * a)
-    hs = math.sin(0.5 * a)
-    qx = yn[3]
-    qy = yn[4]
-    qz = yn[5]
-    qw = yn[6]
-    ex = hs if k == 0 else 0.0
-    ey = hs if k == 1 else 0.0
-    ez = hs if k == 2 else 0.0
-    yn[3] = qw * ex + hc * qx + (qy * ez - qz * ey)
-    yn[4] = qw * ey + hc * qy + (qz * ex - qx * ez)
-    yn[5] = qw * ez + hc * qz + (qx * ey - qy * ex)
-    yn[6] = qw * hc - (qx * ex + qy * ey + qz * ez)
-
-
-@jit_llvm_inline
 def torque_kick(t, h, yn, prob, fns, W):
     """L += h tau(t, L, q): exact for a torque of (t, q) alone (the only torques the splittings take)."""
     call_terms(fns[0], t, yn, prob[2], W)
@@ -468,18 +450,33 @@ def torque_kick(t, h, yn, prob, fns, W):
     yn[2] += h * W[2]
 
 
+#: a body's constants in ``M`` (`body_constants`): I^-1 by rows (9), then the free step's (`free_step`): the
+#: principal inverses and 1/I_s - 1/I_p (4), the symmetry axis (-1: none), and 1 where torques act (0: no kick)
+BODY_CONSTANTS = 15
+
+
+def body_constants(inertia, inv_principal, symmetry, kicks):
+    """``M`` of a body (`BODY_CONSTANTS` numbers): ``inertia``'s inverse by rows, ``inv_principal`` (4, as
+    `rotframe.rigid.checks.check_inertia` gives it, zeros off principal axes), the ``symmetry`` axis (-1: none)
+    and ``kicks`` (whether torques act)."""
+    import numpy as np
+
+    return np.ascontiguousarray(np.concatenate([np.linalg.inv(inertia).ravel(), inv_principal,
+                                                [float(symmetry), 1.0 if kicks else 0.0]]))
+
+
 @jit_llvm_inline
 def lie_poisson_strang(t, h, yn, prob, fns, W):
-    """Kick(h/2) . R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2) . kick(h/2): second order, symplectic on the
-    Lie-Poisson manifold (principal axes: ``M`` holds the diagonal I^-1)."""
+    """Kick(h/2) . free(h) . kick(h/2), the rigid scenes' own step (`rotframe.rigid.kernels.free_step`, written once):
+    the free flow exactly for a symmetric body (turning about L and about its symmetry axis), else the
+    1,2,3,2,1 Lie-Poisson splitting (McLachlan 1993); second order, symplectic on the Lie-Poisson manifold
+    (principal axes). The kicks are skipped where no torque acts."""
     M = prob[1]
-    torque_kick(t, 0.5 * h, yn, prob, fns, W)
-    turn_about_axis(0, 0.5 * h * yn[0] * M[0], yn)
-    turn_about_axis(1, 0.5 * h * yn[1] * M[4], yn)
-    turn_about_axis(2, h * yn[2] * M[8], yn)
-    turn_about_axis(1, 0.5 * h * yn[1] * M[4], yn)
-    turn_about_axis(0, 0.5 * h * yn[0] * M[0], yn)
-    torque_kick(t + h, 0.5 * h, yn, prob, fns, W)
+    if M[14] != 0.0:
+        torque_kick(t, 0.5 * h, yn, prob, fns, W)
+    free_step(yn[0:3], yn[3:7], h, M[9:13], int(M[13]))
+    if M[14] != 0.0:
+        torque_kick(t + h, 0.5 * h, yn, prob, fns, W)
 
 
 @jit_llvm_inline
@@ -495,17 +492,33 @@ def strang(body, t, h, yn, prob, fns, W):
 
 @jit_llvm_inline
 def own_step(body, method, t, y, h, yn, prob, fns, W):
-    """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4)."""
+    """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4);
+    ``SPLITTING6``, ``SPLITTING8``: Kahan & Li's compositions of it (orders 6 and 8). A body's attitude is
+    normalised after the step, as the rigid scenes' splitting does (`rotframe.rigid.kernels.split_run`)."""
     for j in range(y.shape[0]):
         yn[j] = y[j]
     if method == SPLITTING:
         strang(body, t, h, yn, prob, fns, W)
-    else:
+    elif method == SPLITTING4:
         w1 = YOSHIDA4_OUTER
         w0 = YOSHIDA4_INNER
         strang(body, t, w1 * h, yn, prob, fns, W)
         strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
         strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+    elif method == SPLITTING6:
+        done = 0.0
+        for w in KAHAN_LI6_STEPS:
+            strang(body, t + done * h, w * h, yn, prob, fns, W)
+            done += w
+    else:
+        done = 0.0
+        for w in KAHAN_LI8_STEPS:
+            strang(body, t + done * h, w * h, yn, prob, fns, W)
+            done += w
+    if body is not None:
+        norm_q = math.sqrt(yn[3] * yn[3] + yn[4] * yn[4] + yn[5] * yn[5] + yn[6] * yn[6])
+        for j in range(3, 7):
+            yn[j] /= norm_q
 
 
 @jit_uncounted
