@@ -148,10 +148,63 @@ def _describe_torques(terms) -> str:
     return ", ".join(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms)
 
 
-def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
-                         samples=None, jit=True, progress=None, inline=None, plain_tier=True) -> BodyRun:
-    import time
+@dataclass
+class BodySetUp:
+    """A body's run set up (`body_set_up`): what `simulate_rigid_body` and a prepared run
+    (`rotframe.problem.prepared_body.PreparedBody`) share."""
 
+    I: np.ndarray  # the inertia tensor (3, 3), kg m^2
+    L: np.ndarray  # the first start state, checked: L (3,) and q (4,), normalised
+    q: np.ndarray
+    method: str
+    duration: float
+    samples: int
+    times: np.ndarray
+    rtol: float
+    hfix: float
+    terms: list  # [(label, Torque)]
+    params: tuple
+    jit: bool
+    inline: object
+    driver: object = None  # the compiled driver and its problem (None for method exact)
+    prob: tuple = ()
+    fns: tuple = ()
+    functions: dict = None
+    glue: str = ""
+    key: object = None
+    cache_notes: list = None
+
+    def plain_driver(self):
+        """The same body as plain Python, for a first run whose loop is not compiled yet (`rotframe.problem.tiers`)."""
+        plain = {name: uf.plain_function(f) for name, f in self.functions.items()}
+        return Driver(build_module("body", self.key, plain, self.glue, compiled=False), compiled=False)
+
+
+def checked_body_state(L0, q0):
+    """``(L, q)`` as float64 (3,) and (4,), finite, q within 1e-6 of unit length and normalised; a one-line
+    ScenarioError otherwise."""
+    refuse_units(L0, "L0", ScenarioError)
+    refuse_units(q0, "q0", ScenarioError)
+    try:
+        L = np.asarray(L0, dtype=float)
+        q = np.asarray(q0, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"L0, q0: {str(L0)[:40]!r}, {str(q0)[:40]!r} are not numbers") from None
+    if L.shape != (3,) or q.shape != (4,) or not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
+        raise ScenarioError(f"L0, q0: expected finite (3,) and (4,), got shapes {L.shape} and {q.shape}")
+    nq = float(np.linalg.norm(q))
+    if abs(nq - 1.0) > 1e-6:
+        raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
+    return L, q / nq
+
+
+def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                samples=None, jit=True, inline=None) -> BodySetUp:
+    """Check a body's run and build its driver (`rotframe.simulate_body`'s arguments): a `BodySetUp`.
+
+    Every argument is checked, each torque called once at the start state and compiled into the
+    problem's glue (cached on disk); ``method="exact"`` builds no driver.
+    """
     terms = torque_terms(torque)
     attitude_only = all(term.attitude_only for _, term in terms)
     named = _describe_torques(terms)
@@ -174,19 +227,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     if method.startswith("top-splitting") and symmetry < 0:
         raise ScenarioError(f"method={method!r} takes the free flow of a symmetric body: two of the principal moments "
                             f"{np.diag(I).tolist()} must be equal; use a lie-poisson splitting, dop853 or rk4")
-    refuse_units(L0, "L0", ScenarioError)
-    refuse_units(q0, "q0", ScenarioError)
-    try:
-        L = np.asarray(L0, dtype=float)
-        q = np.asarray(q0, dtype=float)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"L0, q0: {str(L0)[:40]!r}, {str(q0)[:40]!r} are not numbers") from None
-    if L.shape != (3,) or q.shape != (4,) or not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
-        raise ScenarioError(f"L0, q0: expected finite (3,) and (4,), got shapes {L.shape} and {q.shape}")
-    nq = float(np.linalg.norm(q))
-    if abs(nq - 1.0) > 1e-6:
-        raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
-    q = q / nq
+    L, q = checked_body_state(L0, q0)
     fixed = method not in ("exact", "dop853")
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
     check_flag(jit, "jit")
@@ -194,52 +235,69 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     for label, term in terms:
         uf.check_compilable(label, term.func, jit)
     params = check_params(params)
+    s = BodySetUp(I, L, q, method, duration, samples, times, rtol, hfix, terms, params, jit, inline)
     if method == "exact":
-        return _exact(I, L, q, times)
+        return s
     if terms:
         for label, term in terms:
             uf.check_call(label, term.func, (0.0, L.copy(), q.copy(), *term.params_for(params)), (3,),
                           when=f"at t = 0 s, L = {L.tolist()}, q = {q.tolist()}")
-        functions = {f"torque_{k}": uf.compiled_for_glue(term.func) if jit else uf.plain_function(term.func)
-                     for k, (_, term) in enumerate(terms)}
-        glue = body_source([term.takes_params for _, term in terms], params)
-        key, cache_note = uf.cache_key([(label, term.func) for label, term in terms], "")
+        s.functions = {f"torque_{k}": uf.compiled_for_glue(term.func) if jit else uf.plain_function(term.func)
+                       for k, (_, term) in enumerate(terms)}
+        s.glue = body_source([term.takes_params for _, term in terms], params)
+        s.key, cache_note = uf.cache_key([(label, term.func) for label, term in terms], "")
     else:
-        functions, glue, key, cache_note = {}, "", "free", None
-    cache_notes = [cache_note] if cache_note and jit else []
-    t0 = time.perf_counter()
+        s.functions, s.glue, s.key, cache_note = {}, "", "free", None
+    s.cache_notes = [cache_note] if cache_note and jit else []
     try:
-        driver = Driver(build_module("body", key, functions, glue, compiled=jit, notes=cache_notes), compiled=jit)
+        s.driver = Driver(build_module("body", s.key, s.functions, s.glue, compiled=jit, notes=s.cache_notes),
+                          compiled=jit)
     except Exception as exc:
         import numba
 
         if isinstance(exc, numba.core.errors.NumbaError):
             _compile_failed(exc, terms, L, q, params)
         raise
+    s.prob = (BODY, body_constants(I, inv_principal, symmetry, bool(terms)), flatten_params(params), 0, np.zeros(1),
+              np.zeros((1, 1, 3)), 0, np.zeros(1), np.zeros((1, 1, 3)))
+    s.fns = s.driver.functions(s.prob)
+    return s
+
+
+def body_arrays(s, L, q):
+    """A run's arrays from the start state ``L``, ``q`` (`checked_body_state`): ``y`` (1, 7), the samples ``OUT``
+    (n, 1, 7) with the start in row 0, the tolerances ``atol`` (1, 7), the per-body counters ``st``, time ``TC`` and
+    step ``H``, and the (empty) event arrays, by the names `rotframe.problem.engine.advance` takes them."""
     y = np.concatenate([L, q])[None, :].copy()
-    n = samples + 1
-    OUT = np.full((n, 1, 7), np.nan)
+    OUT = np.full((s.samples + 1, 1, 7), np.nan)
     OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
     sL = max(float(np.max(np.abs(L))), 1e-300)
-    atol = np.array([[rtol * sL] * 3 + [rtol] * 4])  # one row per body (the stepping's per-particle atol)
-    st = {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")}
-    TC, H = np.zeros(1), np.zeros(1)
-    EVT, EVY, EVK = np.zeros((1, 1)), np.zeros((1, 1, 7)), np.zeros((1, 1), np.int64)
-    GPREV = np.zeros((1, 1))
-    EDIR, ETERM = np.zeros(0), np.zeros(0, dtype=bool)
+    return {"y": y, "OUT": OUT, "atol": np.array([[s.rtol * sL] * 3 + [s.rtol] * 4]),  # a row per body
+            "st": {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")},
+            "TC": np.zeros(1), "H": np.zeros(1), "EVT": np.zeros((1, 1)), "EVY": np.zeros((1, 1, 7)),
+            "EVK": np.zeros((1, 1), np.int64), "GPREV": np.zeros((1, 1)), "EDIR": np.zeros(0),
+            "ETERM": np.zeros(0, dtype=bool), "S": np.empty(0)}
+
+
+def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                         samples=None, jit=True, progress=None, inline=None, plain_tier=True) -> BodyRun:
+    import time
+
+    t0 = time.perf_counter()  # the glue's compile and the first call count as compile time
+    s = body_set_up(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params, method=method,
+                    rtol=rtol, step=step, samples=samples, jit=jit, inline=inline)
+    if s.method == "exact":
+        return _exact(s.I, s.L, s.q, s.times)
+    I, L, q, method, times, rtol, hfix, terms, params = s.I, s.L, s.q, s.method, s.times, s.rtol, s.hfix, s.terms, s.params
+    duration, driver, prob, fns, cache_notes = s.duration, s.driver, s.prob, s.fns, s.cache_notes
+    a = body_arrays(s, L, q)
+    y, OUT, atol, st, TC, H = a["y"], a["OUT"], a["atol"], a["st"], a["TC"], a["H"]
+    EVT, EVY, EVK, GPREV, EDIR, ETERM = a["EVT"], a["EVY"], a["EVK"], a["GPREV"], a["EDIR"], a["ETERM"]
+    n = s.samples + 1
     compile_s = None
-    prob = (BODY, body_constants(I, inv_principal, symmetry, bool(terms)), flatten_params(params), 0, np.zeros(1),
-            np.zeros((1, 1, 3)), 0,
-            np.zeros(1), np.zeros((1, 1, 3)))
-    fns = driver.functions(prob)
     # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
     inlining = Inlining(driver.module, BODY, method, False, 7, None, inline if jit else False)
-
-    def plain_driver():  # the same body as plain Python, for a first run whose loop is not compiled yet
-        plain = {name: uf.plain_function(f) for name, f in functions.items()}
-        return Driver(build_module("body", key, plain, glue, compiled=False), compiled=False)
-
-    tier = Tier(driver, fns, plain_driver if jit and inline is not True and plain_tier else None,
+    tier = Tier(driver, fns, s.plain_driver if jit and inline is not True and plain_tier else None,
                 (BODY, method, False, 7), prob, 1)
 
     def call(budget):

@@ -430,8 +430,9 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
         t, h, idx = load_particle(i, Y, TC, H, IDX, y)
         sub = SUB[i]
         W[RAISED] = 0.0
-        rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
-        NFEV[i] += 1
+        if METHOD == RK4:  # its first stage, f at the step's start (a splitting evaluates what it needs itself)
+            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+            NFEV[i] += 1
         steps = 0
         status = 0
         while idx < n and steps < budget:
@@ -492,8 +493,9 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             t = t_new
             for j in range(D):
                 y[j] = yn[j]
-            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
-            NFEV[i] += 1
+            if METHOD == RK4:
+                rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+                NFEV[i] += 1
         if status == 0 and idx >= n:
             status = 1
         save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)

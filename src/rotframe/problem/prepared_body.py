@@ -1,0 +1,190 @@
+"""Many runs of one rigid body from different start states, set up once: the bodies' `PreparedProblem`.
+
+`rotframe.simulate_body` checks its arguments, calls each torque once, finds the body's compiled
+glue and paces the run in calls: a fraction of a millisecond, more than a short run's
+integration. A `PreparedBody` does the set-up once (`rotframe.problem.body.body_set_up`, the same
+as ``simulate_body``'s) and loads the body's inlined loop (`rotframe.problem.inlined`: the torques
+compiled into the engine's loop, cached on disk); each `PreparedBody.states` then makes the run's
+arrays and makes one call of that loop. For the rigid scenes' bench rows, shooting and Monte Carlo
+over start states: the engine's counterpart of the rigid scenes' `rotframe.rigid.prepared.PreparedBodyRun`.
+
+A run gives ``simulate_body``'s samples for the same arguments, to the bit: the same loop, the same
+steps (a call's budget of steps never changes them: `rotframe.problem.engine`). What it leaves out
+is what ``simulate_body`` adds around them: the progress bar, the run's notes. A run that fails (a
+torque that raised, a state not finite, a step that collapsed) is run again by ``simulate_body``
+from the same start, which raises as it does (the time, the state, the torque to blame, the samples
+up to there).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rotframe.problem.body import (KICK_METHODS, _exact, _run, body_arrays, body_set_up, checked_body_state,
+                                   simulate_rigid_body)
+from rotframe.problem.engine import scratch
+from rotframe.problem.inlined import Inlining
+from rotframe.problem.signatures import BODY
+
+__all__ = ["PreparedBody"]
+
+#: a call's budget of steps: the whole run in one call (the budget never changes the steps)
+_WHOLE_RUN = 2 ** 62
+
+
+class PreparedBody:
+    """A rigid body of `rotframe.simulate_body`, set up once and run from many start states.
+
+    Parameters
+    ----------
+    inertia, L0, q0, duration, torque, params, method, rtol, step, samples
+        As `rotframe.simulate_body` takes them (SI floats here: the core takes no units); ``L0``,
+        ``q0`` the first start state, on which every check is made (each torque is called once).
+    inline : bool
+        True (default): the runs use the body's inlined loop (`rotframe.problem.inlined`), loaded
+        from the disk cache or compiled here (seconds, once per torque ever); False: the engine's
+        loop, which calls the torques by address (nothing to compile).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rotframe.problem.prepared_body import PreparedBody
+    >>> spin = PreparedBody(inertia=[1.0, 2.0, 3.0], L0=[0.0, 2.0, 0.0], q0=[0, 0, 0, 1], duration=1.0,
+    ...                     method="lie-poisson4", step=0.01, samples=10, inline=False)
+    >>> L, q = spin.states([0.0, 2.0, 0.0], [0, 0, 0, 1])
+    >>> L.shape, q.shape
+    ((11, 3), (11, 4))
+    >>> bool(np.allclose(L, [0.0, 2.0, 0.0]))        # a steady spin about the middle axis stays one
+    True
+    """
+
+    def __init__(self, *, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
+                 samples=None, inline=True):
+        from rotframe.errors import ScenarioError
+
+        if not isinstance(inline, bool):
+            raise ScenarioError(f"inline={inline!r}: True (the torques compiled into the loop) or False (called by "
+                                "address)")
+        self._arguments = dict(inertia=inertia, duration=duration, torque=torque, params=params, method=method,
+                               rtol=rtol, step=step, samples=samples)
+        s = self.setup = body_set_up(L0=L0, q0=q0, jit=True, inline=inline, **self._arguments)
+        #: the sample times (s), (samples + 1,), and the method's canonical name
+        self.times, self.method = s.times, s.method
+        #: the last run's accepted steps and evaluations of the right-hand side
+        self.steps = self.nfev = 0
+        self.notes = []
+        self._kernel = None
+        self._exact = s.method == "exact"
+        if not self._exact:
+            inlining = Inlining(s.driver.module, BODY, s.method, False, 7, None, inline)
+            inlining.start()
+            self._kernel = inlining.kernel
+            self.notes = [inlining.note] if inlining.note else []
+        self._work = scratch(7)
+        self._arrays = None if self._exact else _KeptArrays(body_arrays(s, s.L, s.q))
+        #: whether the samples' attitudes are normalised after the run (as simulate_body's, where the method does
+        #: not normalise each step's)
+        self._normalise = s.method not in KICK_METHODS and s.method != "exact"
+
+    def states(self, L0, q0):
+        """The samples of a run from ``L0``, ``q0`` as arrays ``(L (n, 3), q (n, 4))``: ``simulate_body``'s
+        ``trajectory.L`` and ``.q`` for the same arguments, to the bit, without the result around them."""
+        if self._exact:  # the closed-form free flow
+            from rotframe.rigid.free_body import free_body_closed_form
+
+            L, q = checked_body_state(L0, q0)
+            return free_body_closed_form(np.diag(self.setup.I).copy(), L, q, self.times)
+        Y = self._integrate(L0, q0)
+        Ls, qs = Y[:, :3].copy(), Y[:, 3:7].copy()
+        if self._normalise:
+            qs /= np.linalg.norm(qs, axis=1)[:, None]
+        return Ls, qs
+
+    def run(self, L0, q0):
+        """Integrate from ``L0``, ``q0``: a `rotframe.problem.body.BodyRun` (samples, steps and the free body's
+        energy and momentum drifts, as ``simulate_body``'s)."""
+        s = self.setup
+        if self._exact:
+            L, q = checked_body_state(L0, q0)
+            return _exact(s.I, L, q, s.times)
+        Y = self._integrate(L0, q0)
+        counts = {"NSTEP": np.array([self.steps]), "NFEV": np.array([self.nfev])}
+        return _run(s.times, Y, s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
+
+    def _integrate(self, L0, q0):
+        """The run's samples (n, 7), as the loop wrote them: one call of the whole run."""
+        L, q = _state(L0, q0)
+        s = self.setup
+        a = self._arrays.reset(s.rtol, L, q)
+        st = a["st"]
+        try:
+            s.driver.advance(0, 1, s.times, a["y"], a["TC"], a["H"], st["IDX"], st["SUB"], st["ST"], a["OUT"], a["EVT"],
+                             a["EVY"], a["EVK"], st["EVN"], a["GPREV"], st["NSTEP"], st["NFEV"], _WHOLE_RUN, s.method,
+                             s.rtol, a["atol"], s.hfix, a["EDIR"], a["ETERM"], a["S"], s.prob, s.fns,
+                             kernel=self._kernel, work=self._work)
+        except Exception:  # a torque raised in the compiled loop: simulate_body names it
+            self._failed(L0, q0)
+            raise
+        if st["ST"][0] >= 3:
+            self._failed(L0, q0)
+        self.steps, self.nfev = int(st["NSTEP"][0]), int(st["NFEV"][0])
+        return a["OUT"][:, 0].copy()
+
+    def _failed(self, L0, q0):
+        """The run from ``L0``, ``q0`` failed: ``simulate_body`` runs it again and raises as it does."""
+        simulate_rigid_body(L0=L0, q0=q0, jit=True, plain_tier=False, **self._arguments)
+        from rotframe.errors import IntegrationError
+
+        raise IntegrationError(f"simulate_body: the prepared run from L0 = {np.asarray(L0).tolist()} failed, and "
+                               "simulate_body's did not")
+
+
+def _state(L0, q0):
+    """`rotframe.problem.body.checked_body_state` of ``L0``, ``q0``, the same numbers; float64 arrays of the right
+    shapes checked in plain Python (a run's own checks in numpy cost as much as a short run)."""
+    if (type(L0) is np.ndarray and type(q0) is np.ndarray and L0.dtype is _FLOAT and q0.dtype is _FLOAT
+            and L0.shape == (3,) and q0.shape == (4,)):
+        values = L0.tolist() + q0.tolist()
+        if all(map(math.isfinite, values)):
+            nq = float(np.linalg.norm(q0))  # as checked_body_state: the same start to the bit
+            if abs(nq - 1.0) <= 1e-6:
+                return L0, q0 / nq
+    return checked_body_state(L0, q0)
+
+
+_FLOAT = np.dtype(np.float64)
+
+
+class _KeptArrays:
+    """A run's arrays (`rotframe.problem.body.body_arrays`), made once in two blocks and reset by two copies at each
+    run (numpy's cost per array made, not per number, was a third of a short run's time)."""
+
+    def __init__(self, arrays):
+        flat = {k: v for k, v in arrays.items() if k != "st"}
+        flat.update({f"st.{k}": v for k, v in arrays["st"].items()})
+        self._blocks, views = [], {}
+        for kind in (np.float64, np.int64, np.bool_):
+            group = {k: a for k, a in flat.items() if a.dtype == kind}
+            block = np.concatenate([a.ravel() for a in group.values()]) if group else np.zeros(0, kind)
+            self._blocks.append((block, block.copy()))
+            at = 0
+            for k, a in group.items():
+                views[k] = block[at:at + a.size].reshape(a.shape)
+                at += a.size
+        self._views = {k: v for k, v in views.items() if not k.startswith("st.")}
+        self._views["st"] = {k[3:]: v for k, v in views.items() if k.startswith("st.")}
+        self._y, self._first, self._atol = views["y"][0], views["OUT"][0, 0], views["atol"][0]
+
+    def reset(self, rtol, L, q):
+        """The arrays as `body_arrays` makes them for the start ``L``, ``q``."""
+        for block, fresh in self._blocks:
+            block[:] = fresh
+        v = self._views
+        state = L.tolist() + q.tolist()
+        self._y[:] = state
+        self._first[:] = state
+        sL = max(abs(state[0]), abs(state[1]), abs(state[2]), 1e-300)  # as body_arrays: max |L|
+        self._atol[:3] = rtol * sL
+        return v
