@@ -72,7 +72,7 @@ PHASES = [
     ("rotframe.problem.particles", "advance_blocks", 1, ["run", "turntable", "--method", "splitting"], True),
     ("rotframe.problem.particles", "advance_blocks", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
     ("scipy.linalg", "expm", 20, ["run", "inertial-oscillation", "--set", "samples=100000"], True),  # exact
-    ("rotframe.rigid.dynamics", "free_body_closed_form", 3, ["run", "free-top", "--set", "samples=20000"], True),   # rigid exact
+    ("rotframe.rigid.free_body", "free_body_closed_form", 3, ["run", "free-top", "--set", "samples=20000"], True),  # rigid exact
     ("rotframe.app.runner", "summarize", 1, ["run", "tower-drop"], True),                     # analysis
     ("rotframe.app.record.Recording", "finish", 1, ["run", "tower-drop"], True),               # recording
 ]

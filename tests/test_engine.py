@@ -231,3 +231,15 @@ def test_an_omega_function_that_raises_mid_run_is_named():
         rotframe.simulate(omega=omega_raises_after, r0=R0, v0=V0, duration=2.0, samples=20)
     msg = str(info.value)
     assert "omega_raises_after" in msg and "ZeroDivisionError: no rate" in msg
+
+
+@pytest.mark.parametrize("step, per_sample", [(1e-3, 1), (2.5e-4, 2), (1e-4, 5)])
+def test_a_fixed_step_takes_its_count_of_steps_however_far_the_run_goes(step, per_sample):
+    """Each sample interval takes exactly its substeps: the interval's rounding (ulps of t, 2e-12 of a 5e-4 s
+    interval at t = 4 s) once made a step short of a sample and a sliver to it."""
+    n = 20000
+    particle = rotframe.simulate(omega=[0.0, 0.0, 0.5], r0=R0, v0=V0, duration=10.0, method="rk4", step=step,
+                                 samples=n)
+    body = rotframe.simulate_body(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.1], q0=[0, 0, 0, 1], duration=10.0,
+                                  method="lie-poisson", step=step, samples=n)
+    assert particle.to_dict()["steps"] == body.to_dict()["steps"] == n * per_sample

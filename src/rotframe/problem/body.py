@@ -15,11 +15,13 @@ by name.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from rotframe import limits
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted
 from rotframe.problem import callables as uf
@@ -28,7 +30,7 @@ from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
 from rotframe.problem.models import body_constants
 from rotframe.problem.signatures import BODY
-from rotframe.problem.pacing import Pacer
+from rotframe.problem.pacing import FIRST_BUDGET, FIRST_BUDGET_OWN, Pacer
 from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
 from rotframe import method_registry as registry
 from rotframe.problem.arguments import check_flag, check_inline, check_params, run_grid
@@ -95,7 +97,10 @@ class BodyRun:
         return self
 
 
-def _inertia(inertia):
+def _inertia(inertia, method):
+    """The inertia tensor (3, 3), checked: symmetric, its principal moments >= 0 and a triangle's sides. A zero moment
+    (a thin rod about its axis; at least two others non-zero) only on principal axes and for the methods that
+    take it (the exact flow and the splittings, which turn about each axis: Euler's equations divide by it)."""
     refuse_units(inertia, "inertia", ScenarioError)
     try:
         I = np.asarray(inertia, dtype=float)
@@ -108,8 +113,11 @@ def _inertia(inertia):
     if not np.allclose(I, I.T, rtol=1e-12, atol=0.0):
         raise ScenarioError("inertia: the tensor is not symmetric")
     ev = np.linalg.eigvalsh(I)
-    if ev[0] <= 0:
-        raise ScenarioError(f"inertia: principal moments {ev.tolist()} must be > 0")
+    if ev[0] < 0 or ev[1] <= 0:
+        raise ScenarioError(f"inertia: principal moments {ev.tolist()} must be > 0 (one may be 0: a thin rod)")
+    if ev[0] == 0 and (method not in KICK_METHODS and method != "exact" or np.any(I != np.diag(np.diag(I)))):
+        raise ScenarioError(f"method {method}: principal moments {ev.tolist()} kg m2; it needs all > 0 (a thin rod has "
+                            "a zero moment: use exact or a lie-poisson splitting, about the principal axes)")
     a, b, c = ev
     if a + b < c * (1 - 1e-12):
         raise ScenarioError(f"inertia: principal moments {ev.tolist()} break the triangle inequality "
@@ -219,7 +227,7 @@ def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=Non
                             "kick at fixed attitude, exact only for a torque of (t, q) alone; mark such a torque "
                             "rotframe.Torque(f, attitude_only=True), or use dop853 or rk4")
     method = name
-    I = _inertia(inertia)
+    I = _inertia(inertia, name)
     if method in KICK_METHODS and np.any(I != np.diag(np.diag(I))):
         raise ScenarioError(f"method={method!r} turns about the principal axes: give the 3 principal moments (a "
                             "diagonal inertia), or use dop853 or rk4")
@@ -228,6 +236,7 @@ def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=Non
         raise ScenarioError(f"method={method!r} takes the free flow of a symmetric body: two of the principal moments "
                             f"{np.diag(I).tolist()} must be equal; use a lie-poisson splitting, dop853 or rk4")
     L, q = checked_body_state(L0, q0)
+    _check_thin_rod(I, L)
     fixed = method not in ("exact", "dop853")
     duration, samples, times, rtol, hfix = run_grid(duration, samples, rtol, step, fixed=fixed, what=f"method {method}")
     check_flag(jit, "jit")
@@ -264,6 +273,49 @@ def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=Non
     return s
 
 
+#: the set-ups of recent runs of bodies without a torque of their own (`_cached_set_up`)
+_SETUPS: dict = {}
+_SETUPS_KEPT = 16
+
+
+def _cached_set_up(**kwargs) -> BodySetUp:
+    """`body_set_up`, made once for the same body and run settings where the run has no torque of the user's (a free
+    body, or the built-in torques of `rotframe.torques`, whose constants are their own): a scene's run repeated, a
+    bench's repeats, a sweep over start states. The start state is checked at every run; a user's torque is called
+    and fingerprinted at every run, as always (a value it reads may have changed)."""
+    torque = kwargs["torque"]
+    entries = [] if torque is None else list(torque) if isinstance(torque, (list, tuple)) else [torque]
+    key = None
+    if all(isinstance(t, Torque) and not t.takes_params for t in entries):  # built-in: the objects are their constants
+        try:
+            key = (np.asarray(kwargs["inertia"], dtype=float).tobytes(), tuple(id(t) for t in entries),
+                   kwargs["method"], kwargs["rtol"], kwargs["step"], kwargs["samples"], kwargs["duration"],
+                   kwargs["jit"], kwargs["inline"], len(kwargs["params"]))
+            hash(key)
+        except (TypeError, ValueError):
+            key = None
+    cached = _SETUPS.get(key) if key is not None else None
+    if cached is None or cached[1] is not limits.current():
+        s = body_set_up(**kwargs)
+        if key is not None and not kwargs["params"]:
+            if len(_SETUPS) >= _SETUPS_KEPT:
+                _SETUPS.pop(next(iter(_SETUPS)))
+            _SETUPS[key] = (s, limits.current(), entries)  # the torques kept alive: their ids stay theirs
+        return s
+    s = cached[0]
+    L, q = checked_body_state(kwargs["L0"], kwargs["q0"])
+    _check_thin_rod(s.I, L)
+    return dataclasses.replace(s, L=L, q=q)
+
+
+def _check_thin_rod(I, L):
+    """A one-line ScenarioError where ``L`` has a part along an axis of zero moment (`_inertia`)."""
+    for k in np.flatnonzero(np.diag(I) == 0.0):
+        if L[k] != 0.0:
+            raise ScenarioError(f"L0: body axis {k + 1} has a zero moment of inertia (a thin rod), so L0[{k}] must be 0, "
+                                f"not {float(L[k])!r} (its spin would be infinite)")
+
+
 def body_arrays(s, L, q):
     """A run's arrays from the start state ``L``, ``q`` (`checked_body_state`): ``y`` (1, 7), the samples ``OUT``
     (n, 1, 7) with the start in row 0, the tolerances ``atol`` (1, 7), the per-body counters ``st``, time ``TC`` and
@@ -284,10 +336,10 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     import time
 
     t0 = time.perf_counter()  # the glue's compile and the first call count as compile time
-    s = body_set_up(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params, method=method,
-                    rtol=rtol, step=step, samples=samples, jit=jit, inline=inline)
+    s = _cached_set_up(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params, method=method,
+                       rtol=rtol, step=step, samples=samples, jit=jit, inline=inline)
     if s.method == "exact":
-        return _exact(s.I, s.L, s.q, s.times)
+        return _exact(s.I, s.L, s.q, s.times, progress)
     I, L, q, method, times, rtol, hfix, terms, params = s.I, s.L, s.q, s.method, s.times, s.rtol, s.hfix, s.terms, s.params
     duration, driver, prob, fns, cache_notes = s.duration, s.driver, s.prob, s.fns, s.cache_notes
     a = body_arrays(s, L, q)
@@ -305,7 +357,10 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
                             st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob,
                             tier.fns, kernel=None if tier.plain else inlining.kernel)
 
-    pacer = Pacer("simulate_body", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
+    # calls sized in time: signals and progress between them; a compiled loop of no torque of the user's begins long
+    own = not tier.plain and all(not term.takes_params for _, term in terms)
+    pacer = Pacer("simulate_body", duration, adaptive=method == "dop853",
+                  first_budget=FIRST_BUDGET_OWN if own else FIRST_BUDGET)
     try:
         inlining.start()
         while True:
@@ -334,11 +389,12 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
             pacer.check(st["NSTEP"], TC)
     except KeyboardInterrupt:
         k = max(int(st["IDX"][0]), 1)
-        raise RunInterrupted(_run(times[:k], OUT[:k, 0], method, st, I, False, params, terms, compile_s or 0.0,
-                                  [], jit)) from None
+        raise RunInterrupted(_settings(_run(times[:k], OUT[:k, 0], method, st, I, False, params, terms,
+                                            compile_s or 0.0, [], jit), s)) from None
     k = int(st["IDX"][0])
     if st["ST"][0] >= 3:
-        partial = _run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, terms, compile_s, [], jit)
+        partial = _settings(_run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, terms, compile_s,
+                                 [], jit), s)
         t_bad = float(TC[0])
         blame = ""
         if terms:  # a torque that turns non-finite at a time: probe each inside the failed step
@@ -357,9 +413,26 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
-    run = _run(times, OUT[:, 0], method, st, I, True, params, terms, compile_s, [], jit)
+    run = _settings(_run(times, OUT[:, 0], method, st, I, True, params, terms, compile_s, [], jit), s)
     run.notes.extend(cache_notes + [note for note in (tier.note, inlining.note) if note])
     return run
+
+
+def _settings(run, s):
+    """The run's settings in its ``extras`` (what a scene's stated accuracy reads): ``rtol`` of DOP853, ``step`` of a
+    fixed-step method (the step taken, which divides the sample interval), and ``nfev``."""
+    run.extras.update({"rtol": s.rtol} if s.method == "dop853" else {"step": s.hfix} if s.hfix else {})
+    run.extras["nfev"] = run.nfev
+    return run
+
+
+def inverse_inertia(I):
+    """I^-1; of principal moments with a zero one (a thin rod, `_inertia`), 1/I_i and 0 for the zero one (its spin
+    is none: no angular momentum along it)."""
+    if np.all(I == np.diag(np.diag(I))):
+        d = np.diag(I)
+        return np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
+    return np.linalg.inv(I)
 
 
 def _free_step_constants(I):
@@ -417,7 +490,7 @@ def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, 
     notes = []
     torque_samples = None
     if not terms:
-        w = L @ np.linalg.inv(I).T
+        w = L @ inverse_inertia(I).T
         E = 0.5 * np.einsum("ij,ij->i", L, w)
         Lm = np.linalg.norm(L, axis=1)
         diagnostics["energy_rel_drift"] = float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] else 0.0
@@ -434,16 +507,35 @@ def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, 
                    warnings, notes, torque_samples, compile_s or 0.0)
 
 
-def _exact(I, L, q, times):
-    """The torque-free body's closed-form flow (principal axes required)."""
+#: samples of the closed-form flow per call (`_exact`): between calls progress shows and Ctrl-C is seen
+EXACT_SAMPLES_PER_CALL = 4096
+
+
+def _exact(I, L, q, times, progress=None):
+    """The torque-free body's closed-form flow (principal axes required), `EXACT_SAMPLES_PER_CALL` samples a call:
+    progress between them, and Ctrl-C a `RunInterrupted` with the samples before it."""
     from rotframe.rigid.free_body import free_body_closed_form
 
     if np.any(I != np.diag(np.diag(I))):
         raise ScenarioError("method='exact' needs principal axes (a diagonal inertia); give the 3 principal "
                             "moments, or use dop853")
-    Ls, qs = free_body_closed_form(np.diag(I).copy(), L, q, times)  # the reference path: the same bits on every machine
     st = {"NSTEP": np.zeros(1, np.int64), "NFEV": np.zeros(1, np.int64)}
-    return _run(times, np.concatenate([Ls, qs], axis=1), "exact", st, I, True, (), [], 0.0, [], True)
+    n = times.size
+    Y = np.full((n, 7), np.nan)
+    Y[0, :3], Y[0, 3:] = L, q  # the start, until the flow's first call writes it
+    done = 0
+    try:
+        for start in range(0, n, EXACT_SAMPLES_PER_CALL):
+            stop = min(n, start + EXACT_SAMPLES_PER_CALL)
+            # the reference path: the same bits on every machine, whatever the calls' sizes (one time a sample)
+            Y[start:stop, :3], Y[start:stop, 3:] = free_body_closed_form(np.diag(I).copy(), L, q, times[start:stop])
+            done = stop
+            if progress is not None:
+                progress(stop / n)
+    except KeyboardInterrupt:
+        k = max(done, 1)
+        raise RunInterrupted(_run(times[:k], Y[:k], "exact", st, I, False, (), [], 0.0, [], True)) from None
+    return _run(times, Y, "exact", st, I, True, (), [], 0.0, [], True)
 
 
 def _summed(plain, t, L, q):

@@ -100,6 +100,11 @@ def all_finite(y):
     return True
 
 
+#: the right-hand sides a fixed step counts (``NFEV``) by method code: RK4's three stages after the first (f at the
+#: step's end is the next step's first), and two for each Strang step of a splitting (a kick's force on each side)
+#: times its composition's stages (1, 3, 9, 17)
+EVALUATIONS_PER_STEP = (0, 3, 2, 6, 18, 34)
+
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
 SYSTEM = TRAJECTORY = STEPPER = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
 METHOD = DIM = 0
@@ -448,7 +453,10 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             target = stop if at_knot else T[idx]
             interval = T[idx] - T[idx - 1]
             on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-            last = (sub + 1) * hfix >= interval * (1.0 - 1e-12)
+            # the interval's substeps, counted (hfix divides it: `run_grid`); compared as lengths, the interval's
+            # own rounding (ulps of t, 2e-12 of a 5e-4 s interval at t = 4 s) took a step short of each sample and
+            # a sliver to it
+            last = sub + 1 >= math.floor(interval / hfix + 0.5)
             grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
             if at_knot and stop < grid_next:
                 hh = stop - t  # to the knot; the grid goes on from there
@@ -465,7 +473,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
             steps += 1
             NSTEP[i] += 1
-            NFEV[i] += 3 if METHOD == RK4 else 2
+            NFEV[i] += EVALUATIONS_PER_STEP[METHOD]
             if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
                 status = 6
                 break

@@ -320,10 +320,15 @@ def body_rhs(t, y, dy, prob, fns, W):
     w1 = M[0] * L1 + M[1] * L2 + M[2] * L3
     w2 = M[3] * L1 + M[4] * L2 + M[5] * L3
     w3 = M[6] * L1 + M[7] * L2 + M[8] * L3
-    call_terms(fns[0], t, y, prob[2], W)
-    dy[0] = L2 * w3 - L3 * w2 + W[0]
-    dy[1] = L3 * w1 - L1 * w3 + W[1]
-    dy[2] = L1 * w2 - L2 * w1 + W[2]
+    tx = ty = tz = 0.0
+    if M[14] != 0.0:  # torques act (`body_constants`); a free body calls none
+        call_terms(fns[0], t, y, prob[2], W)
+        tx = W[0]
+        ty = W[1]
+        tz = W[2]
+    dy[0] = L2 * w3 - L3 * w2 + tx
+    dy[1] = L3 * w1 - L1 * w3 + ty
+    dy[2] = L1 * w2 - L2 * w1 + tz
     attitude_rate(y, dy, 3, w1, w2, w3)
 
 
@@ -456,12 +461,14 @@ BODY_CONSTANTS = 15
 
 
 def body_constants(inertia, inv_principal, symmetry, kicks):
-    """``M`` of a body (`BODY_CONSTANTS` numbers): ``inertia``'s inverse by rows, ``inv_principal`` (4, as
+    """``M`` of a body (`BODY_CONSTANTS` numbers): ``inertia``'s inverse by rows (`rotframe.problem.body.inverse_inertia`), ``inv_principal`` (4, as
     `rotframe.rigid.checks.check_inertia` gives it, zeros off principal axes), the ``symmetry`` axis (-1: none)
     and ``kicks`` (whether torques act)."""
     import numpy as np
 
-    return np.ascontiguousarray(np.concatenate([np.linalg.inv(inertia).ravel(), inv_principal,
+    from rotframe.problem.body import inverse_inertia
+
+    return np.ascontiguousarray(np.concatenate([inverse_inertia(inertia).ravel(), inv_principal,
                                                 [float(symmetry), 1.0 if kicks else 0.0]]))
 
 

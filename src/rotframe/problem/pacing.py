@@ -27,12 +27,15 @@ import time
 
 import numpy as np
 
-__all__ = ["Pacer", "CALL_SECONDS"]
+__all__ = ["Pacer", "CALL_SECONDS", "FIRST_BUDGET", "FIRST_BUDGET_OWN"]
 
 #: wall time of one compiled call once paced: signals and progress are seen at least this often
 CALL_SECONDS = 0.1
 #: steps of the first call (which also compiles the driver)
 FIRST_BUDGET = 16
+#: steps of the first call where the loop is compiled already and runs no function of the user's (a free body, the
+#: built-in torques): some milliseconds at most, and a short run (a scene's bench row) in one call
+FIRST_BUDGET_OWN = 4096
 #: the running estimate refuses only after this many steps per particle (DOP853's step has settled by then)
 SETTLED_STEPS = 32
 
@@ -49,13 +52,16 @@ class Pacer:
     adaptive : bool
         An adaptive step, whose work is estimated as the run goes (a fixed step's was counted
         before the run).
+    first_budget : int
+        The steps of the first call (`FIRST_BUDGET`; more where the loop is compiled and no function
+        of the user's can be slow: `FIRST_BUDGET_OWN`).
     """
 
-    def __init__(self, what: str, duration: float, adaptive: bool):
+    def __init__(self, what: str, duration: float, adaptive: bool, first_budget: int = FIRST_BUDGET):
         self.what = what
         self.duration = float(duration)
         self.adaptive = bool(adaptive)
-        self.budget = FIRST_BUDGET
+        self.budget = int(first_budget)
         self.calls = 0
         #: the wall time of the last call (s)
         self.last_seconds = 0.0

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rotframe.scenes.base import SceneResult, reject_subnormal, samples_for, unresolved_note, with_parameters
-from rotframe.scenes.rigid_base import (HEAVY_METHODS, adaptive_rel_error, guarded,
-                                       initial_attitude_zxz, integrate_body)
+from rotframe import torques
+from rotframe.scenes.rigid_base import HEAVY_METHODS, adaptive_rel_error, initial_attitude_zxz, run_body
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -95,16 +95,16 @@ def simulate(p, terms, method, run, progress):
     reject_subnormal(p)
     inertia, L0, q0 = build(p)
     method = HEAVY_METHODS.canonical(method or run.get("method") or "top-splitting")
-    top = (p.mass, p.length, p.g)
     period = _nutation_period_estimate(p)
     samples, resolved = samples_for(p.duration, period, run.get("samples") or 2000)
 
-    def finish(traj):
+    def finish(traj, remarks):
         return SceneResult(traj, ["free-rigid-body", "gravity-torque"], traj.method, traj.steps,
-                           extras={"inertia": inertia, "resolved": resolved, "nutation_period": period})
+                           extras={"inertia": inertia, "resolved": resolved, "nutation_period": period, **remarks})
 
-    return guarded(finish, integrate_body, method, inertia, L0, q0, p.duration, dict(run, samples=samples),
-                   progress, top=top)
+    # the engine's heavy top: the free body under the built-in gravity torque, the heavy-top scene's arithmetic
+    return run_body(method, inertia, L0, q0, p.duration, dict(run, samples=samples), progress, finish,
+                    torque=torques.gravity(p.mass, p.length, p.g))
 
 
 #: Order of each fixed-step method (its global error goes as h^order): what its stated accuracy scales by.

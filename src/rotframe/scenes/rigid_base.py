@@ -299,16 +299,45 @@ def free_body_state(inertia, omega_body):
 
 
 def simulate_free_body(body, duration, method, run, progress):
-    """Run a free body ``body = (inertia, L0, q0)``; the default method is the exact flow."""
+    """Run a free body ``body = (inertia, L0, q0)`` on the engine (`run_body`); the default method is the exact flow."""
     from rotframe.scenes.base import SceneResult
 
     inertia, L0, q0 = body
     method = method or run.get("method") or "exact"
 
-    def finish(traj):
-        return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia})
+    def finish(traj, remarks):
+        return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia, **remarks})
 
-    return guarded(finish, integrate_body, method, inertia, L0, q0, duration, run, progress)
+    return run_body(method, inertia, L0, q0, duration, run, progress, finish)
+
+
+def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=None):
+    """Integrate a rigid scene's body on the engine (`rotframe.problem.body.simulate_rigid_body`) with the run
+    settings (``step``, ``rtol``, ``samples``): principal moments ``inertia``, the start ``L0``, ``q0``, the
+    ``torque`` (`rotframe.torques`; None: a free body) and a method of the registry.
+
+    ``finish(traj, remarks)`` builds the scene's result from the run's `BodyTrajectory` (or the one up to an early
+    stop: `rotframe.scenes.base.guarded`) and the engine's notes and warnings (``remarks``, for the result's
+    extras). The trajectory's ``extras`` hold the run's ``rtol`` or ``step`` and ``nfev``; ``steps`` counts the
+    steps taken, and one for the exact flow (its one evaluation, as the scenes count it).
+    """
+    from rotframe.problem.body import simulate_rigid_body  # the engine's front door: imported by a run
+
+    samples = max(1, int(run.get("samples") or 2000))
+    rtol = float(run.get("rtol") or DEFAULT_RTOL)
+
+    def done(body_run):
+        steps = 1 if body_run.method == "exact" else body_run.steps
+        traj = BodyTrajectory(body_run.times, body_run.L, body_run.q, body_run.method, steps, body_run.complete,
+                              body_run.t_reached, dict(body_run.extras))
+        # the engine's notes on the run (its tier, its caches); not its own account of the invariants, which the
+        # scene reports itself
+        notes = [n for n in getattr(body_run, "notes", []) if not n.startswith("a torque acts")]
+        return finish(traj, {"notes": notes, "warnings": list(getattr(body_run, "warnings", []))})
+
+    return guarded(done, simulate_rigid_body, inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque,
+                   method=method, rtol=rtol if method == "dop853" else None, step=run.get("step"), samples=samples,
+                   progress=progress)
 
 
 def _stepper(method, inertia, top):
