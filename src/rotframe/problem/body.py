@@ -15,7 +15,7 @@ by name.
 
 from __future__ import annotations
 
-import dataclasses
+import copy
 import math
 from dataclasses import dataclass
 
@@ -78,7 +78,12 @@ class Torque:
 
 
 class BodyRun:
-    """What `simulate_rigid_body` returns: samples of L and q, diagnostics, warnings."""
+    """What `simulate_rigid_body` returns: samples of L and q, diagnostics, warnings.
+
+    ``diagnostics`` and ``torque_samples`` are measured on the samples when first read (a callable
+    in their place), not by every run: a scene reports its own, and a short run's would cost as
+    much as its integration.
+    """
 
     def __init__(self, times, L, q, method, steps, nfev, complete, inertia, diagnostics, warnings, notes,
                  torque_samples=None, compile_s=0.0):
@@ -86,10 +91,24 @@ class BodyRun:
         self.method, self.steps, self.nfev, self.complete = method, steps, nfev, complete
         self.t_reached = float(times[-1]) if len(times) else math.nan
         self.inertia = inertia
-        self.diagnostics, self.warnings, self.notes = diagnostics, warnings, notes
-        self.torque_samples = torque_samples
+        self._diagnostics, self.warnings, self.notes = diagnostics, warnings, notes
+        self._torque_samples = torque_samples
         self.compile_s = compile_s
         self.extras = {"compile_s": compile_s}
+
+    @property
+    def diagnostics(self) -> dict:
+        """``quaternion_norm_drift``, and for a free body ``energy_rel_drift`` and ``momentum_rel_drift``."""
+        if callable(self._diagnostics):
+            self._diagnostics = self._diagnostics()
+        return self._diagnostics
+
+    @property
+    def torque_samples(self):
+        """The torques' sum at each sample (n, 3), N m, body axes; None for a free body."""
+        if callable(self._torque_samples):
+            self._torque_samples = self._torque_samples()
+        return self._torque_samples
 
     @property
     def trajectory(self):
@@ -156,6 +175,9 @@ def _describe_torques(terms) -> str:
     return ", ".join(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms)
 
 
+_FLOAT = np.dtype(np.float64)
+
+
 @dataclass
 class BodySetUp:
     """A body's run set up (`body_set_up`): what `simulate_rigid_body` and a prepared run
@@ -190,7 +212,13 @@ class BodySetUp:
 
 def checked_body_state(L0, q0):
     """``(L, q)`` as float64 (3,) and (4,), finite, q within 1e-6 of unit length and normalised; a one-line
-    ScenarioError otherwise."""
+    ScenarioError otherwise. Float64 arrays of the right shapes are checked in plain Python (a short run's own checks
+    in numpy cost as much as its integration), with the same numbers."""
+    if (type(L0) is np.ndarray and type(q0) is np.ndarray and L0.dtype is _FLOAT and q0.dtype is _FLOAT
+            and L0.shape == (3,) and q0.shape == (4,) and all(map(math.isfinite, L0.tolist() + q0.tolist()))):
+        nq = float(np.linalg.norm(q0))
+        if abs(nq - 1.0) <= 1e-6:
+            return L0.copy(), q0 / nq
     refuse_units(L0, "L0", ScenarioError)
     refuse_units(q0, "q0", ScenarioError)
     try:
@@ -302,14 +330,16 @@ def _cached_set_up(**kwargs) -> BodySetUp:
                 _SETUPS.pop(next(iter(_SETUPS)))
             _SETUPS[key] = (s, limits.current(), entries)  # the torques kept alive: their ids stay theirs
         return s
-    s = cached[0]
-    L, q = checked_body_state(kwargs["L0"], kwargs["q0"])
-    _check_thin_rod(s.I, L)
-    return dataclasses.replace(s, L=L, q=q)
+    s = copy.copy(cached[0])  # the set-up, with this run's start
+    s.L, s.q = checked_body_state(kwargs["L0"], kwargs["q0"])
+    _check_thin_rod(s.I, s.L)
+    return s
 
 
 def _check_thin_rod(I, L):
     """A one-line ScenarioError where ``L`` has a part along an axis of zero moment (`_inertia`)."""
+    if I[0, 0] != 0.0 and I[1, 1] != 0.0 and I[2, 2] != 0.0:
+        return
     for k in np.flatnonzero(np.diag(I) == 0.0):
         if L[k] != 0.0:
             raise ScenarioError(f"L0: body axis {k + 1} has a zero moment of inertia (a thin rod), so L0[{k}] must be 0, "
@@ -320,15 +350,20 @@ def body_arrays(s, L, q):
     """A run's arrays from the start state ``L``, ``q`` (`checked_body_state`): ``y`` (1, 7), the samples ``OUT``
     (n, 1, 7) with the start in row 0, the tolerances ``atol`` (1, 7), the per-body counters ``st``, time ``TC`` and
     step ``H``, and the (empty) event arrays, by the names `rotframe.problem.engine.advance` takes them."""
-    y = np.concatenate([L, q])[None, :].copy()
+    start = L.tolist() + q.tolist()
+    y = np.array([start])
     OUT = np.full((s.samples + 1, 1, 7), np.nan)
-    OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
-    sL = max(float(np.max(np.abs(L))), 1e-300)
+    OUT[0, 0] = start  # the start, as the loop writes it: a run stopped before its first call keeps it
+    sL = max(abs(start[0]), abs(start[1]), abs(start[2]), 1e-300)
+    counts = np.zeros(6, np.int64)  # IDX, SUB, ST, EVN, NSTEP, NFEV: views of one array
     return {"y": y, "OUT": OUT, "atol": np.array([[s.rtol * sL] * 3 + [s.rtol] * 4]),  # a row per body
-            "st": {k: np.zeros(1, np.int64) for k in ("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV")},
-            "TC": np.zeros(1), "H": np.zeros(1), "EVT": np.zeros((1, 1)), "EVY": np.zeros((1, 1, 7)),
-            "EVK": np.zeros((1, 1), np.int64), "GPREV": np.zeros((1, 1)), "EDIR": np.zeros(0),
-            "ETERM": np.zeros(0, dtype=bool), "S": np.empty(0)}
+            "st": {k: counts[j:j + 1] for j, k in enumerate(("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV"))},
+            "TC": np.zeros(1), "H": np.zeros(1), **_NO_EVENTS}
+
+
+#: a body's event arrays: it has none (the loop's variant without events never reads or writes them)
+_NO_EVENTS = {"EVT": np.zeros((1, 1)), "EVY": np.zeros((1, 1, 7)), "EVK": np.zeros((1, 1), np.int64),
+              "GPREV": np.zeros((1, 1)), "EDIR": np.zeros(0), "ETERM": np.zeros(0, dtype=bool), "S": np.empty(0)}
 
 
 def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
@@ -354,7 +389,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
 
     def call(budget):
         tier.driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,
-                            st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, np.empty(0), prob,
+                            st["NSTEP"], st["NFEV"], budget, method, rtol, atol, hfix, EDIR, ETERM, a["S"], prob,
                             tier.fns, kernel=None if tier.plain else inlining.kernel)
 
     # calls sized in time: signals and progress between them; a compiled loop of no torque of the user's begins long
@@ -364,7 +399,9 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     try:
         inlining.start()
         while True:
-            saved = (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
+            # what a replay needs where a torque of the user's may raise (`_torque_raised`); the pace from two numbers
+            saved = None if own else (y.copy(), TC.copy(), H.copy(), {key: a.copy() for key, a in st.items()})
+            steps_before, t_before = float(st["NSTEP"][0]), float(TC[0])
             budget = tier.budget(pacer.start())
             t_call = time.perf_counter()
             try:
@@ -373,14 +410,16 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
             except Exception as exc:
                 if tier.plain:  # met again compiled, from the start (`simulate_rigid_body`)
                     raise PlainTierFailed from None
+                if saved is None:
+                    raise
                 _torque_raised(exc, call, saved, y, TC, H, st, terms, budget)
             if compile_s is None:  # the glue's compile and the first call; begun plain, the glue's alone
                 compile_s = (t_call if tier.began_plain else time.perf_counter()) - t0
             if tier.plain:  # a failure met again compiled; compiled from here where the run is seen to be long
                 tier.after_call(st["NFEV"], st["NSTEP"], TC, st["ST"], duration)
             else:
-                pacer.done(float(st["NSTEP"][0] - saved[3]["NSTEP"][0]))
-                inlining.after_call(pacer.last_seconds, float(TC[0] - saved[1][0]),
+                pacer.done(float(st["NSTEP"][0]) - steps_before)
+                inlining.after_call(pacer.last_seconds, float(TC[0]) - t_before,
                                     float(duration - TC[0]) if st["ST"][0] == 0 else 0.0)
             if progress is not None:
                 progress(float(st["IDX"][0]) / n)
@@ -428,7 +467,21 @@ def _settings(run, s):
 
 def inverse_inertia(I):
     """I^-1; of principal moments with a zero one (a thin rod, `_inertia`), 1/I_i and 0 for the zero one (its spin
-    is none: no angular momentum along it)."""
+    is none: no angular momentum along it). Kept for the last tensors asked (a run's own diagnostics ask again)."""
+    key = I.tobytes()
+    inverse = _INVERSES.get(key)
+    if inverse is None:
+        if len(_INVERSES) >= 16:
+            _INVERSES.pop(next(iter(_INVERSES)))
+        inverse = _INVERSES[key] = _inverse(I)
+        inverse.flags.writeable = False
+    return inverse
+
+
+_INVERSES: dict = {}
+
+
+def _inverse(I):
     if np.all(I == np.diag(np.diag(I))):
         d = np.diag(I)
         return np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
@@ -484,27 +537,30 @@ def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, 
     L = Y[:, :3].copy()
     q = Y[:, 3:7].copy()
     norms = np.linalg.norm(q, axis=1)
-    diagnostics = {"quaternion_norm_drift": float(np.max(np.abs(norms - 1.0)))}
     if method not in KICK_METHODS and method != "exact":  # the splittings normalise each step's, as the scenes do
         q /= norms[:, None]
-    notes = []
-    torque_samples = None
-    if not terms:
-        w = L @ inverse_inertia(I).T
-        E = 0.5 * np.einsum("ij,ij->i", L, w)
-        Lm = np.linalg.norm(L, axis=1)
-        diagnostics["energy_rel_drift"] = float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] else 0.0
-        diagnostics["momentum_rel_drift"] = float(np.max(np.abs(Lm - Lm[0])) / Lm[0]) if Lm[0] else 0.0
-    else:
+
+    def diagnostics():  # measured when first read (`BodyRun.diagnostics`)
+        out = {"quaternion_norm_drift": float(np.max(np.abs(norms - 1.0)))}
+        if not terms:
+            w = L @ inverse_inertia(I).T
+            E = 0.5 * np.einsum("ij,ij->i", L, w)
+            Lm = np.linalg.norm(L, axis=1)
+            out["energy_rel_drift"] = float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] else 0.0
+            out["momentum_rel_drift"] = float(np.max(np.abs(Lm - Lm[0])) / Lm[0]) if Lm[0] else 0.0
+        return out
+
+    def torque_samples():  # evaluated when first read (`BodyRun.torque_samples`)
         plain = [(uf.plain_function(term.func), term.params_for(params)) for _, term in terms]
-        torque_samples = np.array([_summed(plain, t, L[i], q[i]) for i, t in enumerate(times)])
-        notes.append("a torque acts: energy and |L| are not conserved, and not reported")
+        return np.array([_summed(plain, t, L[i], q[i]) for i, t in enumerate(times)])
+
+    notes = ["a torque acts: energy and |L| are not conserved, and not reported"] if terms else []
     warnings = list(warnings)
     if not jit:
         warnings.append("jit=False: the torque and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
     return BodyRun(times, L, q, method, int(st["NSTEP"][0]), int(st["NFEV"][0]), complete, I, diagnostics,
-                   warnings, notes, torque_samples, compile_s or 0.0)
+                   warnings, notes, torque_samples if terms else None, compile_s or 0.0)
 
 
 #: samples of the closed-form flow per call (`_exact`): between calls progress shows and Ctrl-C is seen

@@ -18,8 +18,6 @@ up to there).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from rotframe.problem.body import (KICK_METHODS, _exact, _run, body_arrays, body_set_up, checked_body_state,
@@ -115,7 +113,7 @@ class PreparedBody:
 
     def _integrate(self, L0, q0):
         """The run's samples (n, 7), as the loop wrote them: one call of the whole run."""
-        L, q = _state(L0, q0)
+        L, q = checked_body_state(L0, q0)
         s = self.setup
         a = self._arrays.reset(s.rtol, L, q)
         st = a["st"]
@@ -139,22 +137,6 @@ class PreparedBody:
 
         raise IntegrationError(f"simulate_body: the prepared run from L0 = {np.asarray(L0).tolist()} failed, and "
                                "simulate_body's did not")
-
-
-def _state(L0, q0):
-    """`rotframe.problem.body.checked_body_state` of ``L0``, ``q0``, the same numbers; float64 arrays of the right
-    shapes checked in plain Python (a run's own checks in numpy cost as much as a short run)."""
-    if (type(L0) is np.ndarray and type(q0) is np.ndarray and L0.dtype is _FLOAT and q0.dtype is _FLOAT
-            and L0.shape == (3,) and q0.shape == (4,)):
-        values = L0.tolist() + q0.tolist()
-        if all(map(math.isfinite, values)):
-            nq = float(np.linalg.norm(q0))  # as checked_body_state: the same start to the bit
-            if abs(nq - 1.0) <= 1e-6:
-                return L0, q0 / nq
-    return checked_body_state(L0, q0)
-
-
-_FLOAT = np.dtype(np.float64)
 
 
 class _KeptArrays:

@@ -277,41 +277,43 @@ def _foucault(quick):
 
 
 def _rigid_runner(inertia, L0, q0, T, top=None, invariant=None):
-    from rotframe.rigid.adaptive import rigid_dop853
-    from rotframe.scenes.rigid_base import integrate_body
+    """A runner of a rigid scene, on the engine as the scene runs: ``simulate_body``'s core for a whole run (compiled
+    from its first), `rotframe.problem.prepared_body.PreparedBody` (set up once, untimed) for the prepared methods.
+    ``top = (mass, length, g)``: the heavy top's gravity (`rotframe.torques.gravity`). The evaluations reported are
+    DOP853's right-hand sides, and a fixed step's steps."""
+    from rotframe import torques
+    from rotframe.problem.body import simulate_rigid_body
+    from rotframe.problem.prepared_body import PreparedBody
 
-    mgl = 0.0 if top is None else top[0] * top[1] * top[2]
+    torque = None if top is None else torques.gravity(*top)
+    body = dict(inertia=inertia, duration=T, torque=torque, samples=1)
     ends = np.array([0.0, T])
     prepared = {}
 
-    def prepared_call(method, setting):  # rigid.prepared.PreparedBodyRun: set up once (untimed), bitwise the plain run
-        from rotframe.rigid.prepared import PreparedBodyRun
+    def settings(method, setting):
+        return {"rtol": setting} if method == "dop853" else {"step": setting} if setting is not None else {}
 
+    def prepared_call(method, setting):  # set up once (untimed): simulate_body's samples to the bit
         base = method.removesuffix(PREPARED)
         pr = prepared.get((base, setting))
         if pr is None:
-            kw = {"rtol": setting, "mgl": mgl} if base == "dop853" else {"step": setting, "top": top}
-            pr = prepared[(base, setting)] = PreparedBodyRun(inertia, base, T, **kw)
+            pr = prepared[(base, setting)] = PreparedBody(L0=L0, q0=q0, method=base, **body, **settings(base, setting))
 
         def finish(Lq):  # the final state and the invariant's path, after the timing
             L, q = Lq
-            return (np.concatenate((L[-1], q[-1])), pr.nfev or pr.steps,
+            return (np.concatenate((L[-1], q[-1])), pr.nfev if base == "dop853" else pr.steps,
                     None if invariant is None else (lambda: invariant(ends, np.concatenate([L, q], axis=1))))
 
-        return (lambda: pr(L0, q0)), finish
+        return (lambda: pr.states(L0, q0)), finish
 
     def run(method, setting):
         if method.endswith(PREPARED):
             call, finish = prepared_call(method, setting)
             return finish(call())
-        if method == "dop853":
-            res = rigid_dop853(inertia, L0, q0, ends, rtol=setting, mgl=mgl)
-            Y = np.concatenate([res.L, res.q], axis=1)
-            return Y[-1], res.nfev, None if invariant is None else (lambda: invariant(ends, Y))
-        rs = {"samples": 1, "step": setting}
-        traj = integrate_body(method, inertia, L0, q0, T, rs, None, top=top)
-        Y = np.concatenate([traj.L, traj.q], axis=1)
-        return Y[-1], traj.steps, None if invariant is None else (lambda: invariant(traj.times, Y))
+        res = simulate_rigid_body(L0=L0, q0=q0, method=method, plain_tier=False, **body, **settings(method, setting))
+        Y = np.concatenate([res.L, res.q], axis=1)
+        return (Y[-1], res.nfev if method == "dop853" else res.steps,
+                None if invariant is None else (lambda: invariant(res.times, Y)))
 
     run.prepared_call = prepared_call
     return run
