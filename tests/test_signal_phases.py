@@ -1,7 +1,7 @@
 """Door 2 (issue 27): a signal in every phase gives 130 / 143, one line and the partial result.
 
 Each test waits for a sign that the phase began (tests/signs.py), then signals from outside:
-a long ``dop853`` heavy-top run (its compiled calls are bounded in steps), the exact propagator
+a long ``dop853`` heavy-top run (the engine's compiled calls are sized in time), the exact propagator
 with its sample limit raised, and numba compiling a kernel from an empty cache.
 """
 
@@ -21,7 +21,7 @@ def finish(proc, bound=120):
 
 
 def test_sigterm_stops_a_long_heavy_top_dop853_run_with_its_partial_recording(tmp_path):
-    proc, sign = start(tmp_path, "rotframe.rigid.adaptive", "rigid_dop853", 3, "run", "heavy-top",
+    proc, sign = start(tmp_path, "rotframe.problem.engine", "advance", 3, "run", "heavy-top",
                        "--method", "dop853", "--set", "duration=2e5", "--set", "samples=2000")
     wait_for(sign, proc)
     proc.send_signal(signal.SIGTERM)

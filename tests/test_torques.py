@@ -142,7 +142,7 @@ def test_the_run_names_the_builtin_torques():
 
 @pytest.mark.parametrize("call, needle", [
     (lambda: torques.gravity(-1.0, LENGTH, G), "gravity: mass=-1.0 must be > 0"),
-    (lambda: torques.gravity(MASS, LENGTH, 0.0), "gravity: g=0.0 must be > 0"),
+    (lambda: torques.gravity(MASS, LENGTH, -9.81), "gravity: g=-9.81 must be >= 0"),
     (lambda: torques.gravity(MASS, "long", G), "gravity: length='long' is not a number"),
     (lambda: torques.gravity(MASS, float("nan"), G), "gravity: length=nan is not finite"),
     (lambda: torques.space_fixed([1.0, 2.0]), "tau"),

@@ -42,7 +42,7 @@ heavy top's equations: docs/physics/rigid-bodies.md.
 from __future__ import annotations
 
 from rotframe.errors import ScenarioError
-from rotframe.problem.body import Torque
+from rotframe.problem.terms import Torque
 from rotframe.validation import check_vector3
 
 __all__ = ["Torque", "gravity", "body_fixed", "space_fixed"]
@@ -78,7 +78,7 @@ def gravity(mass, length, g) -> Torque:
 
     ``tau = l e3 x (-m g z_b) = m g l (z_b[1], -z_b[0], 0)`` in body axes, with ``z_b`` space's
     vertical (gravity along -z of space). ``mass`` in kg, ``length`` in m (negative: the centre of
-    mass below the pivot), ``g`` in m/s^2 (> 0). The heavy-top scene's torque, with ``m g l``
+    mass below the pivot), ``g`` in m/s^2 (>= 0; 0: no torque). The heavy-top scene's torque, with ``m g l``
     multiplied as its splitting does (`rotframe.rigid.checks.heavy_top_mgl`: ``mass * g * length``).
 
     Examples
@@ -96,8 +96,8 @@ def gravity(mass, length, g) -> Torque:
                 _number("gravity", "g", g))
     if not m > 0:
         raise ScenarioError(f"gravity: mass={mass!r} must be > 0 (kg)")
-    if not gv > 0:
-        raise ScenarioError(f"gravity: g={g!r} must be > 0 (m/s^2, along -z of space)")
+    if not gv >= 0:
+        raise ScenarioError(f"gravity: g={g!r} must be >= 0 (m/s^2, along -z of space)")
     mgl = m * gv * l
 
     def gravity(t, L, q):

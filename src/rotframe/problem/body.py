@@ -28,8 +28,9 @@ from rotframe.problem import callables as uf
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.glue import body_source, flatten_params
 from rotframe.problem.inlined import Inlining
-from rotframe.problem.models import body_constants
+from rotframe.problem.models import body_constants, inverse_inertia
 from rotframe.problem.signatures import BODY
+from rotframe.problem.terms import Torque
 from rotframe.problem.pacing import FIRST_BUDGET, FIRST_BUDGET_OWN, Pacer
 from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
 from rotframe import method_registry as registry
@@ -43,38 +44,6 @@ __all__ = ["simulate_rigid_body", "BodyRun", "Torque"]
 #: as a kick at fixed attitude (a torque of (t, q) alone); the top-splittings need a symmetric body
 KICK_METHODS = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "top-splitting", "top-splitting4",
                 "top-splitting6", "top-splitting8")
-
-
-@dataclass(frozen=True)
-class Torque:
-    """A torque with what rotframe should know about it: a user's, or a built-in one (`rotframe.torques`).
-
-    Attributes
-    ----------
-    func : callable
-        ``tau(t, L, q, *params) -> (3,)``, N m, body axes.
-    attitude_only : bool
-        True when ``tau`` depends on ``t`` and ``q`` alone (gravity gradient, a field fixed in
-        space, a thruster's schedule), not on ``L``: its flow at fixed attitude is a kick, and
-        the Lie-Poisson splittings take it.
-    name : str, optional
-        For messages and the run's list of terms (the built-in torques give theirs).
-    takes_params : bool
-        Whether ``func`` takes the run's ``params`` after ``(t, L, q)`` (default True). The built-in
-        torques do not: their constants are their own.
-    """
-
-    func: object
-    attitude_only: bool = False
-    name: str = ""
-    takes_params: bool = True
-
-    def params_for(self, params) -> tuple:
-        """The ``params`` ``func`` is called with: the run's, or none (`takes_params`)."""
-        return tuple(params) if self.takes_params else ()
-
-    def __call__(self, *args):
-        return self.func(*args)
 
 
 class BodyRun:
@@ -374,7 +343,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     s = _cached_set_up(inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque, params=params, method=method,
                        rtol=rtol, step=step, samples=samples, jit=jit, inline=inline)
     if s.method == "exact":
-        return _exact(s.I, s.L, s.q, s.times, progress)
+        return exact_run(s.I, s.L, s.q, s.times, progress)
     I, L, q, method, times, rtol, hfix, terms, params = s.I, s.L, s.q, s.method, s.times, s.rtol, s.hfix, s.terms, s.params
     duration, driver, prob, fns, cache_notes = s.duration, s.driver, s.prob, s.fns, s.cache_notes
     a = body_arrays(s, L, q)
@@ -428,11 +397,11 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
             pacer.check(st["NSTEP"], TC)
     except KeyboardInterrupt:
         k = max(int(st["IDX"][0]), 1)
-        raise RunInterrupted(_settings(_run(times[:k], OUT[:k, 0], method, st, I, False, params, terms,
+        raise RunInterrupted(_settings(body_run(times[:k], OUT[:k, 0], method, st, I, False, params, terms,
                                             compile_s or 0.0, [], jit), s)) from None
     k = int(st["IDX"][0])
     if st["ST"][0] >= 3:
-        partial = _settings(_run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, terms, compile_s,
+        partial = _settings(body_run(times[:max(k, 1)], OUT[:max(k, 1), 0], method, st, I, False, params, terms, compile_s,
                                  [], jit), s)
         t_bad = float(TC[0])
         blame = ""
@@ -452,7 +421,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
         raise IntegrationError(f"simulate_body: {STATUS[int(st['ST'][0])]}{blame} after t = {t_bad:.9g} s "
                                f"(method {method})", t_reached=t_bad, partial=partial)
     compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
-    run = _settings(_run(times, OUT[:, 0], method, st, I, True, params, terms, compile_s, [], jit), s)
+    run = _settings(body_run(times, OUT[:, 0], method, st, I, True, params, terms, compile_s, [], jit), s)
     run.notes.extend(cache_notes + [note for note in (tier.note, inlining.note) if note])
     return run
 
@@ -463,29 +432,6 @@ def _settings(run, s):
     run.extras.update({"rtol": s.rtol} if s.method == "dop853" else {"step": s.hfix} if s.hfix else {})
     run.extras["nfev"] = run.nfev
     return run
-
-
-def inverse_inertia(I):
-    """I^-1; of principal moments with a zero one (a thin rod, `_inertia`), 1/I_i and 0 for the zero one (its spin
-    is none: no angular momentum along it). Kept for the last tensors asked (a run's own diagnostics ask again)."""
-    key = I.tobytes()
-    inverse = _INVERSES.get(key)
-    if inverse is None:
-        if len(_INVERSES) >= 16:
-            _INVERSES.pop(next(iter(_INVERSES)))
-        inverse = _INVERSES[key] = _inverse(I)
-        inverse.flags.writeable = False
-    return inverse
-
-
-_INVERSES: dict = {}
-
-
-def _inverse(I):
-    if np.all(I == np.diag(np.diag(I))):
-        d = np.diag(I)
-        return np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
-    return np.linalg.inv(I)
 
 
 def _free_step_constants(I):
@@ -533,7 +479,7 @@ def _torque_raised(exc, call, saved, y, TC, H, st, terms, budget):
     raise uf.UserFunctionError(f"simulate_body: {names} raised {what} {where}") from None
 
 
-def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, jit):
+def body_run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, jit):
     L = Y[:, :3].copy()
     q = Y[:, 3:7].copy()
     norms = np.linalg.norm(q, axis=1)
@@ -563,11 +509,11 @@ def _run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, 
                    warnings, notes, torque_samples if terms else None, compile_s or 0.0)
 
 
-#: samples of the closed-form flow per call (`_exact`): between calls progress shows and Ctrl-C is seen
+#: samples of the closed-form flow per call (`exact_run`): between calls progress shows and Ctrl-C is seen
 EXACT_SAMPLES_PER_CALL = 4096
 
 
-def _exact(I, L, q, times, progress=None):
+def exact_run(I, L, q, times, progress=None):
     """The torque-free body's closed-form flow (principal axes required), `EXACT_SAMPLES_PER_CALL` samples a call:
     progress between them, and Ctrl-C a `RunInterrupted` with the samples before it."""
     from rotframe.rigid.free_body import free_body_closed_form
@@ -590,8 +536,8 @@ def _exact(I, L, q, times, progress=None):
                 progress(stop / n)
     except KeyboardInterrupt:
         k = max(done, 1)
-        raise RunInterrupted(_run(times[:k], Y[:k], "exact", st, I, False, (), [], 0.0, [], True)) from None
-    return _run(times, Y, "exact", st, I, True, (), [], 0.0, [], True)
+        raise RunInterrupted(body_run(times[:k], Y[:k], "exact", st, I, False, (), [], 0.0, [], True)) from None
+    return body_run(times, Y, "exact", st, I, True, (), [], 0.0, [], True)
 
 
 def _summed(plain, t, L, q):

@@ -60,8 +60,8 @@ from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINI
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
 from rotframe.numerics.step_control import start_short_of
 from rotframe.problem.calls import RAISED, call_event, direct_functions
-from rotframe.problem.models import (DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8, particle_energy,
-                                     rhs)
+from rotframe.problem.models import (DOP853, EVALUATIONS_PER_STEP, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6,
+                                     SPLITTING8, particle_energy, rhs)
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
 from rotframe.problem.stops import next_stop
@@ -99,11 +99,6 @@ def all_finite(y):
             return False
     return True
 
-
-#: the right-hand sides a fixed step counts (``NFEV``) by method code: RK4's three stages after the first (f at the
-#: step's end is the next step's first), and two for each Strang step of a splitting (a kick's force on each side)
-#: times its composition's stages (1, 3, 9, 17)
-EVALUATIONS_PER_STEP = (0, 3, 2, 6, 18, 34)
 
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
 SYSTEM = TRAJECTORY = STEPPER = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
@@ -453,9 +448,8 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             target = stop if at_knot else T[idx]
             interval = T[idx] - T[idx - 1]
             on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-            # the interval's substeps, counted (hfix divides it: `run_grid`); compared as lengths, the interval's
-            # own rounding (ulps of t, 2e-12 of a 5e-4 s interval at t = 4 s) took a step short of each sample and
-            # a sliver to it
+            # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's own
+            # rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
             last = sub + 1 >= math.floor(interval / hfix + 0.5)
             grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
             if at_knot and stop < grid_next:
@@ -509,13 +503,12 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
         save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
 
 
-#: the engine's method codes by name (`rotframe.method_registry`'s names; the codes never leave the engine and its
-#: equations, `rotframe.problem.models`): a particle's rotation splittings and a body's Lie-Poisson splittings are the
-#: model's own splitting of order 2 and 4
+#: the engine's method codes by the registry's names (the codes never leave the engine and its equations,
+#: `rotframe.problem.models`): every splitting is the model's own, composed to its order
 METHOD_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "rotation-splitting4": SPLITTING4,
-                "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4, "lie-poisson6": SPLITTING6,
-                "lie-poisson8": SPLITTING8, "top-splitting": SPLITTING, "top-splitting4": SPLITTING4,
-                "top-splitting6": SPLITTING6, "top-splitting8": SPLITTING8}
+                "lie-poisson": SPLITTING, "lie-poisson4": SPLITTING4, "lie-poisson6": SPLITTING6, "lie-poisson8": SPLITTING8,
+                "top-splitting": SPLITTING, "top-splitting4": SPLITTING4, "top-splitting6": SPLITTING6,
+                "top-splitting8": SPLITTING8}
 #: the variants' names of the codes
 METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4", SPLITTING6: "splitting6",
                 SPLITTING8: "splitting8"}

@@ -86,12 +86,15 @@ from rotframe.rigid.kernels import free_step
 from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
-           "SPLITTING4", "SPLITTING6", "SPLITTING8", "SCRATCH", "BODY_CONSTANTS", "body_constants", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
+           "SPLITTING4", "SPLITTING6", "SPLITTING8", "EVALUATIONS_PER_STEP", "SCRATCH", "BODY_CONSTANTS", "body_constants", "inverse_inertia", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
 
 #: kinds of a vector of time
 ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
 #: method codes of the compiled loop (the names are `rotframe.method_registry`'s; no code leaves this package)
 DOP853, RK4, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8 = range(6)
+#: a fixed step's right-hand sides (``NFEV``) by method code: RK4's stages after the first (f at the step's end is the
+#: next one's first); a splitting's two kicks times its composition's stages (1, 3, 9, 17)
+EVALUATIONS_PER_STEP = (0, 3, 2, 6, 18, 34)
 #: Kahan & Li's fractions of the order-2 step in the compositions of orders 6 and 8 (`rotframe.numerics.composition`,
 #: the scenes' own), constants of the compiled step
 KAHAN_LI6_STEPS = tuple(float(w) for w in composition_weights(6))
@@ -460,13 +463,35 @@ def torque_kick(t, h, yn, prob, fns, W):
 BODY_CONSTANTS = 15
 
 
+def inverse_inertia(I):
+    """I^-1 of the inertia tensor ``I`` (3, 3); of principal moments with a zero one (a thin rod), 1/I_i and 0 for
+    the zero one (no spin along it: no angular momentum there). Kept for the last tensors asked, read-only (a run
+    asks for its body's at its set-up and in its diagnostics)."""
+    import numpy as np
+
+    key = I.tobytes()
+    inverse = _INVERSES.get(key)
+    if inverse is None:
+        if np.all(I == np.diag(np.diag(I))):
+            d = np.diag(I)
+            inverse = np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
+        else:
+            inverse = np.linalg.inv(I)
+        inverse.flags.writeable = False
+        if len(_INVERSES) >= 16:
+            _INVERSES.pop(next(iter(_INVERSES)))
+        _INVERSES[key] = inverse
+    return inverse
+
+
+_INVERSES: dict = {}
+
+
 def body_constants(inertia, inv_principal, symmetry, kicks):
-    """``M`` of a body (`BODY_CONSTANTS` numbers): ``inertia``'s inverse by rows (`rotframe.problem.body.inverse_inertia`), ``inv_principal`` (4, as
+    """``M`` of a body (`BODY_CONSTANTS` numbers): ``inertia``'s inverse by rows (`inverse_inertia`), ``inv_principal`` (4, as
     `rotframe.rigid.checks.check_inertia` gives it, zeros off principal axes), the ``symmetry`` axis (-1: none)
     and ``kicks`` (whether torques act)."""
     import numpy as np
-
-    from rotframe.problem.body import inverse_inertia
 
     return np.ascontiguousarray(np.concatenate([inverse_inertia(inertia).ravel(), inv_principal,
                                                 [float(symmetry), 1.0 if kicks else 0.0]]))
@@ -497,35 +522,65 @@ def strang(body, t, h, yn, prob, fns, W):
         lie_poisson_strang(t, h, yn, prob, fns, W)
 
 
-@jit_llvm_inline
+@jit_inline
 def own_step(body, method, t, y, h, yn, prob, fns, W):
     """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4);
     ``SPLITTING6``, ``SPLITTING8``: Kahan & Li's compositions of it (orders 6 and 8). A body's attitude is
-    normalised after the step, as the rigid scenes' splitting does (`rotframe.rigid.kernels.split_run`)."""
-    for j in range(y.shape[0]):
-        yn[j] = y[j]
+    normalised after the step, as the rigid scenes' splitting does (`rotframe.rigid.kernels.split_run`).
+
+    Inlined by numba into the variant's loop, whose ``method`` is a constant: the other methods' steps are pruned
+    before anything is compiled (each its own function, compiled once and inlined by LLVM)."""
     if method == SPLITTING:
-        strang(body, t, h, yn, prob, fns, W)
+        strang_step(body, t, y, h, yn, prob, fns, W)
     elif method == SPLITTING4:
-        w1 = YOSHIDA4_OUTER
-        w0 = YOSHIDA4_INNER
-        strang(body, t, w1 * h, yn, prob, fns, W)
-        strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
-        strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+        yoshida_step(body, t, y, h, yn, prob, fns, W)
     elif method == SPLITTING6:
-        done = 0.0
-        for w in KAHAN_LI6_STEPS:
-            strang(body, t + done * h, w * h, yn, prob, fns, W)
-            done += w
+        composed_step(body, KAHAN_LI6_STEPS, t, y, h, yn, prob, fns, W)
     else:
-        done = 0.0
-        for w in KAHAN_LI8_STEPS:
-            strang(body, t + done * h, w * h, yn, prob, fns, W)
-            done += w
-    if body is not None:
+        composed_step(body, KAHAN_LI8_STEPS, t, y, h, yn, prob, fns, W)
+
+
+@jit_inline
+def _start_and_normalise(body, y, yn, last):
+    """``yn = y`` (``last`` False), or a body's attitude in ``yn`` normalised (``last`` True)."""
+    if not last:
+        for j in range(y.shape[0]):
+            yn[j] = y[j]
+    elif body is not None:
         norm_q = math.sqrt(yn[3] * yn[3] + yn[4] * yn[4] + yn[5] * yn[5] + yn[6] * yn[6])
         for j in range(3, 7):
             yn[j] /= norm_q
+
+
+@jit_llvm_inline
+def strang_step(body, t, y, h, yn, prob, fns, W):
+    """The model's splitting, order 2 (`own_step`)."""
+    _start_and_normalise(body, y, yn, False)
+    strang(body, t, h, yn, prob, fns, W)
+    _start_and_normalise(body, y, yn, True)
+
+
+@jit_llvm_inline
+def yoshida_step(body, t, y, h, yn, prob, fns, W):
+    """Yoshida's triple jump of the model's splitting, order 4 (`own_step`)."""
+    _start_and_normalise(body, y, yn, False)
+    w1 = YOSHIDA4_OUTER
+    w0 = YOSHIDA4_INNER
+    strang(body, t, w1 * h, yn, prob, fns, W)
+    strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
+    strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+    _start_and_normalise(body, y, yn, True)
+
+
+@jit_llvm_inline
+def composed_step(body, weights, t, y, h, yn, prob, fns, W):
+    """The model's splitting composed with the fractions ``weights`` of the step (`own_step`: Kahan & Li's)."""
+    _start_and_normalise(body, y, yn, False)
+    done = 0.0
+    for w in weights:
+        strang(body, t + done * h, w * h, yn, prob, fns, W)
+        done += w
+    _start_and_normalise(body, y, yn, True)
 
 
 @jit_uncounted

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.problem.body import (KICK_METHODS, _exact, _run, body_arrays, body_set_up, checked_body_state,
+from rotframe.problem.body import (KICK_METHODS, body_arrays, body_run, body_set_up, checked_body_state, exact_run,
                                    simulate_rigid_body)
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
@@ -106,10 +106,10 @@ class PreparedBody:
         s = self.setup
         if self._exact:
             L, q = checked_body_state(L0, q0)
-            return _exact(s.I, L, q, s.times)
+            return exact_run(s.I, L, q, s.times)
         Y = self._integrate(L0, q0)
         counts = {"NSTEP": np.array([self.steps]), "NFEV": np.array([self.nfev])}
-        return _run(s.times, Y, s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
+        return body_run(s.times, Y, s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
 
     def _integrate(self, L0, q0):
         """The run's samples (n, 7), as the loop wrote them: one call of the whole run."""

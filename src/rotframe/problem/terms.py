@@ -18,7 +18,7 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "as_term", "one_constraint", "check_on_string", "check_splitting",
+__all__ = ["Force", "StringConstraint", "Torque", "as_term", "one_constraint", "check_on_string", "check_splitting",
            "model_constants", "FRAME_TERMS", "check_frame_terms"]
 
 #: The frame's own terms, by the scenes' names for them (``-2 w x v``, ``-w x (w x r)``, ``-w' x r``): the ones a
@@ -88,6 +88,38 @@ class StringConstraint:
     length: float
     pivot: tuple
     name: str = "pendulum"
+
+
+@dataclass(frozen=True)
+class Torque:
+    """A torque with what rotframe should know about it: a user's, or a built-in one (`rotframe.torques`).
+
+    Attributes
+    ----------
+    func : callable
+        ``tau(t, L, q, *params) -> (3,)``, N m, body axes.
+    attitude_only : bool
+        True when ``tau`` depends on ``t`` and ``q`` alone (gravity gradient, a field fixed in
+        space, a thruster's schedule), not on ``L``: its flow at fixed attitude is a kick, and
+        the Lie-Poisson splittings take it.
+    name : str, optional
+        For messages and the run's list of terms (the built-in torques give theirs).
+    takes_params : bool
+        Whether ``func`` takes the run's ``params`` after ``(t, L, q)`` (default True). The built-in
+        torques do not: their constants are their own.
+    """
+
+    func: object
+    attitude_only: bool = False
+    name: str = ""
+    takes_params: bool = True
+
+    def params_for(self, params) -> tuple:
+        """The ``params`` ``func`` is called with: the run's, or none (`takes_params`)."""
+        return tuple(params) if self.takes_params else ()
+
+    def __call__(self, *args):
+        return self.func(*args)
 
 
 def as_term(f, k):
