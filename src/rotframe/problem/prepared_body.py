@@ -18,6 +18,8 @@ up to there).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from rotframe.problem.body import (KICK_METHODS, body_arrays, body_run, body_set_up, checked_body_state, exact_run,
@@ -80,8 +82,8 @@ class PreparedBody:
             inlining.start()
             self._kernel = inlining.kernel
             self.notes = [inlining.note] if inlining.note else []
-        self._work = scratch(7)
         self._arrays = None if self._exact else _KeptArrays(body_arrays(s, s.L, s.q))
+        self._call = None if self._exact else self._bound_call()
         #: whether the samples' attitudes are normalised after the run (as simulate_body's, where the method does
         #: not normalise each step's)
         self._normalise = s.method not in KICK_METHODS and s.method != "exact"
@@ -95,7 +97,7 @@ class PreparedBody:
             L, q = checked_body_state(L0, q0)
             return free_body_closed_form(np.diag(self.setup.I).copy(), L, q, self.times)
         Y = self._integrate(L0, q0)
-        Ls, qs = Y[:, :3].copy(), Y[:, 3:7].copy()
+        Ls, qs = Y[:, 0, :3].copy(), Y[:, 0, 3:7].copy()
         if self._normalise:
             qs /= np.linalg.norm(qs, axis=1)[:, None]
         return Ls, qs
@@ -109,26 +111,37 @@ class PreparedBody:
             return exact_run(s.I, L, q, s.times)
         Y = self._integrate(L0, q0)
         counts = {"NSTEP": np.array([self.steps]), "NFEV": np.array([self.nfev])}
-        return body_run(s.times, Y, s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
+        return body_run(s.times, Y[:, 0], s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
+
+    def _bound_call(self):
+        """The loop's call with every argument bound: the kept arrays (`_KeptArrays`, the same objects at every run),
+        the run's settings, the problem, and the loop itself (the inlined one, or the engine's variant)."""
+        from rotframe.problem import engine
+        from rotframe.problem.calls import direct_functions
+
+        s, a = self.setup, self._arrays.views
+        st = a["st"]
+        kernel = self._kernel if self._kernel is not None else engine.variant(BODY, s.method, False, True, 7)
+        fns = direct_functions() if self._kernel is not None else s.fns  # the inlined loop takes tags, not addresses
+        return functools.partial(kernel, 0, 1, s.times, a["y"], a["TC"], a["H"], st["IDX"], st["SUB"], st["ST"],
+                                 a["OUT"], a["EVT"], a["EVY"], a["EVK"], st["EVN"], a["GPREV"], st["NSTEP"], st["NFEV"],
+                                 _WHOLE_RUN, s.rtol, a["atol"], s.hfix, a["EDIR"], a["ETERM"], a["S"], s.prob, fns,
+                                 *scratch(7))
 
     def _integrate(self, L0, q0):
-        """The run's samples (n, 7), as the loop wrote them: one call of the whole run."""
+        """The run's samples (n, 1, 7), as the loop wrote them (the kept array: copy what is kept): one call."""
         L, q = checked_body_state(L0, q0)
-        s = self.setup
-        a = self._arrays.reset(s.rtol, L, q)
+        a = self._arrays.reset(self.setup.rtol, L, q)
         st = a["st"]
         try:
-            s.driver.advance(0, 1, s.times, a["y"], a["TC"], a["H"], st["IDX"], st["SUB"], st["ST"], a["OUT"], a["EVT"],
-                             a["EVY"], a["EVK"], st["EVN"], a["GPREV"], st["NSTEP"], st["NFEV"], _WHOLE_RUN, s.method,
-                             s.rtol, a["atol"], s.hfix, a["EDIR"], a["ETERM"], a["S"], s.prob, s.fns,
-                             kernel=self._kernel, work=self._work)
+            self._call()
         except Exception:  # a torque raised in the compiled loop: simulate_body names it
             self._failed(L0, q0)
             raise
         if st["ST"][0] >= 3:
             self._failed(L0, q0)
         self.steps, self.nfev = int(st["NSTEP"][0]), int(st["NFEV"][0])
-        return a["OUT"][:, 0].copy()
+        return a["OUT"]
 
     def _failed(self, L0, q0):
         """The run from ``L0``, ``q0`` failed: ``simulate_body`` runs it again and raises as it does."""
@@ -157,6 +170,8 @@ class _KeptArrays:
                 at += a.size
         self._views = {k: v for k, v in views.items() if not k.startswith("st.")}
         self._views["st"] = {k[3:]: v for k, v in views.items() if k.startswith("st.")}
+        #: the arrays by `body_arrays`' names: the same objects at every run
+        self.views = self._views
         self._y, self._first, self._atol = views["y"][0], views["OUT"][0, 0], views["atol"][0]
 
     def reset(self, rtol, L, q):
