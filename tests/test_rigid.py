@@ -617,24 +617,3 @@ def test_refusals_name_the_value():
         rigid.heavy_top_splitting(1.0, 0.5, -1.0, 1.0, 9.81, [0, 0, 1.0], IDENTITY, 0.1, 1)
     with pytest.raises(ValueError):
         rigid.free_body_exact([1.0, 2.0, 3.0], [np.nan, 0.0, 0.0], IDENTITY, [1.0])
-
-
-@pytest.mark.parametrize("method,top", [("lie-poisson4", None), ("top-splitting", (0.1, 0.04, 9.81))])
-def test_scene_driver_checks_once_and_gives_the_public_functions_numbers(method, top):
-    # rigid_base runs its chunks through drivers.splitting_stepper with the body checked once (and the
-    # first, one-step call through the public function): the numbers must be those of the public
-    # function to the last bit (the same compiled kernel, the same constants)
-    from rotframe.scenes.rigid_base import integrate_body
-
-    inertia = np.array([1.9e-4, 1.9e-4, 2.5e-5]) if top else np.array([1.0, 2.0, 3.0])
-    L0 = inertia * (np.array([0.1, 0.0, 300.0]) if top else np.array([0.01, 1.0, 0.01]))
-    q0 = np.array([0.0, 0.0, 0.0, 1.0])
-    traj = integrate_body(method, inertia, L0, q0, 0.3, {"samples": 30, "step": 1e-3}, None, top=top)
-    h = traj.extras["step"]
-    if top:
-        L, q, _ = rigid.heavy_top_splitting(*inertia[1:], *top, L0_body=L0, q0=q0, h=h, n_steps=300,
-                                            order=2, sample_every=10)
-    else:
-        L, q, _ = rigid.lie_poisson(inertia, L0, q0, h, 300, order=4, sample_every=10)
-    assert traj.steps == 300 and len(traj.L) == len(L) == 31
-    assert np.array_equal(traj.L, L) and np.array_equal(traj.q, q)

@@ -1,8 +1,9 @@
 """rotframe.rigid.prepared.PreparedBodyRun: bitwise the plain paths, checks once, per-call state checks.
 
-The oracle here is the plain public path with the same settings (``integrate_body`` for the
-fixed-step methods, ``rigid_dop853`` for dop853): a prepared run promises the same IEEE
-operations in the same order, so the comparison is exact (``np.array_equal``), no tolerance.
+The oracle here is the plain public path with the same settings (the rigid layer's
+``lie_poisson`` and ``heavy_top_splitting`` for the fixed-step methods, ``rigid_dop853`` for
+dop853): a prepared run promises the same IEEE operations in the same order, so the comparison is
+exact (``np.array_equal``), no tolerance.
 The physics of those plain paths is proven by their own tests (closed forms, DOP853 in scipy).
 """
 
@@ -12,7 +13,7 @@ import pytest
 from rotframe.errors import IntegrationError, RotframeError, ScenarioError
 from rotframe.rigid.adaptive import rigid_dop853
 from rotframe.rigid.prepared import FIXED_METHODS, PreparedBodyRun
-from rotframe.scenes.rigid_base import integrate_body
+from rotframe.rigid import dynamics as rigid
 
 TOP_INERTIA = np.array([1.0, 1.0, 2.0])
 ASYM_INERTIA = np.array([1.0, 2.0, 3.0])
@@ -20,28 +21,48 @@ TOP = (1.0, 0.5, 9.81)
 Q0 = np.array([0.1, 0.0, 0.0, 1.0])  # not normalised: the runs normalise it, row 0 keeps it as given
 
 
+def _plain_fixed(method, inertia, L0, q0, duration, samples, step, top):
+    """The rigid layer's public splitting over the prepared run's grid (the step divides the sample interval), the
+    start's row keeping ``q0`` as given, as a prepared run's does."""
+    dt = duration / samples
+    per = max(1, int(np.ceil(dt / step - 1e-9)))
+    order = {"": 2, "4": 4, "6": 6, "8": 8}[method.rsplit("splitting", 1)[-1] if "top" in method else
+                                             method.removeprefix("lie-poisson")]
+    if top is not None:
+        L, q, times = rigid.heavy_top_splitting(inertia[0], inertia[2], *top, L0, q0, dt / per, samples * per,
+                                                order=order, sample_every=per)
+    else:
+        L, q, times = rigid.lie_poisson(inertia, L0, q0, dt / per, samples * per, order=order, sample_every=per)
+    q = q.copy()
+    q[0] = q0
+    return L, q, times, samples * per
+
+
 @pytest.mark.parametrize("method", FIXED_METHODS)
 @pytest.mark.parametrize("top", [None, TOP])
 @pytest.mark.parametrize("samples", [1, 7])
-def test_fixed_step_bitwise_integrate_body(method, top, samples):
+def test_fixed_step_bitwise_the_public_splitting(method, top, samples):
     inertia = TOP_INERTIA if top is not None else ASYM_INERTIA
     prep = PreparedBodyRun(inertia, method, 2.0, step=0.013, samples=samples, top=top)
     for omega in ([0.3, 0.1, 5.0], [1.0, -0.2, 0.4]):  # two calls: nothing of the first leaks into the second
         L0 = inertia * np.array(omega)
         L, q = prep.run(L0, Q0)
-        ref = integrate_body(method, inertia, L0, Q0, 2.0, {"samples": samples, "step": 0.013}, None, top=top)
-        assert np.array_equal(L, ref.L) and np.array_equal(q, ref.q)
-        assert prep.steps == ref.steps
-        np.testing.assert_array_equal(prep.times, ref.times)
+        ref_L, ref_q, _, steps = _plain_fixed(method, inertia, L0, Q0, 2.0, samples, 0.013, top)
+        assert np.array_equal(L, ref_L) and np.array_equal(q, ref_q)
+        assert prep.steps == steps
+        np.testing.assert_array_equal(prep.times, np.linspace(0.0, 2.0, samples + 1))
 
 
-def test_fixed_step_in_chunks_bitwise():
-    # 3e6 steps a sample > one kernel call of 2e6: integrate_body's pieces, taken the same way
+def test_fixed_step_in_chunks_stays_on_the_one_call():
+    # 3e6 steps a sample > one kernel call of 2e6: the run in pieces (each starts from a normalised attitude) stays
+    # on the public function's one call to round-off
     prep = PreparedBodyRun(ASYM_INERTIA, "lie-poisson", 2.0, step=2.0 / 3e6 / 2, samples=2)
     L0 = ASYM_INERTIA * np.array([0.01, 1.0, 0.01])
     L, q = prep.run(L0, Q0)
-    ref = integrate_body("lie-poisson", ASYM_INERTIA, L0, Q0, 2.0, {"samples": 2, "step": 2.0 / 3e6 / 2}, None)
-    assert np.array_equal(L, ref.L) and np.array_equal(q, ref.q)
+    ref_L, ref_q, _, _ = _plain_fixed("lie-poisson", ASYM_INERTIA, L0, Q0, 2.0, 2, 2.0 / 3e6 / 2, None)
+    np.testing.assert_allclose(L, ref_L, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(q[1:], ref_q[1:], rtol=0, atol=1e-12)
+    assert not np.allclose(L[-1], L[0])
 
 
 @pytest.mark.parametrize("top", [None, TOP])
@@ -113,13 +134,11 @@ def test_bad_body_refused_by_the_plain_checks():
 
 
 def test_a_huge_momentum_is_refused_by_the_limits_not_run_for_ever():
-    """|L| = 1e300 would take ~1e300 dop853 steps: both paths refuse it (LimitError, exit 2 on the
+    """|L| = 1e300 would take ~1e300 dop853 steps: the prepared run refuses it (LimitError, exit 2 on the
     command line) before integrating; the estimate gives inf rather than an OverflowError."""
     from rotframe.limits import LimitError
 
     L0, q0 = np.array([1e300, 2e300, 1e300]), np.array([1.0, 0.0, 0.0, 0.0])
-    with pytest.raises(LimitError, match="integration steps"):
-        integrate_body("dop853", ASYM_INERTIA, L0, q0, 10.0, {"samples": 5, "rtol": 1e-6}, None)
     run = PreparedBodyRun(ASYM_INERTIA, "dop853", 10.0, samples=5, rtol=1e-6)
     with pytest.raises(LimitError, match="integration steps"):
         run(L0, q0)

@@ -1,6 +1,6 @@
 """Repeated rigid-body runs with everything prepared once (microseconds of overhead a run).
 
-``rotframe.scenes.rigid_base.integrate_body`` and
+The rigid layer's splittings (`rotframe.rigid.dynamics.lie_poisson`, ``heavy_top_splitting``) and
 `rotframe.rigid.adaptive.rigid_dop853` check the body, the method and the
 step, build the step's constants and allocate output on every call: some 50 to
 200 microseconds, more than a short run's integration costs. A
@@ -8,9 +8,10 @@ step, build the step's constants and allocate output on every call: some 50 to
 step (or rtol) and sample count; each call then checks only that ``L0`` and
 ``q0`` are finite vectors of the right shape, copies them in and makes one call
 of the same compiled kernel with the same arguments, so the results are bitwise
-those of the plain functions (``integrate_body`` for the fixed-step methods,
-``rigid_dop853`` at the sample times for ``dop853``). For optimisation loops,
-Monte Carlo over initial states and the bench.
+those of the plain functions (the splittings over the sample grid, in pieces of at most 2e6 steps a
+kernel call, each from a normalised attitude; ``rigid_dop853`` at the sample times for ``dop853``).
+For optimisation loops and Monte Carlo over initial states on the rigid layer alone; the rigid
+scenes and their bench rows run the engine's `rotframe.problem.prepared_body.PreparedBody`.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from rotframe.rigid.adaptive import steps_estimate
 
 __all__ = ["PreparedBodyRun", "FIXED_METHODS"]
 
-#: the fixed-step methods (canonical names, as ``integrate_body`` runs them); ``dop853`` is adaptive
+#: the fixed-step methods (canonical names); ``dop853`` is adaptive
 FIXED_METHODS = ("lie-poisson", "lie-poisson4", "lie-poisson6", "lie-poisson8", "top-splitting",
                  "top-splitting4", "top-splitting6", "top-splitting8")
 
@@ -43,7 +44,7 @@ class PreparedBodyRun:
         Simulated time (s), finite and > 0.
     step : float, optional
         Step (s) of the fixed-step methods (default 1/20 of the sample interval);
-        the step used divides the sample interval, as in ``integrate_body``.
+        the step used divides the sample interval.
     rtol : float
         Relative (and, relative to ``|L0|``, absolute) tolerance of ``dop853``, 1e-15 <= rtol < 1.
     samples : int
@@ -64,7 +65,7 @@ class PreparedBodyRun:
     key and value). ``run(L0, q0)`` returns ``(L, q)``, arrays (samples + 1, 3)
     and (samples + 1, 4) owned by the caller: ``L`` in body axes, ``q``
     scalar-last, body -> space (the fixed-step methods keep ``q0`` as given in
-    row 0, as ``integrate_body`` does; ``dop853`` normalises it, as ``rigid_dop853``
+    row 0; ``dop853`` normalises it, as ``rigid_dop853``
     does; the later rows are normalised). ``times`` holds the sample times; ``steps`` and ``nfev`` (0 for
     the fixed-step methods) count the last call's work. A non-finite state (or,
     for ``dop853``, a step-size collapse) raises ``IntegrationError``.
@@ -123,7 +124,7 @@ class PreparedBodyRun:
         self._weights = composition_weights(k)
         self._split = split_run
         self._stepper = splitting_stepper(*self._consts, k)
-        # integrate_body's chunks (samples per kernel call); one call when the run fits in one
+        # chunks of samples per kernel call (at most 2e6 steps); one call when the run fits in one
         self._chunk = max(1, int(2e6 // sps))
         self._one_call = sps <= 2e6 and samples <= self._chunk
 
@@ -180,7 +181,7 @@ class PreparedBodyRun:
             if kept < samples + 1:
                 self._raise_fixed(kept - 1)
             return out_L, out_q
-        # integrate_body's loop of chunks, with the same stepper
+        # the loop of chunks, each from the last sample's state
         out_L = np.empty((samples + 1, 3))
         out_q = np.empty((samples + 1, 4))
         out_L[0], out_q[0] = L0, q0
