@@ -165,3 +165,33 @@ def test_a_torque_list_is_refused_by_name_where_a_method_cannot_take_an_entry():
         rotframe.simulate_body(**TOP, duration=0.1, method="exact", torque=[torques.gravity(MASS, LENGTH, G)])
     with pytest.raises(ScenarioError, match=r"torque\[1\]: 3 is not callable"):
         rotframe.simulate_body(**TOP, duration=0.1, torque=[torques.gravity(MASS, LENGTH, G), 3])
+
+
+#: what a torque of your own below reads at each run (a module global: its value is part of its compiled glue)
+SPIN_UP = 1e-3
+
+
+def _spin_up(t, L, q):
+    return 0.0, 0.0, SPIN_UP
+
+
+def test_a_torque_of_yours_is_read_afresh_at_every_run_however_it_is_marked():
+    """A run's set-up is kept only for the built-in torques (their constants are their own): a torque of yours,
+    even marked as taking no params, is fingerprinted at every run, so a value it reads that changed is seen."""
+    global SPIN_UP
+    from rotframe.problem.body import simulate_rigid_body
+
+    torque = rotframe.Torque(_spin_up, attitude_only=True, takes_params=False)
+
+    def run():  # compiled (the plain tier would read the global as Python does, whatever the set-up kept)
+        return simulate_rigid_body(**TOP, duration=1.0, torque=torque, method="lie-poisson", step=1e-3, samples=4,
+                                   plain_tier=False)
+
+    first = run()
+    SPIN_UP = 2e-3
+    try:
+        second = run()
+    finally:
+        SPIN_UP = 1e-3
+    # L3 grows by tau3 t (the gravity-free body's torque is along its symmetry axis)
+    assert second.L[-1, 2] - TOP["L0"][2] == pytest.approx(2 * (first.L[-1, 2] - TOP["L0"][2]), rel=1e-9)

@@ -306,8 +306,10 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     torques = [term for _, term in torque_terms(torque)]
     terms = ["euler equations"] + [f"torque {_describe(term)}" for term in torques]
     timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
+    # the diagnostics a torque leaves out, said where they are reported (a scene reports its own)
+    notes = (["a torque acts: energy and |L| are not conserved, and not reported"] if torques else []) + run.notes
     summary = _summary("simulate_body", {"duration": float(duration)}, terms, run.method, run.steps,
-                       run.diagnostics, run.warnings, run.notes, timing, run.complete, run.t_reached)
+                       run.diagnostics, run.warnings, notes, timing, run.complete, run.t_reached)
     scn = ProblemScenario("simulate_body", "simulate_body", "Your own rigid body (rotframe.simulate_body)",
                           "Euler's equations" + (" with a torque" if torques else ", torque-free"))
     from rotframe.scenes.base import SceneResult

@@ -139,9 +139,14 @@ def torque_terms(torque) -> list:
     return terms
 
 
+def _named(label, term) -> str:
+    """One torque for a message: ``torque=name`` or ``torque[k]=name``."""
+    return f"{label}={term.name or uf.display_name(term.func)}"
+
+
 def _describe_torques(terms) -> str:
     """The torques for a message: ``torque=name`` or ``torque[k]=name, ...``."""
-    return ", ".join(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms)
+    return ", ".join(_named(label, term) for label, term in terms)
 
 
 _FLOAT = np.dtype(np.float64)
@@ -218,8 +223,7 @@ def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=Non
         raise ScenarioError(f"method={method!r} cannot take {named}: the exact flow is the "
                             "free body's; use dop853, rk4, or a Lie-Poisson splitting for a torque of (t, q) alone")
     if terms and name in KICK_METHODS and not attitude_only:
-        late = next(f"{label}={term.name or uf.display_name(term.func)}" for label, term in terms
-                    if not term.attitude_only)
+        late = next(_named(label, term) for label, term in terms if not term.attitude_only)
         raise ScenarioError(f"method={method!r} cannot take {late}: it splits the torque as a "
                             "kick at fixed attitude, exact only for a torque of (t, q) alone; mark such a torque "
                             "rotframe.Torque(f, attitude_only=True), or use dop853 or rk4")
@@ -283,18 +287,18 @@ def _cached_set_up(**kwargs) -> BodySetUp:
     torque = kwargs["torque"]
     entries = [] if torque is None else list(torque) if isinstance(torque, (list, tuple)) else [torque]
     key = None
-    if all(isinstance(t, Torque) and not t.takes_params for t in entries):  # built-in: the objects are their constants
+    if not kwargs["params"] and all(built_in(t) for t in entries):  # the objects are their constants
         try:
             key = (np.asarray(kwargs["inertia"], dtype=float).tobytes(), tuple(id(t) for t in entries),
                    kwargs["method"], kwargs["rtol"], kwargs["step"], kwargs["samples"], kwargs["duration"],
-                   kwargs["jit"], kwargs["inline"], len(kwargs["params"]))
+                   kwargs["jit"], kwargs["inline"])
             hash(key)
         except (TypeError, ValueError):
             key = None
     cached = _SETUPS.get(key) if key is not None else None
     if cached is None or cached[1] is not limits.current():
         s = body_set_up(**kwargs)
-        if key is not None and not kwargs["params"]:
+        if key is not None:
             if len(_SETUPS) >= _SETUPS_KEPT:
                 _SETUPS.pop(next(iter(_SETUPS)))
             _SETUPS[key] = (s, limits.current(), entries)  # the torques kept alive: their ids stay theirs
@@ -303,6 +307,12 @@ def _cached_set_up(**kwargs) -> BodySetUp:
     s.L, s.q = checked_body_state(kwargs["L0"], kwargs["q0"])
     _check_thin_rod(s.I, s.L)
     return s
+
+
+def built_in(term) -> bool:
+    """Whether a torque is one of `rotframe.torques` (its function defined there: its constants its own, its
+    arithmetic rotframe's): no value it reads can change between runs, and it is never slow."""
+    return isinstance(term, Torque) and getattr(term.func, "__module__", None) == "rotframe.torques"
 
 
 def _check_thin_rod(I, L):
@@ -319,15 +329,21 @@ def body_arrays(s, L, q):
     """A run's arrays from the start state ``L``, ``q`` (`checked_body_state`): ``y`` (1, 7), the samples ``OUT``
     (n, 1, 7) with the start in row 0, the tolerances ``atol`` (1, 7), the per-body counters ``st``, time ``TC`` and
     step ``H``, and the (empty) event arrays, by the names `rotframe.problem.engine.advance` takes them."""
-    start = L.tolist() + q.tolist()
-    y = np.array([start])
-    OUT = np.full((s.samples + 1, 1, 7), np.nan)
-    OUT[0, 0] = start  # the start, as the loop writes it: a run stopped before its first call keeps it
-    sL = max(abs(start[0]), abs(start[1]), abs(start[2]), 1e-300)
     counts = np.zeros(6, np.int64)  # IDX, SUB, ST, EVN, NSTEP, NFEV: views of one array
-    return {"y": y, "OUT": OUT, "atol": np.array([[s.rtol * sL] * 3 + [s.rtol] * 4]),  # a row per body
-            "st": {k: counts[j:j + 1] for j, k in enumerate(("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV"))},
-            "TC": np.zeros(1), "H": np.zeros(1), **_NO_EVENTS}
+    a = {"y": np.zeros((1, 7)), "OUT": np.full((s.samples + 1, 1, 7), np.nan), "atol": np.full((1, 7), s.rtol),
+         "st": {k: counts[j:j + 1] for j, k in enumerate(("IDX", "SUB", "ST", "EVN", "NSTEP", "NFEV"))},
+         "TC": np.zeros(1), "H": np.zeros(1), **_NO_EVENTS}
+    start_into(a, s.rtol, L, q)
+    return a
+
+
+def start_into(a, rtol, L, q):
+    """Write the start ``L``, ``q`` into a run's arrays ``a`` (`body_arrays`' names): the state ``y``, the samples'
+    row 0 (a run stopped before its first call keeps it) and ``L``'s absolute tolerance, ``rtol`` times max |L|."""
+    start = L.tolist() + q.tolist()
+    a["y"][0] = start
+    a["OUT"][0, 0] = start
+    a["atol"][0, :3] = rtol * max(abs(start[0]), abs(start[1]), abs(start[2]), 1e-300)
 
 
 #: a body's event arrays: it has none (the loop's variant without events never reads or writes them)
@@ -362,7 +378,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
                             tier.fns, kernel=None if tier.plain else inlining.kernel)
 
     # calls sized in time: signals and progress between them; a compiled loop of no torque of the user's begins long
-    own = not tier.plain and all(not term.takes_params for _, term in terms)
+    own = not tier.plain and all(built_in(term) for _, term in terms)
     pacer = Pacer("simulate_body", duration, adaptive=method == "dop853",
                   first_budget=FIRST_BUDGET_OWN if own else FIRST_BUDGET)
     try:
@@ -479,11 +495,17 @@ def _torque_raised(exc, call, saved, y, TC, H, st, terms, budget):
     raise uf.UserFunctionError(f"simulate_body: {names} raised {what} {where}") from None
 
 
+def normalised_after_run(method) -> bool:
+    """Whether a run's attitudes are normalised after it: those of DOP853 and RK4 (the splittings normalise each
+    step's, as the scenes do, and the exact flow's are unit to round-off)."""
+    return method not in KICK_METHODS and method != "exact"
+
+
 def body_run(times, Y, method, st, I, complete, params, terms, compile_s, warnings, jit):
     L = Y[:, :3].copy()
     q = Y[:, 3:7].copy()
     norms = np.linalg.norm(q, axis=1)
-    if method not in KICK_METHODS and method != "exact":  # the splittings normalise each step's, as the scenes do
+    if normalised_after_run(method):
         q /= norms[:, None]
 
     def diagnostics():  # measured when first read (`BodyRun.diagnostics`)
@@ -500,13 +522,12 @@ def body_run(times, Y, method, st, I, complete, params, terms, compile_s, warnin
         plain = [(uf.plain_function(term.func), term.params_for(params)) for _, term in terms]
         return np.array([_summed(plain, t, L[i], q[i]) for i, t in enumerate(times)])
 
-    notes = ["a torque acts: energy and |L| are not conserved, and not reported"] if terms else []
     warnings = list(warnings)
     if not jit:
         warnings.append("jit=False: the torque and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
     return BodyRun(times, L, q, method, int(st["NSTEP"][0]), int(st["NFEV"][0]), complete, I, diagnostics,
-                   warnings, notes, torque_samples if terms else None, compile_s or 0.0)
+                   warnings, [], torque_samples if terms else None, compile_s or 0.0)
 
 
 #: samples of the closed-form flow per call (`exact_run`): between calls progress shows and Ctrl-C is seen

@@ -465,26 +465,13 @@ BODY_CONSTANTS = 15
 
 def inverse_inertia(I):
     """I^-1 of the inertia tensor ``I`` (3, 3); of principal moments with a zero one (a thin rod), 1/I_i and 0 for
-    the zero one (no spin along it: no angular momentum there). Kept for the last tensors asked, read-only (a run
-    asks for its body's at its set-up and in its diagnostics)."""
+    the zero one (no spin along it: no angular momentum there)."""
     import numpy as np
 
-    key = I.tobytes()
-    inverse = _INVERSES.get(key)
-    if inverse is None:
-        if np.all(I == np.diag(np.diag(I))):
-            d = np.diag(I)
-            inverse = np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
-        else:
-            inverse = np.linalg.inv(I)
-        inverse.flags.writeable = False
-        if len(_INVERSES) >= 16:
-            _INVERSES.pop(next(iter(_INVERSES)))
-        _INVERSES[key] = inverse
-    return inverse
-
-
-_INVERSES: dict = {}
+    if np.all(I == np.diag(np.diag(I))):
+        d = np.diag(I)
+        return np.diag(np.divide(1.0, d, out=np.zeros(3), where=d > 0.0))
+    return np.linalg.inv(I)
 
 
 def body_constants(inertia, inv_principal, symmetry, kicks):
@@ -541,12 +528,16 @@ def own_step(body, method, t, y, h, yn, prob, fns, W):
 
 
 @jit_inline
-def _start_and_normalise(body, y, yn, last):
-    """``yn = y`` (``last`` False), or a body's attitude in ``yn`` normalised (``last`` True)."""
-    if not last:
-        for j in range(y.shape[0]):
-            yn[j] = y[j]
-    elif body is not None:
+def _start(y, yn):
+    """``yn = y``: the state a step begins from."""
+    for j in range(y.shape[0]):
+        yn[j] = y[j]
+
+
+@jit_inline
+def _normalise_attitude(body, yn):
+    """A body's attitude in ``yn`` normalised after its step (a particle's state untouched)."""
+    if body is not None:
         norm_q = math.sqrt(yn[3] * yn[3] + yn[4] * yn[4] + yn[5] * yn[5] + yn[6] * yn[6])
         for j in range(3, 7):
             yn[j] /= norm_q
@@ -555,32 +546,32 @@ def _start_and_normalise(body, y, yn, last):
 @jit_llvm_inline
 def strang_step(body, t, y, h, yn, prob, fns, W):
     """The model's splitting, order 2 (`own_step`)."""
-    _start_and_normalise(body, y, yn, False)
+    _start(y, yn)
     strang(body, t, h, yn, prob, fns, W)
-    _start_and_normalise(body, y, yn, True)
+    _normalise_attitude(body, yn)
 
 
 @jit_llvm_inline
 def yoshida_step(body, t, y, h, yn, prob, fns, W):
     """Yoshida's triple jump of the model's splitting, order 4 (`own_step`)."""
-    _start_and_normalise(body, y, yn, False)
+    _start(y, yn)
     w1 = YOSHIDA4_OUTER
     w0 = YOSHIDA4_INNER
     strang(body, t, w1 * h, yn, prob, fns, W)
     strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
     strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
-    _start_and_normalise(body, y, yn, True)
+    _normalise_attitude(body, yn)
 
 
 @jit_llvm_inline
 def composed_step(body, weights, t, y, h, yn, prob, fns, W):
     """The model's splitting composed with the fractions ``weights`` of the step (`own_step`: Kahan & Li's)."""
-    _start_and_normalise(body, y, yn, False)
+    _start(y, yn)
     done = 0.0
     for w in weights:
         strang(body, t + done * h, w * h, yn, prob, fns, W)
         done += w
-    _start_and_normalise(body, y, yn, True)
+    _normalise_attitude(body, yn)
 
 
 @jit_uncounted

@@ -31,6 +31,7 @@ from rotframe.limits import check_run
 from rotframe.particles.trajectory import Trajectory
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
+from rotframe.problem.kept import ArrayBlocks
 from rotframe.problem.models import model_parts
 from rotframe.problem.particle_setup import (check_arrays, checked_atol, checked_attitude, checked_states, fill_states,
                                              plain_states, run_state, set_up, tolerance_rows)
@@ -241,10 +242,9 @@ _WORK = ("K", "Kb", "V", "F", "W")
 
 
 class _KeptArrays:
-    """The arrays of a prepared run of one particle, made once in two blocks and reset by two copies at each run.
+    """The arrays of a prepared run of one particle, made once (`rotframe.problem.kept.ArrayBlocks`) and reset at each run.
 
-    Sixteen arrays made anew took 5 us of a run's own 20 (numpy's cost per array, not per number),
-    as much as a short run's integration. Nothing of them leaves a run: its `Trajectory` holds
+    Nothing of them leaves a run: its `Trajectory` holds
     copies. A run that finds them in use (a call on another thread) makes its own
     (`_fresh_arrays`); so does a run of many particles, whose blocks on threads each need work
     arrays of their own, and whose integration outweighs the arrays.
@@ -252,23 +252,13 @@ class _KeptArrays:
 
     def __init__(self, s, atol):
         y, state, tolerances, OUT, _ = _fresh_arrays(s, 1, atol)
-        arrays = {"y": y, "atol": tolerances, "OUT": OUT, **state, **dict(zip(_WORK, scratch(s.D)))}
         self.lock = threading.Lock()
-        self._blocks = []
-        views = {}
-        for numbers in (np.float64, np.int64):  # one block of each kind, the arrays views of it
-            group = {k: a for k, a in arrays.items() if a.dtype == numbers}
-            block = np.concatenate([a.ravel() for a in group.values()])
-            self._blocks.append((block, block.copy()))
-            at = 0
-            for k, a in group.items():
-                views[k] = block[at:at + a.size].reshape(a.shape)
-                at += a.size
-        self._views = (views["y"], {k: views[k] for k in state}, views["atol"], views["OUT"],
-                       tuple(views[k] for k in _WORK))
+        self._arrays = ArrayBlocks({"y": y, "atol": tolerances, "OUT": OUT, "state": state,
+                                    **dict(zip(_WORK, scratch(s.D)))})
+        v = self._arrays.views
+        self._views = (v["y"], v["state"], v["atol"], v["OUT"], tuple(v[k] for k in _WORK))
 
     def reset(self):
         """The arrays as a fresh run finds them: ``(y, state, atol, OUT, work)``."""
-        for block, fresh in self._blocks:
-            block[:] = fresh
+        self._arrays.reset()
         return self._views

@@ -22,10 +22,11 @@ import functools
 
 import numpy as np
 
-from rotframe.problem.body import (KICK_METHODS, body_arrays, body_run, body_set_up, checked_body_state, exact_run,
-                                   simulate_rigid_body)
+from rotframe.problem.body import (body_arrays, body_run, body_set_up, checked_body_state, exact_run,
+                                   normalised_after_run, simulate_rigid_body, start_into)
 from rotframe.problem.engine import scratch
 from rotframe.problem.inlined import Inlining
+from rotframe.problem.kept import ArrayBlocks
 from rotframe.problem.signatures import BODY
 
 __all__ = ["PreparedBody"]
@@ -82,11 +83,10 @@ class PreparedBody:
             inlining.start()
             self._kernel = inlining.kernel
             self.notes = [inlining.note] if inlining.note else []
-        self._arrays = None if self._exact else _KeptArrays(body_arrays(s, s.L, s.q))
+        self._arrays = None if self._exact else ArrayBlocks(body_arrays(s, s.L, s.q))
         self._call = None if self._exact else self._bound_call()
-        #: whether the samples' attitudes are normalised after the run (as simulate_body's, where the method does
-        #: not normalise each step's)
-        self._normalise = s.method not in KICK_METHODS and s.method != "exact"
+        #: whether the samples' attitudes are normalised after the run (as simulate_body's)
+        self._normalise = normalised_after_run(s.method)
 
     def states(self, L0, q0):
         """The samples of a run from ``L0``, ``q0`` as arrays ``(L (n, 3), q (n, 4))``: ``simulate_body``'s
@@ -114,7 +114,7 @@ class PreparedBody:
         return body_run(s.times, Y[:, 0], s.method, counts, s.I, True, s.params, s.terms, 0.0, [], True)
 
     def _bound_call(self):
-        """The loop's call with every argument bound: the kept arrays (`_KeptArrays`, the same objects at every run),
+        """The loop's call with every argument bound: the kept arrays (`ArrayBlocks`, the same objects at every run),
         the run's settings, the problem, and the loop itself (the inlined one, or the engine's variant)."""
         from rotframe.problem import engine
         from rotframe.problem.calls import direct_functions
@@ -131,7 +131,8 @@ class PreparedBody:
     def _integrate(self, L0, q0):
         """The run's samples (n, 1, 7), as the loop wrote them (the kept array: copy what is kept): one call."""
         L, q = checked_body_state(L0, q0)
-        a = self._arrays.reset(self.setup.rtol, L, q)
+        a = self._arrays.reset()
+        start_into(a, self.setup.rtol, L, q)
         st = a["st"]
         try:
             self._call()
@@ -150,38 +151,3 @@ class PreparedBody:
 
         raise IntegrationError(f"simulate_body: the prepared run from L0 = {np.asarray(L0).tolist()} failed, and "
                                "simulate_body's did not")
-
-
-class _KeptArrays:
-    """A run's arrays (`rotframe.problem.body.body_arrays`), made once in two blocks and reset by two copies at each
-    run (numpy's cost per array made, not per number, was a third of a short run's time)."""
-
-    def __init__(self, arrays):
-        flat = {k: v for k, v in arrays.items() if k != "st"}
-        flat.update({f"st.{k}": v for k, v in arrays["st"].items()})
-        self._blocks, views = [], {}
-        for kind in (np.float64, np.int64, np.bool_):
-            group = {k: a for k, a in flat.items() if a.dtype == kind}
-            block = np.concatenate([a.ravel() for a in group.values()]) if group else np.zeros(0, kind)
-            self._blocks.append((block, block.copy()))
-            at = 0
-            for k, a in group.items():
-                views[k] = block[at:at + a.size].reshape(a.shape)
-                at += a.size
-        self._views = {k: v for k, v in views.items() if not k.startswith("st.")}
-        self._views["st"] = {k[3:]: v for k, v in views.items() if k.startswith("st.")}
-        #: the arrays by `body_arrays`' names: the same objects at every run
-        self.views = self._views
-        self._y, self._first, self._atol = views["y"][0], views["OUT"][0, 0], views["atol"][0]
-
-    def reset(self, rtol, L, q):
-        """The arrays as `body_arrays` makes them for the start ``L``, ``q``."""
-        for block, fresh in self._blocks:
-            block[:] = fresh
-        v = self._views
-        state = L.tolist() + q.tolist()
-        self._y[:] = state
-        self._first[:] = state
-        sL = max(abs(state[0]), abs(state[1]), abs(state[2]), 1e-300)  # as body_arrays: max |L|
-        self._atol[:3] = rtol * sL
-        return v

@@ -113,10 +113,9 @@ def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=No
         steps = 1 if body_run.method == "exact" else body_run.steps
         traj = BodyTrajectory(body_run.times, body_run.L, body_run.q, body_run.method, steps, body_run.complete,
                               body_run.t_reached, dict(body_run.extras))
-        # the engine's notes on the run (its tier, its caches); not its own account of the invariants, which the
-        # scene reports itself
-        notes = [n for n in getattr(body_run, "notes", []) if not n.startswith("a torque acts")]
-        return finish(traj, {"notes": notes, "warnings": list(getattr(body_run, "warnings", []))})
+        # the engine's notes on the run (its tier, its caches)
+        return finish(traj, {"notes": list(getattr(body_run, "notes", [])),
+                             "warnings": list(getattr(body_run, "warnings", []))})
 
     return guarded(done, simulate_rigid_body, inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque,
                    method=method, rtol=rtol if method == "dop853" else None, step=run.get("step"), samples=samples,
