@@ -78,13 +78,15 @@ def _fmt(x: float) -> str:
     return f"{x:.3g}"
 
 
-def check_run(*, steps: float = 0.0, samples: float = 0.0, particles: int = 1, what: str = "run") -> None:
-    """Refuse a run whose estimated ``steps`` (per particle) or ``samples`` exceed the limits."""
+def check_run(*, steps: float = 0.0, samples: float = 0.0, particles: int = 1, what: str = "run",
+              remedy: str = "shorten duration or enlarge step") -> None:
+    """Refuse a run whose estimated ``steps`` (per particle) or ``samples`` exceed the limits; ``remedy`` is what
+    the message asks for first where the steps do."""
     lim = current()
     work = float(steps) * max(int(particles), 1)
     if work > lim.max_steps:
         raise LimitError(f"{what}: about {_fmt(work)} integration steps, over the limit of {_fmt(lim.max_steps)}; "
-                         "shorten duration or enlarge step, or raise the limit with --max-steps N")
+                         f"{remedy}, or raise the limit with --max-steps N")
     stored = float(samples) * max(int(particles), 1)
     if stored > lim.max_samples:
         gb = stored * 6 * 8 * 2 / 1e9
@@ -101,12 +103,15 @@ def check_rows(rows: float, what: str = "sweep") -> None:
                          "points, or raise the limit with --max-rows N")
 
 
-def check_pace(what: str, duration: float, steps, t_reached, repeated: bool = False) -> bool:
+def check_pace(what: str, duration: float, steps, t_reached, repeated: bool = False, step=None) -> bool:
     """The running work estimate of an adaptive run: its steps so far plus the rest at each particle's pace.
 
-    The pace is a particle's average step so far, not its last (which shrinks near a singularity,
-    where the run is about to fail and say why). Returns whether the estimate is over max_steps;
-    raises `LimitError` when it is and was at the previous check too (``repeated``).
+    The pace is a particle's average step so far, or its next ``step`` (per particle, where given) where that is
+    longer: not the next step alone, which shrinks near a singularity, where the run is about to fail and say
+    why; not the average alone, which a run whose steps still grow from a short first one (a time scale far
+    from 1 s: DOP853's first step begins at 1e-6 s where f is tiny) would project many times too long. Returns
+    whether the estimate is over max_steps; raises `LimitError` when it is and was at the previous check too
+    (``repeated``).
     """
     import numpy as np
 
@@ -114,13 +119,15 @@ def check_pace(what: str, duration: float, steps, t_reached, repeated: bool = Fa
     steps = np.asarray(steps, dtype=float)
     t_reached = np.asarray(t_reached, dtype=float)
     pace = np.where(t_reached > 0.0, t_reached / np.maximum(steps, 1.0), np.inf)
+    if step is not None:
+        pace = np.maximum(pace, np.abs(np.asarray(step, dtype=float)))
     remaining = np.maximum(float(duration) - t_reached, 0.0) / pace
     estimate = float(np.sum(steps) + np.sum(remaining))
     over = estimate > lim.max_steps
     if over and repeated:
         raise LimitError(f"{what}: about {_fmt(estimate)} integration steps (at the pace of its first "
-                         f"{int(np.sum(steps))} steps), over the limit of {_fmt(lim.max_steps)}; shorten duration, "
-                         "loosen rtol, or raise the limit (rotframe.limits.applied, --max-steps N)")
+                         f"{int(np.sum(steps))} steps), over the limit of {_fmt(lim.max_steps)}; shorten the run, "
+                         "loosen rtol, or raise the limit (--max-steps N; from Python, rotframe.limits.applied)")
     return over
 
 

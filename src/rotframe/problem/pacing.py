@@ -38,6 +38,10 @@ FIRST_BUDGET = 16
 FIRST_BUDGET_OWN = 4096
 #: the running estimate refuses only after this many steps per particle (DOP853's step has settled by then)
 SETTLED_STEPS = 32
+#: a step that grew more than this since the last check is still growing (from DOP853's first step, which begins
+#: at 1e-6 s where f is tiny: a run on a time scale far from 1 s grows its steps by 1e100 over some 200 steps); its
+#: pace is not projected until it settles
+GROWING = 2.0
 
 
 class Pacer:
@@ -46,7 +50,7 @@ class Pacer:
     Parameters
     ----------
     what : str
-        The caller, for messages (``"simulate"``).
+        What runs, for messages (``"method dop853"``, as the fixed-step methods' count before the run names it).
     duration : float
         The run's span (s).
     adaptive : bool
@@ -67,6 +71,7 @@ class Pacer:
         self.last_seconds = 0.0
         self._started = 0.0
         self._over = False
+        self._last_step = None
 
     def start(self) -> int:
         """Mark a call's start; returns its budget (steps per particle)."""
@@ -82,14 +87,20 @@ class Pacer:
         wanted = self.budget * CALL_SECONDS / max(elapsed, 1e-9)
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
-    def check(self, steps, t_reached) -> None:
+    def check(self, steps, t_reached, step) -> None:
         """Refuse the run when its projected steps exceed max_steps at two checks in a row (`rotframe.limits.check_pace`).
 
-        ``steps``, ``t_reached``: per-particle arrays of the running particles.
+        ``steps``, ``t_reached``, ``step``: per-particle arrays of the running particles (their steps taken, time
+        reached and next step).
         """
         from rotframe import limits
 
         steps = np.asarray(steps, dtype=float)
-        if not self.adaptive or steps.size == 0 or float(np.min(steps)) < SETTLED_STEPS:
+        step = np.abs(np.asarray(step, dtype=float))
+        growing = self._last_step is not None and self._last_step.shape == step.shape and bool(
+            np.any(step > GROWING * self._last_step))
+        self._last_step = step.copy()
+        if not self.adaptive or steps.size == 0 or float(np.min(steps)) < SETTLED_STEPS or growing:
+            self._over = False  # a step still growing from a short first one: no pace to project yet
             return
-        self._over = limits.check_pace(self.what, self.duration, steps, t_reached, repeated=self._over)
+        self._over = limits.check_pace(self.what, self.duration, steps, t_reached, repeated=self._over, step=step)

@@ -19,6 +19,7 @@ attributes ``terminal`` and ``direction``, as in ``scipy.integrate.solve_ivp``.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -117,7 +118,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     OUT = np.full((n, N, D), np.nan)
     OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
     state = run_state(N, D, slots, len(events))
-    pacer = Pacer("simulate", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
+    pacer = Pacer(f"method {method}", duration, adaptive=method == "dop853")  # calls sized in time: signals and progress between them
     first = True
     if on_gpu:  # the same loop on the GPU: every particle at once, the arrays kept there between calls
         from rotframe.problem.gpu import GpuAdvance
@@ -184,7 +185,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
             if np.all(ST != 0):
                 break
             running = ST == 0
-            pacer.check(state["NSTEP"][running], state["TC"][running])
+            pacer.check(state["NSTEP"][running], state["TC"][running], state["H"][running])
     except KeyboardInterrupt:
         if gpu is not None:
             gpu.fetch()
@@ -436,9 +437,15 @@ def _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, note
         return
     w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
     rotating = bool(np.any(w != 0.0)) and "centrifugal" in frame_terms
-    E = energies(rotating)
+    with np.errstate(over="ignore", invalid="ignore"):
+        E = energies(rotating)
     traj.extras["energy"] = E
     name = "jacobi" if rotating else "energy"
+    if not np.all(np.isfinite(E)):  # |v|^2 or the potential past float64's range: no drift to measure, said so
+        diagnostics[f"{name}_rel_drift"] = math.nan
+        notes.append(f"{name}_rel_drift: not measured; the {'Jacobi integral' if rotating else 'energy'} overflows "
+                     "float64 at some sample (a speed or distance near 1e154 in SI, whose square is out of range)")
+        return
     E0 = E[0]
     scale = np.where(E0 != 0.0, np.abs(E0), 1.0)
     drift = float(np.max(np.abs(E - E0) / scale))

@@ -70,7 +70,8 @@ def simulate(p, terms, method, run, progress):
     periods = _periods(p)
     shortest = min(periods) if periods else math.inf
     samples, resolved = samples_for(p.duration, shortest, run.get("samples") or 2000)
-    result = simulate_free_body(build(p), p.duration, method, dict(run, samples=samples), progress)
+    result = simulate_free_body(build(p), p.duration, method, dict(run, samples=samples), progress,
+                                spin="omega3, omega_perp")
     result.extras["resolved"] = resolved
     result.extras["shortest_period"] = shortest
     return result

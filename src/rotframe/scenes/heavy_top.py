@@ -104,7 +104,7 @@ def simulate(p, terms, method, run, progress):
 
     # the engine's heavy top: the free body under the built-in gravity torque, the heavy-top scene's arithmetic
     return run_body(method, inertia, L0, q0, p.duration, dict(run, samples=samples), progress, finish,
-                    torque=torques.gravity(p.mass, p.length, p.g))
+                    torque=torques.gravity(p.mass, p.length, p.g), spin="phidot0, psidot0, wobble")
 
 
 #: Order of each fixed-step method (its global error goes as h^order): what its stated accuracy scales by.

@@ -81,8 +81,10 @@ def free_body_state(inertia, omega_body):
     return inertia, L, np.array([0.0, 0.0, 0.0, 1.0])
 
 
-def simulate_free_body(body, duration, method, run, progress):
-    """Run a free body ``body = (inertia, L0, q0)`` on the engine (`run_body`); the default method is the exact flow."""
+def simulate_free_body(body, duration, method, run, progress, spin="omega"):
+    """Run a free body ``body = (inertia, L0, q0)`` on the engine (`run_body`); the default method is the exact flow.
+
+    ``spin`` names the scene's keys that make ``L0``, for a refusal of it (`run_body`)."""
     from rotframe.scenes.base import SceneResult
 
     inertia, L0, q0 = body
@@ -91,10 +93,10 @@ def simulate_free_body(body, duration, method, run, progress):
     def finish(traj, remarks):
         return SceneResult(traj, ["free-rigid-body"], traj.method, traj.steps, extras={"inertia": inertia, **remarks})
 
-    return run_body(method, inertia, L0, q0, duration, run, progress, finish)
+    return run_body(method, inertia, L0, q0, duration, run, progress, finish, spin=spin)
 
 
-def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=None):
+def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=None, spin="the spin"):
     """Integrate a rigid scene's body on the engine (`rotframe.problem.body.simulate_rigid_body`) with the run
     settings (``step``, ``rtol``, ``samples``): principal moments ``inertia``, the start ``L0``, ``q0``, the
     ``torque`` (`rotframe.torques`; None: a free body) and a method of the registry.
@@ -102,7 +104,9 @@ def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=No
     ``finish(traj, remarks)`` builds the scene's result from the run's `BodyTrajectory` (or the one up to an early
     stop: `rotframe.scenes.base.guarded`) and the engine's notes and warnings (``remarks``, for the result's
     extras). The trajectory's ``extras`` hold the run's ``rtol`` or ``step`` and ``nfev``; ``steps`` counts the
-    steps taken, and one for the exact flow (its one evaluation, as the scenes count it).
+    steps taken, and one for the exact flow (its one evaluation, as the scenes count it). A start the engine refuses
+    by its ``L0`` (out of float64's range for the method: `rotframe.problem.body_checks`) is said of the scene's keys
+    that make it, ``spin``.
     """
     from rotframe.problem.body import simulate_rigid_body  # the engine's front door: imported by a run
 
@@ -117,9 +121,14 @@ def run_body(method, inertia, L0, q0, duration, run, progress, finish, torque=No
         return finish(traj, {"notes": list(getattr(body_run, "notes", [])),
                              "warnings": list(getattr(body_run, "warnings", []))})
 
-    return guarded(done, simulate_rigid_body, inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque,
-                   method=method, rtol=rtol if method == "dop853" else None, step=run.get("step"), samples=samples,
-                   progress=progress)
+    try:
+        return guarded(done, simulate_rigid_body, inertia=inertia, L0=L0, q0=q0, duration=duration, torque=torque,
+                       method=method, rtol=rtol if method == "dop853" else None, step=run.get("step"),
+                       samples=samples, progress=progress)
+    except ScenarioError as exc:
+        if not str(exc).startswith("L0: "):
+            raise
+        raise ScenarioError(f"{spin}: the body's angular momentum {str(exc)[len('L0: '):]}") from None
 
 
 def initial_attitude_zxz(phi, theta, psi):
