@@ -273,3 +273,28 @@ def test_a_force_after_the_string_is_named_by_the_users_own_number():
     with pytest.raises(ScenarioError, match=r"forces\[1\]"):
         simulate_particles(omega=[0, 0, 0], r0=[0.0, 0.0, 0.0], v0=[0, 0, 0], duration=1.0,
                            forces=[forces.pendulum(2.0, [0, 0, 2.0]), broken])
+
+
+@pytest.mark.parametrize("frame_terms", [None, ("coriolis",)])
+def test_the_built_in_terms_energy_is_numpys_and_the_compiled_ones(frame_terms):
+    """Every built-in potential takes arrays (``array_potential``): the run's energy (or Jacobi) diagnostic is then
+    numpy's, and the problem's glue compiles no potential; the same potentials marked as a user's (compiled, summed
+    per sample by the engine) give the same energies to round-off."""
+    import dataclasses
+
+    from rotframe.problem.glue import particle_source
+
+    fs = [forces.gravity([0.0, 0.0, -9.81]), forces.central_gravity(3.986e14, (0.0, 0.0, -6.371e6)),
+          forces.spring(0.3, (1.0, 2.0, 3.0)), forces.altitude_gravity(9.8, 6.371e6)]
+    assert all(f.array_potential for f in fs)
+    assert "def potential" not in particle_source(fs, [], (), splitting=False, omega="", origin=False)
+    kw = dict(omega=[0.0, 0.3, 0.5], r0=[[1.0, 0.0, 0.0], [0.0, 2.0, 1.0]], v0=[[0.0, 1.0, 0.0], [0.5, 0.0, 0.0]],
+              duration=5.0, samples=30, method="dop853", frame_terms=frame_terms)
+    numpys = simulate_particles(forces=fs, **kw)
+    theirs = [dataclasses.replace(f, array_potential=False) for f in fs]
+    assert "def potential" in particle_source(theirs, [], (), splitting=False, omega="", origin=False)
+    compiled = simulate_particles(forces=theirs, **kw)
+    E, E_ref = numpys.trajectory.extras["energy"], compiled.trajectory.extras["energy"]
+    np.testing.assert_allclose(E, E_ref, rtol=1e-14, atol=0)
+    name = "jacobi_rel_drift" if frame_terms is None else "energy_rel_drift"
+    assert numpys.diagnostics[name] == pytest.approx(compiled.diagnostics[name], rel=1e-6, abs=1e-15)

@@ -51,7 +51,6 @@ factory                     acceleration (frame axes)        the scenes' term
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -118,7 +117,7 @@ def gravity(g) -> Force:
     def potential(t, r):
         return -(gx * r[0] + gy * r[1] + gz * r[2])
 
-    return Force(gravity, potential=potential, name="gravity", takes_params=False,
+    return Force(gravity, potential=potential, name="gravity", takes_params=False, array_potential=True,
                  linear=(_ZERO3, _ZERO3, (gx, gy, gz)))
 
 
@@ -139,7 +138,7 @@ def altitude_gravity(g0, radius) -> Force:
     def potential(t, r):
         return -g0 * R * R / (R + r[2])
 
-    return Force(gravity, potential=potential, name="altitude-gravity", takes_params=False)
+    return Force(gravity, potential=potential, name="altitude-gravity", takes_params=False, array_potential=True)
 
 
 def central_gravity(gm, centre) -> Force:
@@ -160,9 +159,9 @@ def central_gravity(gm, centre) -> Force:
         dx = r[0] - cx
         dy = r[1] - cy
         dz = r[2] - cz
-        return -GM / math.sqrt(dx * dx + dy * dy + dz * dz)
+        return -GM / np.sqrt(dx * dx + dy * dy + dz * dz)  # numpy's: r may be (3, M) arrays (array_potential)
 
-    return Force(gravity, potential=potential, name="central-gravity", takes_params=False)
+    return Force(gravity, potential=potential, name="central-gravity", takes_params=False, array_potential=True)
 
 
 def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
@@ -221,7 +220,7 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
         dz = r[2] - az_
         return 0.5 * k * (dx * dx + dy * dy + vertical * dz * dz)
 
-    return Force(spring, potential=potential, name="spring", takes_params=False,
+    return Force(spring, potential=potential, name="spring", takes_params=False, array_potential=True,
                  linear=(_diagonal(-k, -k, -vertical * k), _ZERO3, (k * ax_, k * ay_, vertical * k * az_)))
 
 

@@ -21,6 +21,8 @@ import math
 
 import numpy as np
 
+from rotframe.problem.terms import energy_by_numpy
+
 __all__ = ["flatten_params", "params_source", "particle_source", "body_source", "render"]
 
 
@@ -101,7 +103,7 @@ def particle_source(forces, events, params, *, splitting: bool, omega: str, orig
         src += ["\n@jit(EVENT_SIG)\ndef event(k, t, y, p):\n", views, unpack]
         src += [f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))\n" for k in range(len(events))]
         src.append("    return 0.0\n")
-    if any(f.potential is not None for f in forces):
+    if any(f.potential is not None for f in forces) and not energy_by_numpy(forces):  # else numpy's energies
         src += ["\n@jit(POTENTIAL_SIG)\ndef potential(t, y, p):\n", "    r = readonly(y[0:3])\n", unpack, "    u = 0.0\n"]
         src += [f"    u += float(potential_{k}(t, r{args if f.takes_params else ''}))\n" for k, f in enumerate(forces)
                 if f.potential is not None]

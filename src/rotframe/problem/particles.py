@@ -33,7 +33,7 @@ from rotframe.problem.inlined import Inlining
 from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
-from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint
+from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint, energy_by_numpy
 from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
@@ -201,7 +201,9 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
 
-    def energies(rotating):  # by the loop that ran the run's end: a run ended in the plain tier compiles nothing
+    def energies(rotating):  # numpy's where it can; else by the loop that ran the run's end (plain: nothing compiled)
+        if energy_by_numpy(forces):
+            return array_energies(traj, forces, frame, rotating)
         return tier.driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, tier.fns,
                                     tier.driver.potential(), rotating)
 
@@ -405,19 +407,25 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
                                  "method exact: the inertial straight line turned into the frame by the exact "
                                  "integral of its piecewise-linear rate, to round-off"]
 
-    def energies(rotating):
-        n, N = traj.r.shape[:2]
-        pos = traj.r.reshape(-1, 3).T  # (3, n N): the built-in potentials are arithmetic on r[0], r[1], r[2]
-        t = np.repeat(traj.times, N)
-        E = 0.5 * np.sum(traj.v.reshape(-1, 3) ** 2, axis=1)
-        for f in forces:
-            E = E + np.asarray(f.potential(t, pos), dtype=float)
-        if rotating:
-            E = E - 0.5 * np.sum(np.cross(frame.data[0], pos.T) ** 2, axis=1)
-        return E.reshape(n, N)
-
-    _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)
+    _energy_diagnostics(lambda rotating: array_energies(traj, forces, frame, rotating), traj, frame, origin, forces,
+                        diagnostics, notes, frame_terms)
     return ProblemRun(traj, diagnostics, [], notes, frame, 0.0, frame_terms)
+
+
+def array_energies(traj, forces, frame, rotating):
+    """The energy per unit mass (or the Jacobi integral, ``rotating``) at each sample of ``traj``, (n, N), by numpy:
+    ``v^2/2 + sum U`` (less ``|omega x r|^2 / 2``) with each potential called once on every sample's ``r`` (3, n N).
+    ``omega`` is the steady frame's (`_energy_diagnostics` asks for no other)."""
+    n, N = traj.r.shape[:2]
+    pos = traj.r.reshape(-1, 3).T
+    t = np.repeat(traj.times, N)
+    E = 0.5 * np.sum(traj.v.reshape(-1, 3) ** 2, axis=1)
+    for f in forces:
+        E = E + np.asarray(f.potential(t, pos), dtype=float)
+    if rotating:
+        w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
+        E = E - 0.5 * np.sum(np.cross(w, pos.T) ** 2, axis=1)
+    return E.reshape(n, N)
 
 
 def _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms):

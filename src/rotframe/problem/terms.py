@@ -18,7 +18,7 @@ import numpy as np
 from rotframe.errors import ScenarioError
 from rotframe.problem import callables as uf
 
-__all__ = ["Force", "StringConstraint", "Torque", "as_term", "one_constraint", "check_on_string", "check_splitting",
+__all__ = ["Force", "StringConstraint", "Torque", "energy_by_numpy", "as_term", "one_constraint", "check_on_string", "check_splitting",
            "model_constants", "FRAME_TERMS", "check_frame_terms"]
 
 #: The frame's own terms, by the scenes' names for them (``-2 w x v``, ``-w x (w x r)``, ``-w' x r``): the ones a
@@ -56,6 +56,11 @@ class Force:
         flow takes (``method="exact"``, `rotframe.problem.exact`). Set by the built-in terms that
         are (uniform gravity, a spring, linear drag in uniform air, the Lorentz force); empty
         otherwise, and for a force of your own.
+    array_potential : bool
+        Whether ``potential`` takes ``t`` and ``r`` as arrays, ``r`` (3, M), and gives the M values: the run's
+        energy diagnostic is then computed by numpy, with nothing compiled for it. Set by the built-in terms
+        of `rotframe.forces` whose potential is arithmetic on ``r[0]``, ``r[1]``, ``r[2]``; False for a force
+        of your own, whose potential is compiled.
     """
 
     accel: object
@@ -65,6 +70,7 @@ class Force:
     flow: tuple = ()
     takes_params: bool = True
     linear: tuple = ()
+    array_potential: bool = False
 
     def params_for(self, params) -> tuple:
         """The ``params`` this force's functions are called with: the run's, or none (`takes_params`)."""
@@ -72,6 +78,13 @@ class Force:
 
     def __call__(self, *args):
         return self.accel(*args)
+
+
+def energy_by_numpy(forces) -> bool:
+    """Whether every force's potential takes arrays (`Force.array_potential`: the built-in terms) in the frame's axes:
+    the run's energy diagnostic is then numpy's (`rotframe.problem.particles.array_energies`), and nothing is
+    compiled for it (no potential in the problem's glue, no `rotframe.problem.engine.energies`)."""
+    return all(f.array_potential and f.axes == "frame" for f in forces)
 
 
 @dataclass(frozen=True)
