@@ -23,7 +23,7 @@ PACKAGE = SRC / "rotframe"
 
 #: layer of each top-level part of the package (lower imports nothing higher)
 LAYERS = {
-    "errors": 0, "limits": 0, "validation": 0, "frames": 0, "files": 0, "method_registry": 0,
+    "errors": 0, "limits": 0, "validation": 0, "units": 0, "frames": 0, "files": 0, "method_registry": 0,
     "numerics": 1,
     "particles": 2, "rigid": 2,
     "earth": 3, "analytic": 3, "problem": 3, "forces": 3, "events": 3, "torques": 3,

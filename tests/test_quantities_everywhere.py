@@ -96,3 +96,60 @@ def test_a_function_returning_a_quantity_is_refused_by_name():
 
     with pytest.raises(RotframeError, match=r"omega .*Quantity"):
         rotframe.simulate(omega=omega, r0=[1, 0, 0], v0=[0, 0, 0], duration=1.0, samples=2, jit=False)
+
+
+# the built-in terms' and torques' factories: (factory, its Quantity arguments, the same in SI by hand, a point to
+# evaluate at (t, r, v) or (t, L, q))
+_R, _V = np.array([1.0, 2.0, 3.0]), np.array([0.1, 0.2, 0.3])
+_L, _Q = np.array([1.0, 0.0, 0.0]), np.array([0.3, 0.1, 0.2, math.sqrt(1 - 0.14)])
+FACTORIES = [
+    ("gravity", lambda: rotframe.forces.gravity([0, 0, -980] * u.cm / u.s**2),
+     lambda: rotframe.forces.gravity([0.0, 0.0, -9.8])),
+    ("altitude_gravity", lambda: rotframe.forces.altitude_gravity(980 * u.cm / u.s**2, 6371 * u.km),
+     lambda: rotframe.forces.altitude_gravity(9.8, 6.371e6)),
+    ("central_gravity", lambda: rotframe.forces.central_gravity(3.986e5 * u.km**3 / u.s**2, [0, 0, -6371] * u.km),
+     lambda: rotframe.forces.central_gravity(3.986e14, [0.0, 0.0, -6.371e6])),
+    ("drag", lambda: rotframe.forces.drag(linear=6 / u.min, quadratic=0.02 / u.km, scale_height=8 * u.km),
+     lambda: rotframe.forces.drag(linear=0.1, quadratic=2e-5, scale_height=8000.0)),
+    ("spring", lambda: rotframe.forces.spring(4 * u.Hz**2, [100, 0, 0] * u.cm),
+     lambda: rotframe.forces.spring(4.0, [1.0, 0.0, 0.0])),
+    ("lorentz", lambda: rotframe.forces.lorentz(1 * u.mC / u.g, [0, 0, 1000] * u.mT, [0, 1, 0] * u.kV / u.km),
+     lambda: rotframe.forces.lorentz(1.0, [0.0, 0.0, 1.0], [0.0, 1.0, 0.0])),
+    ("torques.gravity", lambda: rotframe.torques.gravity(2000 * u.g, 3 * u.cm, 980 * u.cm / u.s**2),
+     lambda: rotframe.torques.gravity(2.0, 0.03, 9.8)),
+    ("torques.body_fixed", lambda: rotframe.torques.body_fixed([1, 2, 3] * u.mN * u.m),
+     lambda: rotframe.torques.body_fixed([1e-3, 2e-3, 3e-3])),
+    ("torques.space_fixed", lambda: rotframe.torques.space_fixed([1, 2, 3] * u.mN * u.m),
+     lambda: rotframe.torques.space_fixed([1e-3, 2e-3, 3e-3])),
+]
+
+
+@pytest.mark.parametrize("name, with_units, by_hand", FACTORIES, ids=[f[0] for f in FACTORIES])
+def test_the_factories_convert_quantities(name, with_units, by_hand):
+    a, b = with_units(), by_hand()
+    point = (0.0, _L, _Q) if name.startswith("torques") else (0.0, _R, _V)
+    np.testing.assert_allclose(np.array(a(*point), dtype=float), np.array(b(*point), dtype=float), rtol=1e-12,
+                               atol=1e-300)
+
+
+def test_the_pendulums_length_and_pivot_convert():
+    c = rotframe.forces.pendulum(6700 * u.cm, [0, 0, 0.067] * u.km)
+    assert c.length == pytest.approx(67.0, rel=1e-15) and np.allclose(c.pivot, [0.0, 0.0, 67.0], rtol=1e-15)
+
+
+@pytest.mark.parametrize("call, key", [
+    (lambda: rotframe.forces.gravity([0, 0, -9.8] * u.km), "gravity: g: km cannot be converted to m/s^2"),
+    (lambda: rotframe.forces.spring(4 * u.m), "spring: k: m cannot be converted to 1/s^2"),
+    (lambda: rotframe.forces.pendulum(67 * u.s), "pendulum: length: s cannot be converted to m"),
+    (lambda: rotframe.torques.body_fixed([1, 2, 3] * u.m), "body_fixed: tau: m cannot be converted to N m"),
+    (lambda: rotframe.torques.gravity(2 * u.m, 0.03, 9.8), "gravity: mass: m cannot be converted to kg"),
+    (lambda: rotframe.forces.spring("4"), "spring: k='4' is not a number"),
+    (lambda: rotframe.forces.pendulum(True), "pendulum: length=True is not a number"),
+    (lambda: rotframe.torques.gravity([1, 2] * u.kg, 0.03, 9.8), "gravity: mass=<Quantity [1., 2.] kg> is not a"),
+    (lambda: rotframe.forces.drag(linear=1 + 2j), "drag: linear=(1+2j) is not a number"),
+    (lambda: rotframe.forces.central_gravity(float("inf"), [0, 0, 0]), "central_gravity: gm=inf is not finite"),
+])
+def test_a_factory_refuses_a_wrong_unit_a_string_or_a_bool_in_one_line(call, key):
+    with pytest.raises(RotframeError) as err:
+        call()
+    assert str(err.value).startswith(key) and "\n" not in str(err.value), str(err.value)

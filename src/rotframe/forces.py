@@ -56,7 +56,7 @@ import numpy as np
 
 from rotframe.errors import ScenarioError
 from rotframe.problem.particles import Force, StringConstraint
-from rotframe.validation import check_vector3
+from rotframe.units import si_number, si_vector
 
 __all__ = ["Force", "gravity", "altitude_gravity", "central_gravity", "drag", "spring", "pendulum", "lorentz"]
 
@@ -86,21 +86,6 @@ def _arithmetic():
     from rotframe.particles.accelerations import spring_pull as _spring_pull
 
 
-def _finite(name, **values):
-    for key, v in values.items():
-        try:
-            arr = np.asarray(v, dtype=float)
-        except (TypeError, ValueError):
-            raise ScenarioError(f"{name}: {key}={v!r} is not a number") from None
-        if not np.all(np.isfinite(arr)):
-            raise ScenarioError(f"{name}: {key}={np.asarray(v).tolist()} is not finite")
-
-
-def _vector(name, key, value):
-    """A 3-vector argument as three floats (`rotframe.validation.check_vector3`: its one-line refusal)."""
-    return tuple(float(c) for c in check_vector3(value, key, ScenarioError, caller=name))
-
-
 def gravity(g) -> Force:
     """Uniform gravity: ``a = g`` (m/s^2, the frame's axes); ``U = -g . r``. The scenes' term ``gravity``.
 
@@ -109,7 +94,7 @@ def gravity(g) -> Force:
     >>> gravity([0.0, 0.0, -9.81]).accel(0.0, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
     (0.0, 0.0, -9.81)
     """
-    gx, gy, gz = _vector("gravity", "g", g)
+    gx, gy, gz = si_vector("gravity", "g", g, "m/s^2")
 
     def gravity(t, r, v):
         return gx, gy, gz
@@ -127,8 +112,7 @@ def altitude_gravity(g0, radius) -> Force:
     ``U = -g0 R^2 / (R + z)``. The scenes' term ``altitude-gravity`` (g0 in m/s^2, R in m).
     """
     _arithmetic()
-    _finite("altitude_gravity", g0=g0, radius=radius)
-    g0, R = float(g0), float(radius)
+    g0, R = si_number("altitude_gravity", "g0", g0, "m/s^2"), si_number("altitude_gravity", "radius", radius, "m")
     if not R > 0:
         raise ScenarioError(f"altitude_gravity: radius={R!r} must be > 0 (m)")
 
@@ -148,9 +132,8 @@ def central_gravity(gm, centre) -> Force:
     below a local frame on its surface (GM in m^3/s^2, c in m).
     """
     _arithmetic()
-    _finite("central_gravity", gm=gm)
-    GM = float(gm)
-    cx, cy, cz = _vector("central_gravity", "centre", centre)
+    GM = si_number("central_gravity", "gm", gm, "m^3/s^2")
+    cx, cy, cz = si_vector("central_gravity", "centre", centre, "m")
 
     def gravity(t, r, v):
         return _central_gravity(r[0] - cx, r[1] - cy, r[2] - cz, GM)
@@ -180,8 +163,8 @@ def drag(*, linear=0.0, quadratic=0.0, scale_height=0.0) -> Force:
     (-0.15, -0.2)
     """
     _arithmetic()
-    _finite("drag", linear=linear, quadratic=quadratic, scale_height=scale_height)
-    k1, k2, H = float(linear), float(quadratic), float(scale_height)
+    k1, k2, H = (si_number("drag", "linear", linear, "1/s"), si_number("drag", "quadratic", quadratic, "1/m"),
+                 si_number("drag", "scale_height", scale_height, "m"))
     if k1 < 0 or k2 < 0 or H < 0:
         raise ScenarioError(f"drag: linear={k1!r}, quadratic={k2!r}, scale_height={H!r}; each must be >= 0")
     if k1 == 0.0 and k2 == 0.0:
@@ -206,9 +189,8 @@ def spring(k, anchor=(0.0, 0.0, 0.0), *, horizontal=False) -> Force:
     the scenes' term ``spring``, the small-angle pendulum (``k = g / L``).
     """
     _arithmetic()
-    _finite("spring", k=k)
-    k = float(k)
-    ax_, ay_, az_ = _vector("spring", "anchor", anchor)
+    k = si_number("spring", "k", k, "1/s^2")
+    ax_, ay_, az_ = si_vector("spring", "anchor", anchor, "m")
     vertical = 0.0 if horizontal else 1.0
 
     def spring(t, r, v):
@@ -242,11 +224,10 @@ def pendulum(length, pivot=(0.0, 0.0, 0.0)) -> StringConstraint:
                                                         forces.pendulum(67.0, pivot=[0, 0, 67.0])],
                                 frame_terms=("coriolis",))  # the local g holds the centrifugal term
     """
-    _finite("pendulum", length=length)
-    L = float(length)
+    L = si_number("pendulum", "length", length, "m")
     if not L > 0:
         raise ScenarioError(f"pendulum: length={L!r} must be > 0 (m)")
-    return StringConstraint(L, _vector("pendulum", "pivot", pivot))
+    return StringConstraint(L, si_vector("pendulum", "pivot", pivot, "m"))
 
 
 def lorentz(q_over_m, B, E=(0.0, 0.0, 0.0)) -> Force:
@@ -255,10 +236,9 @@ def lorentz(q_over_m, B, E=(0.0, 0.0, 0.0)) -> Force:
     ``v`` is relative to the frame: these are the fields of a co-rotating plasma, where the
     corotation electric field cancels ``omega x r``. q/m in C/kg, B in T, E in V/m.
     """
-    _finite("lorentz", q_over_m=q_over_m)
-    qm = float(q_over_m)
-    bx, by, bz = _vector("lorentz", "B", B)
-    ex, ey, ez = _vector("lorentz", "E", E)
+    qm = si_number("lorentz", "q_over_m", q_over_m, "C/kg")
+    bx, by, bz = si_vector("lorentz", "B", B, "T")
+    ex, ey, ez = si_vector("lorentz", "E", E, "V/m")
 
     def force(t, r, v):
         return (qm * (ex + v[1] * bz - v[2] * by), qm * (ey + v[2] * bx - v[0] * bz),

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 from rotframe.errors import ScenarioError
 from rotframe.problem.terms import Torque
-from rotframe.validation import check_vector3
+from rotframe.units import si_number, si_vector
 
 __all__ = ["Torque", "gravity", "body_fixed", "space_fixed"]
 
@@ -56,21 +56,6 @@ def _arithmetic():
     """
     global _body_torque
     from rotframe.rigid.kernels import body_torque as _body_torque
-
-
-def _number(name, key, value):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{name}: {key}={value!r} is not a number") from None
-    if x != x or x in (float("inf"), float("-inf")):
-        raise ScenarioError(f"{name}: {key}={value!r} is not finite")
-    return x
-
-
-def _vector(name, key, value):
-    """A 3-vector argument as three floats (`rotframe.validation.check_vector3`: its one-line refusal)."""
-    return tuple(float(c) for c in check_vector3(value, key, ScenarioError, caller=name))
 
 
 def gravity(mass, length, g) -> Torque:
@@ -92,8 +77,8 @@ def gravity(mass, length, g) -> Torque:
     [10.0, 0.0, 0.0]
     """
     _arithmetic()
-    m, l, gv = (_number("gravity", "mass", mass), _number("gravity", "length", length),
-                _number("gravity", "g", g))
+    m, l, gv = (si_number("gravity", "mass", mass, "kg"), si_number("gravity", "length", length, "m"),
+                si_number("gravity", "g", g, "m/s^2"))
     if not m > 0:
         raise ScenarioError(f"gravity: mass={mass!r} must be > 0 (kg)")
     if not gv >= 0:
@@ -115,7 +100,7 @@ def body_fixed(tau) -> Torque:
     (0.0, 0.0, 0.1)
     """
     _arithmetic()
-    nx, ny, nz = _vector("body_fixed", "tau", tau)
+    nx, ny, nz = si_vector("body_fixed", "tau", tau, "N m")
 
     def body_fixed(t, L, q):
         return _body_torque(q[0], q[1], q[2], q[3], 0.0, nx, ny, nz, 0.0, 0.0, 0.0)
@@ -129,7 +114,7 @@ def space_fixed(tau) -> Torque:
     Then ``dL/dt = tau`` in space: the angular momentum in space grows linearly, whatever the body.
     """
     _arithmetic()
-    sx, sy, sz = _vector("space_fixed", "tau", tau)
+    sx, sy, sz = si_vector("space_fixed", "tau", tau, "N m")
 
     def space_fixed(t, L, q):
         return _body_torque(q[0], q[1], q[2], q[3], 0.0, 0.0, 0.0, 0.0, sx, sy, sz)

@@ -14,6 +14,10 @@ __all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quant
            "to_si", "vector_or_table_si", "params_si", "astropy_unit"]
 
 
+# the converter of every door (the Python API, the built-in terms' factories) lives below the layers that use it
+from rotframe.units import holds_quantity, is_quantity, to_si  # noqa: E402,F401  (their home: rotframe.units)
+
+
 class NotAQuantity(ValueError):
     """The text is neither a number nor a quantity (the message: astropy's first line)."""
 
@@ -96,50 +100,6 @@ def as_quantities(values, units) -> dict:
 def astropy_unit(unit: str) -> str:
     """A summary unit string as astropy spells it (``"sidereal day"`` -> ``"sday"``)."""
     return _ASTROPY_SPELLING.get(unit, unit)
-
-
-def is_quantity(value) -> bool:
-    """An astropy Quantity (or anything that carries a unit and converts like one)."""
-    return hasattr(value, "unit") and hasattr(value, "to_value")
-
-
-def holds_quantity(value, depth: int = 0) -> bool:
-    """``value`` is a Quantity, or a list, tuple or object array that holds one (at any depth up to 4)."""
-    if is_quantity(value):
-        return True
-    if depth > 4:
-        return False
-    if isinstance(value, (list, tuple)):
-        return any(holds_quantity(item, depth + 1) for item in value)
-    if getattr(value, "dtype", None) is not None and getattr(value.dtype, "hasobject", False):
-        return any(holds_quantity(item, depth + 1) for item in value.flat)
-    return False
-
-
-def to_si(value, unit: str, key: str):
-    """``value`` with every Quantity in it converted to ``unit`` (a number, a list or a vector of them).
-
-    The one converter of the Python doors (`rotframe.simulate`, `rotframe.simulate_body`): a
-    plain value passes unchanged (SI already); a Quantity, or a list or tuple holding some, is
-    converted element by element (angles as radians), so that no Quantity reaches the numerical
-    core with its unit dropped. A Quantity of another dimension is a one-line `ScenarioError`
-    naming ``key``, its unit and ``unit``.
-    """
-    if not holds_quantity(value):
-        return value
-    if is_quantity(value):
-        import astropy.units as u
-
-        from rotframe.errors import ScenarioError
-
-        try:
-            return value.to_value(u.Unit(unit) if unit else u.dimensionless_unscaled,
-                                  equivalencies=u.dimensionless_angles())
-        except (u.UnitsError, TypeError, ValueError):
-            shown = " ".join(str(value).split())[:60]
-            raise ScenarioError(f"{key}: {value.unit.to_string() or 'dimensionless'} cannot be converted to "
-                                f"{unit or 'a plain number'} ({shown})") from None
-    return [to_si(item, unit, f"{key}[{k}]") for k, item in enumerate(value)]  # a list, tuple or object array
 
 
 def vector_or_table_si(value, unit: str, key: str):
