@@ -12,7 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from rotframe import torques
-from rotframe.errors import IntegrationError
+from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.problem.body import simulate_rigid_body
 from rotframe.problem.callables import UserFunctionError
 from rotframe.problem.prepared_body import PreparedBody
@@ -74,3 +74,15 @@ def test_a_prepared_run_that_fails_raises_what_simulate_body_raises():
         with pytest.raises(error) as got:
             prepared.states(*STARTS[0])
         assert str(got.value) == str(expected.value)
+
+
+@pytest.mark.parametrize("L0, q0, says", [("0.01,2,0", [0, 0, 0, 1], "L0 = '0.01,2,0' is not numbers"),
+                                          ([np.nan, 2.0, 0.0], [0, 0, 0, 1], "L0 = [nan, 2.0, 0.0] is not finite"),
+                                          ([0.01, 2.0], [0, 0, 0, 1], "L0 has shape (2,)"),
+                                          ([0.01, 2.0, 0.0], [0, 0, np.inf, 1], "q0 = [0.0, 0.0, inf, 1.0] is not "
+                                                                                 "finite")])
+def test_a_start_state_that_is_not_finite_numbers_is_named_in_one_line(L0, q0, says):
+    body = PreparedBody(inertia=[1.0, 2.0, 3.0], L0=[0.01, 2.0, 0.0], q0=[0, 0, 0, 1], duration=1.0)
+    with pytest.raises(ScenarioError) as err:
+        body.run(L0, q0)
+    assert str(err.value).startswith(says), str(err.value)

@@ -196,17 +196,26 @@ def checked_body_state(L0, q0):
             return L0.copy(), q0 / nq
     refuse_units(L0, "L0", ScenarioError)
     refuse_units(q0, "q0", ScenarioError)
-    try:
-        L = np.asarray(L0, dtype=float)
-        q = np.asarray(q0, dtype=float)
-    except (TypeError, ValueError):
-        raise ScenarioError(f"L0, q0: {str(L0)[:40]!r}, {str(q0)[:40]!r} are not numbers") from None
-    if L.shape != (3,) or q.shape != (4,) or not (np.all(np.isfinite(L)) and np.all(np.isfinite(q))):
-        raise ScenarioError(f"L0, q0: expected finite (3,) and (4,), got shapes {L.shape} and {q.shape}")
+    L, q = (_numbers(key, value, n) for key, value, n in (("L0", L0, 3), ("q0", q0, 4)))
     nq = float(np.linalg.norm(q))
     if abs(nq - 1.0) > 1e-6:
         raise ScenarioError(f"q0: |q0| = {nq:.9g}; a scalar-last unit quaternion (x, y, z, w) is expected")
     return L, q / nq
+
+
+def _numbers(key, value, n):
+    """``value`` as ``n`` finite float64, or a one-line ScenarioError naming ``key`` and what is wrong."""
+    if isinstance(value, (str, bytes)):
+        raise ScenarioError(f"{key} = {value!r} is not numbers; it must be {n} finite numbers")
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{key} = {str(value)[:60]!r} is not numbers; it must be {n} finite numbers") from None
+    if a.shape != (n,):
+        raise ScenarioError(f"{key} has shape {a.shape}; it must be {n} finite numbers")
+    if not np.all(np.isfinite(a)):
+        raise ScenarioError(f"{key} = {a.tolist()} is not finite; it must be {n} finite numbers")
+    return a
 
 
 def body_set_up(*, inertia, L0, q0, duration, torque=None, params=(), method=None, rtol=None, step=None,
