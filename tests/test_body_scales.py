@@ -155,3 +155,10 @@ def test_a_scene_whose_spin_is_out_of_range_is_refused_naming_its_keys(capsys, a
     code, out, err = call(capsys, "run", *argv, "--no-record")
     assert_clean(code, out, err)
     assert code == 2 and err.startswith(f"rotframe: error: {keys}: the body's angular momentum |L0| = "), err
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "lie-poisson"])
+def test_a_subnormal_momentum_is_refused_by_every_method(method):
+    with pytest.raises(ScenarioError, match=r"^L0: \|L0\| = 1e-310 kg m\^2/s is below the smallest normal float64"):
+        simulate_rigid_body(inertia=INERTIA, L0=[1e-310, 0.0, 0.0], q0=Q0, duration=1.0, method=method,
+                            step=None if method in ("exact", "dop853") else 0.1)

@@ -10,6 +10,7 @@ L did not move, and its drifts read 0). tests/test_body_scales.py.
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -35,10 +36,15 @@ def check_integrable(s):
     subnormal or zero (the body's L would not move, and its drifts would read 0), above it the products
     overflow. The splittings turn L by angles ``h L_i / I_i`` and keep ``|L|`` by its square, which
     overflows past `SPLITTING_MAX_L` (a square that underflows only skips that correction). The exact
-    flow works in scaled numbers and takes any ``L``.
+    flow works in scaled numbers and takes any ``L`` of normal floats; an ``|L|`` below the smallest normal
+    float64 keeps too few significant bits for any method and is refused.
     """
     big = float(np.max(np.abs(s.L)))
     size = big * float(np.linalg.norm(s.L / big)) if big > 0.0 else 0.0
+    if 0.0 < size < sys.float_info.min:  # fewer than 53 significant bits: no method can be right to round-off
+        raise ScenarioError(f"L0: |L0| = {size!r} kg m^2/s is below the smallest normal float64 "
+                            f"({sys.float_info.min:.4g}); allowed: 0 or |L0| >= {sys.float_info.min:.4g} (state the "
+                            "body in other units)")
     if s.method not in ("dop853", "rk4"):
         if s.method != "exact" and size > SPLITTING_MAX_L:
             raise ScenarioError(f"L0: |L0| = {size:.3g} kg m^2/s; method {s.method} keeps |L| by its square, which "
