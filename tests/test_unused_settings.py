@@ -54,3 +54,31 @@ def test_the_kind_rule_matches_the_particle_registry():
     for name, info in METHODS.items():
         expected = "exact" if name == "exact" else "adaptive" if name == "dop853" else "fixed"
         assert info.kind == expected, (name, info.kind)
+
+
+def test_simulate_and_simulate_body_flag_what_nothing_reads_and_it_changes_nothing():
+    """The API's own runs: an unread setting of the method, and params that no function of the caller's takes
+    (the built-in terms' constants are their own); each flagged once, and two values give the same numbers."""
+    import math
+
+    from rotframe import forces, torques
+
+    body = dict(inertia=[0.02, 0.02, 0.01], L0=[0.0, 0.0, 0.4], q0=[0.1, 0.0, 0.0, math.sqrt(0.99)], duration=0.5)
+    runs = [rotframe.simulate_body(method="lie-poisson", step=0.01, rtol=rtol, params=(k,),
+                                   torque=torques.gravity(0.5, 0.04, 9.81), **body) for rtol, k in ((1e-3, 1.0),
+                                                                                                     (1e-9, 2.0))]
+    for run in runs:
+        assert sum(w.startswith("rtol = ") and "lie-poisson" in w for w in run.warnings) == 1, run.warnings
+        assert sum(w.startswith("params = ") and "no torque of yours" in w for w in run.warnings) == 1
+    assert np.array_equal(runs[0].trajectory.q, runs[1].trajectory.q)
+    particle = dict(omega=[0.0, 0.0, 1.0], r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], duration=1.0)
+    runs = [rotframe.simulate(forces=[forces.spring(4.0)], params=(k,), **particle) for k in (1.0, 2.0)]
+    for run in runs:
+        assert sum(w.startswith("params = ") and "no force or event of yours" in w for w in run.warnings) == 1
+    assert np.array_equal(runs[0].trajectory.r, runs[1].trajectory.r)
+    # read: a force of yours that takes them, or a torque; nothing flagged
+    read = rotframe.simulate(forces=[lambda t, r, v, k: (-k * r[0], -k * r[1], -k * r[2])], params=(4.0,), **particle)
+    assert not any("is not used" in w for w in read.warnings)
+    read = rotframe.simulate_body(torque=lambda t, L, q, c: (-c * L[0], -c * L[1], -c * L[2]), params=(0.1,),
+                                  method="dop853", rtol=1e-8, **body)
+    assert not any("is not used" in w for w in read.warnings)

@@ -216,11 +216,28 @@ def simulate(*, omega, r0, v0, duration, forces=(), params=(), origin_accelerati
             bar.close()
     # a setting the caller gave that the method does not read is flagged, as in the scenes' runs (the registry's rule)
     given = {key: value for key, value in (("step", step), ("rtol", rtol), ("atol", atol)) if value is not None}
-    run.warnings[:0] = registry.unread_settings(run.trajectory.method, given)
+    run.warnings[:0] = registry.unread_settings(run.trajectory.method, given) + _unread_params(
+        params, events or any(_takes_params(f) for f in forces), "force or event")
     if frame_attitude is not None and "frame_q" not in run.trajectory.extras:  # read only with an inertial force
         run.warnings.insert(0, "frame_attitude is not used: no force acts in inertial axes "
                                "(rotframe.Force(..., axes='inertial')), so nothing reads the frame's attitude")
     return _particle_result(run, forces, origin_acceleration, duration, time.perf_counter() - t0)
+
+
+def _takes_params(f) -> bool:
+    """Whether the entry ``f`` of ``forces`` is called with the run's ``params``: a function of yours or a
+    `rotframe.Force` that takes them (the built-in terms and the pendulum's string do not)."""
+    from rotframe.problem.terms import Force, StringConstraint
+
+    return f.takes_params if isinstance(f, Force) else not isinstance(f, StringConstraint)
+
+
+def _unread_params(params, read: bool, what: str) -> list:
+    """The warning for ``params`` given where no function reads them (``read`` False): none where they are read."""
+    if read or params is None or len(params) == 0:
+        return []
+    return [f"params = {tuple(params)!r} is not used: no {what} of yours takes them (the built-in terms' constants "
+            "are their own)"]
 
 
 def _particle_result(run, forces, origin_acceleration, duration, simulate_s):
@@ -304,6 +321,10 @@ def simulate_body(*, inertia, L0, q0, duration, torque=None, params=(), method=N
     from rotframe.problem.body import torque_terms
 
     torques = [term for _, term in torque_terms(torque)]
+    # a setting or params the caller gave that nothing reads is flagged, as in `simulate` and the scenes' runs
+    given = {key: value for key, value in (("step", step), ("rtol", rtol)) if value is not None}
+    run.warnings[:0] = registry.unread_settings(run.method, given) + _unread_params(
+        params, any(term.takes_params for term in torques), "torque")
     terms = ["euler equations"] + [f"torque {_describe(term)}" for term in torques]
     timing = {"compile_s": run.compile_s, "simulate_s": simulate_s, "record_s": 0.0, "total_s": simulate_s}
     # the diagnostics a torque leaves out, said where they are reported (a scene reports its own)
