@@ -84,7 +84,7 @@ def start_short_of(t, h, t_end):
 
     For an RK4 step from ``t`` that ends on a knot of the engine's (`rotframe.problem.stops`) at
     ``t_end``: its fourth stage is f at ``t + h``, and at the knot itself a table reads the next
-    interval (`rotframe.problem.models.interval`). Where the rate turns there (a piecewise-linear
+    interval (`rotframe.problem.varying.interval`). Where the rate turns there (a piecewise-linear
     table: omega' jumps), f from the wrong side cost the step an error of order h at every knot.
     Handed a start an ulp or two earlier, every stage reads f at a time that many ulps earlier
     (nothing, for f smooth inside the interval) and the last one reads the step's own interval.

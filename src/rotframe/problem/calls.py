@@ -175,7 +175,7 @@ def direct_calls(module, varying) -> dict:
     the functions its names in capitals are bound to.
 
     A role the glue lacks is the stub the engine would call (`rotframe.problem.stubs`); ``VARYING``
-    is ``varying``, the engine's evaluator of a varying vector (`rotframe.problem.models.varying_into`,
+    is ``varying``, the engine's evaluator of a varying vector (`rotframe.problem.varying.varying_into`,
     which calls `call_vector` in turn). The caller compiles each for its target, callees first, in
     the order given (the GPU's kernel, `rotframe.problem.gpu`; the CPU's inlined loop,
     `rotframe.problem.inlined`).

@@ -181,16 +181,17 @@ class Driver:
         """What the engine calls for the problem ``prob`` (`rotframe.problem.signatures.FUNCTIONS`): terms, event,
         omega, origin, and the engine's evaluator of a varying frame or origin, compiled only where ``prob`` has one
         (else 0: a problem in a steady frame never compiles it)."""
-        from rotframe.problem import models, signatures as sg, stubs
+        from rotframe.problem import signatures as sg, stubs, varying as vary
 
-        if not models.needs_varying((prob[3], prob[6])):
+        kinds = (int(prob[3]), int(prob[6]))
+        if not vary.needs_varying(kinds):
             varying = 0
-        elif self.compiled:
-            varying = self._address(models.varying_into, sg.VARYING_SIG)
+        elif self.compiled:  # the evaluator of the problem's own kinds alone (`varying_into_for`)
+            varying = self._address(vary.varying_into_for(kinds), sg.VARYING_SIG)
         else:
             from rotframe.numerics.plain import plain
 
-            varying = plain(models.varying_into)
+            varying = plain(vary.varying_into_for(kinds))
         return (self._own("terms", stubs.no_terms, sg.TERMS_SIG), self._own("event", stubs.no_event, sg.EVENT_SIG),
                 self._own("omega", stubs.no_vector, sg.VECTOR_SIG), self._own("origin", stubs.no_vector, sg.VECTOR_SIG),
                 varying)

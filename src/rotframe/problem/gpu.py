@@ -62,7 +62,7 @@ def _overrides(module):
     from numba import cuda
 
     from rotframe.particles.gpu import inline_options, device_function
-    from rotframe.problem import calls, models, readonly
+    from rotframe.problem import calls, readonly, varying
 
     made: dict = {}
 
@@ -71,7 +71,7 @@ def _overrides(module):
         return cuda.jit(device=True, **inline_options())(bound(template, template.__name__, **names))
 
     made[readonly.readonly] = device(_same_array)  # the read-only check is the CPU compile's (the glue is built there)
-    for helper, (template, names) in calls.direct_calls(module, models.varying_into).items():
+    for helper, (template, names) in calls.direct_calls(module, varying.varying_into).items():
         made[helper] = device(template, **{name: device_function(f, made) for name, f in names.items()})
     return made
 

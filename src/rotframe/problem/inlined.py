@@ -68,10 +68,10 @@ def _replacements(module, parts, where):
     body).
     """
     from rotframe.numerics.compiled import bound, jit_inline
-    from rotframe.problem import calls, models
+    from rotframe.problem import calls, models, varying
 
     made: dict = {}
-    for helper, (template, names) in calls.direct_calls(module, models.varying_into).items():
+    for helper, (template, names) in calls.direct_calls(module, varying.varying_into).items():
         made[helper] = jit_inline(bound(template, template.__name__,
                                         **{name: _rebuilt(f, made, where) for name, f in names.items()}))
     if parts is not None:

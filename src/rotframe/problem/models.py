@@ -33,7 +33,9 @@ kind: ``ZERO``; ``CONSTANT`` (``C[0, 0]``); ``TABLE``, a C2 cubic spline (``T`` 
 body's omega, omega', omega'' (``T`` its sample times, ``C`` (n, 3, 3)); ``FUNCTION``, the
 user's ``omega(t)`` with omega' from the fourth-order central difference of step ``T[0]``
 (`rotframe.problem.frame.derivative_step`) or ``FUNCTION_DOT``, with the user's omega'.
-The numpy twins used for analysis are in `rotframe.problem.frame`.
+The constant kinds are answered in the right-hand side itself; the others by the engine's
+evaluator of a varying vector, `rotframe.problem.varying` (called by address, compiled for the
+problem's own kinds). The numpy twins used for analysis are in `rotframe.problem.frame`.
 
 **Fixed-step methods of a model's own** (`own_step`, methods ``SPLITTING``, ``SPLITTING4``,
 ``SPLITTING6``, ``SPLITTING8``): a particle's rotation splitting (docs/physics/splitting.md: drift,
@@ -83,10 +85,10 @@ from rotframe.numerics.sphere import great_circle, kick_across
 from rotframe.particles.accelerations import air_density, centrifugal, euler, string_tension
 from rotframe.particles.forces import drag_flow
 from rotframe.rigid.kernels import free_step
-from rotframe.problem.calls import call_potential, call_terms, call_varying, call_vector
+from rotframe.problem.calls import call_potential, call_terms, call_varying
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
-           "SPLITTING4", "SPLITTING6", "SPLITTING8", "EVALUATIONS_PER_STEP", "SCRATCH", "BODY_CONSTANTS", "body_constants", "inverse_inertia", "vector_of_time", "varying_into", "needs_varying", "rhs", "own_step", "particle_energy"]
+           "SPLITTING4", "SPLITTING6", "SPLITTING8", "EVALUATIONS_PER_STEP", "SCRATCH", "BODY_CONSTANTS", "body_constants", "inverse_inertia", "vector_of_time", "rhs", "own_step", "particle_energy"]
 
 #: kinds of a vector of time
 ZERO, CONSTANT, TABLE, BODY_FRAME, FUNCTION, FUNCTION_DOT = range(6)
@@ -104,33 +106,14 @@ SCRATCH = 7
 
 
 @jit_inline
-def interval(knots, t):
-    """The index i of the interval [knots[i], knots[i + 1]] holding t (clipped to the ends)."""
-    n = knots.shape[0]
-    if t <= knots[0]:
-        return 0
-    if t >= knots[n - 1]:
-        return n - 2
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if knots[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
-    return lo
-
-
-@jit_inline
 def vector_of_time(kind, T, C, fn, varying, t, W):
     """The vector of the kind (module docstring) and its derivative at ``t``: ``(x, y, z, dx, dy, dz)``.
 
     ``W`` (6,) receives what a user's function writes (``FUNCTION``, ``FUNCTION_DOT``). The
     constant kinds are answered here (small enough for the compiler to inline into the
-    right-hand side), the others by `varying_into`, called at its address ``varying``
+    right-hand side), the others by `rotframe.problem.varying.varying_into_for`'s copy, called at its address ``varying``
     (`rotframe.problem.calls`): it is compiled only for a problem whose frame or origin varies,
-    not with the engine (`needs_varying`).
+    not with the engine (`rotframe.problem.varying.needs_varying`).
     """
     if kind == CONSTANT:
         return C[0, 0, 0], C[0, 0, 1], C[0, 0, 2], 0.0, 0.0, 0.0
@@ -138,90 +121,6 @@ def vector_of_time(kind, T, C, fn, varying, t, W):
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     call_varying(varying, kind, T, C, fn, t, W)
     return W[0], W[1], W[2], W[3], W[4], W[5]
-
-
-def needs_varying(kinds) -> bool:
-    """Whether a frame's or origin's kinds need `varying_into` (a table, a body's samples, a user's function)."""
-    return any(kind not in (CONSTANT, ZERO) for kind in kinds)
-
-
-@jit_uncounted
-def varying_into(kind, T, C, fn, t, out):
-    """`varying_vector` into ``out[0:6]``: what the engine calls by address (`rotframe.problem.signatures.VARYING_SIG`)."""
-    x, y, z, dx, dy, dz = varying_vector(kind, T, C, fn, t, out)
-    out[0] = x
-    out[1] = y
-    out[2] = z
-    out[3] = dx
-    out[4] = dy
-    out[5] = dz
-
-
-@jit_uncounted
-def varying_vector(kind, T, C, fn, t, buf):
-    """`vector_of_time` of a table, a body's samples or a user's function."""
-    if kind == TABLE:
-        i = interval(T, t)
-        s = t - T[i]
-        x = ((C[i, 0, 0] * s + C[i, 1, 0]) * s + C[i, 2, 0]) * s + C[i, 3, 0]
-        y = ((C[i, 0, 1] * s + C[i, 1, 1]) * s + C[i, 2, 1]) * s + C[i, 3, 1]
-        z = ((C[i, 0, 2] * s + C[i, 1, 2]) * s + C[i, 2, 2]) * s + C[i, 3, 2]
-        dx = (3.0 * C[i, 0, 0] * s + 2.0 * C[i, 1, 0]) * s + C[i, 2, 0]
-        dy = (3.0 * C[i, 0, 1] * s + 2.0 * C[i, 1, 1]) * s + C[i, 2, 1]
-        dz = (3.0 * C[i, 0, 2] * s + 2.0 * C[i, 1, 2]) * s + C[i, 2, 2]
-        return x, y, z, dx, dy, dz
-    if kind == BODY_FRAME:
-        return hermite(T, C, t)
-    call_vector(fn, t, buf)  # the user's function: omega' given (FUNCTION_DOT) or a central difference (FUNCTION)
-    x = buf[0]
-    y = buf[1]
-    z = buf[2]
-    if kind == FUNCTION_DOT:
-        return x, y, z, buf[3], buf[4], buf[5]
-    hh = (t + T[0]) - t  # the step of frame.derivative_step, exact in floats
-    call_vector(fn, t - 2.0 * hh, buf)
-    ax, ay, az = buf[0], buf[1], buf[2]
-    call_vector(fn, t - hh, buf)
-    bx, by, bz = buf[0], buf[1], buf[2]
-    call_vector(fn, t + hh, buf)
-    cx, cy, cz = buf[0], buf[1], buf[2]
-    call_vector(fn, t + 2.0 * hh, buf)
-    return (x, y, z, (ax - 8.0 * bx + 8.0 * cx - buf[0]) / (12.0 * hh), (ay - 8.0 * by + 8.0 * cy - buf[1]) / (12.0 * hh),
-            (az - 8.0 * bz + 8.0 * cz - buf[2]) / (12.0 * hh))
-
-
-@jit_uncounted
-def hermite(T, C, t):
-    """The quintic Hermite interpolant through a body's omega, omega', omega'' (C[i, 0..2]) and its derivative."""
-    i = interval(T, t)
-    h = T[i + 1] - T[i]
-    s = (t - T[i]) / h
-    s2 = s * s
-    s3 = s2 * s
-    s4 = s3 * s
-    s5 = s4 * s
-    h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5
-    h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5
-    h2 = 0.5 * (s2 - 3.0 * s3 + 3.0 * s4 - s5)
-    h3 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5
-    h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5
-    h5 = 0.5 * (s3 - 2.0 * s4 + s5)
-    d0 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4
-    d1 = 1.0 - 18.0 * s2 + 32.0 * s3 - 15.0 * s4
-    d2 = 0.5 * (2.0 * s - 9.0 * s2 + 12.0 * s3 - 5.0 * s4)
-    d3 = 30.0 * s2 - 60.0 * s3 + 30.0 * s4
-    d4 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4
-    d5 = 0.5 * (3.0 * s2 - 8.0 * s3 + 5.0 * s4)
-    return (mix(C, i, 0, h, h0, h1, h2, h3, h4, h5), mix(C, i, 1, h, h0, h1, h2, h3, h4, h5),
-            mix(C, i, 2, h, h0, h1, h2, h3, h4, h5), mix(C, i, 0, h, d0, d1, d2, d3, d4, d5) / h,
-            mix(C, i, 1, h, d0, d1, d2, d3, d4, d5) / h, mix(C, i, 2, h, d0, d1, d2, d3, d4, d5) / h)
-
-
-@jit_uncounted
-def mix(C, i, k, h, a0, a1, a2, a3, a4, a5):
-    """Component k of the Hermite sum with the weights a0..a5 (values, h times first, h^2 times second derivatives)."""
-    return (a0 * C[i, 0, k] + a1 * h * C[i, 1, k] + a2 * h * h * C[i, 2, k] + a3 * C[i + 1, 0, k]
-            + a4 * h * C[i + 1, 1, k] + a5 * h * h * C[i + 1, 2, k])
 
 
 @jit_inline

@@ -50,7 +50,7 @@ TERMS_SIG = types.void(F8, A1, A1, A1)
 EVENT_SIG = F8(I8, F8, A1, A1)
 POTENTIAL_SIG = F8(F8, A1, A1)
 VECTOR_SIG = types.void(F8, A1)
-#: the engine's own evaluator of a varying frame or origin (`rotframe.problem.models.varying_into`): kind, knots,
+#: the engine's own evaluator of a varying frame or origin (`rotframe.problem.varying.varying_into`): kind, knots,
 #: coefficients, the user's function's address, t, out
 VARYING_SIG = types.void(I8, A1, A3, I8, F8, A1)
 
