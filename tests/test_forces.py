@@ -298,3 +298,21 @@ def test_the_built_in_terms_energy_is_numpys_and_the_compiled_ones(frame_terms):
     np.testing.assert_allclose(E, E_ref, rtol=1e-14, atol=0)
     name = "jacobi_rel_drift" if frame_terms is None else "energy_rel_drift"
     assert numpys.diagnostics[name] == pytest.approx(compiled.diagnostics[name], rel=1e-6, abs=1e-15)
+
+
+def test_a_potential_marked_array_potential_that_takes_no_arrays_is_refused_at_the_start():
+    """``array_potential=True`` says numpy may call the potential on every sample at once: a potential of yours that
+    cannot (math.sqrt on an array) is named in one line before the run, not met as a raw error after it."""
+    import math
+
+    from rotframe.problem.callables import UserFunctionError
+
+    def pull(t, r, v):
+        return -r[0], -r[1], -r[2]
+
+    def scalar_only(t, r):
+        return 0.5 * math.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2) ** 2
+
+    with pytest.raises(UserFunctionError, match=r"^forces\[0\]\.potential \(array_potential=True: r as \(3, 2\)"):
+        simulate_particles(omega=W, r0=[1.0, 0.0, 0.0], v0=[0.0, 0.0, 0.0], duration=1.0,
+                           forces=[Force(pull, potential=scalar_only, takes_params=False, array_potential=True)])

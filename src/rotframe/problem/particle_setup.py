@@ -105,6 +105,9 @@ def _check_functions(forces, events, params, r, v, t0, labels):
         uf.check_call(labels[k], f.accel, (t0, r.copy(), v.copy(), *f.params_for(params)), (3,), when=when)
         if f.potential is not None:
             uf.check_call(f"{labels[k]}.potential", f.potential, (t0, r.copy(), *f.params_for(params)), (), when=when)
+        if f.potential is not None and f.array_potential:  # numpy's energies will call it on every sample at once
+            uf.check_call(f"{labels[k]}.potential (array_potential=True: r as (3, 2), t as (2,))", f.potential,
+                          (np.full(2, t0), np.stack([r, r], axis=1), *f.params_for(params)), (2,), when=when)
     for k, g in enumerate(events):
         uf.check_call(f"events[{k}]", g, (t0, r.copy(), v.copy(), *params), (), when=when)
 
