@@ -153,3 +153,15 @@ def test_a_factory_refuses_a_wrong_unit_a_string_or_a_bool_in_one_line(call, key
     with pytest.raises(RotframeError) as err:
         call()
     assert str(err.value).startswith(key) and "\n" not in str(err.value), str(err.value)
+
+
+def test_the_built_in_events_convert_quantities():
+    """`rotframe.events`' values and radius: a Quantity is converted (cm, km/h, km), a wrong unit refused."""
+    r, v = np.array([0.3, 0.2, 2.0]), np.array([0.0, 0.0, 2.0])
+    assert rotframe.events.crossing(2, 100 * u.cm)(0.0, r, v) == rotframe.events.crossing(2, 1.0)(0.0, r, v)
+    assert (rotframe.events.crossing(2, 7.2 * u.km / u.h, of="v")(0.0, r, v)
+            == rotframe.events.crossing(2, 2.0, of="v")(0.0, r, v))
+    assert (rotframe.events.altitude(6371 * u.km, 100 * u.cm)(0.0, r, v)
+            == rotframe.events.altitude(6.371e6, 1.0)(0.0, r, v))
+    with pytest.raises(RotframeError, match=r"^crossing: value: s cannot be converted to m/s"):
+        rotframe.events.crossing(2, 1 * u.s, of="v")

@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 
 from rotframe.errors import ScenarioError
+from rotframe.units import si_number
 
 __all__ = ["crossing", "altitude"]
 
@@ -74,9 +75,7 @@ def crossing(component, value=0.0, *, of="r", direction=0, terminal=False, name=
         raise ScenarioError(f"crossing: component={component!r}; allowed 0, 1, 2 (x, y, z of the frame)")
     if of not in ("r", "v"):
         raise ScenarioError(f"crossing: of={of!r}; allowed 'r' (a position's coordinate) or 'v' (a velocity's)")
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(f"crossing: value={value!r}; a finite number ({'m' if of == 'r' else 'm/s'})")
-    k, c = int(component), float(value)
+    k, c = int(component), si_number("crossing", "value", value, "m" if of == "r" else "m/s")
     if of == "r":
         def event(t, r, v):
             return r[k] - c
@@ -119,12 +118,9 @@ def altitude(radius, value=0.0, *, direction=0, terminal=False, name=None):
     (100.0, 'ground')
     """
     _check_kind("altitude", direction, terminal, name)
-    for key, x in (("radius", radius), ("value", value)):
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-            raise ScenarioError(f"altitude: {key}={x!r}; a finite number (m)")
-    if not radius > 0:
+    R, c = si_number("altitude", "radius", radius, "m"), si_number("altitude", "value", value, "m")
+    if not R > 0:
         raise ScenarioError(f"altitude: radius={radius!r}; must be > 0 (m)")
-    R, c = float(radius), float(value)
 
     def event(t, r, v):
         dz = r[2] + R
