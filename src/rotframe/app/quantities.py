@@ -10,12 +10,11 @@ plain number.
 
 from __future__ import annotations
 
+# the converter of every door (the Python API, the built-in terms' factories) lives below the layers that use it
+from rotframe.units import holds_quantity, is_quantity, to_si  # noqa: F401  (re-exported: their home is rotframe.units)
+
 __all__ = ["NotAQuantity", "WrongDimension", "value_in", "first_line", "as_quantities", "is_quantity", "holds_quantity",
            "to_si", "vector_or_table_si", "params_si", "astropy_unit"]
-
-
-# the converter of every door (the Python API, the built-in terms' factories) lives below the layers that use it
-from rotframe.units import holds_quantity, is_quantity, to_si  # noqa: E402,F401  (their home: rotframe.units)
 
 
 class NotAQuantity(ValueError):

@@ -39,8 +39,7 @@ def check_integrable(s):
     flow works in scaled numbers and takes any ``L`` of normal floats; an ``|L|`` below the smallest normal
     float64 keeps too few significant bits for any method and is refused.
     """
-    big = float(np.max(np.abs(s.L)))
-    size = big * float(np.linalg.norm(s.L / big)) if big > 0.0 else 0.0
+    size = math.hypot(*s.L)  # without overflow or underflow of the squares
     if 0.0 < size < sys.float_info.min:  # fewer than 53 significant bits: no method can be right to round-off
         raise ScenarioError(f"L0: |L0| = {size!r} kg m^2/s is below the smallest normal float64 "
                             f"({sys.float_info.min:.4g}); allowed: 0 or |L0| >= {sys.float_info.min:.4g} (state the "
@@ -79,8 +78,7 @@ def check_turns(s):
     """
     if s.method != "dop853" or s.terms:
         return
-    big = float(np.max(np.abs(s.L)))
-    rate = big * float(np.linalg.norm(s.L / big)) / float(np.max(np.linalg.eigvalsh(s.I))) if big > 0 else 0.0
+    rate = math.hypot(*s.L) / float(np.max(np.linalg.eigvalsh(s.I)))
     limits.check_run(steps=float(s.duration) * (rate / 2.0) / DOP853_IMAGINARY_STABILITY,
                      what=f"method dop853 (the attitude turns at |omega| / 2 >= {rate / 2:.3g} rad/s, a step "
                           f"{DOP853_IMAGINARY_STABILITY} rad of it at most)", remedy="shorten duration")

@@ -412,10 +412,15 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     return ProblemRun(traj, diagnostics, [], notes, frame, 0.0, frame_terms)
 
 
+def steady_omega(frame):
+    """The rate (rad/s, (3,)) of a frame that turns steadily (`_energy_diagnostics` asks for no other)."""
+    return frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
+
+
 def array_energies(traj, forces, frame, rotating):
     """The energy per unit mass (or the Jacobi integral, ``rotating``) at each sample of ``traj``, (n, N), by numpy:
     ``v^2/2 + sum U`` (less ``|omega x r|^2 / 2``) with each potential called once on every sample's ``r`` (3, n N).
-    ``omega`` is the steady frame's (`_energy_diagnostics` asks for no other)."""
+    ``omega`` is the steady frame's (`steady_omega`)."""
     n, N = traj.r.shape[:2]
     pos = traj.r.reshape(-1, 3).T
     t = np.repeat(traj.times, N)
@@ -423,7 +428,7 @@ def array_energies(traj, forces, frame, rotating):
     for f in forces:
         E = E + np.asarray(f.potential(t, pos), dtype=float)
     if rotating:
-        w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
+        w = steady_omega(frame)
         E = E - 0.5 * np.sum(np.cross(w, pos.T) ** 2, axis=1)
     return E.reshape(n, N)
 
@@ -443,7 +448,7 @@ def _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, note
         notes.append("energy is not conserved in a frame whose rotation rate changes or whose origin "
                      "accelerates: no energy diagnostic")
         return
-    w = frame.data[0] if frame.kind == "constant" else frame.vector_at([0.0])[0][0]
+    w = steady_omega(frame)
     rotating = bool(np.any(w != 0.0)) and "centrifugal" in frame_terms
     with np.errstate(over="ignore", invalid="ignore"):
         E = energies(rotating)

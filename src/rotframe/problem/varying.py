@@ -55,13 +55,7 @@ VARYING_VECTOR = None
 
 def _varying_into(kind, T, C, fn, t, out):
     """The template of `varying_into`: `varying_vector` (``VARYING_VECTOR``, a copy's) into ``out[0:6]``."""
-    x, y, z, dx, dy, dz = VARYING_VECTOR(kind, T, C, fn, t, out)
-    out[0] = x
-    out[1] = y
-    out[2] = z
-    out[3] = dx
-    out[4] = dy
-    out[5] = dz
+    out[0], out[1], out[2], out[3], out[4], out[5] = VARYING_VECTOR(kind, T, C, fn, t, out)
 
 
 def _varying_vector(kind, T, C, fn, t, buf):
