@@ -64,10 +64,9 @@ def readable(path):
 PHASES = [
     # (module, attribute, nth call, scenario and options, partial recording expected)
     ("rotframe.scenes", "get", 1, ["run", "tower-drop"], False),                        # loading the scene
-    ("rotframe.particles.drivers", "run_fixed", 1, ["run", "foucault", "--method", "splitting",
-                                                    "--set", "duration=60"], True),  # compiling
-    ("rotframe.particles.drivers", "run_fixed", 3, ["run", "foucault", "--method", "splitting", "--set", "step=1e-6",
-                                                    "--set", "duration=600"], True),
+    # foucault on the engine's steady loop: its compile (the first call), then a call of the run
+    ("rotframe.particles.blocks", "run_blocks", 1, ["run", "foucault", "--set", "duration=60"], True),
+    ("rotframe.particles.blocks", "run_blocks", 4, ["run", "foucault", "--set", "duration=600"], True),
     # the scenes on the engine: its loop's calls (the first may compile it), and one in the middle of a long run
     ("rotframe.problem.particles", "advance_blocks", 1, ["run", "turntable", "--method", "splitting"], True),
     ("rotframe.problem.particles", "advance_blocks", 3, ["run", "turntable", "--method", "splitting", "--set", "step=1e-7"], True),
@@ -119,10 +118,9 @@ def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
 
 
 @pytest.mark.parametrize("target,attr,nth,argv", [
-    # the scenes' kernels: 1e9 steps, more than CALL_EVALS (1.6e7) in each sample interval, called in pieces
-    ("rotframe.particles.chunked", "KernelSetup.one_sample_in_pieces", 1,
-     ["foucault", "--set", "step=1e-8", "--set", "duration=10"]),
-    # the engine (the tower drop): 5.7e8 steps in one sample interval, its loop called in paced pieces
+    # the engine: 1e9 steps of the pendulum (foucault), 5.7e8 of the tower drop, in one sample interval each, its
+    # loop called in paced pieces
+    ("rotframe.problem.particles", "advance_blocks", 2, ["foucault", "--set", "step=1e-8", "--set", "duration=10"]),
     ("rotframe.problem.particles", "advance_blocks", 2, ["tower-drop", "--set", "step=1e-8"]),
 ])
 def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path, target, attr, nth, argv):

@@ -106,6 +106,8 @@ def test_the_frame_terms_for_any_omega_are_the_cross_products(r, w, wd):
     tol = 1e-13 * (1.0 + np.linalg.norm(w)) ** 2 * max(np.linalg.norm(r), 1e-300) + 1e-300
     assert np.max(np.abs(np.array(acc.centrifugal(*r, *w)) + np.cross(w, np.cross(w, r)))) <= tol
     assert np.max(np.abs(np.array(acc.euler(*r, *wd)) - np.cross(wd, r))) <= tol
+    v = r[::-1].copy()  # any velocity; the Coriolis acceleration is minus this
+    assert np.max(np.abs(np.array(acc.coriolis(*v, *w)) - 2.0 * np.cross(w, v))) <= tol
 
 
 @given(r=vec, axis=vec, wd=st.floats(-1e-3, 1e-3), k=st.floats(0.0, 1e2))

@@ -75,8 +75,8 @@ def test_a_driver_without_events_refuses_an_event_table():
         drivers.run_fixed(0, r, v, alive, 0.0, 0.1, 1, 1, model.pack(), None, model.omega.values,
                           model.omega.cumulative(), table, out, out.copy(), None, None, None, None, None, 0, None, None)
     with pytest.raises(ValueError, match="run_dop853_events"):
-        drivers.run_dop853(r, v, alive, 0.0, np.array([1.0]), model.pack(), None, model.omega.values, 1e-9, 1e-9,
-                           1.0, table, out, out.copy(), None, None, None, None, None, 0, np.zeros(1),
+        drivers.run_dop853(r, v, alive, 0.0, np.array([1.0]), model.pack(), None, model.omega.values, 1e-9,
+                           np.full((1, 6), 1e-9), 1.0, table, out, out.copy(), None, None, None, None, None, 0, np.zeros(1),
                            np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
 
 
@@ -87,7 +87,7 @@ from rotframe.particles import dop853_particles, events, schedule
 from rotframe.particles.integrators import integrate_particles
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-# linear drag: the general DOP853 driver (a model without it runs rotframe.particles.dop853_steady)
+# linear drag, a scene's model: the scenes' general DOP853 driver
 model = ParticleModel(("gravity", "coriolis", "linear-drag"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
                       g=np.array([0.0, 0.0, -9.81]), k_linear=0.01)
 traj = integrate_particles(model, [0.0, 0.0, 10.0], [1.0, 0.0, 0.0], 1.0, method=sys.argv[1], samples=3)
@@ -150,24 +150,29 @@ def test_a_free_particle_compiles_only_its_own_step_family(tmp_path):
 
 STEADY = r'''
 import numpy as np
-from rotframe.particles import dop853_particles, dop853_steady, drivers, forces
-from rotframe.particles.integrators import integrate_particles
-from rotframe.particles.model import OmegaSchedule, ParticleModel
+from rotframe import forces
+from rotframe.particles import dop853_particles, dop853_steady, drivers
+from rotframe.particles import forces as scene_forces
+from rotframe.problem import engine
+from rotframe.problem.particles import simulate_particles
 
-model = ParticleModel(("gravity", "coriolis", "pendulum"), omega=OmegaSchedule.constant([0.0, 4e-5, 5e-5]),
-                      g=np.array([0.0, 0.0, -9.81]), pendulum_length=10.0, pivot=np.array([0.0, 0.0, 10.0]))
-traj = integrate_particles(model, [1.0, 0.0, 10.0 - np.sqrt(99.0)], [0.0, 0.0, 0.0], 5.0, method="dop853", samples=5)
-assert np.all(np.isfinite(traj.r))
+run = simulate_particles(omega=[0.0, 4e-5, 5e-5], r0=[1.0, 0.0, 10.0 - np.sqrt(99.0)], v0=[0.0, 0.0, 0.0],
+                         duration=5.0, samples=5, forces=[forces.gravity([0.0, 0.0, -9.81]),
+                                                          forces.pendulum(10.0, [0.0, 0.0, 10.0])])
+assert np.all(np.isfinite(run.trajectory.r))
 general = [drivers.run_dop853, dop853_particles.particle_stages, dop853_particles.particle_rhs,
-           forces.state_acceleration]
-print(sum(len(f.signatures) for f in general), len(dop853_steady.run_dop853_steady.signatures))
+           scene_forces.state_acceleration]
+loops = [f for f in vars(engine).values() if hasattr(f, "signatures")]
+print(sum(len(f.signatures) for f in general + loops), len(dop853_steady.run_dop853_steady.signatures))
 '''
 
 
-def test_a_steady_model_compiles_only_the_specialised_dop853_driver(tmp_path):
-    # a steady rotation, uniform gravity, no drag and no events: rotframe.particles.dop853_steady, whose
-    # first run compiles three functions instead of the general driver's fourteen
-    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+def test_a_steady_problem_compiles_only_the_steady_dop853_loop(tmp_path):
+    # a steady rotation, uniform gravity, a string, no drag and no events: the engine's steady loop
+    # (rotframe.problem.steady), which compiles a few small functions, and neither the scenes' general driver nor any
+    # of the engine's own loops
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "numba"),
+               ROTFRAME_CACHE_DIR=str(tmp_path / "rotframe"))
     res = subprocess.run([sys.executable, "-c", STEADY], capture_output=True, text=True, env=env, timeout=600)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["0", "1"], res.stdout

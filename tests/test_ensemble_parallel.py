@@ -117,12 +117,16 @@ def test_threads_scope_is_not_seen_by_other_threads():
 
 
 def test_large_steady_dop853_run_takes_the_steady_driver_in_blocks_bitwise(monkeypatch):
-    """More particles than a block run DOP853 on the steady driver, block by block; the same bits as one block."""
+    """More particles than a block run the engine's steady loop (`rotframe.problem.steady`) block by block; the same
+    bits as one block."""
+    from rotframe import forces
     from rotframe.particles import blocks
+    from rotframe.problem.particles import simulate_particles
 
     r0, v0 = _start(12, seed=9)
-    model = _model()
-    one = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
+    kw = dict(omega=[0.0, 4.6e-5, 5.7e-5], forces=[forces.gravity([0.0, 0.0, -9.81])], duration=5.0, rtol=1e-9,
+              samples=3, frame_terms=("coriolis",))
+    one = simulate_particles(r0=r0, v0=v0, **kw).trajectory
     monkeypatch.setattr(threads, "BLOCK", 5)
     calls = []
     real = blocks.run_blocks
@@ -133,7 +137,7 @@ def test_large_steady_dop853_run_takes_the_steady_driver_in_blocks_bitwise(monke
         return real(one_block, n, per_particle, outputs)
 
     monkeypatch.setattr(blocks, "run_blocks", spy)
-    many = integrate_particles(model, r0, v0, 5.0, method="dop853", rtol=1e-9, atol=1e-7, samples=3)
+    many = simulate_particles(r0=r0, v0=v0, **kw).trajectory
     assert calls and set(calls) == {"run_dop853_steady"}  # the steady driver ran, in blocks
     assert np.array_equal(one.r, many.r) and np.array_equal(one.v, many.v)
 

@@ -1,6 +1,6 @@
 """A particle's default absolute tolerances, made by the engine's DOP853 loop from its start state.
 
-`rotframe.problem.engine.own_tolerances` is the rule compiled into the loop (a prepared run made it
+`rotframe.numerics.step_control.own_tolerances` is the rule compiled into the loop (a prepared run made it
 in numpy at every run, 6 us of its own 20). Checked against the rule as the docs state it, written
 here apart in numpy, and, through the whole engine, against a run given those tolerances by hand:
 a run with ``atol=None`` and one with ``atol=`` the rule's six numbers take the same steps, to the bit.
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import rotframe
-from rotframe.problem.engine import own_tolerances
+from rotframe.numerics.step_control import own_tolerances
 from rotframe.problem.particles import simulate_particles
 
 

@@ -43,7 +43,7 @@ def test_sigterm_in_the_exact_propagator_keeps_the_partial_result(tmp_path):
 def test_a_signal_while_numba_compiles_is_the_signal_not_an_internal_error(tmp_path, sig, code):
     # an empty numba cache: the kernel is compiled in this run, and the signal arrives while it is
     proc, sign = start(tmp_path, "rotframe.particles.chunked", "KernelSetup.warm_up", 1, "run", "foucault",
-                       "--method", "rk4", "--set", "duration=1", "--no-record",
+                       "--set", "duration=1", "--no-record",
                        env={"NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")})
     wait_for(sign, proc)
     proc.send_signal(getattr(signal, sig))

@@ -247,36 +247,32 @@ def reference():
     return reference_dop853(particle_rhs, 0.0, np.concatenate([R0, V0]), 20.0, 1e-10, 1e-6, samples=times)
 
 
-def test_the_particle_scenes_take_the_oracles_steps_and_samples(reference, monkeypatch):
-    from rotframe.particles import dop853_steady
+def test_the_particle_scenes_take_the_oracles_steps_and_samples(reference):
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
     model = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=OmegaSchedule.constant(W), g=G)
     n, y, samples = reference
-    for driver in ("steady", "general"):
-        if driver == "general":  # the general driver, for a model the steady one would take (a new set-up)
-            from rotframe.particles import integrators
-
-            monkeypatch.setattr(dop853_steady, "is_steady_model", lambda model, events=(), packed=None: False)
-            monkeypatch.setattr(integrators, "_SETUPS", {})
-        traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6,
-                                   samples=SAMPLES)
-        assert traj.steps == n
-        got = np.concatenate([traj.r[1:, 0], traj.v[1:, 0]], axis=1)
-        np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
+    traj = integrate_particles(model, R0[None], V0[None], 20.0, method="dop853", rtol=1e-10, atol=1e-6,
+                               samples=SAMPLES)
+    assert traj.steps == n
+    got = np.concatenate([traj.r[1:, 0], traj.v[1:, 0]], axis=1)
+    np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
 
 
 def test_a_problem_of_your_own_takes_the_oracles_steps_and_samples(reference):
     from rotframe import forces
     from rotframe.problem.particles import simulate_particles
 
-    run = simulate_particles(omega=W, r0=R0, v0=V0, duration=20.0, forces=[forces.gravity(G)], method="dop853",
-                             rtol=1e-10, atol=1e-6, samples=SAMPLES)
     n, y, samples = reference
-    assert run.trajectory.steps == n
-    got = np.concatenate([run.trajectory.r[1:, 0], run.trajectory.v[1:, 0]], axis=1)
-    np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
+    # the steady loop (rotframe.problem.steady, chosen for this problem) and the engine's own (inline=False)
+    for inline in (None, False):
+        run = simulate_particles(omega=W, r0=R0, v0=V0, duration=20.0, forces=[forces.gravity(G)], method="dop853",
+                                 rtol=1e-10, atol=1e-6, samples=SAMPLES, inline=inline)
+        assert any("steady loop" in note for note in run.notes) == (inline is None)
+        assert run.trajectory.steps == n
+        got = np.concatenate([run.trajectory.r[1:, 0], run.trajectory.v[1:, 0]], axis=1)
+        np.testing.assert_allclose(got, samples, rtol=1e-11, atol=1e-9)
 
 
 def test_the_bench_ceiling_takes_the_oracles_steps(reference):

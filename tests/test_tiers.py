@@ -85,9 +85,10 @@ CASES = {
         method="dop853", omega=(np.linspace(0.0, 5.0, 11), np.column_stack([np.zeros(11), np.zeros(11),
                                                                             0.4 + 0.05 * np.linspace(0.0, 5.0, 11)])),
         forces=[spring, Force(inertial_push, axes="inertial")], duration=5.0, samples=30),
+    # inline=False: the engine's loop by name (the steady loop, rotframe.problem.steady, takes this problem otherwise)
     "dop853, a pendulum and gravity with its potential": dict(
         method="dop853", omega=[0.0, 0.0, 0.3], forces=[rf.pendulum(2.0), rf.gravity((0.0, 0.0, -9.81))], duration=4.0, samples=20,
-        r0=np.array([[1.2, 0.0, -1.6]]), v0=np.array([[0.0, 0.3, 0.0]])),
+        r0=np.array([[1.2, 0.0, -1.6]]), v0=np.array([[0.0, 0.3, 0.0]]), inline=False),
     "rk4, altitude gravity and a spring": dict(
         method="rk4", omega=[0.0, 0.0, 0.2], forces=[rf.altitude_gravity(9.81, 100.0), rf.spring(2.0)],
         duration=3.0, samples=12, step=0.01),

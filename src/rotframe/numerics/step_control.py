@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import math
 
-from rotframe.numerics.compiled import jit_inline, jit_internal
+from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
-__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "SAFE", "FACC1", "FACC2",
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "own_tolerances", "own_tolerance_rows", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
 SAFE = 0.9  # dop853.f's safety factor
@@ -152,3 +152,36 @@ def first_step(y, f0, f1, h0, rtol, atol, h_max):
     if h1 < h:
         h = h1
     return h if h < h_max else h_max
+
+
+@jit_inline
+def own_tolerances(y, duration, rtol, atol):
+    """A particle's absolute tolerances from its start state ``y`` (r, v, ...) into ``atol`` (D,), where a DOP853 loop
+    first takes it (NaN until then: `rotframe.problem.particle_setup.tolerance_rows`; the engine's loop,
+    `rotframe.problem.engine`, and the scenes' ensemble wrapper, `rotframe.particles.dop853_ensemble`): ``rtol s_r`` for r, ``rtol s_v``
+    for v, ``rtol`` for the rest (the frame's attitude); ``s_r = max(max|r|, max|v| duration)``, ``s_v = max(max|v|,
+    s_r / duration)``, 1 and 1 / duration at rest at the origin. Its own scales: its numbers do not depend on the
+    ensemble."""
+    ar = 0.0
+    av = 0.0
+    for j in range(3):
+        a = abs(y[j])
+        b = abs(y[3 + j])
+        ar = a if a > ar else ar
+        av = b if b > av else av
+    sr = av * duration
+    sr = ar if ar >= sr else sr
+    sv = sr / duration
+    sv = av if av >= sv else sv
+    if sr == 0.0:
+        sr = 1.0
+        sv = 1.0 / duration
+    for j in range(atol.shape[0]):
+        atol[j] = rtol * (sr if j < 3 else sv if j < 6 else 1.0)
+
+
+@jit_kernel
+def own_tolerance_rows(y, duration, rtol, rows):
+    """`own_tolerances` of every state ``y[i]`` (N, D) into ``rows[i]`` (N, D): a large ensemble's, before its loop."""
+    for i in range(y.shape[0]):
+        own_tolerances(y[i], duration, rtol, rows[i])

@@ -19,8 +19,9 @@ model, the steady vector, a closure's constants). Conventions: SI units, per uni
 rotating frame's axes; docs/physics/rotating-frames.md for the equation of motion. The frame's own
 terms are here in two forms, each the fast one where it runs: about a fixed unit axis ``u`` with a
 rate ``w`` (``*_about_axis``: the scenes' schedules, `rotframe.particles.model.OmegaSchedule`), and
-for any vector omega, which may turn (`centrifugal`, `euler`: the kick of the engine's splittings,
-`rotframe.problem.models`, whose right-hand side writes the frame's terms in place, measured faster). The two give the same physics to round-off, not the same bits.
+for any vector omega, which may turn (`centrifugal`, `coriolis`, `euler`: the kick of the engine's splittings,
+`rotframe.problem.models`, whose right-hand side writes the frame's terms in place, measured faster, and the
+engine's steady loop, `rotframe.particles.dop853_steady`). The two give the same physics to round-off, not the same bits.
 
 Called from Python (a built-in term's ``accel``, plain-Python runs), numba compiles them on first use.
 """
@@ -32,7 +33,7 @@ import math
 from rotframe.numerics.compiled import jit_inline
 
 __all__ = ["altitude_gravity", "central_gravity", "spring_pull", "air_density", "drag_rate", "centrifugal_about_axis",
-           "coriolis_about_axis", "euler_about_axis", "centrifugal", "euler", "string_tension"]
+           "coriolis_about_axis", "euler_about_axis", "centrifugal", "coriolis", "euler", "string_tension"]
 
 
 @jit_inline
@@ -109,6 +110,12 @@ def centrifugal(x, y, z, wx, wy, wz):
     wr = wx * x + wy * y + wz * z
     w2 = wx * wx + wy * wy + wz * wz
     return w2 * x - wr * wx, w2 * y - wr * wy, w2 * z - wr * wz
+
+
+@jit_inline
+def coriolis(vx, vy, vz, wx, wy, wz):
+    """``2 w x v`` for any vector omega ``w`` (rad/s): the Coriolis acceleration is minus this."""
+    return 2.0 * (wy * vz - wz * vy), 2.0 * (wz * vx - wx * vz), 2.0 * (wx * vy - wy * vx)
 
 
 @jit_inline

@@ -47,6 +47,24 @@ def sample_times(duration, samples):
     return times
 
 
+def own_tolerance_rows(r0, v0, duration, rtol):
+    """Each particle's own absolute tolerances (N, 6) from its start ``r0``, ``v0`` (N, 3): the engine's rule
+    (`rotframe.numerics.step_control.own_tolerances`, the function itself), made before the loop rather than in
+    it (inlined into the steady loop, it made its first compile 0.2 to 0.3 s longer). A few particles by Python,
+    more by the compiled rule (`rotframe.numerics.step_control.own_tolerance_rows`)."""
+    from rotframe.numerics.step_control import own_tolerance_rows as compiled_rows, own_tolerances
+
+    n = r0.shape[0]
+    rows = np.empty((n, 6))
+    y = np.concatenate([r0, v0], axis=1)
+    if n <= 256:
+        for i in range(n):
+            own_tolerances.py_func(y[i], duration, rtol, rows[i])
+    else:
+        compiled_rows(y, duration, rtol, rows)
+    return rows
+
+
 def steps_per_sample(dt_sample, step):
     """Fixed steps per sample interval: the fewest whose length ``dt_sample / n`` is at most ``step``.
 
@@ -79,10 +97,17 @@ class KernelSetup:
         Fixed-step methods: the requested step (s), default 1/20 of the sample
         interval; the step used, `h`, divides the sample interval (``sps``
         steps a sample) and is never larger.
-    rtol, atol : float
-        DOP853 tolerances; a falsy ``atol`` means ``rtol`` times the initial
-        state's scale (`abs_tol`).
+    rtol : float
+        DOP853's relative tolerance.
+    atol : float, tuple of 6 floats or "own", optional
+        DOP853's absolute tolerance (`abs_tol`): one number for the six components, six (r then v),
+        ``"own"`` for each particle's own scales (the engine's default,
+        `rotframe.numerics.step_control.own_tolerances`), or a falsy value for ``rtol`` times the
+        initial states' scale (the scenes' default).
     events : sequence of Event
+    steady : (12,) array, optional
+        The parameters of the steady DOP853 loop (`rotframe.particles.dop853_steady.steady_parameters`), which then
+        runs the calls: the engine's steady problems (`rotframe.problem.steady`), ``model`` the same problem.
 
     Raises
     ------
@@ -90,7 +115,7 @@ class KernelSetup:
         A step that is not > 0.
     """
 
-    def __init__(self, model, info, duration, samples, *, step=None, rtol=1e-10, atol=None, events=()):
+    def __init__(self, model, info, duration, samples, *, step=None, rtol=1e-10, atol=None, events=(), steady=None):
         self.info = info
         self.P = model.pack()
         self.wt, self.wv = model.omega.times, model.omega.values
@@ -105,8 +130,9 @@ class KernelSetup:
         # the fixed-step family, None where absent (pruned): RK4, the splitting on the sphere
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
-        self.steady_args = None  # q, the parameters of the specialised DOP853 driver, where the model allows it
         self.fixed = info.step == "fixed"
+        # the engine's steady problems run the steady loop (rotframe.problem.steady)
+        self.steady_args = None if self.fixed else steady
         # the arguments of every fixed-step driver call that do not change (unpacked into it)
         self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
         self._family = (self.rk4, self.sphere)
@@ -121,14 +147,8 @@ class KernelSetup:
             self.h = dt / self.sps
             self.evals_per_step = EVALS_PER_STEP[info.name]
         else:
-            from rotframe.particles.dop853_steady import is_steady_model, steady_parameters
-
             self.sps = 0
             self.h = 0.0
-            # a steady model without events runs the specialised driver (bitwise the same results,
-            # a smaller first compile): rotframe.particles.dop853_steady
-            if is_steady_model(model, self.events, self.P):
-                self.steady_args = steady_parameters(model, self.P)
 
     def kernel(self):
         """The compiled driver of this method."""
@@ -158,11 +178,18 @@ class KernelSetup:
         return g
 
     def abs_tol(self, r0, v0):
-        """DOP853's absolute tolerance: ``atol``, else ``rtol`` times max(1, |r0|, |v0|) (componentwise max)."""
+        """DOP853's absolute tolerances of the particles ``r0``, ``v0`` (N, 3), a row (r then v) each, (N, 6): ``atol``
+        (`KernelSetup`), else ``rtol`` times max(1, |r0|, |v0|) (componentwise max over the ensemble); for ``"own"``,
+        each particle's own (`own_tolerance_rows`)."""
+        n = r0.shape[0]
+        if isinstance(self.atol, str):
+            return own_tolerance_rows(r0, v0, self.duration, self.rtol)
+        if self.atol is not None and np.ndim(self.atol):
+            return np.repeat(np.asarray(self.atol, dtype=float).reshape(1, 6), n, axis=0)
         if self.atol:
-            return float(self.atol)
+            return np.full((n, 6), float(self.atol))
         scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
-        return self.rtol * scale
+        return np.full((n, 6), self.rtol * scale)
 
     def event_records(self, evb):
         """The record arrays of ``evb`` as the drivers take them; None for each without an event table.
@@ -174,12 +201,12 @@ class KernelSetup:
             return None, None, None, None, None, evb.max_events
         return evb.args()
 
-    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=0.0, h_state=None, t0=None,
+    def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=None, h_state=None, t0=None,
              sps=None, times=None):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
-        the events; ``atol`` and ``h_state`` (N,) are DOP853's. Returns
+        the events; ``atol`` (N, 6) and ``h_state`` (N,) are DOP853's (`abs_tol`). Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
         of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
@@ -204,11 +231,11 @@ class KernelSetup:
         from rotframe.particles.blocks import run_blocks
 
         ev_t, ev_r, ev_v, ev_count, ev_which, max_events = records
-        per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state)
+        per_particle = (r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol)
         if self.info.step == "fixed":
             k = self.sps if sps is None else sps
 
-            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
                 return kernel(r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
                               self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
                               max_events, self.rk4, self.sphere) + (k * count,)
@@ -220,17 +247,15 @@ class KernelSetup:
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
         from rotframe.particles.dop853_ensemble import WORK_ROWS  # here: importing a scene compiles nothing
 
-        # a steady model runs the steady driver at any size: on 20000 particles it was measured 15 to 20 % faster than
-        # the general one (which large ensembles took until the one DOP853 loop inlined both forces alike), bitwise
-        # the same (tests/test_dop853_steady.py)
+        # the engine's steady problem: the steady loop at any size (`rotframe.problem.steady`)
         if self.steady_args is not None:
             q = self.steady_args
 
-            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
                 return kernel(r, v, start, times, q, self.rtol, atol, span, np.empty((WORK_ROWS, 6)), out_r, out_v,
                               h_state)
         else:
-            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, out_r, out_v):
+            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
                 return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span,
                               self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state,
                               np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
@@ -260,7 +285,7 @@ class KernelSetup:
         empty = np.empty((0, 3))
         out = np.empty((0, 0, 3))
         self.call(empty.copy(), empty.copy(), np.ones(0, dtype=np.bool_), 0, 0, out, out.copy(),
-                  EventBuffers(0, 1), 1.0, np.zeros(0), 1.0)
+                  EventBuffers(0, 1), np.empty((0, 6)), np.zeros(0), 1.0)
         elapsed = time.perf_counter() - t_load
         return elapsed if overloads is not None and len(kernel.overloads) > before else 0.0
 
@@ -323,7 +348,8 @@ def _probe(setup, r, v, alive, evb, atol, h_state, out_r, out_v, whole):
             result = setup.call(r, v, alive, 0, 1, out_r, out_v, evb, atol, h_state)
             return float(result[3]), result
         steps = setup.call(r[:1].copy(), v[:1].copy(), alive[:1].copy(), 0, 1, scratch, scratch.copy(),
-                           EventBuffers(1, evb.max_events), atol, h_state[:1].copy(), times=np.array([end]))[3]
+                           EventBuffers(1, evb.max_events), atol[:1].copy(), h_state[:1].copy(),
+                           times=np.array([end]))[3]
         if k == 0 or steps >= PROBE_STEPS:
             return float(steps) * dt / (end - t0), None
     return 1.0, None
@@ -404,7 +430,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     r0, v0 = out_r[0], out_v[0]  # the initial state, kept (r, v advance in place)
     if info.step == "fixed":
         cost = setup.sps * n * setup.evals_per_step
-        atol = 0.0
+        atol = None
         h_state = None
     else:
         atol = setup.abs_tol(r0, v0)

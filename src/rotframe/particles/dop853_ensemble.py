@@ -2,11 +2,11 @@
 
 `run_particles` runs `rotframe.numerics.dop853_loop`'s trajectory for each particle of an
 ensemble; the particle's right-hand side and events live in `rotframe.particles.dop853_particles`,
-a steady model's in `rotframe.particles.dop853_steady` (which imports only this module, so that
-importing the Foucault scene imports neither scipy nor the general force).
+the engine's steady problems' in `rotframe.particles.dop853_steady` (which imports only this module,
+so that a steady run imports neither scipy nor the general force).
 
 Work arrays (`WORK_ROWS`, 6): rows 0..15 the stages ``K``, 16 ``y``, 17 ``y_new``, 18 and 19
-scratch states, 20 the absolute tolerances, 21..27 the interpolant's coefficients.
+scratch states, 20..26 the interpolant's coefficients (the absolute tolerances are the caller's rows).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from rotframe.numerics.dop853_loop import REACHED, STOPPED, UNLIMITED, dop853_st
 __all__ = ["run_particles", "store_sample", "WORK_ROWS"]
 
 #: rows of the (WORK_ROWS, 6) work array of `run_particles`
-WORK_ROWS = 28
+WORK_ROWS = 27
 
 
 @jit_llvm_inline
@@ -43,7 +43,8 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
     events' data ``wctx``, None for none), and ``start(wctx, ctx, t, y)`` the events' values at
     each particle's start (`rotframe.particles.dop853_particles.start_events`; None for none). ``r, v`` receive the
     states at the end, ``out_r, out_v`` (n, N, 3) the samples: a particle that stopped or failed
-    keeps its last state in the rest. Returns ``(n_done, bad, nfev, steps)``: samples completed
+    keeps its last state in the rest. ``atol`` (N, 6) each particle's absolute tolerances (r then v:
+    `rotframe.particles.chunked.KernelSetup.abs_tol`). Returns ``(n_done, bad, nfev, steps)``: samples completed
     by every particle, the first particle that failed (or -1), and particle 0's cost.
 
     Inlined into each driver (numba IR), so that ``rhs`` and ``trajectory`` are the driver's globals:
@@ -54,10 +55,7 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
     y_new = work[17]
     tmp = work[18]
     yt = work[19]
-    atol_vec = work[20]
-    F = work[21:28]
-    for j in range(6):
-        atol_vec[j] = atol
+    F = work[20:27]
     n_out = times.shape[0]
     t_end = times[n_out - 1]
     n_done = n_out
@@ -68,6 +66,7 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
         for i in range(3):
             y[i] = r[p, i]
             y[3 + i] = v[p, i]
+        atol_vec = atol[p]
         t = t0
         h = h_state[p]
         rhs(ctx, t, y, K, 0)

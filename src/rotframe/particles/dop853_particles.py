@@ -4,9 +4,8 @@
 `rotframe.particles.dop853_ensemble.run_particles` runs it for each particle of an ensemble. The scene
 drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853` and
 `run_dop853_events` with `particle_rhs` (every term and rotation schedule; the second watches
-the events), and
-`rotframe.particles.dop853_steady.run_dop853_steady` with a steady model's force (a smaller first
-compile). Events are watched after each accepted step (`watch_events`) and located by bisection on
+the events); `rotframe.particles.dop853_steady.run_dop853_steady` is the same loop with the engine's
+steady problems' force (`rotframe.problem.steady`). Events are watched after each accepted step (`watch_events`) and located by bisection on
 the length of one DOP853 step from the step's start (`locate_event_dop853`: rotframe's one locator,
 `rotframe.numerics.bisection.locator`, with that trial).
 """

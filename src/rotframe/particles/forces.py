@@ -9,8 +9,7 @@ piecewise linear in time (a constant is a one-node table). Each term is
 switched by a flag in ``P``; a term that is off costs one branch. The arithmetic of each term is
 `rotframe.particles.accelerations`' (written once, for the scenes and your own problems alike); here
 it is summed over the packed model's terms. One exception, measured: the Coriolis term is written in
-place (`state_acceleration`), the same arithmetic as `coriolis_about_axis`, which
-``tests/test_dop853_steady.py`` keeps bitwise equal to it.
+place (`state_acceleration`), the same arithmetic as `coriolis_about_axis`.
 
 The step kernels (`rotframe.particles.kernels`), the DOP853 stages
 (`rotframe.particles.dop853_particles`) and the event rules

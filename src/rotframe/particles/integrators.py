@@ -55,7 +55,7 @@ if TYPE_CHECKING:  # names used only in annotations
 
     from rotframe.particles.model import ParticleModel
 
-__all__ = ["METHODS", "ALIASES", "METHOD_NAMES", "canonical_method", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method"]
+__all__ = ["METHODS", "ALIASES", "METHOD_NAMES", "canonical_method", "Event", "Trajectory", "RunInterrupted", "integrate_particles", "default_method", "check_work"]
 
 
 #: The methods of the scenes' particle models, read from the one registry
@@ -167,7 +167,7 @@ def integrate_particles(model: ParticleModel, r0: ArrayLike, v0: ArrayLike, dura
     if info.step != "exact":
         setup = _setup(model, info, duration, samples, step, rtol, atol, events, r0.shape[0])
         return run_chunked(setup, model, r0, v0, progress, max_events, records, owned=True)
-    _check_work(info, duration, step, samples, r0.shape[0], model)
+    check_work(info, duration, step, samples, r0.shape[0], model)
     check_exact(model)
     return integrate_exact(model, r0, v0, duration, samples, events, progress)
 
@@ -209,14 +209,14 @@ def _setup(model, info, duration, samples, step, rtol, atol, events, n):
     entry = _SETUPS.get(key) if key is not None else None
     lim = limits.current()
     if entry is None:
-        _check_work(info, duration, step, samples, n, model)
+        check_work(info, duration, step, samples, n, model)
         entry = [KernelSetup(model, info, duration, samples, step=step, rtol=rtol, atol=atol, events=events), lim, n]
         if key is not None:
             if len(_SETUPS) >= _SETUPS_KEPT:
                 _SETUPS.pop(next(iter(_SETUPS)))
             _SETUPS[key] = entry
     elif entry[1] is not lim or entry[2] != n:
-        _check_work(info, duration, step, samples, n, model)
+        check_work(info, duration, step, samples, n, model)
         entry[1], entry[2] = lim, n
     return entry[0]
 
@@ -229,7 +229,7 @@ def _finite(r0, v0):
     return bool(np.isfinite(r0).all() and np.isfinite(v0).all())
 
 
-def _check_work(info, duration, step, samples, n, model):
+def check_work(info, duration, step, samples, n, model):
     """Refuse, before allocating anything, a run over the work limits (`rotframe.limits`)."""
     from rotframe import limits
 

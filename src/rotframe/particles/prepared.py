@@ -47,15 +47,18 @@ class PreparedRun:
         Output samples after t = 0 (uniform in time).
     n : int
         Particles per call.
+    steady : (12,) array, optional
+        ``dop853`` on the steady loop with these parameters (`rotframe.particles.chunked.KernelSetup`): the engine's
+        steady problems prepared (`rotframe.problem.prepared`), ``model`` the same problem.
 
     Notes
     -----
     Calling ``run(r0, v0)`` returns ``(r, v)``, arrays (samples + 1, n, 3),
     owned by the caller (fresh each call); ``times`` holds the sample times and
-    ``nfev`` the force evaluations of particle 0 in the last call.
+    ``nfev`` and ``steps`` the force evaluations and steps of particle 0 in the last call.
     """
 
-    def __init__(self, model, method, duration, *, step=None, rtol=1e-10, atol=None, samples=1, n=1):
+    def __init__(self, model, method, duration, *, step=None, rtol=1e-10, atol=None, samples=1, n=1, steady=None):
         from rotframe.errors import ScenarioError
         from rotframe.particles.chunked import KernelSetup
         from rotframe.particles.integrators import METHODS, canonical_method
@@ -68,7 +71,7 @@ class PreparedRun:
         self.info = METHODS[method]
         self.samples = samples = max(1, int(samples))
         self.n = n = int(n)
-        self.nfev = 0
+        self.nfev = self.steps = 0
         if self.info.step == "exact":
             from rotframe.particles.chunked import sample_times
             from rotframe.particles.linear import ExactFlow
@@ -85,12 +88,12 @@ class PreparedRun:
             self._apply = apply_flow
             apply_flow(self.phi_t, np.zeros((n, 3)), np.zeros((n, 3)))  # load or compile the kernel now
             return
-        self.setup = KernelSetup(model, self.info, duration, samples, step=step, rtol=rtol, atol=atol)
+        self.setup = KernelSetup(model, self.info, duration, samples, step=step, rtol=rtol, atol=atol, steady=steady)
         self.times = self.setup.times
         self.alive = np.ones(n, dtype=np.bool_)
         self.evb = EventBuffers(n, 1)
         self.h_state = np.zeros(n)
-        self.run(np.zeros((n, 3)), np.zeros((n, 3)))  # load or compile the kernel now
+        self.setup.warm_up()  # load or compile the kernel now (an empty call: no state that the model may refuse)
 
     def _run_exact(self, r0, v0):
         """The exact flow's states: the kept matrices times the initial states, one compiled loop."""
@@ -124,8 +127,8 @@ class PreparedRun:
         self.alive[:] = True
         self.evb.reset()
         self.h_state[:] = 0.0
-        atol = self.setup.abs_tol(r, v) if self.info.step == "adaptive" else 0.0
-        n_done, bad, self.nfev, _ = self.setup.call(r, v, self.alive, 0, samples, out_r[1:], out_v[1:], self.evb,
+        atol = self.setup.abs_tol(r, v) if self.info.step == "adaptive" else None
+        n_done, bad, self.nfev, self.steps = self.setup.call(r, v, self.alive, 0, samples, out_r[1:], out_v[1:], self.evb,
                                                     atol, self.h_state)
         if n_done < samples or bad >= 0:
             from rotframe.errors import IntegrationError

@@ -58,7 +58,7 @@ from rotframe.numerics.bisection import MAX_HALVINGS, locator
 from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
-from rotframe.numerics.step_control import start_short_of
+from rotframe.numerics.step_control import own_tolerances, start_short_of
 from rotframe.problem.calls import RAISED, call_event, direct_functions
 from rotframe.problem.models import (DOP853, EVALUATIONS_PER_STEP, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6,
                                      SPLITTING8, particle_energy, rhs)
@@ -159,31 +159,6 @@ def _start_sign(tctx, h):
         if not moved:
             break
     return g_near
-
-
-@jit_inline
-def own_tolerances(y, duration, rtol, atol):
-    """A particle's absolute tolerances from its start state ``y`` (r, v, ...) into ``atol`` (D,), where the DOP853 loop
-    first takes it (NaN until then: `rotframe.problem.particle_setup.tolerance_rows`): ``rtol s_r`` for r, ``rtol s_v``
-    for v, ``rtol`` for the rest (the frame's attitude); ``s_r = max(max|r|, max|v| duration)``, ``s_v = max(max|v|,
-    s_r / duration)``, 1 and 1 / duration at rest at the origin. Its own scales: its numbers do not depend on the
-    ensemble."""
-    ar = 0.0
-    av = 0.0
-    for j in range(3):
-        a = abs(y[j])
-        b = abs(y[3 + j])
-        ar = a if a > ar else ar
-        av = b if b > av else av
-    sr = av * duration
-    sr = ar if ar >= sr else sr
-    sv = sr / duration
-    sv = av if av >= sv else sv
-    if sr == 0.0:
-        sr = 1.0
-        sv = 1.0 / duration
-    for j in range(atol.shape[0]):
-        atol[j] = rtol * (sr if j < 3 else sv if j < 6 else 1.0)
 
 
 @jit_inline

@@ -162,7 +162,7 @@ def _particle_rhs(t, y, dy, prob, fns, W):
     ax = W[0]
     ay = W[1]
     az = W[2]
-    # the frame's terms in place, the arithmetic of accelerations.centrifugal and euler: called
+    # the frame's terms in place, the arithmetic of accelerations.coriolis, centrifugal and euler: called
     # (inlined), they made a user force's evaluation 4 % slower (bench user-force, 2026-11-29);
     # each where the run keeps it (M[9:12], `rotframe.problem.terms.check_frame_terms`)
     if (M[9] != 0.0) if CORIOLIS == AT_RUN_TIME else CORIOLIS:

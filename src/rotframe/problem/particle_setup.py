@@ -24,6 +24,7 @@ from rotframe.problem.arguments import (array_of, check_event, check_flag, check
 from rotframe.problem.codegen import Driver, build_module
 from rotframe.problem.frame import frame_spec, origin_spec, stop_times
 from rotframe.problem.glue import flatten_params, particle_source
+from rotframe.problem.steady import steady_model
 from rotframe.problem.terms import Force, as_term, check_frame_terms, check_splitting, model_constants, one_constraint
 
 __all__ = ["SetUp", "set_up", "checked_states", "plain_states", "checked_atol", "checked_attitude", "check_arrays", "start_states",
@@ -138,7 +139,7 @@ def checked_atol(atol) -> np.ndarray | None:
 def tolerance_rows(N, D, rtol, atol):
     """Absolute tolerances, one row per particle ((N, D)): ``atol`` (`checked_atol`) for r and v and ``rtol`` for the
     rest of the state where given, else rows of NaN, which the engine's DOP853 loop fills with each particle's own
-    (`rotframe.problem.engine.own_tolerances`, from its start state: its steps, and its numbers, do not depend on the
+    (`rotframe.numerics.step_control.own_tolerances`, from its start state: its steps, and its numbers, do not depend on the
     other particles of the ensemble). The rule is compiled into the loop, not made here at every run: a prepared run
     spent 6 us of numpy on it, where the whole of its own cost is some 20 us."""
     if atol is None:
@@ -184,16 +185,19 @@ class SetUp:
     t0: float = 0.0
     #: makes the same problem's driver as plain Python (`rotframe.problem.tiers`); None for a plain run
     plain_driver: object = None
+    #: ``(model, q)`` of a run that the steady loop runs (`rotframe.problem.steady`); None for the engine's loop
+    steady: object = None
 
 
 def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples,
-           omega_dot, jit, max_events, device, frame_terms, inline=None):
+           omega_dot, jit, max_events, device, frame_terms, inline=None, steady=True):
     """Check a particle problem and build what runs it, from the start states ``r0``, ``v0``: a `SetUp`.
 
     Every argument as `simulate_particles` takes it, checked in its order; the start states are
     checked too (the string's sphere, each function called once at particle 0's), and their
     number sizes the work limits. For method ``exact`` nothing is built: the set-up is returned
-    checked, its driver None (the flow is the caller's, `rotframe.problem.exact`).
+    checked, its driver None (the flow is the caller's, `rotframe.problem.exact`). Nor for a run
+    that the steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem.
     """
     import time
 
@@ -232,6 +236,10 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
+    steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms) if steady else None
+    if steady is not None:  # the steady loop, compiled once for every such problem: nothing of this one is built
+        return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
+                     frame_terms, on_gpu, steady=steady)
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
     roles = function_roles(frame, origin, forces, events, labels)

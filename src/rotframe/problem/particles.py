@@ -34,7 +34,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint, energy_by_numpy
-from rotframe.problem.tiers import PlainTierFailed, Tier, run_falling_back
+from rotframe.problem.tiers import PlainTierFailed, SteadyLoopFailed, Tier, run_falling_back
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
            "raised_later", "trajectory_of", "exact_model"]
@@ -89,7 +89,7 @@ def simulate_particles(**kwargs) -> ProblemRun:
 def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                         method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
                         frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
-                        frame_terms=None, inline=None, plain_tier=True) -> ProblemRun:
+                        frame_terms=None, inline=None, plain_tier=True, steady=True) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -103,12 +103,14 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                samples=samples, omega_dot=omega_dot, jit=jit, max_events=max_events, device=device,
-               frame_terms=frame_terms, inline=inline)
+               frame_terms=frame_terms, inline=inline, steady=steady)
     r, v = s.r, s.v
     attitude = None if frame_attitude is None else checked_attitude(frame_attitude)  # refused even where unread
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress)
+    if s.steady is not None:  # the steady loop: chosen from the terms, compiled once for every such problem
+        return _steady_run(s, checked_atol(atol), progress)
     method, duration, times, rtol, hfix, D, N = s.method, s.duration, s.times, s.rtol, s.hfix, s.D, r.shape[0]
     frame, origin, forces, events = s.frame, s.origin, s.forces, s.events
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
@@ -410,6 +412,36 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     _energy_diagnostics(lambda rotating: array_energies(traj, forces, frame, rotating), traj, frame, origin, forces,
                         diagnostics, notes, frame_terms)
     return ProblemRun(traj, diagnostics, [], notes, frame, 0.0, frame_terms)
+
+
+def _steady_run(s, atol, progress) -> ProblemRun:
+    """DOP853 on the steady loop (`rotframe.problem.steady`: `rotframe.particles.dop853_steady`, run in calls by
+    `rotframe.particles.chunked`) for the set-up ``s``: the engine's loop's steps and numbers, each particle's own
+    tolerances where ``atol`` is None; the energy diagnostic numpy's. The trajectory's ``steps`` and ``nfev`` are
+    particle 0's (the engine's loop gives the most any particle took: the same for one particle).
+
+    A run that fails (a state not finite, the step collapsed, a speed that grew without a force) raises
+    `SteadyLoopFailed`: `simulate_particles` runs it again on the engine's loop, which meets the failure at the same
+    step and names its cause and the term to blame."""
+    from rotframe.particles.chunked import KernelSetup, run_chunked
+    from rotframe.particles.integrators import METHODS, check_work
+
+    model, q = s.steady
+    info, samples = METHODS["dop853"], s.times.size - 1
+    check_work(info, s.duration, None, samples, s.r.shape[0], model)
+    setup = KernelSetup(model, info, s.duration, samples, rtol=s.rtol,
+                        atol="own" if atol is None else tuple(atol.tolist()), steady=q)
+    try:
+        traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, owned=True)
+    except IntegrationError:
+        raise SteadyLoopFailed from None
+    traj.extras["status"] = np.ones(s.r.shape[0], dtype=np.int64)  # the engine's status: every particle reached the end
+    diagnostics = {}
+    notes = list(s.frame.notes) + ["method dop853: the engine's steady loop (a constant rotation rate, uniform "
+                                   "gravity, a string: rotframe.problem.steady), compiled once for every such problem"]
+    _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
+                        s.forces, diagnostics, notes, s.frame_terms)
+    return ProblemRun(traj, diagnostics, [], notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
 
 
 def steady_omega(frame):

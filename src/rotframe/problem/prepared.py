@@ -79,10 +79,16 @@ frame_attitude, frame_terms
         if not isinstance(inline, bool):
             raise ScenarioError(f"inline={inline!r}: True (the problem's functions compiled into the loop) or False "
                                 "(called by address)")
+        arguments = dict(r0=r0, v0=v0, omega=omega, duration=duration, forces=forces, params=params,
+                         origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
+                         samples=samples, omega_dot=omega_dot, atol=atol, frame_attitude=frame_attitude,
+                         frame_terms=frame_terms)
+        # the steady loop where simulate takes it (`rotframe.problem.steady`): inline given by default here, so the
+        # choice is made as simulate makes it, with inline as simulate's default
         s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                    origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                    samples=samples, omega_dot=omega_dot, jit=True, max_events=256, device=None,
-                   frame_terms=frame_terms, inline=inline)
+                   frame_terms=frame_terms, inline=None if inline is True else inline)
         self.setup = s
         self._omega = omega
         #: the frame's attitude, checked once (refused even where no force reads it, as simulate refuses it)
@@ -97,6 +103,11 @@ frame_attitude, frame_terms
         self._exact = _ExactFlow(s) if s.method == "exact" else None
         if self._exact is not None:  # its calls bound here: a run of a few microseconds pays no second dispatch
             self.states, self.run = self._exact.states, self._exact.run
+            return
+        if s.steady is not None:  # the steady loop (as simulate runs this problem): its calls bound here too
+            self._steady = _SteadyLoop(s, self._atol, self._string, arguments)
+            self.run = self._steady.run
+            self.notes = ["method dop853: the engine's steady loop (rotframe.problem.steady)"]
             return
         inlining = Inlining(s.driver.module, s.prob[0], s.method, s.events, s.D, model_parts(s.prob), inline)
         inlining.start()
@@ -227,6 +238,46 @@ class _ExactFlow:
             raise IntegrationError(f"simulate: the exact flow gave a non-finite state at t = {times[k_bad]:.9g} s; "
                                    "samples up to there are kept", t_reached=float(times[good - 1]), partial=partial)
         return rs, vs
+
+
+class _SteadyLoop:
+    """``method="dop853"`` on a steady problem prepared (`rotframe.problem.steady`): the steady loop's set-up made once
+    per count of particles (the scenes' `rotframe.particles.prepared.PreparedRun` with the problem's parameters); each
+    run is one call of it. ``simulate``'s numbers to the bit. A run that fails runs again on the engine's loop
+    (a `PreparedProblem` made with ``inline=False`` from the same ``arguments``), which raises as ``simulate`` does."""
+
+    def __init__(self, s, atol, string, arguments):
+        self._s, self._string, self._arguments = s, string, arguments
+        self._atol = "own" if atol is None else tuple(atol.tolist())
+        self._runs = {}  # particles -> PreparedRun
+        self._times = s.times.copy()
+        self._times.flags.writeable = False  # shared by every run's Trajectory, as its sample times
+        self._prepared(s.r.shape[0])  # load or compile the loop now
+
+    def _prepared(self, N):
+        from rotframe.particles.prepared import PreparedRun
+
+        pr = self._runs.get(N)
+        if pr is None:
+            s = self._s
+            if N > s.r.shape[0]:  # more particles than the set-up's: their samples within the limits
+                check_arrays(N, s.times.size, s.D, 1, 2)
+            model, q = s.steady
+            pr = self._runs[N] = PreparedRun(model, "dop853", s.duration, rtol=s.rtol, atol=self._atol,
+                                             samples=s.times.size - 1, n=N, steady=q)
+        return pr
+
+    def run(self, r0, v0):
+        """The `Trajectory` from the start states ``r0``, ``v0`` (as ``simulate`` takes them)."""
+        r, v = checked_states(r0, v0)
+        if self._string is not None:
+            check_on_string(*self._string, r, v)
+        pr = self._prepared(r.shape[0])
+        try:
+            rs, vs = pr.run(r, v)
+        except IntegrationError:  # met again, and named, by the engine's loop
+            return PreparedProblem(**dict(self._arguments, r0=r, v0=v), inline=False).run(r, v)
+        return Trajectory(self._times, rs, vs, "dop853", pr.steps, pr.nfev, True, float(self._times[-1]))
 
 
 def _fresh_arrays(s, N, atol):

@@ -8,7 +8,7 @@ takes 13 us in all (the Foucault model over 1 s; one pinned core, best of 2000, 
 Compiled, it is one call of about a microsecond. It compiles in 0.25 s, once (cached on disk),
 for a problem with a string alone: the other check every run makes (finite numbers) stays in
 numpy, whose calls cost less than a first compile (a particle's default tolerances are made by
-the engine's loop itself, `rotframe.problem.engine.own_tolerances`).
+the engine's loop itself, `rotframe.numerics.step_control.own_tolerances`).
 """
 
 from __future__ import annotations

@@ -181,17 +181,18 @@ def one_constraint(terms, r, v):
         raise ScenarioError(f"forces[{found[1][0]}]: a second pendulum; a particle hangs on one string")
     if not found:
         return None
-    check_on_string(*found[0], r, v)
+    check_on_string(*found[0], r, v, compiled=r.shape[0] > 8)  # a few particles, once: Python's, no compile
     return found[0][1]
 
 
-def check_on_string(k, c, r, v):
+def check_on_string(k, c, r, v, compiled=True):
     """Refuse start states ``r``, ``v`` (N, 3; finite, C-ordered) off the sphere of the string ``c``, ``forces[k]``, or
     moving along it, in one line naming the particle (`rotframe.problem.string_start.string_defect`: compiled, as a
-    prepared run checks at every run; imported at first use, as this module imports no numba)."""
+    prepared run checks at every run; imported at first use, as this module imports no numba). ``compiled=False``
+    runs the same function as plain Python (the same arithmetic: a check once of a few particles compiles nothing)."""
     from rotframe.problem.string_start import ALONG_STRING, OFF_SPHERE, string_defect
 
-    kind, i, value = string_defect(r, v, *c.pivot, c.length)
+    kind, i, value = (string_defect if compiled else string_defect.py_func)(r, v, *c.pivot, c.length)
     if kind == OFF_SPHERE:
         raise ScenarioError(f"r0: particle {i} is {value:.9g} m from the pivot of forces[{k}] (pendulum), not its "
                             f"length {c.length:.9g} m; start it on the string's sphere")

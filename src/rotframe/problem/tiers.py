@@ -52,7 +52,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -81,13 +81,23 @@ class PlainTierFailed(Exception):
     square root of a negative number where the compiled loop goes on with inf or NaN)."""
 
 
+class SteadyLoopFailed(Exception):
+    """A run on the engine's steady loop (`rotframe.problem.steady`) failed: it runs again on the engine's own loop,
+    which gives the same numbers to the bit up to there and names the failure's cause (a state not finite, a step
+    that collapsed) and the term to blame, as any run's failure is named."""
+
+
 def run_falling_back(run, kwargs):
     """``run(**kwargs)`` (a particle or body run that may begin in the plain tier); where it fails there
-    (`PlainTierFailed`), ``run(**kwargs, plain_tier=False)``: the same run compiled from its start."""
+    (`PlainTierFailed`), ``run(**kwargs, plain_tier=False)``: the same run compiled from its start; where it fails on
+    the steady loop (`SteadyLoopFailed`), the same run on the engine's loop (``steady=False``), itself falling back
+    so."""
     try:
         return run(**kwargs)
     except PlainTierFailed:
         return run(**kwargs, plain_tier=False)
+    except SteadyLoopFailed:
+        return run_falling_back(run, dict(kwargs, steady=False))
 
 
 def loop_is_compiled(variant) -> bool:

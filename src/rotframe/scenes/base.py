@@ -14,10 +14,10 @@ import numpy as np
 from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.method_registry import MethodNames, names
 from rotframe.scenes.run_settings import RUN_DEFAULTS, run_setting
-from rotframe.particles.integrators import RunInterrupted, integrate_particles
+from rotframe.particles.integrators import RunInterrupted
 
 
-__all__ = ["UNDERFLOW", "RUN_DEFAULTS", "run_setting", "SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "run_particles", "rel_drift", "until_event",
+__all__ = ["UNDERFLOW", "RUN_DEFAULTS", "run_setting", "SceneResult", "scene_parameters", "with_parameters", "MethodNames", "particle_methods", "rel_drift", "until_event",
            "landing",
            "resolve_terms", "earth_model_constants", "energy_in_rotating_frame", "CONSERVATIVE_TERMS",
            "potential_energy", "jacobi_energy", "SAMPLES_PER_PERIOD", "MAX_SAMPLES", "samples_for",
@@ -148,19 +148,6 @@ class SceneResult:
         return bool(getattr(self.trajectory, "complete", True))
 
 
-def run_particles(model, r0, v0, duration, method, run, progress, finish, events=(), step=None):
-    """Integrate a particle scene with the run settings (``step``, ``rtol``, ``samples``).
-
-    ``finish(trajectory) -> SceneResult`` builds the scene's result; it is
-    applied to a partial trajectory too, so that an interrupted or failed run
-    re-raises with a SceneResult in ``exc.partial`` that can be analysed and
-    recorded like a complete one.
-    """
-    return guarded(finish, integrate_particles, model, r0, v0, duration, method=method, step=step or run.get("step"),
-                   rtol=run_setting(run, "rtol"), samples=int(run_setting(run, "samples")), events=events,
-                   progress=progress)
-
-
 def engine_terms(model):
     """A scene's model (`rotframe.particles.model.ParticleModel`, its terms by name) as the engine takes it:
     ``(omega, forces, frame_terms)``.
@@ -207,19 +194,20 @@ def engine_remarks(res) -> dict:
             "warnings": list(getattr(res, "warnings", []))}
 
 
-def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=()):
+def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=(), atol=None):
     """Integrate a particle scene's model on the engine (`rotframe.problem.particles.simulate_particles`) with the
-    run settings (``step``, ``rtol``, ``samples``), as `run_particles` does on the scenes' kernels.
+    run settings (``step``, ``rtol``, ``samples``): every particle scene's run.
 
     ``finish(result)`` builds the scene's result from the engine's run (a `ProblemRun`, or the trajectory up to an
-    early stop: `guarded`); its ``notes`` and ``warnings`` are the engine's.
+    early stop: `guarded`); its ``notes`` and ``warnings`` are the engine's. ``atol`` (DOP853's absolute tolerance,
+    as ``rotframe.simulate`` takes it) where the scene has its own scale; None for each particle's own.
     """
     from rotframe.problem.particles import simulate_particles  # the engine's front door: imported by a run
 
     omega, forces, frame_terms = engine_terms(model)
     return guarded(finish, simulate_particles, omega=omega, r0=r0, v0=v0, duration=duration, method=method,
                    forces=forces, frame_terms=frame_terms, events=list(events), rtol=run_setting(run, "rtol"),
-                   step=run.get("step"), samples=int(run_setting(run, "samples")), progress=progress)
+                   atol=atol, step=run.get("step"), samples=int(run_setting(run, "samples")), progress=progress)
 
 
 def guarded(finish, func, *args, **kwargs):

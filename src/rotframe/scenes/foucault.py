@@ -27,9 +27,9 @@ from rotframe import analytic
 from rotframe.numerics.linefit import line_fit
 from rotframe.particles.integrators import default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
-from rotframe.scenes.base import (SceneResult, earth_model_constants, jacobi_energy, method_rel_error,
-                                  particle_methods, potential_energy, reject_subnormal, run_particles,
-                                  unresolved_note, with_parameters)
+from rotframe.scenes.base import (SceneResult, earth_model_constants, engine_remarks, jacobi_energy,
+                                  method_rel_error, particle_methods, potential_energy, reject_subnormal,
+                                  run_on_engine, run_setting, unresolved_note, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -92,11 +92,17 @@ def simulate(p, terms, method, run, progress):
     # pendulum by dop853, the cheapest for its stated accuracy in `rotframe bench foucault`
     method = method or ("dop853" if model.has("pendulum") else default_method(model))
 
-    def finish(traj):
+    def finish(res):  # a ProblemRun, or the trajectory up to an early stop
+        traj = getattr(res, "trajectory", res)
         return SceneResult(traj, list(model.terms), traj.method, traj.steps, traj.nfev,
-                           extras={"model": model, "g": g, "Omega": Omega, "resolved": resolved})
+                           extras={"model": model, "g": g, "Omega": Omega, "resolved": resolved,
+                                   **engine_remarks(res)})
 
-    return run_particles(model, r0, v0, T, method, run, progress, finish)
+    # DOP853's absolute tolerance on the swing's scale, rtol max(1 m, |r0|, |v0|) for r and v alike (the scale
+    # `rotframe.app.dense` restarts from), not the engine's default, which scales v by |r0| / duration: over an
+    # hour, a thousandth of the swing's speed, and some 1.5 times the steps for nothing the metrics resolve
+    atol = run_setting(run, "rtol") * max(1.0, float(np.max(np.abs(r0))), float(np.max(np.abs(v0))))
+    return run_on_engine(model, r0, v0, T, method, run, progress, finish, atol=atol)
 
 
 def swing_angle(r, v, w0):
@@ -209,7 +215,8 @@ def analyse(p, result):
         notes.append("the swing plane does not turn measurably (no hours per turn)")
     notes.append(f"simulated {duration / 3600:.3g} h of motion ({len(traj.times) - 1} samples)")
     return {"metrics": metrics, "theory": theory, "theory_notes": theory_notes, "tolerance": tolerance,
-            "diagnostics": diagnostics, "notes": notes, "warnings": warnings}
+            "diagnostics": diagnostics, "notes": notes + result.extras.get("notes", []),
+            "warnings": warnings + result.extras.get("warnings", [])}
 
 
 @with_parameters(FoucaultParameters, position=1)

@@ -79,42 +79,8 @@ def _ladder(quick, full, short):
     return short if quick else full
 
 
-#: suffix of a rotframe method run through rotframe.particles.prepared.PreparedRun (prepared once, untimed)
+#: suffix of a rotframe method run set up once (untimed): `rotframe.problem.prepared.PreparedProblem`, `PreparedBody`
 PREPARED = " prepared"
-
-
-def _particle_runner(model, r0, v0, t_end, invariant_fn):
-    from rotframe.particles.integrators import integrate_particles
-    from rotframe.particles.prepared import PreparedRun
-
-    prepared = {}
-    times = np.array([0.0, t_end])
-
-    def prepared_call(method, setting):
-        base = method.removesuffix(PREPARED)
-        pr = prepared.get((base, setting))
-        if pr is None:
-            kw = {"rtol": setting} if base == "dop853" else {"step": setting}
-            pr = prepared[(base, setting)] = PreparedRun(model, base, t_end, **kw)
-
-        def finish(rv):  # the final state and the invariant's path, after the timing
-            r, v = rv
-            return (np.concatenate((r[-1, 0], v[-1, 0])), pr.nfev,
-                    lambda: invariant_fn(times, np.concatenate([r[:, 0], v[:, 0]], axis=1)))
-
-        return (lambda: pr(r0, v0)), finish
-
-    def run(method, setting):
-        if method.endswith(PREPARED):
-            call, finish = prepared_call(method, setting)
-            return finish(call())
-        kw = {"rtol": setting} if method == "dop853" else {"step": setting}
-        traj = integrate_particles(model, r0, v0, t_end, method=method, samples=1, **kw)
-        Y = np.concatenate([traj.r[:, 0], traj.v[:, 0]], axis=1)
-        return Y[-1], traj.nfev, lambda: invariant_fn(traj.times, Y)
-
-    run.prepared_call = prepared_call
-    return run
 
 
 def _with_prepared(runs, quick):
@@ -126,10 +92,11 @@ def _with_prepared(runs, quick):
     return out
 
 
-def _engine_runner(problem, r0, v0, t_end, invariant_fn):
+def _engine_runner(problem, r0, v0, t_end, invariant_fn, atol_scale=None):
     """A runner of a scene built on the engine (`rotframe.problem`): ``rotframe.simulate``'s core for a whole run,
     `rotframe.problem.prepared.PreparedProblem` (set up once, untimed) for the prepared methods. ``problem``: the
-    engine's arguments of the scene's model (``omega``, ``forces``, ``frame_terms``)."""
+    engine's arguments of the scene's model (``omega``, ``forces``, ``frame_terms``); ``atol_scale``: DOP853's
+    absolute tolerance is ``rtol`` times it, where the scene gives its own (`rotframe.scenes.foucault`)."""
     from rotframe.problem.particles import simulate_particles
     from rotframe.problem.prepared import PreparedProblem
 
@@ -138,7 +105,9 @@ def _engine_runner(problem, r0, v0, t_end, invariant_fn):
     problem = dict(problem, duration=t_end, samples=1)
 
     def settings(method, setting):
-        return {"rtol": setting} if method == "dop853" else {"step": setting} if setting is not None else {}
+        if method == "dop853":
+            return {"rtol": setting} if atol_scale is None else {"rtol": setting, "atol": setting * atol_scale}
+        return {"step": setting} if setting is not None else {}
 
     def final(out, at=times):  # the final state and the invariant's path (after the timing, where timed)
         r, v, nfev = (*out, 0) if isinstance(out, tuple) else (out.r, out.v, out.nfev)
@@ -241,6 +210,7 @@ def _foucault(quick):
     from rotframe.app.bench.peers import python_rhs
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.scenes.base import engine_terms
 
     lat = math.radians(48.846)
     g = float(earth.normal_gravity(lat))
@@ -268,10 +238,14 @@ def _foucault(quick):
                            "dop853": _ladder(quick, [1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-11, 1e-13],
                                              [1e-9])}, quick)
     ref_kind = "rotation-splitting4, h = 2e-4 s" if not quick else "rotation-splitting4, h = 1e-3 s (quick)"
+    # the scene on the engine (its terms as rotframe.forces', the steady loop under dop853), with the scene's own
+    # absolute tolerance, rtol max(1 m, |r0|, |v0|) (rotframe.scenes.foucault)
+    omega, forces, frame_terms = engine_terms(model)
+    runner = _engine_runner({"omega": omega, "forces": forces, "frame_terms": frame_terms}, r0, v0, T, constraint,
+                            atol_scale=max(1.0, float(np.max(np.abs(np.concatenate([r0, v0]))))))
     return [Problem("foucault", f"{T / 3600:g} h, {T / 16.42:.0f} periods", T, np.concatenate([r0, v0]),
                     python_rhs(spec), lambda y: float(np.linalg.norm(y[:3] - y_ref[:3])),
-                    f"reference ({ref_kind}): final position error (m)", constraint, runs,
-                    _particle_runner(model, r0, v0, T, constraint), atol=1e-10,
+                    f"reference ({ref_kind}): final position error (m)", constraint, runs, runner, atol=1e-10,
                     scipy_rtols=tuple(10.0 ** -k for k in range(3, 12)), spec=spec,
                     ref_error=3e-9)]
 

@@ -1,0 +1,148 @@
+"""The engine's steady specialisation (`rotframe.problem.steady`) is the engine's loop, to the bit, and is chosen only
+where the terms allow it.
+
+``inline=False`` asks for the engine's general loop by name, so it is the oracle here: the same problem, the same
+method and tolerances, run by the loop whose physics the rest of the suite checks against closed forms and
+conserved quantities. The steady loop must give its very steps and numbers (a planted change of a term's sign, of
+the tolerance rule or of the sample times fails these tests).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotframe import forces
+from rotframe.problem.particles import simulate_particles
+
+STEADY_NOTE = "steady loop"
+
+
+def _on_string(rng, L, pivot, n):
+    """n start states on the sphere of radius L about pivot, below it, moving across the string."""
+    r, v = [], []
+    for _ in range(n):
+        d = rng.normal(size=3)
+        d[2] = -abs(d[2]) - 1.0
+        d /= np.linalg.norm(d)
+        r.append(pivot + L * d)
+        u = np.cross(d, rng.normal(size=3))
+        v.append(0.3 * u)
+    return np.array(r), np.array(v)
+
+
+def _random_problem(seed):
+    rng = np.random.default_rng(seed)
+    w = rng.normal(size=3) * 10.0 ** rng.uniform(-5, -0.5)
+    g = np.array([0.0, 0.0, -9.81]) + rng.normal(size=3) * 0.1
+    frame_terms = tuple(t for t in ("coriolis", "centrifugal", "euler") if rng.random() < 0.7)
+    n = int(rng.integers(1, 4))
+    terms = [forces.gravity(g)] if rng.random() < 0.8 else []
+    if rng.random() < 0.6:
+        L = float(rng.uniform(0.5, 70.0))
+        pivot = rng.normal(size=3)
+        terms.append(forces.pendulum(L, pivot))
+        r0, v0 = _on_string(rng, L, pivot, n)
+    else:
+        r0, v0 = rng.normal(size=(n, 3)) * 10.0, rng.normal(size=(n, 3))
+    rng.shuffle(terms)
+    atol = None if rng.random() < 0.6 else float(10.0 ** rng.uniform(-12, -7))
+    rtol = float(10.0 ** rng.uniform(-12, -5))
+    return dict(omega=w, r0=r0, v0=v0, duration=float(rng.uniform(1.0, 40.0)), samples=int(rng.integers(1, 30)),
+                forces=terms, frame_terms=frame_terms, rtol=rtol, atol=atol)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_steady_loop_is_the_engines_loop_to_the_bit(seed):
+    kw = _random_problem(seed)
+    steady = simulate_particles(**kw)
+    general = simulate_particles(**kw, inline=False)
+    assert any(STEADY_NOTE in n for n in steady.notes), steady.notes
+    assert not any(STEADY_NOTE in n for n in general.notes)
+    a, b = steady.trajectory, general.trajectory
+    if a.r.shape[1] == 1:  # the steady loop counts particle 0's steps, the engine's the most any particle took
+        assert a.steps == b.steps > 0
+    assert np.array_equal(a.times, b.times)
+    assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v)
+    assert steady.diagnostics.keys() == general.diagnostics.keys()
+    for key in steady.diagnostics:
+        assert steady.diagnostics[key] == general.diagnostics[key]
+
+
+def _foucault_like():
+    L = 10.0
+    pivot = np.array([0.0, 0.0, L])
+    a = 0.5
+    return dict(omega=[0.0, 4e-5, 5e-5], r0=[a, 0.0, L - np.sqrt(L * L - a * a)], v0=[0.0, 0.0, 0.0], duration=5.0,
+                samples=5, forces=[forces.gravity([0.0, 0.0, -9.81]), forces.pendulum(L, pivot)])
+
+
+def _steady(**kw):
+    return any(STEADY_NOTE in n for n in simulate_particles(**kw).notes)
+
+
+def test_the_foucault_model_runs_the_steady_loop():
+    assert _steady(**_foucault_like())
+
+
+@pytest.mark.parametrize("change", [
+    {"method": "rk4", "step": 0.01},
+    {"inline": True},
+    {"events": [lambda t, r, v: r[0] - 10.0]},
+    {"omega": lambda t: (0.0, 4e-5, 5e-5 * (1.0 + 0.01 * t))},
+    {"origin_acceleration": [0.0, 0.0, 0.1]},
+    {"forces": [forces.gravity([0.0, 0.0, -9.81]), forces.drag(linear=0.01)]},
+    {"forces": [forces.gravity([0.0, 0.0, -9.81]), forces.spring(1.0)]},
+    {"forces": [forces.gravity([0.0, 0.0, -9.81]), forces.gravity([0.0, 0.1, 0.0])]},
+    {"forces": [lambda t, r, v: (0.0, 0.0, -9.81)]},
+])
+def test_other_runs_take_the_engines_loop(change):
+    kw = dict(_foucault_like(), **change)
+    if "forces" in change:  # no string: any start
+        kw["r0"] = [1.0, 2.0, 3.0]
+    assert not _steady(**kw)
+
+
+def test_a_failure_on_the_steady_loop_is_met_and_named_by_the_engines_loop():
+    # a rate so large that the centrifugal term overflows once the particle moves (its work estimate is over the
+    # limit: raised so that it runs to the failure); the steady loop fails, and the run is made again on the engine's
+    # loop, which names the cause, as a run with inline=False does
+    from rotframe import limits
+    from rotframe.errors import IntegrationError
+
+    kw = dict(omega=[0.0, 0.0, 1e150], r0=[1e-160, 0.0, 0.0], v0=[0.0, 0.0, 0.0], duration=1.0, samples=4,
+              frame_terms=("centrifugal",))
+    with limits.applied(limits.current().with_overrides(max_steps=1e300)):
+        with pytest.raises(IntegrationError) as steady:
+            simulate_particles(**kw)
+        with pytest.raises(IntegrationError) as general:
+            simulate_particles(**kw, inline=False)
+    assert str(steady.value) == str(general.value)
+    assert "step size collapsed" in str(steady.value)
+    assert steady.value.t_reached == general.value.t_reached
+    assert np.array_equal(steady.value.partial.r, general.value.partial.r)
+
+
+def test_a_prepared_steady_problem_is_simulate_to_the_bit_and_fails_as_it_does():
+    from rotframe import limits
+    from rotframe.errors import IntegrationError
+    from rotframe.problem.prepared import PreparedProblem
+
+    kw = _random_problem(5)
+    r0, v0 = kw.pop("r0"), kw.pop("v0")
+    prepared = PreparedProblem(r0=r0, v0=v0, **kw)
+    assert any(STEADY_NOTE in n for n in prepared.notes)
+    for scale in (1.0, 1.5):  # a second start (off the string's sphere where there is one: scaled about it)
+        if any(isinstance(f, forces.pendulum(1.0).__class__) for f in kw["forces"]) and scale != 1.0:
+            continue
+        a = prepared.run(r0 * scale, v0)
+        b = simulate_particles(r0=r0 * scale, v0=v0, **kw).trajectory
+        assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v) and np.array_equal(a.times, b.times)
+    bad = dict(omega=[0.0, 0.0, 1e150], duration=1.0, samples=4, frame_terms=("centrifugal",))
+    start = ([1e-160, 0.0, 0.0], [0.0, 0.0, 0.0])
+    with limits.applied(limits.current().with_overrides(max_steps=1e300)):
+        with pytest.raises(IntegrationError) as from_prepared:
+            PreparedProblem(r0=start[0], v0=start[1], **bad).run(*start)
+        with pytest.raises(IntegrationError) as from_simulate:
+            simulate_particles(r0=start[0], v0=start[1], **bad)
+    assert str(from_prepared.value) == str(from_simulate.value)
