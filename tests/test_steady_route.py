@@ -146,3 +146,20 @@ def test_a_prepared_steady_problem_is_simulate_to_the_bit_and_fails_as_it_does()
         with pytest.raises(IntegrationError) as from_simulate:
             simulate_particles(r0=start[0], v0=start[1], **bad)
     assert str(from_prepared.value) == str(from_simulate.value)
+
+
+def test_an_ensemble_beyond_the_python_rule_takes_the_compiled_tolerances_to_the_bit():
+    # more than 256 particles: their own tolerances are made by the compiled rule (rotframe.particles.chunked), a few
+    # by the same function run as Python; both are the engine's loop's, particle by particle
+    rng = np.random.default_rng(4)
+    n = 300
+    kw = dict(omega=[0.0, 1e-3, 2e-3], r0=rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-3, 3, size=(n, 1)),
+              v0=rng.normal(size=(n, 3)), duration=2.0, samples=2, forces=[forces.gravity([0.0, 0.0, -9.81])],
+              rtol=1e-8)
+    steady = simulate_particles(**kw)
+    assert any(STEADY_NOTE in note for note in steady.notes)
+    general = simulate_particles(**kw, inline=False)
+    assert np.array_equal(steady.trajectory.r, general.trajectory.r)
+    assert np.array_equal(steady.trajectory.v, general.trajectory.v)
+    few = simulate_particles(**dict(kw, r0=kw["r0"][:5], v0=kw["v0"][:5]))  # the Python rule: the same rows
+    assert np.array_equal(few.trajectory.r, steady.trajectory.r[:, :5])

@@ -17,7 +17,9 @@ Equations I*, 2nd ed., II.4 and II.10; docs/physics/dop853.md), with the code's 
   controller);
 * the starting step is Hairer's ``hinit`` of order 8: an explicit Euler trial step from the
   sizes of ``y`` and ``f(y)``, then the step at which the second derivative, estimated from
-  one more evaluation, keeps the local error at the tolerance.
+  one more evaluation, keeps the local error at the tolerance;
+* a particle's default absolute tolerances are rotframe's own rule (`own_tolerances`), from its
+  start state and the run's length, so that its steps do not depend on the ensemble it runs in.
 
 The particle scenes (`rotframe.particles.drivers`, `rotframe.particles.dop853_steady`), the
 rigid bodies (`rotframe.rigid.adaptive`) and the engine of your own problems
@@ -32,7 +34,8 @@ import math
 
 from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
-__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "own_tolerances", "own_tolerance_rows", "SAFE", "FACC1", "FACC2",
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "own_tolerances",
+           "own_tolerance_rows", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
 SAFE = 0.9  # dop853.f's safety factor
@@ -158,10 +161,10 @@ def first_step(y, f0, f1, h0, rtol, atol, h_max):
 def own_tolerances(y, duration, rtol, atol):
     """A particle's absolute tolerances from its start state ``y`` (r, v, ...) into ``atol`` (D,), where a DOP853 loop
     first takes it (NaN until then: `rotframe.problem.particle_setup.tolerance_rows`; the engine's loop,
-    `rotframe.problem.engine`, and the scenes' ensemble wrapper, `rotframe.particles.dop853_ensemble`): ``rtol s_r`` for r, ``rtol s_v``
-    for v, ``rtol`` for the rest (the frame's attitude); ``s_r = max(max|r|, max|v| duration)``, ``s_v = max(max|v|,
-    s_r / duration)``, 1 and 1 / duration at rest at the origin. Its own scales: its numbers do not depend on the
-    ensemble."""
+    `rotframe.problem.engine`), or before the loop (`own_tolerance_rows`: the steady loop's, `rotframe.problem.steady`):
+    ``rtol s_r`` for r, ``rtol s_v`` for v, ``rtol`` for the rest (the frame's attitude); ``s_r = max(max|r|, max|v|
+    duration)``, ``s_v = max(max|v|, s_r / duration)``, 1 and 1 / duration at rest at the origin. Its own scales: its
+    numbers do not depend on the ensemble."""
     ar = 0.0
     av = 0.0
     for j in range(3):

@@ -21,7 +21,8 @@ terms are here in two forms, each the fast one where it runs: about a fixed unit
 rate ``w`` (``*_about_axis``: the scenes' schedules, `rotframe.particles.model.OmegaSchedule`), and
 for any vector omega, which may turn (`centrifugal`, `coriolis`, `euler`: the kick of the engine's splittings,
 `rotframe.problem.models`, whose right-hand side writes the frame's terms in place, measured faster, and the
-engine's steady loop, `rotframe.particles.dop853_steady`). The two give the same physics to round-off, not the same bits.
+engine's steady loop, `rotframe.particles.dop853_steady`). The two give the same physics to round-off, not the
+same bits.
 
 Called from Python (a built-in term's ``accel``, plain-Python runs), numba compiles them on first use.
 """

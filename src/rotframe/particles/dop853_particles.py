@@ -5,8 +5,8 @@
 drivers are this loop with a right-hand side each: `rotframe.particles.drivers.run_dop853` and
 `run_dop853_events` with `particle_rhs` (every term and rotation schedule; the second watches
 the events); `rotframe.particles.dop853_steady.run_dop853_steady` is the same loop with the engine's
-steady problems' force (`rotframe.problem.steady`). Events are watched after each accepted step (`watch_events`) and located by bisection on
-the length of one DOP853 step from the step's start (`locate_event_dop853`: rotframe's one locator,
+steady problems' force (`rotframe.problem.steady`). Events are watched after each accepted step
+(`watch_events`) and located by bisection on the length of one DOP853 step from the step's start (`locate_event_dop853`: rotframe's one locator,
 `rotframe.numerics.bisection.locator`, with that trial).
 """
 

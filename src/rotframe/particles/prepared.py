@@ -128,8 +128,8 @@ class PreparedRun:
         self.evb.reset()
         self.h_state[:] = 0.0
         atol = self.setup.abs_tol(r, v) if self.info.step == "adaptive" else None
-        n_done, bad, self.nfev, self.steps = self.setup.call(r, v, self.alive, 0, samples, out_r[1:], out_v[1:], self.evb,
-                                                    atol, self.h_state)
+        n_done, bad, self.nfev, self.steps = self.setup.call(r, v, self.alive, 0, samples, out_r[1:], out_v[1:],
+                                                              self.evb, atol, self.h_state)
         if n_done < samples or bad >= 0:
             from rotframe.errors import IntegrationError
 
