@@ -205,3 +205,40 @@ def test_sol_refuses_other_methods():
     r = rotframe.run("tower-drop")  # exact
     with pytest.raises(ScenarioError, match="allowed: a dop853 run"):
         r.sol(1.0)
+
+
+def test_sol_restarts_with_the_tolerances_the_run_took(monkeypatch):
+    """Dense output restarts each particle with the absolute tolerances its run took (the engine's own rule for the
+    tower drop: its scale in r and another in v; the scene's for foucault), and gives the run restarted from the
+    sample on the engine, to round-off."""
+    from rotframe.particles import integrators
+    from rotframe.problem.particles import simulate_particles
+    from rotframe.scenes.base import engine_terms
+
+    taken = []
+    real = integrators.integrate_particles
+
+    def spy(*args, **kwargs):
+        taken.append(kwargs["atol"])
+        return real(*args, **kwargs)
+
+    for name, kw in (("tower-drop", {"samples": 20, "rtol": 1e-6}), ("foucault", {"duration": 60.0, "rtol": 1e-6})):
+        r = rotframe.run(name, "DOP853", **kw)
+        traj = r._scene_result.trajectory
+        rows = traj.extras["atol"]
+        assert rows.shape == (1, 6)
+        if name == "tower-drop":  # the engine's own rule: not one number for r and v
+            assert rows[0, 0] != rows[0, 3]
+        k = 3
+        t = 0.5 * (traj.times[k] + traj.times[k + 1])
+        with monkeypatch.context() as m:
+            m.setattr(integrators, "integrate_particles", spy)
+            pos, vel = r.sol(t)
+        assert taken[-1] == tuple(rows[0])
+        omega, forces, frame_terms = engine_terms(r._scene_result.extras["model"])
+        again = simulate_particles(omega=omega, forces=forces, frame_terms=frame_terms, r0=traj.r[k, 0],
+                                   v0=traj.v[k, 0], duration=t - traj.times[k], method="dop853", rtol=kw["rtol"],
+                                   atol=rows[0], samples=1).trajectory
+        scale = np.max(np.abs(traj.r[k, 0])) + 1.0
+        assert np.allclose(pos[0], again.r[-1, 0], rtol=0, atol=1e-12 * scale), name
+        assert np.allclose(vel[0], again.v[-1, 0], rtol=0, atol=1e-12 * scale), name

@@ -1,11 +1,12 @@
 """``Result.sol(t)``: the state of a finished ``dop853`` particle run at any time, as scipy's
 ``solve_ivp(dense_output=True).sol(t)`` gives it.
 
-The run keeps only its samples. ``sol(t)`` restarts the same integrator, with the same
-tolerances (``rtol`` of the run, and its absolute tolerance from the initial state), from the
-last sample at or before ``t`` and integrates the short gap to ``t``: the answer is as accurate
-as the run's own samples (each step's local error below ``rtol``), and at a sample time it
-is that sample exactly. After a terminal event (the ground) the state is the state at the event,
+The run keeps only its samples. ``sol(t)`` restarts the same integrator (DOP853, its step control), with
+the same tolerances (``rtol`` of the run, and each particle's absolute tolerances as the run took them:
+``Trajectory.extras["atol"]``), from the last sample at or before ``t`` and integrates the short gap to
+``t`` on the scenes' kernels (the engine's terms in their arithmetic: the same motion to round-off): the
+answer is as accurate as the run's own samples (each step's local error below its tolerance), and at a
+sample time it is that sample exactly. After a terminal event (the ground) the state is the state at the event,
 as in the samples.
 
 Only runs whose model does not depend on time are restarted this way (a constant rotation
@@ -48,9 +49,13 @@ class DenseSolution:
         self._r = np.asarray(traj.r, dtype=float)
         self._v = np.asarray(traj.v, dtype=float)
         self._rtol = float(run_setting(run_settings, "rtol"))
-        # the absolute tolerance the run used: rtol times the initial state's scale (chunked.abs_tol)
-        scale = max(1.0, float(np.max(np.abs(np.concatenate([self._r[0].ravel(), self._v[0].ravel()])))))
-        self._atol = self._rtol * scale
+        # the absolute tolerances the run took, a row (r then v) per particle (the engine's record of them,
+        # rotframe.problem.particles.tolerances_used), else rtol times the initial states' scale (chunked.abs_tol)
+        rows = (getattr(traj, "extras", None) or {}).get("atol")
+        if rows is None:
+            scale = max(1.0, float(np.max(np.abs(np.concatenate([self._r[0].ravel(), self._v[0].ravel()])))))
+            rows = np.full((self._r.shape[1], 6), self._rtol * scale)
+        self._atol = np.asarray(rows, dtype=float)
         # the terminal event of the built-in scenes: a particle stops at the ground
         ground = (getattr(traj, "event_times", {}) or {}).get("ground", [])
         self._stops = [float(np.min(ground[p])) if p < len(ground) and np.size(ground[p]) else np.inf
@@ -84,8 +89,8 @@ class DenseSolution:
         stopped = [p for p in range(r.shape[0]) if p not in moving]
         if stopped:
             r[stopped], v[stopped] = self._r[-1, stopped], self._v[-1, stopped]
-        if moving:
-            traj = integrate_particles(self._model, r[moving], v[moving], gap, method="dop853", rtol=self._rtol,
-                                       atol=self._atol, samples=1)
-            r[moving], v[moving] = traj.r[-1], traj.v[-1]
+        for p in moving:  # each with the run's own tolerances
+            traj = integrate_particles(self._model, r[p], v[p], gap, method="dop853", rtol=self._rtol,
+                                       atol=tuple(self._atol[p].tolist()), samples=1)
+            r[p], v[p] = traj.r[-1, 0], traj.v[-1, 0]
         return r, v
