@@ -57,8 +57,10 @@ frame_attitude, frame_terms
         As `rotframe.simulate` takes them (SI floats here: the core takes no units).
     inline : bool
         True (default): the runs use the problem's inlined loop (`rotframe.problem.inlined`),
-        loaded from the disk cache or compiled here (seconds, once per problem ever); False:
-        the engine's loop, which calls your functions by address (nothing to compile).
+        loaded from the disk cache or compiled here (seconds, once per problem ever), or, for a
+        problem that ``simulate`` runs on the engine's steady loop (`rotframe.problem.steady`),
+        that loop (compiled once for every such problem); False: the engine's loop, which calls
+        your functions by address (nothing to compile).
 
     Examples
     --------
@@ -83,8 +85,8 @@ frame_attitude, frame_terms
                          origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                          samples=samples, omega_dot=omega_dot, atol=atol, frame_attitude=frame_attitude,
                          frame_terms=frame_terms)
-        # the steady loop where simulate takes it (`rotframe.problem.steady`): inline given by default here, so the
-        # choice is made as simulate makes it, with inline as simulate's default
+        # the steady loop where simulate takes it (`rotframe.problem.steady`): inline=True is this class's default,
+        # so the choice is made as simulate makes it with its own default (None)
         s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                    origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                    samples=samples, omega_dot=omega_dot, jit=True, max_events=256, device=None,
