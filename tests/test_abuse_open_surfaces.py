@@ -252,6 +252,27 @@ def test_a_huge_duration_is_refused_not_called_non_finite():
         rotframe.simulate(omega=[0, 0, 0], r0=[1, 0, 0], v0=[0, 1, 0], duration=1e300, forces=[spring], params=(1.0,))
 
 
+@pytest.mark.parametrize("inline", [None, False])  # the steady loop (rotframe.problem.steady) and the engine's
+@pytest.mark.parametrize("max_steps", [None, 1000])  # its bound from the motion's rate, and its projected pace
+def test_an_adaptive_run_over_the_limit_is_told_what_helps_it(inline, max_steps):
+    """An adaptive method has no step to enlarge: the refusal asks for a shorter run (and, where the count comes from
+    the run's own pace at its tolerance, a looser rtol), whichever loop runs it."""
+    from rotframe import forces, limits
+
+    L = 10.0
+    kw = dict(omega=[0.0, 4e-5, 5e-5], r0=[0.5, 0.0, L - np.sqrt(L * L - 0.25)], v0=[0.0, 0.0, 0.0],
+              duration=1e12 if max_steps is None else 3600.0, rtol=1e-10,
+              forces=[forces.gravity([0.0, 0.0, -9.81]), forces.pendulum(L, [0.0, 0.0, L])], inline=inline)
+    overrides = {} if max_steps is None else {"max_steps": max_steps}
+    with limits.applied(limits.current().with_overrides(**overrides)):
+        with pytest.raises(limits.LimitError) as err:
+            rotframe.simulate(**kw)
+    text = str(err.value)
+    assert "shorten" in text and "enlarge step" not in text and "smaller step" not in text, text
+    if max_steps is not None:
+        assert "rtol" in text, text
+
+
 def test_event_slots_count_in_the_memory_limit():
     from rotframe import limits
 

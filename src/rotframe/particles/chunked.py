@@ -385,7 +385,8 @@ def _adaptive_chunk(info, per_sample, samples, n):
     """
     per_sample = max(float(per_sample), 1.0)
     limits.check_run(steps=per_sample * samples, particles=n,
-                     what=f"method {info.name} (projected from its first sample interval)")
+                     what=f"method {info.name} (projected from its first sample interval)",
+                     remedy="shorten duration or loosen rtol")
     return int(max(1.0, CALL_STEPS / (per_sample * max(n, 1))))
 
 

@@ -233,7 +233,7 @@ def check_work(info, duration, step, samples, n, model):
     """Refuse, before allocating anything, a run over the work limits (`rotframe.limits`)."""
     from rotframe import limits
 
-    steps = 0.0
+    steps, remedy = 0.0, "shorten duration or enlarge step"
     if info.step == "fixed":
         # in floats: a step far below the sample interval gives a count beyond any integer a float holds
         per = (duration / samples) / float(step) if step else 20.0
@@ -242,7 +242,8 @@ def check_work(info, duration, step, samples, n, model):
         # the least an adaptive method can take, from the model's own rates (a closed form, before any
         # compiling or probing): no step spans more than MAX_RAD_PER_STEP of its fastest oscillation
         steps = duration * fastest_rate(model) / MAX_RAD_PER_STEP
-    limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}")
+        remedy = "shorten duration (no tolerance takes fewer steps than the motion's own rate allows)"
+    limits.check_run(steps=steps, samples=samples + 1, particles=n, what=f"method {info.name}", remedy=remedy)
 
 
 #: The most radians of its fastest oscillation one adaptive step can span: DOP853's stability interval on

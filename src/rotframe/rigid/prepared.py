@@ -89,7 +89,9 @@ class PreparedBodyRun:
             self._setup_fixed(inertia, duration, step, top)
         else:
             raise ScenarioError(f"method: {method!r}; allowed: {', '.join(FIXED_METHODS)}, dop853")
-        limits.check_run(steps=self._steps_estimate, samples=samples + 1, what=f"method {method}")
+        limits.check_run(steps=self._steps_estimate, samples=samples + 1, what=f"method {method}",
+                         remedy="shorten duration or loosen rtol" if method == "dop853" else
+                         "shorten duration or enlarge step")
         self.run(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))  # every input checked; kernel loaded or compiled
 
     def _setup_fixed(self, inertia, duration, step, top):
@@ -218,7 +220,7 @@ class PreparedBodyRun:
         if not steps <= self._max_steps:
             from rotframe import limits
 
-            limits.check_run(steps=steps, what="method dop853")
+            limits.check_run(steps=steps, what="method dop853", remedy="shorten duration or loosen rtol")
         y0 = np.empty(7)
         y0[:3] = L0
         y0[3:] = q0
