@@ -1,0 +1,70 @@
+"""How the engine runs the tower drop's sweep ensembles, beside the scenes' kernels that run them today (issue 32).
+
+The sweeps' vectorised ensembles (`rotframe.scenes.tower_drop.simulate_ensemble`) call
+`rotframe.particles.ensemble.integrate_ensemble` on the scenes' kernels. Moving them onto the engine
+must keep their ratio to the hand-written ceiling (`rotframe bench ensemble`: 0.7 or more). This
+tool times the same ensemble (gravity and Coriolis, the ground as a terminal event that no particle
+reaches in the run, so both take the same steps) both ways, best of three after a first run that
+compiles or loads every loop, and prints the engine's time over the scenes' kernels': by address
+(``inline=False``) and with the problem's functions compiled into the loop (``inline=True``)::
+
+    python tools/ensembles_on_engine.py            # 20000 particles, 2 s at h = 1e-3 s
+    python tools/ensembles_on_engine.py 100000     # the bench's ensemble size
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+
+def best(func, repeats=3):
+    """The least wall time (s) of ``repeats`` calls of ``func``."""
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main(argv):
+    from rotframe import earth, forces
+    from rotframe.events import crossing
+    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.particles.integrators import Event
+    from rotframe.particles.model import OmegaSchedule, ParticleModel
+    from rotframe.problem.particles import simulate_particles
+
+    n = int(argv[0]) if argv else 20000
+    duration, h = 2.0, 1e-3
+    lat = math.radians(50.88)
+    g = float(earth.normal_gravity(lat))
+    w = earth.omega_enu(lat)
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]))
+    rng = np.random.default_rng(1)
+    r0 = np.zeros((n, 3))
+    r0[:, 2] = rng.uniform(100.0, 200.0, n)  # none lands within the run: the same steps for every particle
+    v0 = np.zeros((n, 3))
+    ground = Event("ground", "r", 2, 0.0, -1, True)
+    for method in ("rk4", "rotation-splitting"):
+        run = {"step": h, "samples": 16}
+        integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run)
+        scene = best(lambda: integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run))
+        engine = {}
+        for inline in (False, True):
+            kw = dict(omega=w, r0=r0, v0=v0, duration=duration, forces=[forces.gravity([0.0, 0.0, -g])],
+                      frame_terms=("coriolis",), method=method, step=h, samples=16, inline=inline,
+                      events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")])
+            simulate_particles(**kw)  # compiles or loads the loop
+            engine[inline] = best(lambda: simulate_particles(**kw))
+        print(f"{method}: the scenes' kernels {n * duration / h / scene / 1e6:.1f} M particle-steps/s; the engine "
+              f"{engine[False] / scene:.2f}x their time by address, {engine[True] / scene:.2f}x inlined")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
