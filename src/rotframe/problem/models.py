@@ -101,8 +101,11 @@ EVALUATIONS_PER_STEP = (0, 3, 2, 6, 18, 34)
 #: the scenes' own), constants of the compiled step
 KAHAN_LI6_STEPS = tuple(float(w) for w in composition_weights(6))
 KAHAN_LI8_STEPS = tuple(float(w) for w in composition_weights(8))
-#: the length of the scratch ``W`` (its last slot: `rotframe.problem.calls.RAISED`)
-SCRATCH = 7
+#: the slots of the scratch ``W`` that keep the Coriolis turn's last two angles, each with its cosine and sine
+#: (`turn_cos_sin`), after `rotframe.problem.calls.RAISED`
+TURN = 7
+#: the length of the scratch ``W``
+SCRATCH = TURN + 6
 
 
 @jit_inline
@@ -280,6 +283,32 @@ def drag_rates(M, y):
     return M[6] * air, M[7] * air
 
 
+@jit_inline
+def turn_cos_sin(angle, W):
+    """``cos(angle), sin(angle)`` of the Coriolis turn, kept in ``W[TURN:TURN + 6]`` for the last two angles.
+
+    A fixed step in a steady frame turns the velocity by the same angle at every step (by two, in
+    turn, under Yoshida's composition), and its cosine and sine cost as much as the rest of the
+    splitting's step. A kept pair is the one computed for that very angle, so the step's numbers are
+    those of computing it anew. A slot whose cosine is 0 is empty (``W`` starts as zeros, and no
+    float's cosine is 0); a zero angle (either sign) is never kept, as the two zeros compare equal."""
+    if angle == 0.0:
+        return 1.0, angle  # cos(+-0) = 1, sin(+-0) = +-0
+    if angle == W[TURN] and W[TURN + 1] != 0.0:
+        return W[TURN + 1], W[TURN + 2]
+    if angle == W[TURN + 3] and W[TURN + 4] != 0.0:
+        return W[TURN + 4], W[TURN + 5]
+    c = math.cos(angle)
+    s = math.sin(angle)
+    W[TURN + 3] = W[TURN]
+    W[TURN + 4] = W[TURN + 1]
+    W[TURN + 5] = W[TURN + 2]
+    W[TURN] = angle
+    W[TURN + 1] = c
+    W[TURN + 2] = s
+    return c, s
+
+
 @jit_llvm_inline
 def rotation_strang(t, h, yn, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
@@ -297,8 +326,8 @@ def rotation_strang(t, h, yn, prob, fns, W):
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     w = math.sqrt(wx * wx + wy * wy + wz * wz)
     if w > 0.0 and prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term
-        angle = -2.0 * w * h
-        vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, math.cos(angle), math.sin(angle))
+        c, s = turn_cos_sin(-2.0 * w * h, W)
+        vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, c, s)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     yn[3] = vx + hh * ax
     yn[4] = vy + hh * ay
