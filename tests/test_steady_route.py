@@ -163,3 +163,22 @@ def test_an_ensemble_beyond_the_python_rule_takes_the_compiled_tolerances_to_the
     assert np.array_equal(steady.trajectory.v, general.trajectory.v)
     few = simulate_particles(**dict(kw, r0=kw["r0"][:5], v0=kw["v0"][:5]))  # the Python rule: the same rows
     assert np.array_equal(few.trajectory.r, steady.trajectory.r[:, :5])
+
+
+@pytest.mark.parametrize("samples", [1, 100])
+def test_a_run_longer_than_one_call_runs_on_the_engines_loop(samples):
+    # the calls' driver ends each call with a step cut to land on its last sample (and cuts a long sample interval
+    # into pieces), where the engine's loop only samples inside its steps: a run of more than one call (here some
+    # 5e5 steps) goes to the engine's loop, so the steps, and the numbers, are the engine's whatever the run's length
+    L = 1.0
+    kw = dict(omega=[0.0, 4e-5, 5e-5], r0=[0.5, 0.0, L - np.sqrt(L * L - 0.25)], v0=[0.0, 0.0, 0.0],
+              duration=3e4, samples=samples,
+              forces=[forces.gravity([0.0, 0.0, -9.81]), forces.pendulum(L, [0.0, 0.0, L])])
+    long_run = simulate_particles(**kw)
+    assert not any(STEADY_NOTE in n for n in long_run.notes)
+    assert long_run.trajectory.steps > 2e5
+    assert np.array_equal(long_run.trajectory.r, simulate_particles(**kw, inline=False).trajectory.r)
+    short = dict(kw, duration=3e3)  # some 5e4 steps: one call, the steady loop, the same bits
+    assert any(STEADY_NOTE in n for n in simulate_particles(**short).notes)
+    assert np.array_equal(simulate_particles(**short).trajectory.r,
+                          simulate_particles(**short, inline=False).trajectory.r)

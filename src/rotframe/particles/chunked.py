@@ -25,7 +25,7 @@ from rotframe.particles import threads
 from rotframe.particles.advice import remedy
 from rotframe.particles.trajectory import EventBuffers, RunInterrupted, Trajectory, event_table
 
-__all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT"]
+__all__ = ["KernelSetup", "run_chunked", "sample_times", "steps_per_sample", "GROWTH_LIMIT", "RunNeedsCuts"]
 
 #: Relative growth of the inertial speed beyond which a run of a force-free model is unstable.
 GROWTH_LIMIT = 1e-3
@@ -131,8 +131,13 @@ class KernelSetup:
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.fixed = info.step == "fixed"
-        # the engine's steady problems run the steady loop (rotframe.problem.steady)
+        # the engine's steady problems run the steady loop (rotframe.problem.steady): in one call, as a call ends with
+        # a step cut to land on its last sample, which the engine's loop never cuts (`RunNeedsCuts` where the run is
+        # longer than a call), and with a probe from a 4^-8 part of the first interval up (a short run's 25 probing
+        # calls were most of its time; the work's bound from the motion's rate, checked before, keeps it small)
         self.steady_args = None if self.fixed else steady
+        self.one_call = steady is not None
+        self.probe_depth = PROBE_DEPTH if steady is None else STEADY_PROBE_DEPTH
         # the arguments of every fixed-step driver call that do not change (unpacked into it)
         self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
         self._family = (self.rk4, self.sphere)
@@ -318,9 +323,17 @@ class KernelSetup:
 
 #: an adaptive call is kept under this many particle-steps (about a tenth of a second)
 CALL_STEPS = 2e5
+class RunNeedsCuts(Exception):
+    """A run whose set-up runs in one call (`KernelSetup.one_call`: the engine's steady loop) needs more than one: a
+    call ends on a sample with a step cut short to land there, where the engine's loop only samples inside its steps,
+    so the steps would differ. ``args[0]``: the steps its probe projected for the run."""
+
+
 #: the probe's spans: from the first sample interval over 4^PROBE_DEPTH up, by factors of 4, until it took
 #: PROBE_STEPS steps (a span of 1e15 s is never integrated whole to learn its cost)
 PROBE_DEPTH = 24
+#: the same for the engine's steady loop (`KernelSetup`)
+STEADY_PROBE_DEPTH = 8
 PROBE_STEPS = 2000
 
 
@@ -340,7 +353,7 @@ def _probe(setup, r, v, alive, evb, atol, h_state, out_r, out_v, whole):
     # the count is particle 0's (the drivers report its cost), so the tries integrate particle 0 alone:
     # a try over the whole ensemble cost its every particle a first step and more, 25 times
     scratch = np.empty((1, 1, 3))
-    for k in range(PROBE_DEPTH, -1, -1):
+    for k in range(setup.probe_depth, -1, -1):
         end = t1 if k == 0 else t0 + dt / 4.0 ** k
         if k > 0 and not end > t0:
             continue
@@ -453,6 +466,8 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             per_sample, first = _probe(setup, r, v, alive, evb, atol, h_state, out_r[1:2], out_v[1:2], samples == 1)
             chunk = min(chunk, _adaptive_chunk(info, per_sample, samples, n))
             pieces = _pieces(per_sample, n)
+            if setup.one_call and (pieces > 1 or chunk < samples):
+                raise RunNeedsCuts(per_sample * samples)
         # fixed steps: calls of equal length (within a sample), no short last call that is all dispatch
         # (an adaptive method's last step in a call ends on the call's last sample: its calls keep their cut)
         calls = -(-samples // chunk) if info.step == "fixed" else None

@@ -425,8 +425,10 @@ def _steady_run(s, atol, progress) -> ProblemRun:
 
     A run that fails (a state not finite, the step collapsed, a speed that grew without a force) raises
     `SteadyLoopFailed`: `simulate_particles` runs it again on the engine's loop, which meets the failure at the same
-    step and names its cause and the term to blame."""
-    from rotframe.particles.chunked import KernelSetup, run_chunked
+    step and names its cause and the term to blame. So does a run longer than one call of the calls' driver (a tenth
+    of a second of work: `rotframe.particles.chunked.RunNeedsCuts`, seen by its probe before the run): a call ends
+    with a step cut to land on its last sample, which the engine's loop never cuts, so the steps would differ."""
+    from rotframe.particles.chunked import KernelSetup, RunNeedsCuts, run_chunked
     from rotframe.particles.integrators import METHODS, check_work
 
     model, q = s.steady
@@ -436,7 +438,7 @@ def _steady_run(s, atol, progress) -> ProblemRun:
                         atol="own" if atol is None else tuple(atol.tolist()), steady=q)
     try:
         traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, owned=True)
-    except IntegrationError:
+    except (IntegrationError, RunNeedsCuts):
         raise SteadyLoopFailed from None
     traj.extras["status"] = np.ones(s.r.shape[0], dtype=np.int64)  # the engine's status: every particle reached the end
     traj.extras["atol"] = tolerances_used(atol, s.r, s.v, s.duration, s.rtol)

@@ -29,7 +29,11 @@ A problem qualifies (`steady_model`) where:
 - the terms are at most one force with a constant linear form (``Force.linear`` with ``K = C = 0``:
   `rotframe.forces.gravity`) and at most one string (`rotframe.forces.pendulum`), in frame axes, their
   potentials numpy's where given (`rotframe.problem.terms.energy_by_numpy`);
-- there are no events.
+- there are no events;
+- and, seen by the calls' driver's probe before the run, the work fits one call (some 2e5
+  particle-steps, a tenth of a second): a call ends with a step cut to land on its last sample, which
+  the engine's loop never cuts, so a longer run goes to the engine's loop
+  (`rotframe.particles.chunked.RunNeedsCuts`, `rotframe.problem.particles`), as a failure does.
 """
 
 from __future__ import annotations
