@@ -37,7 +37,8 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
     """Each particle of ``r, v`` (N, 3) from ``t0`` over the sample ``times``, by `dop853_trajectory`.
 
     ``h_state`` (N,) each particle's next step (0: Hairer's starting step, at most ``span``, the
-    whole run's length, so that the steps do not depend on how a run is cut into calls);
+    whole run's length, the same in every call; a call still ends with a step cut to land on its last
+    sample, so the steps depend on where the calls end: `rotframe.particles.chunked.RunNeedsCuts`);
     ``alive`` (N,) whether it moves (None: all do; a terminal event clears it); ``rhs`` and
     ``trajectory`` the system's (`particle_trajectory`, or `particle_trajectory_events` with the
     events' data ``wctx``, None for none), and ``start(wctx, ctx, t, y)`` the events' values at

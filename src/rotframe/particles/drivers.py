@@ -280,8 +280,8 @@ def run_dop853(r, v, alive, t0, sample_times, P, wt, wv, rtol, atol, span, event
     located on the method's own steps: bisection on the length of one extra DOP853 step from the
     step's start (`run_dop853_events`). ``h_state`` (N,) carries each particle's step between
     calls; where it is 0, the particle starts with Hairer's starting step, at most ``span`` (the
-    whole run's length, the same in every call, so that the steps do not depend on how the run is
-    cut into calls). ``events`` is None (a run with an event table calls `run_dop853_events`);
+    whole run's length, the same in every call; each call still ends with a step cut to land on its
+    last sample, so the steps depend on where the calls end). ``events`` is None (a run with an event table calls `run_dop853_events`);
     ``wt`` None (a steady rotation rate) prunes the schedule readers at compile time. ``work``
     (`rotframe.particles.dop853_ensemble.WORK_ROWS`, 6) and ``Kt`` (13, 6, the event locator's
     stages) are work arrays from the caller (a kernel that allocates compiles numpy's allocators
