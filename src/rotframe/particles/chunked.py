@@ -131,12 +131,11 @@ class KernelSetup:
         self.rk4 = True if info.name == "rk4" else None
         self.sphere = True if model.pendulum_length > 0 else None
         self.fixed = info.step == "fixed"
-        # the engine's steady problems run the steady loop (rotframe.problem.steady): in one call, as a call ends with
+        # the engine's steady problems run the steady loop (rotframe.problem.steady): in one call (`run_chunked`), as a call ends with
         # a step cut to land on its last sample, which the engine's loop never cuts (`RunNeedsCuts` where the run is
         # longer than a call), and with a probe from a 4^-8 part of the first interval up (a short run's 25 probing
         # calls were most of its time; the work's bound from the motion's rate, checked before, keeps it small)
         self.steady_args = None if self.fixed else steady
-        self.one_call = steady is not None
         self.probe_depth = PROBE_DEPTH if steady is None else STEADY_PROBE_DEPTH
         # the arguments of every fixed-step driver call that do not change (unpacked into it)
         self._model_args = (self.P, self.wt_arg, self.wv, self.wint, self.ev_tab)
@@ -324,7 +323,7 @@ class KernelSetup:
 #: an adaptive call is kept under this many particle-steps (about a tenth of a second)
 CALL_STEPS = 2e5
 class RunNeedsCuts(Exception):
-    """A run whose set-up runs in one call (`KernelSetup.one_call`: the engine's steady loop) needs more than one: a
+    """A run whose set-up runs in one call (one with `KernelSetup.steady_args`: the engine's steady loop) needs more than one: a
     call ends on a sample with a step cut short to land there, where the engine's loop only samples inside its steps,
     so the steps would differ. ``args[0]``: the steps its probe projected for the run."""
 
@@ -466,7 +465,7 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
             per_sample, first = _probe(setup, r, v, alive, evb, atol, h_state, out_r[1:2], out_v[1:2], samples == 1)
             chunk = min(chunk, _adaptive_chunk(info, per_sample, samples, n))
             pieces = _pieces(per_sample, n)
-            if setup.one_call and (pieces > 1 or chunk < samples):
+            if setup.steady_args is not None and (pieces > 1 or chunk < samples):
                 raise RunNeedsCuts(per_sample * samples)
         # fixed steps: calls of equal length (within a sample), no short last call that is all dispatch
         # (an adaptive method's last step in a call ends on the call's last sample: its calls keep their cut)

@@ -98,11 +98,15 @@ def simulate(p, terms, method, run, progress):
                            extras={"model": model, "g": g, "Omega": Omega, "resolved": resolved,
                                    **engine_remarks(res)})
 
-    # DOP853's absolute tolerance on the swing's scale, rtol max(1 m, |r0|, |v0|) for r and v alike (the scale
-    # `rotframe.app.dense` restarts from), not the engine's default, which scales v by |r0| / duration: over an
-    # hour, a thousandth of the swing's speed, and some 1.5 times the steps for nothing the metrics resolve
-    atol = run_setting(run, "rtol") * max(1.0, float(np.max(np.abs(r0))), float(np.max(np.abs(v0))))
-    return run_on_engine(model, r0, v0, T, method, run, progress, finish, atol=atol)
+    return run_on_engine(model, r0, v0, T, method, run, progress, finish,
+                         atol=run_setting(run, "rtol") * swing_scale(r0, v0))
+
+
+def swing_scale(r0, v0):
+    """The scale of DOP853's absolute tolerance for the swing from ``r0``, ``v0``: max(1 m, |r0|, |v0|), for r and
+    v alike (DOP853's ``atol`` is ``rtol`` times it). Not the engine's default, which scales v by |r0| / duration:
+    over an hour, a thousandth of the swing's speed, and some 1.5 times the steps for nothing the metrics resolve."""
+    return max(1.0, float(np.max(np.abs(r0))), float(np.max(np.abs(v0))))
 
 
 def swing_angle(r, v, w0):

@@ -211,6 +211,7 @@ def _foucault(quick):
     from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.model import OmegaSchedule, ParticleModel
     from rotframe.scenes.base import engine_terms
+    from rotframe.scenes.foucault import swing_scale
 
     lat = math.radians(48.846)
     g = float(earth.normal_gravity(lat))
@@ -242,7 +243,7 @@ def _foucault(quick):
     # absolute tolerance, rtol max(1 m, |r0|, |v0|) (rotframe.scenes.foucault)
     omega, forces, frame_terms = engine_terms(model)
     runner = _engine_runner({"omega": omega, "forces": forces, "frame_terms": frame_terms}, r0, v0, T, constraint,
-                            atol_scale=max(1.0, float(np.max(np.abs(np.concatenate([r0, v0]))))))
+                            atol_scale=swing_scale(r0, v0))
     return [Problem("foucault", f"{T / 3600:g} h, {T / 16.42:.0f} periods", T, np.concatenate([r0, v0]),
                     python_rhs(spec), lambda y: float(np.linalg.norm(y[:3] - y_ref[:3])),
                     f"reference ({ref_kind}): final position error (m)", constraint, runs, runner, atol=1e-10,
