@@ -59,6 +59,8 @@ def _compile(py_func, args, failures, name):
         print(f"FAILED {name}: {str(exc)[-2000:]}", flush=True)
         raise _Launched() from None
     registers = ""
+    if os.environ.get("PTX_DIR"):  # each kernel's PTX kept for reading (ld.local / st.local: its local memory)
+        Path(os.environ["PTX_DIR"], f"{len(compiled) + len(failures):02d}.ptx").write_text(f"// {name}\n{ptx}")
     ptxas = _ptxas()
     if ptxas:
         with tempfile.NamedTemporaryFile("w", suffix=".ptx", delete=False) as f:
@@ -66,7 +68,8 @@ def _compile(py_func, args, failures, name):
         out = subprocess.run([ptxas, f"-arch=sm_{CC[0]}{CC[1]}", "-v", f.name, "-o", os.devnull],
                              capture_output=True, text=True).stderr
         os.unlink(f.name)
-        registers = "; " + "; ".join(line.split(":", 1)[1].strip() for line in out.splitlines() if "registers" in line)
+        registers = "; " + "; ".join(line.split(":", 1)[-1].strip() for line in out.splitlines()
+                                     if "registers" in line or "stack frame" in line)
     print(f"ok {name}{registers}", flush=True)
     compiled.append(name)
     raise _Launched()
@@ -160,7 +163,8 @@ def _cases():
                               lambda model=model, method=method, event=event: integrate_ensemble(
                                   model, r0, v0, 0.016, ground if event else None, method=method,
                                   run={"step": 1e-3, "samples": 16}, device="gpu")))
-    return cases
+    only = os.environ.get("ONLY")  # the cases whose names hold this text (all by default)
+    return [case for case in cases if not only or only in case[0]]
 
 
 def main() -> int:
@@ -182,8 +186,9 @@ def main() -> int:
         current[0] = name
         try:
             call()
-        except Exception:  # noqa: BLE001 -- _Launched, or the run's own wrapping of it (a user function's call)
-            pass
+        except Exception as exc:  # noqa: BLE001 -- _Launched, or the run's own wrapping of it (a user function's call)
+            if name not in failures and name not in failures.compiled:
+                print(f"{name}: {type(exc).__name__}: {exc}", flush=True)
         if name not in failures and name not in failures.compiled:
             failures.append(name)
             print(f"FAILED {name}: no kernel was launched", flush=True)

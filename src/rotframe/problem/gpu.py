@@ -49,7 +49,7 @@ _RESULTS = ("OUT", "EVT", "EVY", "EVK")
 _ARRAYS = ("T", "Y", "TC", "H", "IDX", "SUB", "ST", "OUT", "EVT", "EVY", "EVK", "EVN", "GPREV", "NSTEP", "NFEV")
 
 
-def _overrides(module):
+def _overrides(module, parts=None):
     """The GPU versions of the calls by address (`rotframe.problem.calls`): direct calls of ``module``'s functions.
 
     ``module`` is the problem's compiled glue (`rotframe.problem.codegen.build_module`); a role it
@@ -73,6 +73,11 @@ def _overrides(module):
     made[readonly.readonly] = device(_same_array)  # the read-only check is the CPU compile's (the glue is built there)
     for helper, (template, names) in calls.direct_calls(module, varying.varying_into).items():
         made[helper] = device(template, **{name: device_function(f, made) for name, f in names.items()})
+    if parts is not None:  # the model's parts as constants: the parts the problem lacks are pruned
+        from rotframe.problem import models
+
+        for kernel, template in models.with_parts(parts).items():
+            made[kernel] = device_function(template, made)
     return made
 
 
@@ -104,9 +109,9 @@ def _kernel_source(T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NS
     LIVE[i] = 0
 
 
-def _kernel(module, method, events, D):
+def _kernel(module, method, events, D, parts=None):
     """The compiled kernel of one problem (its glue ``module``), method (its name) and events, for states of D numbers."""
-    key = (module.__name__, method, bool(events), int(D))
+    key = (module.__name__, method, bool(events), int(D), None if parts is None else tuple(sorted(parts.items())))
     done = _KERNELS.get(key)
     if done is not None:
         return done
@@ -117,7 +122,7 @@ def _kernel(module, method, events, D):
     from rotframe.problem.calls import direct_functions
     from rotframe.problem.signatures import PARTICLE
 
-    loop = device_function(engine.variant_loop(PARTICLE, method, events, D), _overrides(module))
+    loop = device_function(engine.variant_loop(PARTICLE, method, events, D), _overrides(module, parts))
     done = _KERNELS[key] = cuda.jit(bound(_kernel_source, "rotframe_problem_kernel", cuda=cuda, float64=float64,
                                            loop=loop, DIM=int(D), SCRATCH=models.SCRATCH,
                                            FNS=direct_functions()))
@@ -153,7 +158,9 @@ class GpuAdvance:
 
         host = dict(zip(_ARRAYS, (T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV)))
         if self.device is None:
-            self.kernel = _kernel(self.module, *self.key)
+            from rotframe.problem.models import model_parts
+
+            self.kernel = _kernel(self.module, *self.key, model_parts(prob))
             self.host = host
             self.device = {name: cuda.to_device(np.ascontiguousarray(a)) for name, a in host.items()}
             self.settings = [cuda.to_device(np.ascontiguousarray(a)) for a in (atol, EDIR, ETERM, S, prob[1], prob[2],

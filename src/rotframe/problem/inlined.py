@@ -64,8 +64,8 @@ def _replacements(module, parts, where):
     Returns the dict that `_rebuilt` takes: each helper of `rotframe.problem.calls` -> its direct
     template bound to the glue's functions (`rotframe.problem.calls.direct_calls`, the GPU's too;
     the engine's evaluator of a varying vector rebuilt on them), and a particle's right-hand side
-    with the model's ``parts`` as constants (`rotframe.problem.models.particle_rhs_of`; None for a
-    body).
+    and its splittings' kick with the model's ``parts`` as constants (`rotframe.problem.models.with_parts`;
+    None for a body).
     """
     from rotframe.numerics.compiled import bound, jit_inline
     from rotframe.problem import calls, models, varying
@@ -75,7 +75,8 @@ def _replacements(module, parts, where):
         made[helper] = jit_inline(bound(template, template.__name__,
                                         **{name: _rebuilt(f, made, where) for name, f in names.items()}))
     if parts is not None:
-        made[models.particle_rhs] = _copy(models.particle_rhs_of(parts), made, where, like=models.particle_rhs)
+        for kernel, template in models.with_parts(parts).items():
+            made[kernel] = _copy(template, made, where, like=kernel)
     return made
 
 

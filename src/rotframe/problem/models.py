@@ -251,12 +251,13 @@ def rhs(body, t, y, dy, prob, fns, W):
         body_rhs(t, y, dy, prob, fns, W)
 
 
-@jit_llvm_inline
-def kick_acceleration(t, y, prob, fns, W):
-    """What the rotation splittings kick with: the forces (of t and r alone) and the frame's terms of position,
-    centrifugal and Euler (where the run keeps them, ``M[10:12]``) and the origin's, with omega at t (returned
-    too, for the Coriolis turn)."""
-    wx, wy, wz, ex, ey, ez = vector_of_time(prob[3], prob[4], prob[5], fns[2], fns[4], t, W)
+def _kick_acceleration(t, y, prob, fns, W):
+    """The template of what the rotation splittings kick with (`kick_acceleration`, `kick_acceleration_of`): the
+    forces (of t and r alone) and the frame's terms of position, centrifugal and Euler (where the run keeps them,
+    ``M[10:12]``) and the origin's, with omega at t (returned too, for the Coriolis turn). Each part of the model is
+    read from ``prob`` where its name in capitals is `AT_RUN_TIME`, else it is that constant (`_particle_rhs`)."""
+    fk = prob[3] if FRAME_KIND == AT_RUN_TIME else FRAME_KIND
+    wx, wy, wz, ex, ey, ez = vector_of_time(fk, prob[4], prob[5], fns[2], fns[4], t, W)
     M = prob[1]
     x = y[0]
     yy = y[1]
@@ -265,13 +266,32 @@ def kick_acceleration(t, y, prob, fns, W):
     ax = W[0]
     ay = W[1]
     az = W[2]
-    ox, oy, oz, _, _, _ = vector_of_time(prob[6], prob[7], prob[8], fns[3], fns[4], t, W)
-    cx, cy, cz = centrifugal(x, yy, z, wx, wy, wz) if M[10] != 0.0 else (0.0, 0.0, 0.0)
-    qx, qy, qz = euler(x, yy, z, ex, ey, ez) if M[11] != 0.0 else (0.0, 0.0, 0.0)
+    ok = prob[6] if ORIGIN_KIND == AT_RUN_TIME else ORIGIN_KIND
+    ox, oy, oz, _, _, _ = vector_of_time(ok, prob[7], prob[8], fns[3], fns[4], t, W)
+    keep = (M[10] != 0.0) if CENTRIFUGAL == AT_RUN_TIME else CENTRIFUGAL
+    cx, cy, cz = centrifugal(x, yy, z, wx, wy, wz) if keep else (0.0, 0.0, 0.0)
+    keep = (M[11] != 0.0) if EULER == AT_RUN_TIME else EULER
+    qx, qy, qz = euler(x, yy, z, ex, ey, ez) if keep else (0.0, 0.0, 0.0)
     ax += cx - qx - ox
     ay += cy - qy - oy
     az += cz - qz - oz
     return ax, ay, az, wx, wy, wz
+
+
+#: what the engine's own splittings kick with: every part of the model read from ``prob``
+kick_acceleration = jit_llvm_inline(bound(_kick_acceleration, "kick_acceleration"))
+
+
+def kick_acceleration_of(parts):
+    """`kick_acceleration` with the model's ``parts`` (`model_parts`) as constants, as Python (`particle_rhs_of`)."""
+    return bound(_kick_acceleration, "kick_acceleration_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
+
+
+def with_parts(parts) -> dict:
+    """The functions of a particle's model that read its parts, each -> its copy with the model's ``parts`` as
+    constants, as Python: what a loop compiled for one problem takes in their place (`rotframe.problem.inlined` on
+    the CPU, `rotframe.problem.gpu`), so that the parts the problem lacks are pruned from every method's step."""
+    return {particle_rhs: particle_rhs_of(parts), kick_acceleration: kick_acceleration_of(parts)}
 
 
 @jit_inline

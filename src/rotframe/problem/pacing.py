@@ -27,10 +27,14 @@ import time
 
 import numpy as np
 
-__all__ = ["Pacer", "CALL_SECONDS", "FIRST_BUDGET", "FIRST_BUDGET_OWN"]
+__all__ = ["Pacer", "CALL_SECONDS", "BETWEEN_CALLS_FACTOR", "FIRST_BUDGET", "FIRST_BUDGET_OWN"]
 
 #: wall time of one compiled call once paced: signals and progress are seen at least this often
 CALL_SECONDS = 0.1
+#: ... or this many times the host's work between two calls, where that is longer: the copies and checks between calls
+#: grow with the particles (some 0.05 s a call for a million on a GPU, where 0.1 s is a thousand steps), and a call of
+#: CALL_SECONDS would spend as much time between the calls as in them
+BETWEEN_CALLS_FACTOR = 10.0
 #: steps of the first call (which also compiles the driver)
 FIRST_BUDGET = 16
 #: steps of the first call where the loop is compiled already and runs no function of the user's (a free body, the
@@ -70,21 +74,28 @@ class Pacer:
         #: the wall time of the last call (s)
         self.last_seconds = 0.0
         self._started = 0.0
+        self._ended = None  # when the last call ended (`done`)
+        #: the host's wall time between the last two calls (s): the copies and checks of the run's loop
+        self.between_seconds = 0.0
         self._over = False
         self._last_step = None
 
     def start(self) -> int:
         """Mark a call's start; returns its budget (steps per particle)."""
         self._started = time.perf_counter()
+        if self._ended is not None:
+            self.between_seconds = self._started - self._ended
         return self.budget
 
     def done(self, steps_in_call: float) -> None:
-        """After a call that took ``steps_in_call`` steps (all particles): size the next one to CALL_SECONDS."""
-        elapsed = self.last_seconds = time.perf_counter() - self._started
+        """After a call that took ``steps_in_call`` steps (all particles): size the next one to CALL_SECONDS, or to
+        `BETWEEN_CALLS_FACTOR` times the host's work between the calls where that is longer."""
+        self._ended = time.perf_counter()
+        elapsed = self.last_seconds = self._ended - self._started
         self.calls += 1
         if self.calls == 1 or steps_in_call <= 0:  # the first call compiled: its time says nothing of a step's
             return
-        wanted = self.budget * CALL_SECONDS / max(elapsed, 1e-9)
+        wanted = self.budget * max(CALL_SECONDS, BETWEEN_CALLS_FACTOR * self.between_seconds) / max(elapsed, 1e-9)
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
     def check(self, steps, t_reached, step) -> None:
