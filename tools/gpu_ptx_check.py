@@ -132,6 +132,7 @@ def _intercept(failures, current):
     cuda.is_available = lambda: True
     threads.gpu_available = lambda: True
     cuda.to_device = lambda a, *args, **kw: np.array(a).view(HostArray)
+    cuda.device_array_like = lambda a, *args, **kw: np.empty_like(a).view(HostArray)
     cuda.device_array = lambda shape, *args, **kw: np.zeros(shape).view(HostArray)
 
 

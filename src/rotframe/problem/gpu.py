@@ -41,8 +41,11 @@ _KERNELS: dict = {}
 #: particle-calls of this process that a user function's exception ended on the GPU and the CPU ran again
 #: (`GpuAdvance.ended`): `tools/gpu_user_check.py` shows that none of its checks were answered by the CPU
 RERUNS = [0]
-#: the per-particle arrays of the loop that come back after every call (the pacing and the progress read them)
+#: the per-particle arrays of the loop (`rotframe.problem.engine.advance`)
 _STATE = ("Y", "TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
+#: those that come back after every call: what the pacing, the progress and the run's loop read between calls (the
+#: rest, two thirds of the bytes, come back with the results, `GpuAdvance.fetch`)
+_PACED = ("TC", "IDX", "ST", "NSTEP", "NFEV")
 #: the arrays that come back at the end (`GpuAdvance.fetch`)
 _RESULTS = ("OUT", "EVT", "EVY", "EVK")
 #: the loop's arguments, in order, up to the budget (`rotframe.problem.engine.advance`)
@@ -132,17 +135,20 @@ def _kernel(module, method, events, D, parts=None):
 class GpuAdvance:
     """`rotframe.problem.engine.advance` on the GPU, for one run: the same arguments, the arrays kept on the GPU.
 
-    The first call uploads every array; each call launches one thread per particle (``lo``,
-    ``hi`` are the whole ensemble: the GPU takes every particle at once) and brings back the
-    per-particle state (`_STATE`) into the caller's arrays. `fetch` brings back the samples
-    and the events. A thread that a user function's exception ended is given status 6
-    (a user function raised) by the caller, which runs its call again on the CPU.
+    The first call uploads every array; each call keeps a copy of the per-particle state on the
+    GPU (`saved`: what a call is replayed from), launches one thread per particle (``lo``, ``hi``
+    are the whole ensemble: the GPU takes every particle at once) and brings back what the run's
+    loop reads between calls (`_PACED`) into the caller's arrays. `fetch` brings back the rest of
+    the state, the samples and the events. A thread that a user function's exception ended is
+    given status 6 (a user function raised) by the caller, which runs its call again on the CPU
+    from `saved`.
     """
 
     def __init__(self, module, method, events, D):
         self.module = module
         self.key = (method, events, D)
         self.device = None  # name -> device array
+        self.before = None  # name -> the device array's copy before the last call (`saved`)
         self.host = None  # name -> the caller's array
         self.live = None
         #: the particles whose thread a user function's exception ended in the last call (`rotframe.problem.particles`
@@ -167,8 +173,12 @@ class GpuAdvance:
                                                                                  prob[4], prob[5], prob[7], prob[8])]
             self.kinds = (int(prob[3]), int(prob[6]))
             self.live = cuda.to_device(np.zeros(Y.shape[0], np.int64))
+            self.before = {name: cuda.device_array_like(self.device[name]) for name in _STATE}
         atol_d, edir, eterm, stops, M, p, FT, FC, OT, OC = self.settings
         d = self.device
+        for name in _STATE:  # on the GPU, at its own memory's speed (some 0.1 ms for a million particles)
+            self.before[name].copy_to_device(d[name])
+        self.fetched = False
         try:
             self.kernel[launch_shape(Y.shape[0])](
                 *(d[name] for name in _ARRAYS), int(budget), float(rtol), atol_d, float(hfix), edir, eterm, stops, M, p,
@@ -176,7 +186,7 @@ class GpuAdvance:
         except Exception as exc:  # noqa: BLE001 -- numba's compile errors, named for the user
             _launch_failed(exc)
         cuda.synchronize()
-        for name in _STATE:
+        for name in _PACED:
             d[name].copy_to_host(self.host[name])
         live = self.live.copy_to_host()
         # a user function raised: CUDA ended the thread (its state is the call's start), where the CPU sets status 6
@@ -190,12 +200,20 @@ class GpuAdvance:
         self.fetched = False
 
     def fetch(self):
-        """Bring the samples and the event records back into the caller's arrays (after the last call; once)."""
+        """Bring the state, the samples and the event records back into the caller's arrays (after a call; once)."""
         if self.device is None or self.fetched:
             return
         self.fetched = True
-        for name in _RESULTS:
-            self.device[name].copy_to_host(self.host[name])
+        for name in _STATE + _RESULTS:
+            if name not in _PACED:
+                self.device[name].copy_to_host(self.host[name])
+
+    def saved(self):
+        """The per-particle state as it was before the last call, ``{name: host array}`` (`_STATE`'s names, ``Y``
+        among them): what `rotframe.problem.particles` replays a call from; None before the first upload."""
+        if self.before is None:  # nothing was uploaded: the caller's arrays are the state
+            return None
+        return {name: self.before[name].copy_to_host() for name in _STATE}
 
 
 def _launch_failed(exc):

@@ -106,12 +106,14 @@ class Pacer:
         """
         from rotframe import limits
 
+        if not self.adaptive:  # a fixed step's count was checked before the run
+            return
         steps = np.asarray(steps, dtype=float)
         step = np.abs(np.asarray(step, dtype=float))
         growing = self._last_step is not None and self._last_step.shape == step.shape and bool(
             np.any(step > GROWING * self._last_step))
         self._last_step = step.copy()
-        if not self.adaptive or steps.size == 0 or float(np.min(steps)) < SETTLED_STEPS or growing:
+        if steps.size == 0 or float(np.min(steps)) < SETTLED_STEPS or growing:
             self._over = False  # a step still growing from a short first one: no pace to project yet
             return
         self._over = limits.check_pace(self.what, self.duration, steps, t_reached, repeated=self._over, step=step)

@@ -149,8 +149,10 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                   state["EVY"], state["EVK"], state["EVN"], state["GPREV"], state["NSTEP"], state["NFEV"])
         while True:
             after = (method, rtol, atol_arr, hfix, EDIR, ETERM, stops, prob, tier.fns)
-            saved = {key: state[key].copy() for key in _REPLAYED}
-            saved["Y"] = y.copy()
+            # the state before the call, to replay it from where a user function raised in it; the GPU keeps its own
+            # copy (`GpuAdvance.saved`), brought back only for a replay
+            saved = _saved(y, state) if gpu is None else None
+            steps_before = np.sum(state["NSTEP"])
             budget = tier.budget(pacer.start())
             t_call = time.perf_counter()
             try:
@@ -158,7 +160,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                     gpu(0, N, *before, budget, *after)
                     if gpu.ended.size:  # a user function raised on the GPU: the CPU runs the call again, to the step
                         gpu.fetch()
-                        _again_on_the_cpu(gpu.ended, advance, y, state, saved, before + (budget,) + after)
+                        _again_on_the_cpu(gpu.ended, advance, y, state, gpu.saved(), before + (budget,) + after)
                         if np.all(state["ST"][gpu.ended] == 0):  # it did not raise there: the GPU goes on from it
                             gpu.resume()
                 else:
@@ -169,15 +171,17 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                     raise PlainTierFailed from None
                 if gpu is not None:
                     gpu.fetch()
+                    saved = gpu.saved() or _saved(y, state)  # None: nothing went to the GPU, the arrays are as before
                 raised_later(exc, advance, y, saved, {"before": before, "after": after, "budget": budget}, s, OUT,
                              state)
             if first:  # the glue's compile and the first call (the engine's load); begun plain, the glue's alone
                 compile_s = (t_call if tier.began_plain else time.perf_counter()) - t0
                 first = False
             if not tier.plain:  # the plain tier's calls are counted in steps, and say nothing of the compiled pace
-                pacer.done(float(np.sum(state["NSTEP"]) - np.sum(saved["NSTEP"])))
-                inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
-                                    float(np.sum(duration - state["TC"][state["ST"] == 0])))
+                pacer.done(float(np.sum(state["NSTEP"]) - steps_before))
+                if saved is not None:  # the GPU's run never switches loops (`Inlining`, off there)
+                    inlining.after_call(pacer.last_seconds, float(np.sum(state["TC"] - saved["TC"])),
+                                        float(np.sum(duration - state["TC"][state["ST"] == 0])))
             ST = state["ST"]
             if progress is not None:
                 progress(float(np.min(state["IDX"])) / n)
@@ -286,6 +290,13 @@ def advance_blocks(advance, N, args):
 #: the per-particle arrays a driver call changes besides the samples and event records (copied before each
 #: call, so that a call in which a user function raised can be replayed one step at a time)
 _REPLAYED = ("TC", "H", "IDX", "SUB", "ST", "EVN", "GPREV", "NSTEP", "NFEV")
+
+
+def _saved(y, state):
+    """Copies of the per-particle state (``Y`` and `_REPLAYED`), what a call is replayed from."""
+    saved = {key: state[key].copy() for key in _REPLAYED}
+    saved["Y"] = y.copy()
+    return saved
 
 
 def _restore(y, state, saved):
