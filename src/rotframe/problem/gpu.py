@@ -12,16 +12,20 @@ The one difference is how the loop reaches the problem's functions. On the CPU i
 them at their addresses (`rotframe.problem.calls`), so that the engine compiles once for
 every problem; a GPU has no such calls, so each call by address is replaced by a direct
 call of the problem's function (`_overrides`) and the loop is compiled with the problem's
-functions inlined into it, once per problem and method (kept for the process, `_KERNELS`).
+functions inlined into it, once per problem and method (kept for the process, `_KERNELS`), with the
+model's parts as constants (`rotframe.problem.models.with_parts`, as the CPU's inlined loop): the
+frame's kinds and terms the problem lacks are not compiled in (a third fewer registers a thread).
 The user's functions must then compile for the GPU too: plain arithmetic on numbers and
 arrays, returning a tuple, allocating no array (one line names the failure otherwise).
 
 What stays on the CPU: the checks, the events' start values, the energy diagnostics and the
 frame's interpolation check (`rotframe.problem.particles`). The GPU runs the fixed-step
 methods (`rotframe.method_registry`, ``gpu=True``). The arrays stay on the GPU for the whole
-run: after each call (a budget of steps, as on the CPU) only the per-particle state comes back,
-for the progress and the pacing; the samples and the events come back once, at the end
-(`GpuAdvance.fetch`).
+run: after each call (a budget of steps, as on the CPU) only what the run's loop reads between
+calls comes back (`_PACED`: times, statuses, counts), for the progress and the pacing; the rest of
+the state, the samples and the events come back once, at the end (`GpuAdvance.fetch`). The state
+before each call is copied on the GPU, and brought back only to replay a call on the CPU
+(`GpuAdvance.saved`).
 
 Results agree with the CPU's to round-off, not to the bit: the GPU's compiler fuses
 multiplies and adds, and its ``sin``, ``cos`` and ``exp`` are its own.
