@@ -38,3 +38,20 @@ def test_a_compiled_step_keeps_the_same_numbers():
     W1, W2 = np.zeros(SCRATCH), np.zeros(SCRATCH)
     for angle in (0.1, 0.2, 0.1, 0.1, 0.2, 0.3, 0.1, -0.0):
         assert turn_cos_sin(angle, W1) == turn_cos_sin.py_func(angle, W2)
+
+
+def test_a_steady_frames_kept_axis_is_the_one_computed_anew():
+    from rotframe.problem.models import AXIS, turn_axis
+
+    rng = np.random.default_rng(7)
+    for w in [rng.normal(size=3) * 10.0 ** rng.uniform(-150, 2) for _ in range(20)] + [np.array([0.0, -0.0, 3e-5])]:
+        W = np.zeros(SCRATCH)
+        fresh = turn_axis.py_func(False, *w, W)
+        assert not W[AXIS:].any()  # an unsteady frame keeps nothing
+        norm = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+        assert fresh == (norm, w[0] / norm, w[1] / norm, w[2] / norm)
+        for _ in range(3):  # the first call keeps it, the next ones answer from it: the same numbers, signs of zero too
+            kept = turn_axis.py_func(True, *w, W)
+            assert kept == fresh and [math.copysign(1.0, a) for a in kept] == [math.copysign(1.0, a) for a in fresh]
+    W = np.zeros(SCRATCH)
+    assert turn_axis.py_func(True, 0.0, 0.0, 0.0, W) == (0.0, 0.0, 0.0, 0.0) and not W[AXIS:].any()  # no turn: none kept

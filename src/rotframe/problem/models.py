@@ -69,9 +69,11 @@ loop compiled for one problem takes (`particle_rhs_of`, `rotframe.problem.inline
 them as constants, so that numba and LLVM drop the parts the problem lacks: the same arithmetic,
 in the same order, for the parts it has.
 
-Scratch ``W`` (7 numbers, one per calling block): what a user's function writes (the terms, a
+Scratch ``W`` (`SCRATCH` numbers, one per calling block): what a user's function writes (the terms, a
 vector of time; ``W[6]`` set where one raised), read into locals at once (no slice of it is
-taken: a view costs more than the arithmetic of a term).
+taken: a view costs more than the arithmetic of a term); then what the rotation splitting keeps from
+step to step: its Coriolis turns' cosines and sines (`TURN`, `turn_cos_sin`) and a steady frame's
+axis (`AXIS`, `turn_axis`).
 """
 
 from __future__ import annotations
@@ -104,8 +106,10 @@ KAHAN_LI8_STEPS = tuple(float(w) for w in composition_weights(8))
 #: the slots of the scratch ``W`` that keep the Coriolis turn's last two angles, each with its cosine and sine
 #: (`turn_cos_sin`), after `rotframe.problem.calls.RAISED`
 TURN = 7
+#: the slots that keep a steady frame's |w| and its unit axis (`turn_axis`)
+AXIS = TURN + 6
 #: the length of the scratch ``W``
-SCRATCH = TURN + 6
+SCRATCH = AXIS + 4
 
 
 @jit_inline
@@ -329,6 +333,32 @@ def turn_cos_sin(angle, W):
     return c, s
 
 
+@jit_inline
+def turn_axis(steady, wx, wy, wz, W):
+    """``|w|`` and the unit axis ``w / |w|`` of the Coriolis turn (zeros where ``|w|`` is 0); in a ``steady`` frame,
+    kept in ``W[AXIS:AXIS + 4]`` from the first step on.
+
+    A steady frame's omega is the same at every step of a problem, and its norm and the three
+    quotients cost as much as the rest of the splitting's step. The kept values are those computed
+    from that omega, so the step's numbers are those of computing them anew. ``W`` is the work array
+    of one problem (`rotframe.problem.engine.scratch`, made per run or per prepared problem; a GPU
+    thread's own): it never meets another omega. A slot holding 0 is empty (a kept ``|w|`` is > 0)."""
+    if steady and W[AXIS] > 0.0:
+        return W[AXIS], W[AXIS + 1], W[AXIS + 2], W[AXIS + 3]
+    w = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if not w > 0.0:
+        return w, 0.0, 0.0, 0.0
+    ux = wx / w
+    uy = wy / w
+    uz = wz / w
+    if steady:
+        W[AXIS] = w
+        W[AXIS + 1] = ux
+        W[AXIS + 2] = uy
+        W[AXIS + 3] = uz
+    return w, ux, uy, uz
+
+
 @jit_llvm_inline
 def rotation_strang(t, h, yn, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
@@ -344,10 +374,11 @@ def rotation_strang(t, h, yn, prob, fns, W):
     vz = yn[5] + hh * az
     k1, k2 = drag_rates(prob[1], yn)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
-    w = math.sqrt(wx * wx + wy * wy + wz * wz)
-    if w > 0.0 and prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term
-        c, s = turn_cos_sin(-2.0 * w * h, W)
-        vx, vy, vz = rodrigues_rotate(vx, vy, vz, wx / w, wy / w, wz / w, c, s)
+    if prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term (and w is not 0)
+        w, ux, uy, uz = turn_axis(prob[3] == CONSTANT, wx, wy, wz, W)
+        if w > 0.0:
+            c, s = turn_cos_sin(-2.0 * w * h, W)
+            vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     yn[3] = vx + hh * ax
     yn[4] = vy + hh * ay
