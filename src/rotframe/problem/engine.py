@@ -93,8 +93,10 @@ def raised(ctx):
 
 
 @jit_inline
-def all_finite(y):
-    for j in range(y.shape[0]):
+def all_finite(y, n):
+    """Whether the first ``n`` numbers of ``y`` are finite; ``n`` a constant of the caller's code (`DIM`), so that the
+    compiler unrolls the loop: over ``y.shape[0]``, known only at run time, it was a sixth of a splitting's step."""
+    for j in range(n):
         if not math.isfinite(y[j]):
             return False
     return True
@@ -451,7 +453,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
                 status = 6
                 break
-            if not all_finite(yn):
+            if not all_finite(yn, D):
                 status = 3
                 break
             if EVENTS:  # a constant of the variant: without events, none of this is compiled
