@@ -48,3 +48,8 @@ def test_a_call_is_sized_to_ten_times_the_hosts_work_between_calls_where_that_is
 
 def test_a_call_grows_at_most_eightfold(monkeypatch):
     assert paced(monkeypatch, between=10.0) == 8 * 1000
+
+
+def test_a_call_is_never_sized_past_the_longest_call(monkeypatch):
+    # a second of host work between calls would ask for 10 s calls: a signal would wait that long
+    assert paced(monkeypatch, between=1.0, call=0.5) == pytest.approx(1000 * pacing.LONGEST_CALL_SECONDS / 0.5, rel=1e-9)

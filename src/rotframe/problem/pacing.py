@@ -4,8 +4,10 @@ A compiled driver call holds the thread until it returns, and Python sees a sign
 SIGTERM) and reports progress only between calls. Calls sized in steps made a slow user
 function (0.2 ms an evaluation) hold a signal for minutes. `Pacer` sizes them in time instead:
 the first call takes a few steps (it compiles, too), each later one as many steps as about
-`CALL_SECONDS` of work took before. The numbers do not depend on where a call ends: the drivers
-keep everything a step needs in their arrays (`rotframe.problem.engine`).
+`CALL_SECONDS` of work took before, or `BETWEEN_CALLS_FACTOR` times the host's own work between
+two calls where that is longer (a million particles' copies and checks), up to
+`LONGEST_CALL_SECONDS`. The numbers do not depend on where a call ends: the drivers keep
+everything a step needs in their arrays (`rotframe.problem.engine`).
 
 The work is estimated against `rotframe.limits`:
 
@@ -27,7 +29,7 @@ import time
 
 import numpy as np
 
-__all__ = ["Pacer", "CALL_SECONDS", "BETWEEN_CALLS_FACTOR", "FIRST_BUDGET", "FIRST_BUDGET_OWN"]
+__all__ = ["Pacer", "CALL_SECONDS", "BETWEEN_CALLS_FACTOR", "LONGEST_CALL_SECONDS", "FIRST_BUDGET", "FIRST_BUDGET_OWN"]
 
 #: wall time of one compiled call once paced: signals and progress are seen at least this often
 CALL_SECONDS = 0.1
@@ -35,6 +37,8 @@ CALL_SECONDS = 0.1
 #: grow with the particles (some 0.05 s a call for a million on a GPU, where 0.1 s is a thousand steps), and a call of
 #: CALL_SECONDS would spend as much time between the calls as in them
 BETWEEN_CALLS_FACTOR = 10.0
+#: ... but never longer than this (s): a signal is still answered within a second
+LONGEST_CALL_SECONDS = 1.0
 #: steps of the first call (which also compiles the driver)
 FIRST_BUDGET = 16
 #: steps of the first call where the loop is compiled already and runs no function of the user's (a free body, the
@@ -89,13 +93,15 @@ class Pacer:
 
     def done(self, steps_in_call: float) -> None:
         """After a call that took ``steps_in_call`` steps (all particles): size the next one to CALL_SECONDS, or to
-        `BETWEEN_CALLS_FACTOR` times the host's work between the calls where that is longer."""
+        `BETWEEN_CALLS_FACTOR` times the host's work between the calls where that is longer (at most
+        `LONGEST_CALL_SECONDS`)."""
         self._ended = time.perf_counter()
         elapsed = self.last_seconds = self._ended - self._started
         self.calls += 1
         if self.calls == 1 or steps_in_call <= 0:  # the first call compiled: its time says nothing of a step's
             return
-        wanted = self.budget * max(CALL_SECONDS, BETWEEN_CALLS_FACTOR * self.between_seconds) / max(elapsed, 1e-9)
+        target = min(max(CALL_SECONDS, BETWEEN_CALLS_FACTOR * self.between_seconds), LONGEST_CALL_SECONDS)
+        wanted = self.budget * target / max(elapsed, 1e-9)
         self.budget = int(max(1, min(wanted, self.budget * 8, 1_000_000)))
 
     def check(self, steps, t_reached, step) -> None:
