@@ -42,6 +42,19 @@ def test_every_kind_of_user_problem_gives_the_cpu_numbers_on_the_gpu():
     assert res.stdout.rstrip().endswith("ran again (a thread ended by an exception): 0")  # the GPU answered, not the CPU
 
 
+def test_the_kernel_with_the_models_parts_compiled_in_gives_the_numbers_of_the_one_that_reads_them():
+    """`tools/gpu_user_rows.py` runs your own problem with the model's parts as constants of the kernel
+    (`rotframe.problem.models.with_parts`) and with them read as the run goes: on the simulator, the same Python,
+    so the same numbers to the bit (the ``apart`` column), under both methods, with and without the ground event."""
+    res = _simulated([str(ROOT / "tools" / "gpu_user_rows.py")])
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    rows = [line.split() for line in res.stdout.splitlines() if line.startswith(("rotation-splitting", "rk4"))]
+    assert len(rows) == 4, res.stdout
+    for row in rows:
+        apart = row[row.index("first") - 1]
+        assert float(apart) == 0.0, row
+
+
 REFUSALS = textwrap.dedent("""
     import numpy as np, rotframe
     from numba import config

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 26's and 32's checks on a lent GPU machine, in one call (see docs/guide/bench.md):
-#   the machine, the GPU bench (rotframe bench gpu, with the user-force rows), your own problems on the GPU against
-#   the CPU (tools/gpu_user_check.py), the GPU kernel's register limits (tools/gpu_variants.py; VARIANTS=0 skips
+#   the machine, the GPU bench (rotframe bench gpu, with the user-force rows), your own problem beside the scenes'
+#   ensemble (tools/gpu_user_rows.py; USER_ROWS=0 skips it), your own problems on the GPU against the CPU
+#   (tools/gpu_user_check.py), the GPU kernel's register limits (tools/gpu_variants.py; VARIANTS=0 skips
 #   them) and the CPU ensemble bench on every core (CPU=0 skips it). The most wanted first: a run cut short by its
 #   limit still leaves what it finished in $OUT.
 # Run from the repository root; results land in $OUT (default /tmp/rotframe-device).
@@ -42,6 +43,12 @@ gpu_rows(False, each=write)
 PY
 echo "bench gpu: rc=$? in $(( $(date +%s) - t0 )) s"; tail -c 3000 "$OUT/gpu.err"
 $PY tools/gpu_table.py "$OUT/gpu.json" | tee "$OUT/gpu.md"
+if [ "${USER_ROWS:-1}" = 1 ]; then
+  t0=$(date +%s)
+  # your own problem on the GPU beside the scenes' ensemble, the time in its compiled calls apart (docs/bench/gpu-user-rows.txt)
+  timeout ${USER_ROWS_TIMEOUT:-240} $PY tools/gpu_user_rows.py 1048576 8192 2>&1 | grep -v Warning | tee "$OUT/user_rows.txt"
+  echo "gpu user rows: in $(( $(date +%s) - t0 )) s"
+fi
 t0=$(date +%s)
 # your own problem on the GPU against the CPU (rotframe.simulate(device="gpu")): exits 1 unless they agree to 1e-9
 timeout ${USER_TIMEOUT:-240} $PY tools/gpu_user_check.py ${USER_PARTICLES:-4096} 2>&1 | tee "$OUT/user_check.txt" | grep -v Warning
