@@ -64,6 +64,9 @@ def test_the_steady_loop_is_the_engines_loop_to_the_bit(seed):
         assert a.steps == b.steps > 0
     assert np.array_equal(a.times, b.times)
     assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v)
+    # the tolerances each records (for Result.sol's restarts): the calls' driver's rows and the rows the engine's
+    # loop filled in place, the same
+    assert a.extras["atol"].shape == (a.r.shape[1], 6) and np.array_equal(a.extras["atol"], b.extras["atol"])
     assert steady.diagnostics.keys() == general.diagnostics.keys()
     for key in steady.diagnostics:
         assert steady.diagnostics[key] == general.diagnostics[key]

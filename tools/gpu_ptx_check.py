@@ -46,8 +46,8 @@ def _ptxas():
 
 
 def _compile(py_func, args, failures, name):
-    compiled = failures.compiled
     """Compile ``py_func`` for sm_90 with the types of ``args``; print the registers; record a failure."""
+    compiled = failures.compiled
     from numba import cuda, typeof
     from numba.core import types
 
@@ -185,14 +185,14 @@ def main() -> int:
     _intercept(failures, current)
     for name, call in _cases():
         current[0] = name
+        reason = ""
         try:
             call()
         except Exception as exc:  # noqa: BLE001 -- _Launched, or the run's own wrapping of it (a user function's call)
-            if name not in failures and name not in failures.compiled:
-                print(f"{name}: {type(exc).__name__}: {exc}", flush=True)
+            reason = f" ({type(exc).__name__}: {exc})"
         if name not in failures and name not in failures.compiled:
             failures.append(name)
-            print(f"FAILED {name}: no kernel was launched", flush=True)
+            print(f"FAILED {name}: no kernel was launched{reason}", flush=True)
     print(f"{len(failures)} failed")
     return 1 if failures else 0
 

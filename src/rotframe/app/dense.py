@@ -49,12 +49,13 @@ class DenseSolution:
         self._r = np.asarray(traj.r, dtype=float)
         self._v = np.asarray(traj.v, dtype=float)
         self._rtol = float(run_setting(run_settings, "rtol"))
-        # the absolute tolerances the run took, a row (r then v) per particle (the engine's record of them,
-        # rotframe.problem.particles.tolerances_used), else rtol times the initial states' scale (chunked.abs_tol)
+        # the absolute tolerances the run took, a row (r then v) per particle (the engine's and the calls' driver's
+        # record of them), else rtol times the initial states' scale (chunked.KernelSetup.abs_tol's default)
         rows = (getattr(traj, "extras", None) or {}).get("atol")
         if rows is None:
-            scale = max(1.0, float(np.max(np.abs(np.concatenate([self._r[0].ravel(), self._v[0].ravel()])))))
-            rows = np.full((self._r.shape[1], 6), self._rtol * scale)
+            from rotframe.numerics.step_control import ensemble_scale
+
+            rows = np.full((self._r.shape[1], 6), self._rtol * ensemble_scale(self._r[0], self._v[0]))
         self._atol = np.asarray(rows, dtype=float)
         # the terminal event of the built-in scenes: a particle stops at the ground
         ground = (getattr(traj, "event_times", {}) or {}).get("ground", [])

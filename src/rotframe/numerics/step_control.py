@@ -19,7 +19,8 @@ Equations I*, 2nd ed., II.4 and II.10; docs/physics/dop853.md), with the code's 
   sizes of ``y`` and ``f(y)``, then the step at which the second derivative, estimated from
   one more evaluation, keeps the local error at the tolerance;
 * a particle's default absolute tolerances are rotframe's own rule (`own_tolerances`), from its
-  start state and the run's length, so that its steps do not depend on the ensemble it runs in.
+  start state and the run's length, so that its steps do not depend on the ensemble it runs in;
+  the scenes' ensembles take one scale for all, ``rtol`` times `ensemble_scale`.
 
 The particle scenes (`rotframe.particles.drivers`, `rotframe.particles.dop853_steady`), the
 rigid bodies (`rotframe.rigid.adaptive`) and the engine of your own problems
@@ -32,10 +33,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
 __all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "own_tolerances",
-           "own_tolerance_rows", "SAFE", "FACC1", "FACC2",
+           "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
 SAFE = 0.9  # dop853.f's safety factor
@@ -188,3 +191,10 @@ def own_tolerance_rows(y, duration, rtol, rows):
     """`own_tolerances` of every state ``y[i]`` (N, D) into ``rows[i]`` (N, D): a large ensemble's, before its loop."""
     for i in range(y.shape[0]):
         own_tolerances(y[i], duration, rtol, rows[i])
+
+
+def ensemble_scale(r, v):
+    """max(1, |r|, |v|) over every component of the states ``r``, ``v`` (numpy; any shapes): the scale of the
+    absolute tolerance (``rtol`` times it, r and v alike) that the scenes' DOP853 ensembles take for all their
+    particles (`rotframe.particles.chunked.KernelSetup.abs_tol`, `rotframe.particles.ensemble`)."""
+    return max(1.0, float(np.max(np.abs(r), initial=0.0)), float(np.max(np.abs(v), initial=0.0)))

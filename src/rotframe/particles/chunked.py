@@ -192,8 +192,9 @@ class KernelSetup:
             return np.repeat(np.asarray(self.atol, dtype=float).reshape(1, 6), n, axis=0)
         if self.atol:
             return np.full((n, 6), float(self.atol))
-        scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
-        return np.full((n, 6), self.rtol * scale)
+        from rotframe.numerics.step_control import ensemble_scale
+
+        return np.full((n, 6), self.rtol * ensemble_scale(r0, v0))
 
     def event_records(self, evb):
         """The record arrays of ``evb`` as the drivers take them; None for each without an event table.
@@ -412,7 +413,8 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
 
     ``traj.extras``: ``step`` (the fixed step, 0 for DOP853) and ``compile_s``
     (`KernelSetup.warm_up`: seconds spent loading or compiling the compiled
-    driver in this call, 0.0 when it was already loaded).
+    driver in this call, 0.0 when it was already loaded); for DOP853, ``atol``, the absolute
+    tolerances each particle took (`KernelSetup.abs_tol`, (N, 6)).
 
     Raises
     ------
@@ -521,6 +523,8 @@ def run_chunked(setup, model, r0, v0, progress=None, max_events=64, records=Fals
     traj = Trajectory(times, out_r, out_v, info.name, steps, nfev, True, setup.duration)
     traj.extras["step"] = setup.h
     traj.extras["compile_s"] = compile_s
+    if atol is not None:
+        traj.extras["atol"] = atol
     if records:
         traj.extras["event_records"] = evb
     else:

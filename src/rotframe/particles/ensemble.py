@@ -96,8 +96,9 @@ def integrate_ensemble(model, r0, v0, duration, event, *, method, run, keep=(), 
     # one absolute tolerance for the whole ensemble (dop853), whatever the blocks
     atol = run.get("atol")
     if method == "dop853" and not atol and n:
-        scale = max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))
-        atol = float(run.get("rtol") or 1e-10) * scale
+        from rotframe.numerics.step_control import ensemble_scale
+
+        atol = float(run.get("rtol") or 1e-10) * ensemble_scale(r0, v0)
     run = dict(run, atol=atol)
     if (check_device(device) or device_in_force()) == "gpu":
         return _on_gpu(model, r0, v0, duration, event, method, run, keep, path_samples)

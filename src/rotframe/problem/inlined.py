@@ -31,7 +31,7 @@ fingerprinted) has its inlined loop compiled in memory too.
 
 What the inlined loop gains is the call by address (opaque to the compiler) and the parts of the
 model the problem lacks (the engine reads them from the problem's constants at every
-evaluation; the inlined loop holds them as constants, `rotframe.problem.models.particle_rhs_of`).
+evaluation; the inlined loop holds them as constants, `rotframe.problem.models.with_parts`).
 It does not make the engine's loop as fast as the scenes' kernels, whose steps keep the state in
 registers (docs/architecture.md).
 

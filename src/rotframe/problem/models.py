@@ -65,7 +65,7 @@ reference counting (`rotframe.numerics.compiled.jit_uncounted`, see `rotframe.pr
 A particle's right-hand side is one template (`_particle_rhs`) with two kinds of copy: the
 engine's own (`particle_rhs`), which reads each part of the model (the frame's and the origin's
 kinds, the frame's terms, the string) from the problem's constants as it runs, and the copy a
-loop compiled for one problem takes (`particle_rhs_of`, `rotframe.problem.inlined`), which holds
+loop compiled for one problem takes (`with_parts`, `rotframe.problem.inlined`), which holds
 them as constants, so that numba and LLVM drop the parts the problem lacks: the same arithmetic,
 in the same order, for the parts it has.
 
@@ -144,14 +144,14 @@ def attitude_rate(y, dy, k, wx, wy, wz):
 
 
 #: a part of a particle's model read from its constants as the run goes (the engine's own loop, one for every problem),
-#: where a loop compiled for one problem holds it as a constant (`particle_rhs_of`)
+#: where a loop compiled for one problem holds it as a constant (`with_parts`)
 AT_RUN_TIME = -1
 # the template's names of the model's parts (`_particle_rhs`): read at run time in the engine's own copy
 FRAME_KIND = ORIGIN_KIND = CORIOLIS = CENTRIFUGAL = EULER = STRING = AT_RUN_TIME
 
 
 def _particle_rhs(t, y, dy, prob, fns, W):
-    """The template of a particle's right-hand side (`particle_rhs`, `particle_rhs_of`).
+    """The template of a particle's right-hand side (`particle_rhs`, `with_parts`).
 
     Each part of the model (the frame's and the origin's kinds, the frame's terms, the string) is
     read from ``prob`` where its name in capitals is `AT_RUN_TIME`, else it is that constant.
@@ -214,12 +214,6 @@ def model_parts(prob) -> dict:
             "CENTRIFUGAL": int(M[10] != 0.0), "EULER": int(M[11] != 0.0), "STRING": int(M[0] != 0.0)}
 
 
-def particle_rhs_of(parts):
-    """A particle's right-hand side with the model's ``parts`` (`model_parts`) as constants, as Python (to compile
-    where a loop is compiled for one problem, `rotframe.problem.inlined`): the other parts' code pruned."""
-    return bound(_particle_rhs, "particle_rhs_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
-
-
 @jit_llvm_inline
 def body_rhs(t, y, dy, prob, fns, W):
     M = prob[1]
@@ -256,7 +250,7 @@ def rhs(body, t, y, dy, prob, fns, W):
 
 
 def _kick_acceleration(t, y, prob, fns, W):
-    """The template of what the rotation splittings kick with (`kick_acceleration`, `kick_acceleration_of`): the
+    """The template of what the rotation splittings kick with (`kick_acceleration`, `with_parts`): the
     forces (of t and r alone) and the frame's terms of position, centrifugal and Euler (where the run keeps them,
     ``M[10:12]``) and the origin's, with omega at t (returned too, for the Coriolis turn). Each part of the model is
     read from ``prob`` where its name in capitals is `AT_RUN_TIME`, else it is that constant (`_particle_rhs`)."""
@@ -286,16 +280,13 @@ def _kick_acceleration(t, y, prob, fns, W):
 kick_acceleration = jit_llvm_inline(bound(_kick_acceleration, "kick_acceleration"))
 
 
-def kick_acceleration_of(parts):
-    """`kick_acceleration` with the model's ``parts`` (`model_parts`) as constants, as Python (`particle_rhs_of`)."""
-    return bound(_kick_acceleration, "kick_acceleration_" + "_".join(str(parts[k]) for k in sorted(parts)), **parts)
-
-
 def with_parts(parts) -> dict:
     """The functions of a particle's model that read its parts, each -> its copy with the model's ``parts`` as
     constants, as Python: what a loop compiled for one problem takes in their place (`rotframe.problem.inlined` on
     the CPU, `rotframe.problem.gpu`), so that the parts the problem lacks are pruned from every method's step."""
-    return {particle_rhs: particle_rhs_of(parts), kick_acceleration: kick_acceleration_of(parts)}
+    tag = "_".join(str(parts[k]) for k in sorted(parts))
+    return {particle_rhs: bound(_particle_rhs, f"particle_rhs_{tag}", **parts),
+            kick_acceleration: bound(_kick_acceleration, f"kick_acceleration_{tag}", **parts)}
 
 
 @jit_inline

@@ -115,8 +115,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     frame, origin, forces, events = s.frame, s.origin, s.forces, s.events
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
     frame_terms, cache_notes, EDIR, ETERM, stops = s.frame_terms, s.cache_notes, s.EDIR, s.ETERM, s.stops
-    atol = checked_atol(atol)
-    y, atol_arr = start_states(s, r, v, atol, attitude, omega)
+    y, atol_arr = start_states(s, r, v, checked_atol(atol), attitude, omega)
     y0_first = y[:1].copy()
     OUT = np.full((n, N, D), np.nan)
     OUT[0] = y  # the start, as the loop writes it: a run stopped before its first call keeps it
@@ -227,8 +226,8 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
     compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
     traj.extras["compile_s"] = compile_s
-    if method == "dop853":
-        traj.extras["atol"] = tolerances_used(atol, r, v, duration, rtol)
+    if method == "dop853":  # the rows the loop took: a particle's own filled in where it began (`rotframe.problem.engine`)
+        traj.extras["atol"] = atol_arr[:, :6].copy()
     return ProblemRun(traj, diagnostics, warnings, notes, frame, compile_s, frame_terms)
 
 
@@ -452,25 +451,12 @@ def _steady_run(s, atol, progress) -> ProblemRun:
     except (IntegrationError, RunNeedsCuts):
         raise SteadyLoopFailed from None
     traj.extras["status"] = np.ones(s.r.shape[0], dtype=np.int64)  # the engine's status: every particle reached the end
-    traj.extras["atol"] = tolerances_used(atol, s.r, s.v, s.duration, s.rtol)
     diagnostics = {}
     notes = list(s.frame.notes) + ["method dop853: the engine's steady loop (a constant rotation rate, uniform "
                                    "gravity, a string: rotframe.problem.steady), compiled once for every such problem"]
     _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
                         s.forces, diagnostics, notes, s.frame_terms)
     return ProblemRun(traj, diagnostics, [], notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
-
-
-def tolerances_used(atol, r, v, duration, rtol):
-    """The absolute tolerances (N, 6: r then v) a DOP853 run of the start states ``r``, ``v`` (N, 3) took: ``atol``
-    (`rotframe.problem.particle_setup.checked_atol`) for every particle, else each one's own, by the loop's own rule
-    (`rotframe.particles.chunked.own_tolerance_rows`, the same numbers). ``Trajectory.extras["atol"]``: what a restart
-    from a sample takes to be as accurate as the run (`rotframe.app.dense`)."""
-    from rotframe.particles.chunked import own_tolerance_rows
-
-    if atol is not None:
-        return np.repeat(np.asarray(atol, dtype=float)[None, :6], r.shape[0], axis=0)
-    return own_tolerance_rows(r, v, duration, rtol)
 
 
 def steady_omega(frame):

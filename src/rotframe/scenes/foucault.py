@@ -105,8 +105,11 @@ def simulate(p, terms, method, run, progress):
 def swing_scale(r0, v0):
     """The scale of DOP853's absolute tolerance for the swing from ``r0``, ``v0``: max(1 m, |r0|, |v0|), for r and
     v alike (DOP853's ``atol`` is ``rtol`` times it). Not the engine's default, which scales v by |r0| / duration:
-    over an hour, a thousandth of the swing's speed, and some 1.5 times the steps for nothing the metrics resolve."""
-    return max(1.0, float(np.max(np.abs(r0))), float(np.max(np.abs(v0))))
+    over an hour, a thousandth of the swing's speed, and some 1.5 times the steps for nothing the metrics resolve.
+    The scenes' ensembles' scale (`rotframe.numerics.step_control.ensemble_scale`)."""
+    from rotframe.numerics.step_control import ensemble_scale
+
+    return ensemble_scale(r0, v0)
 
 
 def swing_angle(r, v, w0):

@@ -149,7 +149,9 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
     v0 = rng.normal(size=(n, 3))
     model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=g)
     ground = Event("ground", "r", 2, 0.0, -1, True)
-    atol = rtol * max(1.0, float(np.max(np.abs(np.concatenate([r0, v0])))))  # the ensemble's own rule
+    from rotframe.numerics.step_control import ensemble_scale
+
+    atol = rtol * ensemble_scale(r0, v0)  # the ensemble's own rule
     run = {"step": h or None, "samples": 1, "rtol": rtol}
 
     def ours(threads):
