@@ -138,7 +138,8 @@ def test_a_variant_compiles_only_its_own_model_method_and_events(tmp_path):
             "dop853_trajectory_engine_particle6"} <= particle, particle
     # the right-hand side is compiled once, marked for LLVM to inline, and no DOP853 stage calls it any more
     assert lines[1] == "inline True, calls left 0", lines[1]
-    assert not particle & {"body_rhs", "own_step", "strang", "rk4_step_engine_particle", "kick_acceleration",
+    assert not particle & {"body_rhs", "own_step", "particle_strang", "body_split", "rotation_strang",
+                           "rk4_step_engine_particle", "kick_acceleration",
                            "lie_poisson_strang",
                            "sphere_strang", "varying_into", "varying_vector", "hermite"}, particle
     # then a body: its own variant and right-hand side, no particle's

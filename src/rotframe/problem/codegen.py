@@ -214,7 +214,7 @@ from rotframe.problem.signatures import TERMS_SIG, EVENT_SIG, POTENTIAL_SIG, VEC
 def jit(signature):
     # called by address alone (rotframe.problem.calls): no CPython or C entry point to build
     return njit(signature, cache={cache}, error_model="numpy", nogil=True, no_cpython_wrapper=True,
-                no_cfunc_wrapper=True)
+                no_cfunc_wrapper=True, forceinline=True)
 """
 
 _HEADER_PLAIN = """\

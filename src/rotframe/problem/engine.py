@@ -58,11 +58,13 @@ from rotframe.numerics.bisection import MAX_HALVINGS, locator
 from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
-from rotframe.numerics.step_control import own_tolerances, start_short_of
+from rotframe.numerics.step_control import own_tolerances
 from rotframe.problem.calls import RAISED, call_event, direct_functions
-from rotframe.problem.models import (DOP853, EVALUATIONS_PER_STEP, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6,
-                                     SPLITTING8, particle_energy, rhs)
+from rotframe.problem.models import (DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8,
+                                     particle_energy, rhs)
 from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
+from rotframe.problem.fixed_step import fixed_step_loop
+from rotframe.problem.loop_state import load_particle, save_particle, watcher_context
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
 from rotframe.problem.stops import next_stop
 
@@ -90,16 +92,6 @@ def store_rows(out, k, p, y):
 def raised(ctx):
     """Whether a user function raised since the flag was cleared (`rotframe.problem.calls`)."""
     return ctx[2][RAISED] != 0.0
-
-
-@jit_inline
-def all_finite(y, n):
-    """Whether the first ``n`` numbers of ``y`` are finite; ``n`` a constant of the caller's code (`DIM`), so that the
-    compiler unrolls the loop: over ``y.shape[0]``, known only at run time, it was a sixth of a splitting's step."""
-    for j in range(n):
-        if not math.isfinite(y[j]):
-            return False
-    return True
 
 
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
@@ -161,34 +153,6 @@ def _start_sign(tctx, h):
         if not moved:
             break
     return g_near
-
-
-@jit_inline
-def load_particle(i, Y, TC, H, IDX, y):
-    """Particle ``i``'s state into ``y``; returns its time, step and next sample ``(t, h, idx)``."""
-    for j in range(y.shape[0]):
-        y[j] = Y[i, j]
-    return TC[i], H[i], IDX[i]
-
-
-@jit_inline
-def save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status):
-    """Particle ``i``'s state, time, step, next sample, fixed-step count and status, where the next call goes on."""
-    for j in range(y.shape[0]):
-        Y[i, j] = y[j]
-    TC[i] = t
-    H[i] = h
-    IDX[i] = idx
-    SUB[i] = sub
-    ST[i] = status
-
-
-@jit_inline
-def watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
-    """The data of a variant's watcher, ``wctx`` (`_watch_events`): the events' arrays, the run's start, the
-    locator's stages ``Kb`` and states ``V[4:7]`` (the loops keep ``V[0:4]`` for their own). A variant without
-    events passes 0 instead (``EVENTS``, a constant of its code): no tuple of twelve to build, type and pass on."""
-    return GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T[0], Kb, V[4], V[5], V[6]
 
 
 def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
@@ -280,7 +244,7 @@ def variant_loop(model, method, events, D=None):
 
     DOP853 runs the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`, `_dop853_loop`)
     for the model's right-hand side, from stop to stop. The fixed-step methods run
-    `_fixed_step_loop`, which the GPU compiles too (`rotframe.problem.gpu`). ``D`` (default
+    `rotframe.problem.fixed_step`'s loop, which the GPU compiles too (`rotframe.problem.gpu`). ``D`` (default
     `STATE_LENGTH`) is the length of the state (a particle's is 10 where a force acts in inertial
     axes), a constant of the steps' code too (`stepper`).
     """
@@ -292,7 +256,8 @@ def variant_loop(model, method, events, D=None):
             f"{'_events' if events else ''}")
     if method == DOP853:
         return _dop853_loop(name, body, events, D)
-    return _fixed_step_loop(name, body, method, events, D)
+    step = stepper(body, method, D)
+    return fixed_step_loop(name, body, method, D, step, _watcher(name, step, body, method) if events else None)
 
 
 def _watcher(kind, step, body, method):
@@ -375,116 +340,6 @@ def _dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, 
         elif end == ABORTED:
             status = 6
         save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, 0, status)
-
-
-def _fixed_step_loop(name, body, method, events, D):
-    """The loop of a fixed-step variant (RK4, the model's splittings): a step that divides each sample interval.
-
-    A step ends on the next sample or the next stop, whichever is first; RK4's grid goes on from a
-    stop. The template `_fixed_step_advance` reads the variant's constants as globals
-    (`rotframe.numerics.compiled.bound`), the length of the state ``D`` among them; the GPU compiles
-    this loop too (`rotframe.problem.gpu`).
-    """
-    step = stepper(body, method, D)
-    watch = _watcher(name, step, body, method) if events else None
-    return bound(_fixed_step_advance, name, STEPPER=step, BODY_FLAG=body, METHOD=method, EVENTS=bool(events),
-                 WATCH=watch, DIM=int(D))
-
-
-def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
-                        atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
-    """The template of a fixed-step variant's loop (`_fixed_step_loop`)."""
-    # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
-    # set for the block
-    n = T.shape[0]
-    D = DIM
-    y, yt, yn, yev = V[0], V[1], V[2], V[3]
-    ctx = (prob, fns, W)
-    wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
-    for i in range(lo, hi):
-        if ST[i] != 0:
-            continue
-        t, h, idx = load_particle(i, Y, TC, H, IDX, y)
-        sub = SUB[i]
-        W[RAISED] = 0.0
-        # the particle's counts kept here and added to NSTEP and NFEV once, where the call leaves it: on a GPU, two
-        # reads and writes of global memory per step were more traffic than the step's own
-        steps = 0
-        nfev = 0
-        if METHOD == RK4:  # its first stage, f at the step's start (a splitting evaluates what it needs itself)
-            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
-            nfev += 1
-        status = 0
-        per = -1.0  # the steps of the current sample interval, counted once an interval (`run_grid`'s hfix divides it)
-        while idx < n and steps < budget:
-            if t >= T[idx]:
-                for j in range(D):
-                    OUT[idx, i, j] = y[j]
-                idx += 1
-                sub = 0
-                per = -1.0
-                continue
-            # a step ends on the next sample or the next stop, whichever is first
-            stop = next_stop(S, t)
-            at_knot = stop < T[idx]
-            target = stop if at_knot else T[idx]
-            if per < 0.0:
-                per = math.floor((T[idx] - T[idx - 1]) / hfix + 0.5)
-            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-            # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's own
-            # rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
-            last = sub + 1 >= per
-            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
-            if at_knot and stop < grid_next:
-                hh = stop - t  # to the knot; the grid goes on from there
-                landing = True
-            else:
-                target = T[idx]
-                hh = hfix if on_grid else grid_next - t
-                sub += 1
-                landing = last
-            t_new = target if landing else T[idx - 1] + sub * hfix
-            t_stages = t
-            if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
-                t_stages = start_short_of(t, hh, t_new)
-            take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
-            steps += 1
-            nfev += EVALUATIONS_PER_STEP[METHOD]
-            if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
-                status = 6
-                break
-            if not all_finite(yn, D):
-                status = 3
-                break
-            if EVENTS:  # a constant of the variant: without events, none of this is compiled
-                stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
-                if stop_now:
-                    if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
-                        status = 5
-                        break
-                    # the state at the terminal event: the step of that length from the step's start (the
-                    # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
-                    t = t + tau
-                    for j in range(D):
-                        y[j] = yev[j]
-                    while idx < n:
-                        for j in range(D):
-                            OUT[idx, i, j] = y[j]
-                        idx += 1
-                    status = 2
-                    break
-            t = t_new
-            for j in range(D):
-                y[j] = yn[j]
-            if METHOD == RK4:
-                rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
-                nfev += 1
-        if status == 0 and idx >= n:
-            status = 1
-        NSTEP[i] += steps
-        NFEV[i] += nfev
-        save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
 
 
 #: the engine's method codes by the registry's names (the codes never leave the engine and its equations,

@@ -350,20 +350,36 @@ def turn_axis(steady, wx, wy, wz, W):
     return w, ux, uy, uz
 
 
+@jit_inline
+def _kicked_state(yt, x, y, z, vx, vy, vz):
+    """The state a splitting's kick reads (the forces are functions of arrays): written to the scratch ``yt``."""
+    yt[0] = x
+    yt[1] = y
+    yt[2] = z
+    yt[3] = vx
+    yt[4] = vy
+    yt[5] = vz
+
+
 @jit_llvm_inline
-def rotation_strang(t, h, yn, prob, fns, W):
+def rotation_strang(t, h, s, yt, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
     drift h/2, kick h/2, a drag term's exact flow h/2, the Coriolis flow v' = -2 w x v (v turned by
     -2 |w| h about w, with w at the step's middle: exact for a constant omega, symmetric always),
-    the drag flow h/2, kick h/2, drift h/2."""
+    the drag flow h/2, kick h/2, drift h/2. The state ``s`` is a particle's six numbers, and so is
+    the result: it stays in registers from step to step (`particle_split`); the kick reads it from ``yt``,
+    after the drift (the velocity still the step's first)."""
+    x, y, z, vx, vy, vz = s
     hh = 0.5 * h
-    for j in range(3):
-        yn[j] += hh * yn[j + 3]
-    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yn, prob, fns, W)
-    vx = yn[3] + hh * ax
-    vy = yn[4] + hh * ay
-    vz = yn[5] + hh * az
-    k1, k2 = drag_rates(prob[1], yn)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
+    x = x + hh * vx
+    y = y + hh * vy
+    z = z + hh * vz
+    _kicked_state(yt, x, y, z, vx, vy, vz)
+    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yt, prob, fns, W)
+    vx = vx + hh * ax
+    vy = vy + hh * ay
+    vz = vz + hh * az
+    k1, k2 = drag_rates(prob[1], yt)  # a drag term's exact flow, h/2 on each side of the turn (none: the identity)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     if prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term (and w is not 0)
         w, ux, uy, uz = turn_axis(prob[3] == CONSTANT, wx, wy, wz, W)
@@ -371,37 +387,35 @@ def rotation_strang(t, h, yn, prob, fns, W):
             c, s = turn_cos_sin(-2.0 * w * h, W)
             vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
-    yn[3] = vx + hh * ax
-    yn[4] = vy + hh * ay
-    yn[5] = vz + hh * az
-    for j in range(3):
-        yn[j] += hh * yn[j + 3]
+    vx = vx + hh * ax
+    vy = vy + hh * ay
+    vz = vz + hh * az
+    return x + hh * vx, y + hh * vy, z + hh * vz, vx, vy, vz
 
 
 @jit_llvm_inline
-def sphere_strang(t, h, yn, prob, fns, W):
+def sphere_strang(t, h, s, yt, prob, fns, W):
     """One step of the rotation splitting on the string's sphere, as the scenes' pendulum splitting
     (`rotframe.particles.kernels`; docs/physics/splitting.md): the great-circle flow h/2
     (`rotframe.numerics.sphere`), the kick's part across the string h/2, a drag term's exact flow h/2,
     the Coriolis flow across the string (v turned about the string's direction n by -2 (w . n) h, w at
     the step's middle), the drag flow h/2, the kick h/2, the great-circle flow h/2. The string's
-    tension is the part of every force along n, which the flows on the sphere take exactly."""
+    tension is the part of every force along n, which the flows on the sphere take exactly. The state
+    as `rotation_strang`'s; the kick reads the position after the first flow, the velocity the step's first."""
     M = prob[1]
     px = M[1]
     py = M[2]
     pz = M[3]
     L = M[4]
     hh = 0.5 * h
-    x, y, z, vx, vy, vz = great_circle(yn[0], yn[1], yn[2], yn[3], yn[4], yn[5], hh, px, py, pz, L)
-    yn[0] = x
-    yn[1] = y
-    yn[2] = z
-    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yn, prob, fns, W)
+    x, y, z, vx, vy, vz = great_circle(s[0], s[1], s[2], s[3], s[4], s[5], hh, px, py, pz, L)
+    _kicked_state(yt, x, y, z, s[3], s[4], s[5])
+    ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yt, prob, fns, W)
     nx = (x - px) / L
     ny = (y - py) / L
     nz = (z - pz) / L
     ax, ay, az, vx, vy, vz = kick_across(vx, vy, vz, ax, ay, az, nx, ny, nz, hh)
-    k1, k2 = drag_rates(M, yn)
+    k1, k2 = drag_rates(M, yt)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     if M[9] != 0.0:  # the Coriolis flow, where the run keeps the term
         angle = -2.0 * (wx * nx + wy * ny + wz * nz) * h
@@ -410,13 +424,7 @@ def sphere_strang(t, h, yn, prob, fns, W):
     vx += hh * ax
     vy += hh * ay
     vz += hh * az
-    x, y, z, vx, vy, vz = great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, L)
-    yn[0] = x
-    yn[1] = y
-    yn[2] = z
-    yn[3] = vx
-    yn[4] = vy
-    yn[5] = vz
+    return great_circle(x, y, z, vx, vy, vz, hh, px, py, pz, L)
 
 
 @jit_llvm_inline
@@ -469,85 +477,86 @@ def lie_poisson_strang(t, h, yn, prob, fns, W):
 
 
 @jit_llvm_inline
-def strang(body, t, h, yn, prob, fns, W):
-    if body is None:  # a constant (`rhs`)
-        if prob[1][0] != 0.0:  # a pendulum's string: the splitting on its sphere
-            sphere_strang(t, h, yn, prob, fns, W)
-        else:
-            rotation_strang(t, h, yn, prob, fns, W)
-    else:
+def particle_strang(t, h, s, yt, prob, fns, W):
+    """A particle's splitting, order 2: on the string's sphere where it has one, else the rotation splitting."""
+    if prob[1][0] != 0.0:
+        return sphere_strang(t, h, s, yt, prob, fns, W)
+    return rotation_strang(t, h, s, yt, prob, fns, W)
+
+
+@jit_inline
+def particle_split(method, t, s, h, yt, prob, fns, W):
+    """A particle's step of the splitting ``method`` (`own_step`) from its state ``s`` at t, six numbers in and out:
+    the loops carry it in registers from step to step (`rotframe.problem.engine`'s fixed-step loop); ``yt`` (6,)
+    is the scratch its kicks read the state from."""
+    if method == SPLITTING:
+        return particle_strang(t, h, s, yt, prob, fns, W)
+    if method == SPLITTING4:
+        w1 = YOSHIDA4_OUTER
+        w0 = YOSHIDA4_INNER
+        s = particle_strang(t, w1 * h, s, yt, prob, fns, W)
+        s = particle_strang(t + w1 * h, w0 * h, s, yt, prob, fns, W)
+        return particle_strang(t + (w1 + w0) * h, w1 * h, s, yt, prob, fns, W)
+    if method == SPLITTING6:
+        return _particle_composed(KAHAN_LI6_STEPS, t, s, h, yt, prob, fns, W)
+    return _particle_composed(KAHAN_LI8_STEPS, t, s, h, yt, prob, fns, W)
+
+
+@jit_llvm_inline
+def _particle_composed(weights, t, s, h, yt, prob, fns, W):
+    """`particle_strang` composed with the fractions ``weights`` of the step (Kahan & Li's)."""
+    done = 0.0
+    for w in weights:
+        s = particle_strang(t + done * h, w * h, s, yt, prob, fns, W)
+        done += w
+    return s
+
+
+@jit_llvm_inline
+def _body_composed(weights, t, h, yn, prob, fns, W):
+    """`lie_poisson_strang` composed in place with the fractions ``weights`` of the step (Kahan & Li's)."""
+    done = 0.0
+    for w in weights:
+        lie_poisson_strang(t + done * h, w * h, yn, prob, fns, W)
+        done += w
+
+
+@jit_llvm_inline
+def body_split(method, t, y, h, yn, prob, fns, W):
+    """A rigid body's step of the splitting ``method`` (`own_step`), in place in ``yn``: its splitting
+    (`lie_poisson_strang`) composed as a particle's (`particle_split`), the attitude normalised after the step."""
+    for j in range(y.shape[0]):
+        yn[j] = y[j]
+    if method == SPLITTING:
         lie_poisson_strang(t, h, yn, prob, fns, W)
+    elif method == SPLITTING4:
+        w1 = YOSHIDA4_OUTER
+        w0 = YOSHIDA4_INNER
+        lie_poisson_strang(t, w1 * h, yn, prob, fns, W)
+        lie_poisson_strang(t + w1 * h, w0 * h, yn, prob, fns, W)
+        lie_poisson_strang(t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
+    elif method == SPLITTING6:
+        _body_composed(KAHAN_LI6_STEPS, t, h, yn, prob, fns, W)
+    else:
+        _body_composed(KAHAN_LI8_STEPS, t, h, yn, prob, fns, W)
+    norm_q = math.sqrt(yn[3] * yn[3] + yn[4] * yn[4] + yn[5] * yn[5] + yn[6] * yn[6])
+    for j in range(3, 7):
+        yn[j] /= norm_q
 
 
 @jit_inline
 def own_step(body, method, t, y, h, yn, prob, fns, W):
     """``SPLITTING``: the model's splitting (order 2); ``SPLITTING4``: Yoshida's triple jump of it (order 4);
-    ``SPLITTING6``, ``SPLITTING8``: Kahan & Li's compositions of it (orders 6 and 8). A body's attitude is
-    normalised after the step, as the rigid scenes' splitting does (`rotframe.rigid.kernels.split_run`).
+    ``SPLITTING6``, ``SPLITTING8``: Kahan & Li's compositions of it (orders 6 and 8). From (t, y) into ``yn``: a
+    particle's by `particle_split` (``yn`` the kicks' scratch until the step is done), a body's by `body_split`.
 
     Inlined by numba into the variant's loop, whose ``method`` is a constant: the other methods' steps are pruned
     before anything is compiled (each its own function, compiled once and inlined by LLVM)."""
-    if method == SPLITTING:
-        strang_step(body, t, y, h, yn, prob, fns, W)
-    elif method == SPLITTING4:
-        yoshida_step(body, t, y, h, yn, prob, fns, W)
-    elif method == SPLITTING6:
-        composed_step(body, KAHAN_LI6_STEPS, t, y, h, yn, prob, fns, W)
+    if body is None:
+        yn[0], yn[1], yn[2], yn[3], yn[4], yn[5] = particle_split(method, t, (y[0], y[1], y[2], y[3], y[4], y[5]), h,
+                                                                  yn, prob, fns, W)
     else:
-        composed_step(body, KAHAN_LI8_STEPS, t, y, h, yn, prob, fns, W)
-
-
-@jit_inline
-def _start(y, yn):
-    """``yn = y``: the state a step begins from. A particle's six numbers by a loop of a constant count, which the
-    compiler unrolls: over the state's length, known only at run time, it was a tenth of a splitting's step
-    (2026-11-30)."""
-    if y.shape[0] == 6:
-        for j in range(6):
-            yn[j] = y[j]
-    else:
-        for j in range(y.shape[0]):
-            yn[j] = y[j]
-
-
-@jit_inline
-def _normalise_attitude(body, yn):
-    """A body's attitude in ``yn`` normalised after its step (a particle's state untouched)."""
-    if body is not None:
-        norm_q = math.sqrt(yn[3] * yn[3] + yn[4] * yn[4] + yn[5] * yn[5] + yn[6] * yn[6])
-        for j in range(3, 7):
-            yn[j] /= norm_q
-
-
-@jit_llvm_inline
-def strang_step(body, t, y, h, yn, prob, fns, W):
-    """The model's splitting, order 2 (`own_step`)."""
-    _start(y, yn)
-    strang(body, t, h, yn, prob, fns, W)
-    _normalise_attitude(body, yn)
-
-
-@jit_llvm_inline
-def yoshida_step(body, t, y, h, yn, prob, fns, W):
-    """Yoshida's triple jump of the model's splitting, order 4 (`own_step`)."""
-    _start(y, yn)
-    w1 = YOSHIDA4_OUTER
-    w0 = YOSHIDA4_INNER
-    strang(body, t, w1 * h, yn, prob, fns, W)
-    strang(body, t + w1 * h, w0 * h, yn, prob, fns, W)
-    strang(body, t + (w1 + w0) * h, w1 * h, yn, prob, fns, W)
-    _normalise_attitude(body, yn)
-
-
-@jit_llvm_inline
-def composed_step(body, weights, t, y, h, yn, prob, fns, W):
-    """The model's splitting composed with the fractions ``weights`` of the step (`own_step`: Kahan & Li's)."""
-    _start(y, yn)
-    done = 0.0
-    for w in weights:
-        strang(body, t + done * h, w * h, yn, prob, fns, W)
-        done += w
-    _normalise_attitude(body, yn)
+        body_split(method, t, y, h, yn, prob, fns, W)
 
 
 @jit_uncounted

@@ -1,0 +1,163 @@
+"""The engine's loop of a fixed-step method (RK4, the models' splittings): a step that divides each sample interval.
+
+A variant of the engine (`rotframe.problem.engine.variant_loop`) for a fixed-step method runs this
+loop, one particle (or body) at a time, a bounded number of steps per call, on the CPU and on the
+GPU (`rotframe.problem.gpu` compiles the same template). A step ends on the next sample or the next
+stop, whichever is first (the steps of a sample interval are counted, so the step divides it);
+RK4's grid goes on from a stop; the events are watched after each step
+(`rotframe.problem.engine`'s watcher).
+
+A particle's splitting carries its six numbers in registers from step to step (``CARRIED``:
+`rotframe.problem.models.particle_split` takes and returns them), and writes them to the arrays
+only where they are read: at a sample, for the events' watcher, where the call ends. The arrays'
+round trips on the state's path were half of a step's time: the tower drop's ensemble (20,000
+particles, 2 s at 1 ms, one thread) took 1.84 times the scenes' kernels' time, 1.53 times carried
+(`python tools/ensembles_on_engine.py`, 2026-11-30). The numbers are those of the array step to
+the bit (`rotframe.problem.steps.take_step`, which the events' re-steps take: it calls the same
+`particle_split`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from rotframe.numerics.compiled import bound
+from rotframe.numerics.step_control import start_short_of
+from rotframe.problem.calls import RAISED
+from rotframe.problem.loop_state import (all_finite, load_particle, save_particle, store_state, store_tuple,
+                                         tuple_finite, watcher_context)
+from rotframe.problem.models import EVALUATIONS_PER_STEP, RK4, particle_split, rhs
+from rotframe.problem.steps import take_step
+from rotframe.problem.stops import next_stop
+
+__all__ = ["fixed_step_loop"]
+
+# the names a loop binds (`fixed_step_loop`): None, 0 or False in the template itself, which is never compiled
+STEPPER = BODY_FLAG = WATCH = None
+METHOD = DIM = 0
+EVENTS = CARRIED = False
+
+
+def fixed_step_loop(name, body, method, D, step, watch):
+    """The loop of a fixed-step variant, as Python: the template `_fixed_step_advance` with the variant's constants
+    as its globals (`rotframe.numerics.compiled.bound`): ``body`` (None: a particle), the ``method``'s code, the
+    length of the state ``D``, the method's ``step`` (`rotframe.problem.steps.stepper`) and the events' ``watch``
+    (None: no events, none of the watching compiled). A particle's splitting carries its state (``CARRIED``)."""
+    return bound(_fixed_step_advance, name, STEPPER=step, BODY_FLAG=body, METHOD=method, EVENTS=watch is not None,
+                 WATCH=watch, DIM=int(D), CARRIED=body is None and method != RK4)
+
+
+def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
+                        atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
+    """The template of a fixed-step variant's loop (`fixed_step_loop`)."""
+    # K (16, D), Kb (13, D) stages, V (7, D) state vectors, W the models' scratch: the caller's (`scratch`), one
+    # set for the block
+    n = T.shape[0]
+    D = DIM
+    y, yt, yn, yev = V[0], V[1], V[2], V[3]
+    ctx = (prob, fns, W)
+    wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
+    for i in range(lo, hi):
+        if ST[i] != 0:
+            continue
+        t, h, idx = load_particle(i, Y, TC, H, IDX, y)
+        s = (y[0], y[1], y[2], y[3], y[4], y[5])  # a particle's splitting carries its state in registers (CARRIED)
+        sub = SUB[i]
+        W[RAISED] = 0.0
+        # the particle's counts kept here and added to NSTEP and NFEV once, where the call leaves it: on a GPU, two
+        # reads and writes of global memory per step were more traffic than the step's own
+        steps = 0
+        nfev = 0
+        if METHOD == RK4:  # its first stage, f at the step's start (a splitting evaluates what it needs itself)
+            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+            nfev += 1
+        status = 0
+        per = -1.0  # the steps of the current sample interval, counted once an interval (`run_grid`'s hfix divides it)
+        while idx < n and steps < budget:
+            if t >= T[idx]:
+                if CARRIED:
+                    store_tuple(OUT, idx, i, s)
+                else:
+                    for j in range(D):
+                        OUT[idx, i, j] = y[j]
+                idx += 1
+                sub = 0
+                per = -1.0
+                continue
+            # a step ends on the next sample or the next stop, whichever is first
+            stop = next_stop(S, t)
+            at_knot = stop < T[idx]
+            target = stop if at_knot else T[idx]
+            if per < 0.0:
+                per = math.floor((T[idx] - T[idx - 1]) / hfix + 0.5)
+            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
+            # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's own
+            # rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
+            last = sub + 1 >= per
+            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
+            if at_knot and stop < grid_next:
+                hh = stop - t  # to the knot; the grid goes on from there
+                landing = True
+            else:
+                target = T[idx]
+                hh = hfix if on_grid else grid_next - t
+                sub += 1
+                landing = last
+            t_new = target if landing else T[idx - 1] + sub * hfix
+            t_stages = t
+            if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
+                t_stages = start_short_of(t, hh, t_new)
+            if CARRIED:  # the step of `take_step`, on the state in registers (yt: its kicks' scratch)
+                sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
+            else:
+                take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
+            steps += 1
+            nfev += EVALUATIONS_PER_STEP[METHOD]
+            if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
+                status = 6
+                break
+            if CARRIED:
+                if not tuple_finite(sn):
+                    status = 3
+                    break
+            elif not all_finite(yn, D):
+                status = 3
+                break
+            if EVENTS:  # a constant of the variant: without events, none of this is compiled
+                if CARRIED:  # the watcher reads the step's ends from the arrays
+                    store_state(y, s)
+                    store_state(yn, sn)
+                stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
+                if stop_now:
+                    if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
+                        status = 5
+                        break
+                    # the state at the terminal event: the step of that length from the step's start (the
+                    # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
+                    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
+                    t = t + tau
+                    for j in range(D):
+                        y[j] = yev[j]
+                    s = (y[0], y[1], y[2], y[3], y[4], y[5])
+                    while idx < n:
+                        for j in range(D):
+                            OUT[idx, i, j] = y[j]
+                        idx += 1
+                    status = 2
+                    break
+            t = t_new
+            if CARRIED:
+                s = sn
+            else:
+                for j in range(D):
+                    y[j] = yn[j]
+            if METHOD == RK4:
+                rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+                nfev += 1
+        if status == 0 and idx >= n:
+            status = 1
+        NSTEP[i] += steps
+        NFEV[i] += nfev
+        if CARRIED:
+            store_state(y, s)
+        save_particle(i, Y, TC, H, IDX, SUB, ST, y, t, h, idx, sub, status)
