@@ -87,73 +87,86 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             # a step ends on the next sample or the next stop, whichever is first
             stop = next_stop(S, t)
             at_knot = stop < T[idx]
-            target = stop if at_knot else T[idx]
             if per < 0.0:
                 per = math.floor((T[idx] - T[idx - 1]) / hfix + 0.5)
-            on_grid = t == (T[idx - 1] + sub * hfix if sub > 0 else T[idx - 1])
-            # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's own
-            # rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
-            last = sub + 1 >= per
-            grid_next = T[idx] if last else T[idx - 1] + (sub + 1) * hfix
-            if at_knot and stop < grid_next:
-                hh = stop - t  # to the knot; the grid goes on from there
-                landing = True
-            else:
-                target = T[idx]
-                hh = hfix if on_grid else grid_next - t
-                sub += 1
-                landing = last
-            t_new = target if landing else T[idx - 1] + sub * hfix
-            t_stages = t
-            if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
-                t_stages = start_short_of(t, hh, t_new)
-            if CARRIED:  # the step of `take_step`, on the state in registers (yt: its kicks' scratch)
-                sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
-            else:
-                take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
-            steps += 1
-            nfev += EVALUATIONS_PER_STEP[METHOD]
-            if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
-                status = 6
-                break
-            if CARRIED:
-                if not tuple_finite(sn):
+            t0 = T[idx - 1]
+            t_end = T[idx]
+            on_grid = t == (t0 + sub * hfix if sub > 0 else t0)
+            # on the grid with no stop before the sample, the rest of the interval is a run of steps of hfix, each
+            # ending on the grid (the last on the sample): decided here once, not at every step
+            regular = on_grid and not at_knot
+            hh = hfix
+            t_new = t_end
+            if not regular:
+                # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's
+                # own rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
+                last = sub + 1 >= per
+                grid_next = t_end if last else t0 + (sub + 1) * hfix
+                if at_knot and stop < grid_next:
+                    hh = stop - t  # to the knot; the grid goes on from there
+                    t_new = stop
+                else:
+                    hh = hfix if on_grid else grid_next - t
+                    sub += 1
+                    t_new = t_end if last else t0 + sub * hfix
+            while True:
+                if regular:
+                    sub += 1
+                    t_new = t_end if sub >= per else t0 + sub * hfix
+                t_stages = t
+                if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
+                    t_stages = start_short_of(t, hh, t_new)
+                if CARRIED:  # the step of `take_step`, on the state in registers (yt: its kicks' scratch)
+                    sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
+                else:
+                    take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
+                steps += 1
+                nfev += EVALUATIONS_PER_STEP[METHOD]
+                if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
+                    status = 6
+                    break
+                if CARRIED:
+                    if not tuple_finite(sn):
+                        status = 3
+                        break
+                elif not all_finite(yn, D):
                     status = 3
                     break
-            elif not all_finite(yn, D):
-                status = 3
-                break
-            if EVENTS:  # a constant of the variant: without events, none of this is compiled
-                if CARRIED:  # the watcher reads the step's ends from the arrays
-                    store_state(y, s)
-                    store_state(yn, sn)
-                stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
-                if stop_now:
-                    if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
-                        status = 5
-                        break
-                    # the state at the terminal event: the step of that length from the step's start (the
-                    # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
-                    t = t + tau
-                    for j in range(D):
-                        y[j] = yev[j]
-                    s = (y[0], y[1], y[2], y[3], y[4], y[5])
-                    while idx < n:
+                if EVENTS:  # a constant of the variant: without events, none of this is compiled
+                    if CARRIED:  # the watcher reads the step's ends from the arrays
+                        store_state(y, s)
+                        store_state(yn, sn)
+                    stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
+                    if stop_now:
+                        if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
+                            status = 5
+                            break
+                        # the state at the terminal event: the step of that length from the step's start (the
+                        # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
+                        take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
+                        t = t + tau
                         for j in range(D):
-                            OUT[idx, i, j] = y[j]
-                        idx += 1
-                    status = 2
+                            y[j] = yev[j]
+                        s = (y[0], y[1], y[2], y[3], y[4], y[5])
+                        while idx < n:
+                            for j in range(D):
+                                OUT[idx, i, j] = y[j]
+                            idx += 1
+                        status = 2
+                        break
+                t = t_new
+                if CARRIED:
+                    s = sn
+                else:
+                    for j in range(D):
+                        y[j] = yn[j]
+                if METHOD == RK4:
+                    rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+                    nfev += 1
+                if not regular or sub >= per or t >= t_end or steps >= budget:
                     break
-            t = t_new
-            if CARRIED:
-                s = sn
-            else:
-                for j in range(D):
-                    y[j] = yn[j]
-            if METHOD == RK4:
-                rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
-                nfev += 1
+            if status != 0:
+                break
         if status == 0 and idx >= n:
             status = 1
         NSTEP[i] += steps
