@@ -213,16 +213,20 @@ def test_a_force_that_raises_mid_run_is_named_with_time_state_and_samples(method
     assert 0.4 <= part.times[-1] <= 0.5 and np.all(np.isfinite(part.r))
 
 
-def test_an_event_that_gives_nan_mid_run_is_named():
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_an_event_that_gives_nan_mid_run_is_named(method):
     with pytest.raises(IntegrationError) as info:
-        rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=2.0, events=[event_nan_after], samples=20)
+        rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=2.0, events=[event_nan_after], samples=20,
+                          method=method, step=0.01)
     msg = str(info.value)
     assert "event_nan_after" in msg and "non-finite" in msg and "nan" in msg
 
 
-def test_an_event_that_raises_mid_run_is_named():
+@pytest.mark.parametrize("method", ["dop853", "rk4", "rotation-splitting"])
+def test_an_event_that_raises_mid_run_is_named(method):
     with pytest.raises(ScenarioError) as info:
-        rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=2.0, events=[event_raises_after], samples=20)
+        rotframe.simulate(omega=[0, 0, 1.0], r0=R0, v0=V0, duration=2.0, events=[event_raises_after], samples=20,
+                          method=method, step=0.01)
     msg = str(info.value)
     assert "event_raises_after" in msg and "RuntimeError: event broke" in msg
 
