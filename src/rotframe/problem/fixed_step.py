@@ -7,12 +7,13 @@ stop, whichever is first (the steps of a sample interval are counted, so the ste
 RK4's grid goes on from a stop; the events are watched after each step
 (`rotframe.problem.engine`'s watcher).
 
-A particle's splitting carries its six numbers in registers from step to step (``CARRIED``:
-`rotframe.problem.models.particle_split` takes and returns them), and writes them to the arrays
-only where they are read: at a sample, for the events' watcher, where the call ends. The arrays'
-round trips on the state's path were half of a step's time. The numbers are those of the array
-step to the bit (`rotframe.problem.steps.take_step`, which the events' re-steps take: it calls the
-same `particle_split`).
+A particle carries its six numbers in registers from step to step (``CARRIED``): a splitting's
+step takes and returns them (`rotframe.problem.models.particle_split`), RK4's too with the
+acceleration at the step's start beside them (`rotframe.problem.steps.carried_rk4`); they are
+written to the arrays only where they are read: at a sample, for the events' watcher, where the
+call ends. The arrays' round trips on the state's path were half of a splitting's step. The
+numbers are those of the array steps to the bit (`rotframe.problem.steps.take_step`, which the
+events' re-steps take, calls the same functions).
 
 What a step costs beyond its arithmetic is decided as seldom as it can be: the sample grid once a
 run of steps (on the grid, with no stop before the sample, the rest of the interval is steps of
@@ -20,7 +21,8 @@ run of steps (on the grid, with no stop before the sample, the rest of the inter
 asks the watcher (and writes the step's start for its re-steps) only where the step may cross. On
 the tower drop's ensemble (20,000 particles, 2 s at 1 ms, one thread; `python
 tools/ensembles_on_engine.py`, 2026-11-30) the inlined splitting went from 1.84 to 1.24 times the
-scenes' kernels' time without an event and from 2.3 to 1.65 with the ground event.
+scenes' kernels' time without an event and from 2.3 to 1.52 with the ground event (the watcher a
+function of its own, `rotframe.problem.engine._watcher`), RK4 from 1.21 to 1.06 with or without it.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.loop_state import (all_finite, load_particle, save_particle, store_state, store_tuple,
                                          tuple_finite, watcher_context)
 from rotframe.problem.models import EVALUATIONS_PER_STEP, RK4, particle_split, rhs
-from rotframe.problem.steps import take_step
+from rotframe.problem.steps import carried_rk4, particle_acceleration, take_step
 from rotframe.problem.stops import next_stop
 
 __all__ = ["fixed_step_loop"]
@@ -48,9 +50,9 @@ def fixed_step_loop(name, body, method, D, step, watch):
     """The loop of a fixed-step variant, as Python: the template `_fixed_step_advance` with the variant's constants
     as its globals (`rotframe.numerics.compiled.bound`): ``body`` (None: a particle), the ``method``'s code, the
     length of the state ``D``, the method's ``step`` (`rotframe.problem.steps.stepper`) and the events' ``watch``
-    (None: no events, none of the watching compiled). A particle's splitting carries its state (``CARRIED``)."""
+    (None: no events, none of the watching compiled). A particle of six numbers carries its state (``CARRIED``)."""
     return bound(_fixed_step_advance, name, STEPPER=step, BODY_FLAG=body, METHOD=method, EVENTS=watch is not None,
-                 WATCH=watch, DIM=int(D), CARRIED=body is None and method != RK4)
+                 WATCH=watch, DIM=int(D), CARRIED=body is None and D == 6)
 
 
 @jit_inline
@@ -82,6 +84,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
     D = DIM
     y, yt, yn, yev = V[0], V[1], V[2], V[3]
     ctx = (prob, fns, W)
+    stage = (prob, fns, W, yt, K[1])  # a carried RK4 step's (`rotframe.problem.steps.carried_rk4`)
     wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
     for i in range(lo, hi):
         if ST[i] != 0:
@@ -94,8 +97,12 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
         # reads and writes of global memory per step were more traffic than the step's own
         steps = 0
         nfev = 0
+        a1 = (0.0, 0.0, 0.0)  # RK4's first stage carried: the acceleration at the step's start
         if METHOD == RK4:  # its first stage, f at the step's start (a splitting evaluates what it needs itself)
-            rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+            if CARRIED:
+                a1 = particle_acceleration(stage, t, s)
+            else:
+                rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
             nfev += 1
         status = 0
         per = -1.0  # the steps of the current sample interval, counted once an interval (`run_grid`'s hfix divides it)
@@ -143,7 +150,10 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
                     t_stages = start_short_of(t, hh, t_new)
                 if CARRIED:  # the step of `take_step`, on the state in registers (yt: its kicks' scratch)
-                    sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
+                    if METHOD == RK4:
+                        sn = carried_rk4(stage, t_stages, s, hh, a1)
+                    else:
+                        sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
                 else:
                     take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
                 steps += 1
@@ -191,7 +201,10 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                     for j in range(D):
                         y[j] = yn[j]
                 if METHOD == RK4:
-                    rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
+                    if CARRIED:
+                        a1 = particle_acceleration(stage, t, s)
+                    else:
+                        rhs(BODY_FLAG, t, y, K[0], prob, fns, W)
                     nfev += 1
                 if not regular or sub >= per or t >= t_end or steps >= budget:
                     break

@@ -23,7 +23,8 @@ from rotframe.numerics.dop853_loop import dop853_stages, dop853_step
 from rotframe.numerics.rk4 import rk4_particle_step, rk4_step
 from rotframe.problem.models import DOP853, RK4, own_step, rhs
 
-__all__ = ["particle_system", "body_system", "particle_rk4", "stepper", "take_step"]
+__all__ = ["particle_system", "body_system", "particle_rk4", "carried_rk4", "particle_acceleration", "stepper",
+           "take_step"]
 
 
 @jit_inline
@@ -60,15 +61,27 @@ def _stage_acceleration(ctx, t, state):
 _particle_step = rk4_particle_step("engine", _stage_acceleration, jit_inline)
 
 
+@jit_inline
+def carried_rk4(stage, t, s, h, a1):
+    """A particle's RK4 step on its six numbers ``s`` at t, ``a1`` its acceleration there, ``stage = (prob, fns, W, yt,
+    dy)`` (`particle_acceleration`'s): the state after ``h``, in registers (the fixed-step loop carries it,
+    `rotframe.problem.fixed_step`)."""
+    return _particle_step(stage, stage, t, s, h, a1)
+
+
+#: a particle's acceleration at ``(t, s)`` with ``stage = (prob, fns, W, yt, dy)``: the right-hand side's, through ``yt``
+particle_acceleration = _stage_acceleration
+
+
 @jit_llvm_inline  # not numba's inlining: take_step passes each variant's step to the other method's branches too
 def particle_rk4(ctx, t, y, h, K, yt, yn):
     """A particle's RK4 step (6 numbers) in the protocol of `rotframe.numerics.rk4.rk4_step`: from ``(t, y)``, with
     ``K[0] = f(t, y)``, the state after ``h`` into ``yn``; ``yt`` the stages' states and ``K[1]`` their rates, each
-    read back at once (the stages are in registers)."""
+    read back at once (the stages are in registers): `carried_rk4` on the arrays."""
     prob, fns, W = ctx
-    stage = (prob, fns, W, yt, K[1])
-    yn[0], yn[1], yn[2], yn[3], yn[4], yn[5] = _particle_step(stage, stage, t, (y[0], y[1], y[2], y[3], y[4], y[5]),
-                                                              h, (K[0, 3], K[0, 4], K[0, 5]))
+    yn[0], yn[1], yn[2], yn[3], yn[4], yn[5] = carried_rk4((prob, fns, W, yt, K[1]), t,
+                                                           (y[0], y[1], y[2], y[3], y[4], y[5]), h,
+                                                           (K[0, 3], K[0, 4], K[0, 5]))
 
 
 @functools.lru_cache(maxsize=None)
