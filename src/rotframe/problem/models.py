@@ -88,6 +88,7 @@ from rotframe.particles.accelerations import air_density, centrifugal, euler, st
 from rotframe.particles.forces import drag_flow
 from rotframe.rigid.kernels import free_step
 from rotframe.problem.calls import call_potential, call_terms, call_varying
+from rotframe.problem.loop_state import store_state
 
 __all__ = ["ZERO", "CONSTANT", "TABLE", "BODY_FRAME", "FUNCTION", "FUNCTION_DOT", "DOP853", "RK4", "SPLITTING",
            "SPLITTING4", "SPLITTING6", "SPLITTING8", "EVALUATIONS_PER_STEP", "SCRATCH", "BODY_CONSTANTS", "body_constants", "inverse_inertia", "vector_of_time", "rhs", "own_step", "particle_energy"]
@@ -350,17 +351,6 @@ def turn_axis(steady, wx, wy, wz, W):
     return w, ux, uy, uz
 
 
-@jit_inline
-def _kicked_state(yt, x, y, z, vx, vy, vz):
-    """The state a splitting's kick reads (the forces are functions of arrays): written to the scratch ``yt``."""
-    yt[0] = x
-    yt[1] = y
-    yt[2] = z
-    yt[3] = vx
-    yt[4] = vy
-    yt[5] = vz
-
-
 @jit_llvm_inline
 def rotation_strang(t, h, s, yt, prob, fns, W):
     """One step of the rotation splitting (docs/physics/splitting.md), as the scenes' particle kernels:
@@ -374,7 +364,7 @@ def rotation_strang(t, h, s, yt, prob, fns, W):
     x = x + hh * vx
     y = y + hh * vy
     z = z + hh * vz
-    _kicked_state(yt, x, y, z, vx, vy, vz)
+    store_state(yt, (x, y, z, vx, vy, vz))  # what the kick's forces read (they are functions of arrays)
     ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yt, prob, fns, W)
     vx = vx + hh * ax
     vy = vy + hh * ay
@@ -384,8 +374,8 @@ def rotation_strang(t, h, s, yt, prob, fns, W):
     if prob[1][9] != 0.0:  # the Coriolis flow, where the run keeps the term (and w is not 0)
         w, ux, uy, uz = turn_axis(prob[3] == CONSTANT, wx, wy, wz, W)
         if w > 0.0:
-            c, s = turn_cos_sin(-2.0 * w * h, W)
-            vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, c, s)
+            cos_turn, sin_turn = turn_cos_sin(-2.0 * w * h, W)
+            vx, vy, vz = rodrigues_rotate(vx, vy, vz, ux, uy, uz, cos_turn, sin_turn)
     vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     vx = vx + hh * ax
     vy = vy + hh * ay
@@ -409,7 +399,7 @@ def sphere_strang(t, h, s, yt, prob, fns, W):
     L = M[4]
     hh = 0.5 * h
     x, y, z, vx, vy, vz = great_circle(s[0], s[1], s[2], s[3], s[4], s[5], hh, px, py, pz, L)
-    _kicked_state(yt, x, y, z, s[3], s[4], s[5])
+    store_state(yt, (x, y, z, s[3], s[4], s[5]))
     ax, ay, az, wx, wy, wz = kick_acceleration(t + hh, yt, prob, fns, W)
     nx = (x - px) / L
     ny = (y - py) / L
@@ -487,8 +477,8 @@ def particle_strang(t, h, s, yt, prob, fns, W):
 @jit_inline
 def particle_split(method, t, s, h, yt, prob, fns, W):
     """A particle's step of the splitting ``method`` (`own_step`) from its state ``s`` at t, six numbers in and out:
-    the loops carry it in registers from step to step (`rotframe.problem.engine`'s fixed-step loop); ``yt`` (6,)
-    is the scratch its kicks read the state from."""
+    the loops carry it in registers from step to step (`rotframe.problem.fixed_step`); ``yt`` (6,) is the scratch
+    its kicks read the state from."""
     if method == SPLITTING:
         return particle_strang(t, h, s, yt, prob, fns, W)
     if method == SPLITTING4:
@@ -521,10 +511,11 @@ def _body_composed(weights, t, h, yn, prob, fns, W):
         done += w
 
 
-@jit_llvm_inline
+@jit_inline
 def body_split(method, t, y, h, yn, prob, fns, W):
     """A rigid body's step of the splitting ``method`` (`own_step`), in place in ``yn``: its splitting
-    (`lie_poisson_strang`) composed as a particle's (`particle_split`), the attitude normalised after the step."""
+    (`lie_poisson_strang`) composed as a particle's (`particle_split`), the attitude normalised after the step.
+    Inlined by numba, as `particle_split`: a variant compiles its own composition alone."""
     for j in range(y.shape[0]):
         yn[j] = y[j]
     if method == SPLITTING:
