@@ -8,8 +8,12 @@ reaches in the run, so both take the same steps) both ways, best of three after 
 compiles or loads every loop, and prints the engine's time over the scenes' kernels': by address
 (``inline=False``) and with the problem's functions compiled into the loop (``inline=True``)::
 
-    python tools/ensembles_on_engine.py            # 20000 particles, 2 s at h = 1e-3 s
+    python tools/ensembles_on_engine.py            # 20000 particles, 2 s at h = 1e-3 s, every core
     python tools/ensembles_on_engine.py 100000     # the bench's ensemble size
+    python tools/ensembles_on_engine.py 20000 1    # on one thread (steadier on a shared machine)
+
+Each method is timed with the ground event and without it (the engine's loop then compiles no
+watcher; the scenes' kernels run their event-free driver).
 """
 
 from __future__ import annotations
@@ -34,12 +38,14 @@ def best(func, repeats=3):
 def main(argv):
     from rotframe import earth, forces
     from rotframe.events import crossing
-    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.particles.ensemble import integrate_ensemble, resolve_threads, threads_scope
+    from rotframe.particles.integrators import integrate_particles
     from rotframe.particles.integrators import Event
     from rotframe.particles.model import OmegaSchedule, ParticleModel
     from rotframe.problem.particles import simulate_particles
 
     n = int(argv[0]) if argv else 20000
+    threads = int(argv[1]) if len(argv) > 1 else None
     duration, h = 2.0, 1e-3
     lat = math.radians(50.88)
     g = float(earth.normal_gravity(lat))
@@ -50,19 +56,29 @@ def main(argv):
     r0[:, 2] = rng.uniform(100.0, 200.0, n)  # none lands within the run: the same steps for every particle
     v0 = np.zeros((n, 3))
     ground = Event("ground", "r", 2, 0.0, -1, True)
-    for method in ("rk4", "rotation-splitting"):
-        run = {"step": h, "samples": 16}
-        integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run)
-        scene = best(lambda: integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run))
-        engine = {}
-        for inline in (False, True):
-            kw = dict(omega=w, r0=r0, v0=v0, duration=duration, forces=[forces.gravity([0.0, 0.0, -g])],
-                      frame_terms=("coriolis",), method=method, step=h, samples=16, inline=inline,
-                      events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")])
-            simulate_particles(**kw)  # compiles or loads the loop
-            engine[inline] = best(lambda: simulate_particles(**kw))
-        print(f"{method}: the scenes' kernels {n * duration / h / scene / 1e6:.1f} M particle-steps/s; the engine "
-              f"{engine[False] / scene:.2f}x their time by address, {engine[True] / scene:.2f}x inlined")
+    with threads_scope(resolve_threads(threads)):
+        for method in ("rk4", "rotation-splitting"):
+            for watched in (True, False):
+                run = {"step": h, "samples": 16}
+                if watched:
+                    def scenes():
+                        return integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run)
+                else:
+                    def scenes():
+                        return integrate_particles(model, r0, v0, duration, method=method, step=h, samples=16)
+                scenes()
+                scene = best(scenes)
+                engine = {}
+                for inline in (False, True):
+                    events = [crossing(2, 0.0, direction=-1, terminal=True, name="ground")] if watched else []
+                    kw = dict(omega=w, r0=r0, v0=v0, duration=duration, forces=[forces.gravity([0.0, 0.0, -g])],
+                              frame_terms=("coriolis",), method=method, step=h, samples=16, inline=inline,
+                              events=events)
+                    simulate_particles(**kw)  # compiles or loads the loop
+                    engine[inline] = best(lambda: simulate_particles(**kw))
+                print(f"{method}, {'the ground event' if watched else 'no event'}: the scenes' kernels "
+                      f"{n * duration / h / scene / 1e6:.1f} M particle-steps/s; the engine {engine[False] / scene:.2f}x "
+                      f"their time by address, {engine[True] / scene:.2f}x inlined", flush=True)
     return 0
 
 

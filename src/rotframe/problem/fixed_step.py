@@ -19,10 +19,11 @@ What a step costs beyond its arithmetic is decided as seldom as it can be: the s
 run of steps (on the grid, with no stop before the sample, the rest of the interval is steps of
 ``hfix``), the state's finiteness by one test of its sum, and a single event by `quiet_step`, which
 asks the watcher (and writes the step's start for its re-steps) only where the step may cross. On
-the tower drop's ensemble (20,000 particles, 2 s at 1 ms, one thread; `python
-tools/ensembles_on_engine.py`, 2026-11-30) the inlined splitting went from 1.84 to 1.24 times the
-scenes' kernels' time without an event and from 2.3 to 1.52 with the ground event (the watcher a
-function of its own, `rotframe.problem.engine._watcher`), RK4 from 1.21 to 1.06 with or without it.
+the tower drop's ensemble with the ground event (20,000 particles, 2 s at 1 ms, one thread; `python
+tools/ensembles_on_engine.py 20000 1`, 2026-11-30) the inlined loop went from 2.3 to 1.54 times the
+scenes' kernels' time under the splitting (the watcher a function of its own,
+`rotframe.problem.engine._watcher`) and from 1.33 to 1.13 under RK4; without an event, 1.33 and
+1.12 times the scenes' event-free driver.
 """
 
 from __future__ import annotations
