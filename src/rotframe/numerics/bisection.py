@@ -28,10 +28,22 @@ from __future__ import annotations
 
 from rotframe.numerics.compiled import bound, jit_inline, jit_internal
 
-__all__ = ["MAX_HALVINGS", "bisection_midpoint", "narrow", "locator"]
+__all__ = ["MAX_HALVINGS", "crossed", "bisection_midpoint", "narrow", "locator"]
 
 #: Most halvings of a bracket: more than any double's round-off needs (from 1e308 to 5e-324, 2100 halvings)
 MAX_HALVINGS = 2200
+
+
+@jit_internal
+def crossed(direction, g0, g1):
+    """Whether an event function went from g0 to g1 across zero in ``direction`` (> 0 rising, < 0 falling, 0 either;
+    a zero reached counts as crossed, a zero left does not): the rule of every watcher (the scenes' drivers,
+    `rotframe.particles.events`; the engine's, `rotframe.problem.engine`, `rotframe.problem.fixed_step`)."""
+    if direction > 0.0:
+        return g0 < 0.0 and g1 >= 0.0
+    if direction < 0.0:
+        return g0 > 0.0 and g1 <= 0.0
+    return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
 
 
 @jit_internal

@@ -18,7 +18,7 @@ import math
 
 from numba import njit
 
-from rotframe.numerics.bisection import locator
+from rotframe.numerics.bisection import crossed, locator
 from rotframe.particles.forces import state_acceleration
 from rotframe.particles.kernels import make_plan, method_steps
 from rotframe.particles.packed import jit_internal
@@ -129,16 +129,6 @@ def start_value(events, e, state, m, w, wd):
     if d2 != 0.0:
         return 1e-300 if d2 > 0.0 else -1e-300
     return 0.0
-
-
-@jit_internal
-def crossed(direction, g0, g1):
-    """Whether the event function went from g0 to g1 across zero in the given direction."""
-    if direction > 0.0:
-        return g0 < 0.0 and g1 >= 0.0
-    if direction < 0.0:
-        return g0 > 0.0 and g1 <= 0.0
-    return (g0 < 0.0 and g1 >= 0.0) or (g0 > 0.0 and g1 <= 0.0)
 
 
 _crossed = _inline(crossed.py_func)  # the same rule, inlined into the watch loop

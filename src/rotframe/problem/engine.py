@@ -54,7 +54,7 @@ import math
 import numpy as np
 from numba import njit, types
 
-from rotframe.numerics.bisection import MAX_HALVINGS, locator
+from rotframe.numerics.bisection import MAX_HALVINGS, crossed, locator
 from rotframe.numerics.compiled import bound, jit_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
@@ -188,9 +188,7 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
                 rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
                 started = True
             g_old = START_SIGN(tctx, h)
-        rising = g_old < 0.0 and g_new >= 0.0
-        falling = g_old > 0.0 and g_new <= 0.0
-        if (rising and EDIR[k] >= 0) or (falling and EDIR[k] <= 0):
+        if crossed(EDIR[k], g_old, g_new):
             if not started:
                 rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
                 started = True

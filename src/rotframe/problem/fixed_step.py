@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 
+from rotframe.numerics.bisection import crossed
 from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.step_control import start_short_of
 from rotframe.problem.calls import RAISED, call_event
@@ -68,9 +69,7 @@ def quiet_step(wctx, ctx, p, t, t_new, y_new):
     prob, fns, W = ctx
     g_new = call_event(fns[1], 0, t_new, y_new, prob[2])
     g_old = GPREV[p, 0]
-    if not math.isfinite(g_new) or (g_old == 0.0 and t == t0):
-        return False
-    if (g_old < 0.0 and g_new >= 0.0 and EDIR[0] >= 0) or (g_old > 0.0 and g_new <= 0.0 and EDIR[0] <= 0):
+    if not math.isfinite(g_new) or (g_old == 0.0 and t == t0) or crossed(EDIR[0], g_old, g_new):
         return False
     GPREV[p, 0] = g_new
     return True
