@@ -131,15 +131,16 @@ def test_large_steady_dop853_run_takes_the_steady_driver_in_blocks_bitwise(monke
     calls = []
     real = blocks.run_blocks
 
-    def spy(one_block, n, per_particle, outputs):
+    def spy(one_block, n, per_particle, outputs, **how):
         kernel = dict(zip(one_block.__code__.co_freevars, (c.cell_contents for c in one_block.__closure__)))["kernel"]
         calls.append(kernel.py_func.__name__)
-        return real(one_block, n, per_particle, outputs)
+        return real(one_block, n, per_particle, outputs, **how)
 
     monkeypatch.setattr(blocks, "run_blocks", spy)
     many = simulate_particles(r0=r0, v0=v0, **kw).trajectory
     assert calls and set(calls) == {"run_dop853_steady"}  # the steady driver ran, in blocks
     assert np.array_equal(one.r, many.r) and np.array_equal(one.v, many.v)
+    assert one.steps == many.steps and one.nfev == many.nfev  # the most any particle took, in blocks as in one
 
 
 @pytest.mark.parametrize("n", [1, 4095, 4096, 4097, 10_000, 100_000, 123_457])

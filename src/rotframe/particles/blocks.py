@@ -77,7 +77,7 @@ def thread_pool(workers):
     return pool
 
 
-def run_blocks(one, n, per_particle, per_sample, scalars=()):
+def run_blocks(one, n, per_particle, per_sample, scalars=(), most=False):
     """Run ``one(*block_arrays)`` on every block of ``n`` particles, on the thread pool; merged results.
 
     Parameters
@@ -95,12 +95,15 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
         each block gets contiguous copies, written back.
     scalars : sequence
         Passed after the arrays unchanged.
+    most : bool
+        Whether each block reports the most any of its particles took (the cost returned is then the most over
+        the blocks), not its first particle's.
 
     Returns
     -------
     (n_done, bad, nfev, steps)
         The fewest samples done over the blocks, the first bad particle (an index into
-        the whole call) or -1, and the cost of particle 0 (block 0's).
+        the whole call) or -1, and the cost of particle 0 (block 0's), or with ``most`` the most of any.
     """
     from rotframe.particles import threads
 
@@ -139,4 +142,6 @@ def run_blocks(one, n, per_particle, per_sample, scalars=()):
         if r[1] >= 0:
             bad = lo + int(r[1])
             break
+    if most:
+        return n_done, bad, max(r[2] for r in results), max(r[3] for r in results)
     return n_done, bad, results[0][2], results[0][3]

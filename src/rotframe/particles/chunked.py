@@ -259,11 +259,13 @@ class KernelSetup:
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
                 return kernel(r, v, start, times, q, self.rtol, atol, span, np.empty((WORK_ROWS, 6)), out_r, out_v,
                               h_state)
-        else:
-            def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
-                return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span,
-                              self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state,
-                              np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
+
+            return run_blocks(one, r.shape[0], per_particle, (out_r, out_v), most=True)  # its count: the engine's
+
+        def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
+            return kernel(r, v, alive, start, times, self.P, self.wt_arg, self.wv, self.rtol, atol, span,
+                          self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, h_state,
+                          np.empty((WORK_ROWS, 6)), np.empty((13, 6)))
         return run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
 
     def warm_up(self):

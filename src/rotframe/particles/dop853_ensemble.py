@@ -33,7 +33,7 @@ def store_sample(out, k, p, y):
 
 @jit_inline
 def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, atol, span, out_r, out_v, h_state, work,
-                  wctx):
+                  wctx, most=False):
     """Each particle of ``r, v`` (N, 3) from ``t0`` over the sample ``times``, by `dop853_trajectory`.
 
     ``h_state`` (N,) each particle's next step (0: Hairer's starting step, at most ``span``, the
@@ -46,7 +46,8 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
     states at the end, ``out_r, out_v`` (n, N, 3) the samples: a particle that stopped or failed
     keeps its last state in the rest. ``atol`` (N, 6) each particle's absolute tolerances (r then v:
     `rotframe.particles.chunked.KernelSetup.abs_tol`). Returns ``(n_done, bad, nfev, steps)``: samples completed
-    by every particle, the first particle that failed (or -1), and particle 0's cost.
+    by every particle, the first particle that failed (or -1), and particle 0's cost (the scenes' cost of one
+    trajectory), or with ``most`` the most any particle took (the engine's count: `rotframe.problem.particles`).
 
     Inlined into each driver (numba IR), so that ``rhs`` and ``trajectory`` are the driver's globals:
     a function passed on from an argument is compiled as a dynamic address, which numba cannot cache.
@@ -97,7 +98,8 @@ def run_particles(rhs, trajectory, start, ctx, r, v, alive, t0, times, rtol, ato
             r[p, i] = y[i]
             v[p, i] = y[3 + i]
         h_state[p] = h
-        if p == 0:
+        if p == 0 or (most and nf > nfev0):
             nfev0 = nf
+        if p == 0 or (most and steps > steps0):
             steps0 = steps
     return n_done, bad, nfev0, steps0

@@ -95,7 +95,7 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, 
 
     Parameters and results as `rotframe.particles.drivers.run_dop853`, with ``q`` from
     `steady_parameters`. There are no events, so every particle stays alive. Returns
-    ``(n_done, bad, nfev, steps)`` (cost of particle 0).
+    ``(n_done, bad, nfev, steps)``, the cost the most any particle took (as the engine's loop counts it).
     """
     return run_particles(_steady_rhs, _steady_trajectory, None, q, r, v, None, t0, sample_times, rtol, atol, span,
-                         out_r, out_v, h_state, work, None)
+                         out_r, out_v, h_state, work, None, True)

@@ -431,7 +431,7 @@ def _steady_run(s, atol, progress) -> ProblemRun:
     """DOP853 on the steady loop (`rotframe.problem.steady`: `rotframe.particles.dop853_steady`, run in calls by
     `rotframe.particles.chunked`) for the set-up ``s``: the engine's loop's steps and numbers, each particle's own
     tolerances where ``atol`` is None; the energy diagnostic numpy's. The trajectory's ``steps`` and ``nfev`` are
-    particle 0's (the engine's loop gives the most any particle took: the same for one particle).
+    the most any particle took, as the engine's loop counts them.
 
     A run that fails (a state not finite, the step collapsed, a speed that grew without a force) raises
     `SteadyLoopFailed`: `simulate_particles` runs it again on the engine's loop, which meets the failure at the same
