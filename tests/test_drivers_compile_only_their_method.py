@@ -72,7 +72,7 @@ def test_a_driver_without_events_refuses_an_event_table():
     out = np.empty((1, 1, 3))
     table = np.array([[0.0, 2.0, -1.0, 0.0, 1.0]])
     with pytest.raises(ValueError, match="run_fixed_events"):
-        drivers.run_fixed(0, r, v, alive, 0.0, 0.1, 1, 1, model.pack(), None, model.omega.values,
+        drivers.run_fixed(0, r, v, alive, np.array([0.0, 0.1]), 0, 0.1, 1, 1, model.pack(), None, model.omega.values,
                           model.omega.cumulative(), table, out, out.copy(), None, None, None, None, None, 0, None, None)
     with pytest.raises(ValueError, match="run_dop853_events"):
         drivers.run_dop853(r, v, alive, 0.0, np.array([1.0]), model.pack(), None, model.omega.values, 1e-9,

@@ -63,7 +63,8 @@ def _run_fixed(model, method, events, t0=0.3, h=0.01, steps_per_sample=7, n_samp
     records = (np.full((n, 4), np.nan), np.zeros((n, 4, 3)), np.zeros((n, 4, 3)), np.zeros(n, np.int64),
                np.zeros((n, 4), np.int64), 4)
     kernel = run_fixed if events is None else run_fixed_events
-    result = kernel(method, r, v, alive, t0, h, steps_per_sample, n_samples, model.pack(),
+    times = t0 + np.arange(n_samples + 1) * (steps_per_sample * h)  # the sample times, from t0
+    result = kernel(method, r, v, alive, times, 0, h, steps_per_sample, n_samples, model.pack(),
                     wt, model.omega.values, model.omega.cumulative(), events,
                     out_r, out_v, *records, *family)
     return result, out_r, out_v, r, v

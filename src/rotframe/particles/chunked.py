@@ -207,30 +207,32 @@ class KernelSetup:
         return evb.args()
 
     def call(self, r, v, alive, first, count, out_r, out_v, evb, atol=None, h_state=None, t0=None,
-             sps=None, times=None):
+             sps=None, times=None, j0=0):
         """Advance ``r, v`` (N, 3) in place over samples ``first + 1 .. first + count``.
 
         ``out_r, out_v`` (count, N, 3) receive the samples; ``evb`` ([`EventBuffers`][rotframe.particles.trajectory.EventBuffers])
         the events; ``atol`` (N, 6) and ``h_state`` (N,) are DOP853's (`abs_tol`). Returns
         ``(n_done, bad, nfev, steps)`` as the compiled drivers (``n_done`` samples
         completed, ``bad`` the first particle with a non-finite state or -1, the cost
-        of particle 0). ``t0`` (default the sample time ``first``) and ``sps`` (default
+        of particle 0). ``j0`` (steps of the interval made before) and ``sps`` (default
         `sps`) let a fixed-step call start inside a sample interval and take part
-        of it (`one_sample_in_pieces`). ``times`` (adaptive only) replaces the sample times
-        the call lands on: the probe's short spans, or the pieces of a long sample interval
-        (`run_chunked`).
+        of it (`one_sample_in_pieces`): a fixed step starts on its interval's grid, ``T[s] + j h``, whatever
+        the call (`rotframe.particles.kernels.grid_time`). ``t0`` (adaptive only: default the sample time
+        ``first``) and ``times`` (adaptive only) replace the start and the sample times the call lands on: the
+        probe's short spans, or the pieces of a long sample interval (`run_chunked`).
 
         More particles than one block (`rotframe.particles.threads.BLOCK`) run in
         blocks on every core (`rotframe.particles.blocks.run_blocks`),
         bitwise as one call.
         """
-        start = float(self.times[first]) if t0 is None else t0
         kernel = self.__dict__.get("_kernel") or self.kernel()
         records = self.event_records(evb)
+        if self.fixed:
+            grid = self.times[first:first + count + 1]  # the call's sample times, from its first interval's start
         if self.fixed and r.shape[0] <= threads.BLOCK:
             # one block: the driver itself, without the pool's bookkeeping (a short run's overhead)
             k = self.sps if sps is None else sps
-            n_done, bad, nfev = kernel(r, v, alive, start, self.h, k, count, *self._model_args,
+            n_done, bad, nfev = kernel(r, v, alive, grid, j0, self.h, k, count, *self._model_args,
                                        out_r, out_v, *records, *self._family)
             return n_done, bad, nfev, k * n_done
         from rotframe.particles.blocks import run_blocks
@@ -241,12 +243,13 @@ class KernelSetup:
             k = self.sps if sps is None else sps
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
-                return kernel(r, v, alive, start, self.h, k, count, self.P, self.wt_arg,
+                return kernel(r, v, alive, grid, j0, self.h, k, count, self.P, self.wt_arg,
                               self.wv, self.wint, self.ev_tab, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which,
                               max_events, self.rk4, self.sphere) + (k * count,)
 
             n_done, bad, nfev, steps = run_blocks(one, r.shape[0], per_particle, (out_r, out_v))
             return n_done, bad, nfev, k * n_done
+        start = float(self.times[first]) if t0 is None else t0
         span = self.duration  # the starting step's bound: the whole run, however it is cut into calls
         end = first + 1 + max(count, 1)
         times = self.times[first + 1:end] if times is None else np.ascontiguousarray(times, dtype=float)
@@ -307,15 +310,13 @@ class KernelSetup:
         most = max(1, int(CALL_EVALS // (n * self.evals_per_step)))
         sps = self.sps
         pieces = -(-sps // most)
-        t0 = self.times[first]
         j = 0
         nfev = 0
         for p in range(pieces):
             k = (p + 1) * sps // pieces - j
             # each piece writes its end state into the sample's slot; the last piece's is the sample
             # (a slot of megabytes allocated for each piece cost page faults on every thread)
-            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1], out_v[:1], evb, t0=t0 + j * self.h,
-                                           sps=k)
+            n_done, bad, nf, _ = self.call(r, v, alive, first, 1, out_r[:1], out_v[:1], evb, j0=j, sps=k)
             nfev += nf
             if n_done < 1 or bad >= 0:
                 return 0, bad, nfev, 0

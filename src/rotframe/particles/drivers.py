@@ -27,7 +27,7 @@ from rotframe.numerics.compiled import inlined
 from rotframe.particles.dop853_ensemble import run_particles
 from rotframe.particles.dop853_particles import particle_rhs, particle_trajectory, particle_trajectory_events, start_events
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
-from rotframe.particles.kernels import advance, free_step, loop_code, make_plan, method_steps, rk4_step_of, sphere_step
+from rotframe.particles.kernels import advance, free_step, grid_time, loop_code, make_plan, method_steps, rk4_step_of, sphere_step
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
@@ -109,7 +109,7 @@ def _steady_run(method, r, v, alive, n_samples, steps_per_sample, h, m, plan, rk
 
 
 @jit_kernel
-def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
+def run_fixed(method, r, v, alive, times, j0, h, steps_per_sample, n_samples, P, wt, wv, wint,
               events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, rk4, sphere):
     """Advance an ensemble with a fixed-step method and store samples.
 
@@ -118,11 +118,18 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     method : int
         0 splitting, 1 splitting4, 2 rk4.
     r, v : (N, 3) arrays
-        State at ``t0`` (rotating frame, m and m/s); updated in place.
+        State at the call's start (rotating frame, m and m/s); updated in place.
     alive : (N,) bool array
         Particles still moving; a terminal event clears the flag (in place).
+    times : (n_samples + 1,) array
+        The run's sample times from the start of the call's first sample interval (s).
+    j0 : int
+        The steps of the first interval made before the call (a call that starts inside it: the pieces of
+        `rotframe.particles.chunked.KernelSetup.one_sample_in_pieces`).
     h : float
-        Step (s). Samples are stored every ``steps_per_sample`` steps.
+        Step (s). Samples are stored every ``steps_per_sample`` steps. Step ``j`` of sample interval ``s``
+        starts at ``times[s] + j h`` (`grid_time`), however the run is cut into calls: the engine's rule
+        (`rotframe.problem.fixed_step`).
     events : None
         No event table (an array raises `ValueError`): a run with one calls
         `run_fixed_events`, with the same arguments (each kernel compiles only
@@ -149,7 +156,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     if events is not None:
         raise ValueError("run_fixed takes no event table (events=None): a run with one calls run_fixed_events")
     m = unpack(P, wt, wv)
-    plan = make_plan(method, t0, h, m, wt, wv, wint)
+    plan = make_plan(method, grid_time(times, 0, j0, h), h, m, wt, wv, wint)
     nfev_step = NFEV[method]
     if wt is None or m.steady:
         # the throughput path: one loop compiled once for every variant of this driver
@@ -161,12 +168,11 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
     bad = -1
     for p in range(r.shape[0]):
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
-        k_step = int(0)  # an int64: a literal 0 would compile advance a second time
         for s in range(n_samples):
             if alive[p]:
                 # a varying rate: the whole sample interval in one call
-                state = _advance(method, state, t0, k_step, steps_per_sample, h, m, wt, wv, wint, plan, rk4, sphere)
-                k_step += steps_per_sample
+                state = _advance(method, state, times[s], j0 if s == 0 else 0, steps_per_sample, h, m, wt, wv, wint,
+                                 plan, rk4, sphere)
                 if p == 0:
                     nfev0 += nfev_step * steps_per_sample
                 if not _is_finite(state):
@@ -178,7 +184,7 @@ def run_fixed(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv
 
 
 @jit_kernel
-def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P, wt, wv, wint,
+def run_fixed_events(method, r, v, alive, times, j0, h, steps_per_sample, n_samples, P, wt, wv, wint,
                      events, out_r, out_v, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, rk4, sphere):
     """`run_fixed` with an event table ``events`` (E, 5) (`rotframe.particles.events.event_table`).
 
@@ -189,7 +195,8 @@ def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P,
     event clears the particle's ``alive`` flag; it keeps its state at the event in later samples.
     """
     m = unpack(P, wt, wv)
-    plan = make_plan(method, t0, h, m, wt, wv, wint)
+    t_start = grid_time(times, 0, j0, h)
+    plan = make_plan(method, t_start, h, m, wt, wv, wint)
     nfev_step = NFEV[method]
     n_ev = events.shape[0]
     g_old = np.empty(n_ev)
@@ -200,12 +207,12 @@ def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P,
     for p in range(r.shape[0]):
         state = (r[p, 0], r[p, 1], r[p, 2], v[p, 0], v[p, 1], v[p, 2])
         is_alive = alive[p]
-        k_step = int(0)  # an int64: a literal 0 would compile advance a second time
-        w0, wd0 = rates(t0, m.steady, m.w, wt, wv)
+        w0, wd0 = rates(t_start, m.steady, m.w, wt, wv)
         for e in range(n_ev):
             g_old[e] = start_value(events, e, state, m, w0, wd0)
         for s in range(n_samples):
             if is_alive:
+                j = j0 if s == 0 else 0  # the steps of this sample interval made before (`grid_time`)
                 if n_ev == 1 and (wt is None or m.steady):
                     # one event at a steady rate (an ensemble to the ground): the watch loop keeps the
                     # step and the event test in registers; the same steps, tests and location as below
@@ -224,10 +231,9 @@ def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P,
                                                   g_old[0])
                         done, start, state, g_start, g_new, hit = watched
                         k += done
-                        k_step += done
                         g_old[0] = g_new
                         if hit:
-                            t = t0 + (k_step - 1) * h
+                            t = grid_time(times, s, j + k - 1, h)
                             tau, at = locate_event(method, events, 0, start, g_start, t, h, m, wt, wv, wint,
                                                    rk4, sphere)
                             record_event(ev_t, ev_r, ev_v, ev_count, ev_which, max_events, p, 0, t + tau, at)
@@ -239,13 +245,13 @@ def run_fixed_events(method, r, v, alive, t0, h, steps_per_sample, n_samples, P,
                         nfev0 += nfev_step * k
                 else:
                     for _ in range(steps_per_sample):
-                        t = t0 + k_step * h
+                        t = grid_time(times, s, j, h)
                         start = state
                         step_plan = plan if m.steady else make_plan(method, t, h, m, wt, wv, wint)
                         state = method_steps(method, state, int(1), h, m, step_plan, rk4, sphere)  # int64 1
                         if p == 0:
                             nfev0 += nfev_step
-                        k_step += 1
+                        j += 1
                         stop = False
                         for e in range(n_ev):
                             g_new = event_value(events, e, state, m.radius)

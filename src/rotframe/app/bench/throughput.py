@@ -94,7 +94,7 @@ def call_overhead_rows(repeats=2000):
     out_r, out_v = np.empty((1, 1, 3)), np.empty((1, 1, 3))
 
     def driver():
-        kernel(r, v, alive, 0.0, setup.h, setup.sps, 1, setup.P, setup.wt_arg, setup.wv,
+        kernel(r, v, alive, setup.times, 0, setup.h, setup.sps, 1, setup.P, setup.wt_arg, setup.wv,
                setup.wint, None, out_r, out_v, None, None, None, None, None, 0, setup.rk4, setup.sphere)
 
     prepared = PreparedRun(model, "rotation-splitting", 1.0, step=0.1, samples=1, n=1)
