@@ -17,6 +17,7 @@ from rotframe.particles.threads import BLOCK
 from rotframe.problem.particles import simulate_particles
 
 STEADY_NOTE = "steady loop"
+FIXED_NOTE = "fixed-step drivers"
 
 
 def _on_string(rng, L, pivot, n):
@@ -105,7 +106,7 @@ def test_the_steady_loop_counts_the_costliest_particle_wherever_it_is(n_small):
 
 
 @pytest.mark.parametrize("change", [
-    {"method": "rk4", "step": 0.01},
+    {"method": "rk4", "step": 0.01, "inline": True},
     {"inline": True},
     {"events": [lambda t, r, v: r[0] - 10.0]},
     {"omega": lambda t: (0.0, 4e-5, 5e-5 * (1.0 + 0.01 * t))},
@@ -120,6 +121,90 @@ def test_other_runs_take_the_engines_loop(change):
     if "forces" in change:  # no string: any start
         kw["r0"] = [1.0, 2.0, 3.0]
     assert not _steady(**kw)
+
+
+def _random_fixed_problem(seed):
+    """A steady problem of uniform gravity and the Coriolis term (the tower drop's class) under RK4 or the rotation
+    splitting, with one built-in crossing or none."""
+    from rotframe.events import crossing
+
+    rng = np.random.default_rng(1000 + seed)
+    n = int(rng.integers(1, 5))
+    w = rng.normal(size=3) * 10.0 ** rng.uniform(-5, -1) if rng.random() < 0.9 else np.zeros(3)
+    terms = [forces.gravity(np.array([0.0, 0.0, -9.81]) + rng.normal(size=3) * 0.1)] if rng.random() < 0.85 else []
+    r0, v0 = rng.normal(size=(n, 3)) * 10.0, rng.normal(size=(n, 3)) * 3.0
+    duration = float(rng.uniform(0.5, 6.0))
+    samples = int(rng.integers(1, 30))
+    kw = dict(omega=w, r0=r0, v0=v0, duration=duration, samples=samples, forces=terms,
+              frame_terms=("coriolis", "euler") if rng.random() < 0.5 else ("coriolis",),
+              method=str(rng.choice(["rk4", "rotation-splitting"])), step=duration / samples / rng.uniform(1.0, 60.0))
+    if rng.random() < 0.8:
+        of = "v" if rng.random() < 0.3 else "r"
+        k = int(rng.integers(0, 3))
+        value = float(np.mean((r0 if of == "r" else v0)[:, k]) + rng.normal() * 0.3)  # some particles cross it
+        kw["events"] = [crossing(k, value, of=of, direction=int(rng.integers(-1, 2)), terminal=bool(rng.random() < 0.6),
+                                 name="level")]
+    return kw
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_the_fixed_step_drivers_are_the_engines_loop_to_the_bit(seed):
+    # a steady problem of uniform gravity and the Coriolis term under RK4 or the rotation splitting runs on the
+    # scenes' fixed-step drivers (chosen from the terms, `rotframe.problem.steady`) where their model keeps the
+    # frame's omega to the bit: the engine's loop (inline=False) is the oracle, sample by sample, event by event,
+    # with its counts and statuses
+    from rotframe.problem.steady import omega_kept
+
+    kw = _random_fixed_problem(seed)
+    fixed = simulate_particles(**kw)
+    general = simulate_particles(**kw, inline=False)
+    routed = any(FIXED_NOTE in n for n in fixed.notes)
+    assert routed == (not np.any(kw["omega"]) or omega_kept(kw["omega"])), fixed.notes
+    assert not any(FIXED_NOTE in n for n in general.notes)
+    a, b = fixed.trajectory, general.trajectory
+    assert np.array_equal(a.times, b.times)
+    assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v)
+    assert a.event_times.keys() == b.event_times.keys()
+    for name in a.event_times:
+        for x, y in zip(a.event_times[name], b.event_times[name]):
+            assert np.array_equal(x, y)
+        for x, y in zip(a.event_states[name], b.event_states[name]):
+            assert np.array_equal(x, y)
+    assert np.array_equal(a.extras["status"], b.extras["status"])
+    assert a.steps == b.steps > 0 and a.extras["step"] == b.extras["step"]
+    assert fixed.diagnostics == general.diagnostics and fixed.warnings == general.warnings
+
+
+@pytest.mark.parametrize("change", [{"frame_terms": ("coriolis", "centrifugal")}, {"method": "rotation-splitting4"},
+                                    {"forces": [forces.gravity([0.0, 0.0, -9.81]), forces.pendulum(20.0, [0, 0, 25.0])]},
+                                    {"omega": [1e-3, 2e-3, 2e-3]}])
+def test_fixed_step_runs_outside_the_drivers_arithmetic_take_the_engines_loop(change):
+    # terms whose arithmetic the drivers group otherwise (centrifugal, the string, the fourth-order splitting's
+    # re-step to an event), and an omega their model rounds (its axis times its rate is not omega again)
+    from rotframe.events import crossing
+    from rotframe.problem.steady import omega_kept
+
+    kw = dict(omega=[0.0, 4.6e-5, 5.7e-5], r0=[[0.0, 0.0, 5.0]], v0=[[0.0, 0.0, 0.0]], duration=2.0,
+              forces=[forces.gravity([0.0, 0.0, -9.81])], frame_terms=("coriolis",), method="rotation-splitting",
+              step=1e-3, events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")])
+    assert any(FIXED_NOTE in n for n in simulate_particles(**kw).notes)  # the tower drop's problem: the drivers
+    kw.update(change)
+    if "forces" in change:
+        kw["r0"] = [[20.0 * np.sin(0.1), 0.0, 25.0 - 20.0 * np.cos(0.1)]]
+    assert "omega" not in change or not omega_kept(np.array(change["omega"]))
+    assert not any(FIXED_NOTE in n for n in simulate_particles(**kw).notes)
+
+
+def test_a_run_whose_event_is_zero_at_a_start_takes_the_engines_loop():
+    # the drivers take the sign just after a zero start from derivatives, the engine from re-steps: not the same rule
+    from rotframe.events import crossing
+
+    kw = dict(omega=[0.0, 4e-5, 5e-5], r0=[[0.0, 0.0, 0.0], [0.0, 0.0, 5.0]], v0=[[1.0, 0.0, 3.0], [0.0, 0.0, 0.0]],
+              duration=2.0, forces=[forces.gravity([0.0, 0.0, -9.81])], method="rk4", step=1e-3,
+              frame_terms=("coriolis",), events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")])
+    run = simulate_particles(**kw)
+    assert not any(FIXED_NOTE in n for n in run.notes)
+    assert any(FIXED_NOTE in n for n in simulate_particles(**dict(kw, r0=[[0.0, 0.0, 1e-9], [0.0, 0.0, 5.0]])).notes)
 
 
 def test_a_failure_on_the_steady_loop_is_met_and_named_by_the_engines_loop():

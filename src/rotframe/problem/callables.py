@@ -29,7 +29,7 @@ from rotframe.errors import ScenarioError
 
 __all__ = ["blame_in_step", "raised_during_run", "fingerprint", "Unfingerprintable", "cache_key", "plain_function", "compiled_for_glue", "display_name", "check_call",
            "check_compilable", "UserFunctionError", "read_only_args", "raised_message", "readonly_view",
-           "readonly_array"]
+           "readonly_array", "event_names"]
 
 
 class UserFunctionError(ScenarioError):
@@ -391,3 +391,20 @@ def diagnose_compile(roles_and_functions, sample_args) -> str | None:
         except Exception:  # it compiled; what it does at run time is checked elsewhere
             continue
     return None
+
+
+def event_names(events):
+    """Each event's name in ``Result.trajectory.event_times``: its function's ``__name__`` (``event_k`` for a lambda
+    or none), numbered ``_2``, ``_3``... where names repeat."""
+    names = []
+    for k, g in enumerate(events):
+        base = getattr(plain_function(g), "__name__", "") or f"event_{k}"
+        if base == "<lambda>":
+            base = f"event_{k}"
+        name = base
+        j = 2
+        while name in names:
+            name = f"{base}_{j}"
+            j += 1
+        names.append(name)
+    return names

@@ -185,19 +185,20 @@ class SetUp:
     t0: float = 0.0
     #: makes the same problem's driver as plain Python (`rotframe.problem.tiers`); None for a plain run
     plain_driver: object = None
-    #: ``(model, q)`` of a run that the steady loop runs (`rotframe.problem.steady`); None for the engine's loop
+    #: the `rotframe.problem.steady.SteadyProblem` of a run that a steady loop runs; None for the engine's loop
     steady: object = None
 
 
 def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples,
-           omega_dot, jit, max_events, device, frame_terms, inline=None, steady=True):
+           omega_dot, jit, max_events, device, frame_terms, inline=None, steady=True, fixed_steady=True):
     """Check a particle problem and build what runs it, from the start states ``r0``, ``v0``: a `SetUp`.
 
     Every argument as `simulate_particles` takes it, checked in its order; the start states are
     checked too (the string's sphere, each function called once at particle 0's), and their
     number sizes the work limits. For method ``exact`` nothing is built: the set-up is returned
     checked, its driver None (the flow is the caller's, `rotframe.problem.exact`). Nor for a run
-    that the steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem.
+    that a steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem
+    (``fixed_steady`` False: DOP853's alone, not the scenes' fixed-step drivers).
     """
     import time
 
@@ -236,10 +237,11 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
-    steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms) if steady else None
+    steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r, v,
+                          uf.event_names(events), fixed_steady) if steady else None
     if steady is not None:  # the steady loop, compiled once for every such problem: nothing of this one is built
         return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
-                     frame_terms, on_gpu, steady=steady)
+                     frame_terms, on_gpu, slots=max_events if events else 1, steady=steady)
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
     roles = function_roles(frame, origin, forces, events, labels)

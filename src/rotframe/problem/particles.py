@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rotframe.errors import IntegrationError
+from rotframe.errors import IntegrationError, ScenarioError
 from rotframe.particles.trajectory import RunInterrupted, Trajectory, per_particle
 from rotframe.problem import callables as uf
 from rotframe.problem.frame_error import frame_interpolation
@@ -109,7 +109,9 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress)
-    if s.steady is not None:  # the steady loop: chosen from the terms, compiled once for every such problem
+    if s.steady is not None:  # a steady loop: chosen from the terms, compiled once for every such problem
+        if s.method != "dop853":
+            return _steady_fixed_run(s, progress)
         return _steady_run(s, checked_atol(atol), progress)
     method, duration, times, rtol, hfix, D, N = s.method, s.duration, s.times, s.rtol, s.hfix, s.D, r.shape[0]
     frame, origin, forces, events = s.frame, s.origin, s.forces, s.events
@@ -368,7 +370,7 @@ def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
     N = OUT.shape[1]
     if events:
         kept = np.arange(state["EVT"].shape[1])[None, :] < np.minimum(state["EVN"], state["EVT"].shape[1])[:, None]
-    for k, name in enumerate(_event_names(events)):
+    for k, name in enumerate(uf.event_names(events)):
         # each particle's crossings of event k in time order (ties in the order located), split per particle
         i, j = np.nonzero(kept & (state["EVK"] == k))
         order = np.lexsort((state["EVT"][i, j], i))
@@ -380,21 +382,6 @@ def trajectory_of(times, OUT, state, events, method, n_kept, step=0.0):
     if step:
         traj.extras["step"] = step
     return traj
-
-
-def _event_names(events):
-    names = []
-    for k, g in enumerate(events):
-        base = getattr(uf.plain_function(g), "__name__", "") or f"event_{k}"
-        if base == "<lambda>":
-            base = f"event_{k}"
-        name = base
-        j = 2
-        while name in names:
-            name = f"{base}_{j}"
-            j += 1
-        names.append(name)
-    return names
 
 
 def exact_model(terms, frame, origin, events, frame_terms):
@@ -412,7 +399,7 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
     from rotframe.problem.exact import event_row
 
     model = exact_model(terms, frame, origin, events, frame_terms)
-    rows = [event_row(g, name) for g, name in zip(events, _event_names(events))]  # built-in crossings: the flow's own
+    rows = [event_row(g, name) for g, name in zip(events, uf.event_names(events))]  # built-in crossings: the flow's own
     traj = integrate_exact(model, r, v, duration, samples, rows, progress, ordered=True)  # per particle, as the engine
     traj.extras["compile_s"] = 0.0
     forces = [f for f in terms if isinstance(f, Force)]
@@ -441,7 +428,7 @@ def _steady_run(s, atol, progress) -> ProblemRun:
     from rotframe.particles.chunked import KernelSetup, RunNeedsCuts, run_chunked
     from rotframe.particles.integrators import METHODS, check_work
 
-    model, q = s.steady
+    model, q = s.steady.model, s.steady.q
     info, samples = METHODS["dop853"], s.times.size - 1
     check_work(info, s.duration, None, samples, s.r.shape[0], model)
     setup = KernelSetup(model, info, s.duration, samples, rtol=s.rtol,
@@ -457,6 +444,62 @@ def _steady_run(s, atol, progress) -> ProblemRun:
     _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
                         s.forces, diagnostics, notes, s.frame_terms)
     return ProblemRun(traj, diagnostics, [], notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
+
+
+def _steady_fixed_run(s, progress) -> ProblemRun:
+    """A fixed-step method on a steady problem (`rotframe.problem.steady`): the scenes' fixed-step drivers
+    (`rotframe.particles.drivers`, run in calls by `rotframe.particles.chunked`), which take the engine's loop's
+    steps, samples and event times to the bit, its one event a row of theirs. The counts are the engine's: each
+    particle's steps up to the end or to the step of its terminal event, the most any took; the force evaluations
+    are the drivers' own (``evals_per_step`` a step). A run that fails raises `SteadyLoopFailed`, as `_steady_run`."""
+    from rotframe.particles.chunked import KernelSetup, run_chunked
+    from rotframe.particles.integrators import METHODS
+
+    model, rows = s.steady.model, s.steady.rows
+    info = METHODS[s.method]
+    samples, N = s.times.size - 1, s.r.shape[0]
+    try:
+        setup = KernelSetup(model, info, s.duration, samples, step=s.hfix, events=rows)
+        traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, s.slots, records=True, owned=True)
+    except (IntegrationError, ScenarioError):
+        raise SteadyLoopFailed from None
+    warnings = []
+    status = np.ones(N, dtype=np.int64)
+    steps = np.full(N, samples * setup.sps, dtype=np.int64)
+    evb = traj.extras.pop("event_records", None)
+    if rows:
+        evb.attach(traj, rows)
+        dropped = int(np.sum(np.maximum(evb.count - evb.max_events, 0)))
+        if dropped:
+            warnings.append(f"{dropped} event crossings beyond {evb.max_events} per particle were located but not kept")
+        if rows[0].terminal:
+            stopped = evb.count > 0
+            status[stopped] = 2
+            steps[stopped] = _steps_to(evb.t[stopped, 0], s.times, setup.sps, setup.h)
+    traj.steps = int(steps.max()) if N else 0
+    traj.nfev = traj.steps * setup.evals_per_step
+    traj.extras["status"] = status
+    diagnostics = {}
+    notes = list(s.frame.notes) + [f"method {s.method}: the scenes' fixed-step drivers (a constant rotation rate, "
+                                   "uniform gravity, the Coriolis term, one built-in crossing: rotframe.problem.steady), "
+                                   "the engine's steps to the bit"]
+    _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
+                        s.forces, diagnostics, notes, s.frame_terms)
+    return ProblemRun(traj, diagnostics, warnings, notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
+
+
+def _steps_to(t_event, times, sps, h):
+    """The steps each particle took to the one in which its terminal event at ``t_event`` fell: step ``j`` of sample
+    interval ``k`` runs from ``times[k] + j h`` (`rotframe.particles.kernels.grid_time`) to the next step's start
+    (``times[k + 1]`` for the last), and the event is in ``(start, end]``."""
+    k = np.clip(np.searchsorted(times, t_event, side="left") - 1, 0, times.size - 2)
+    j = np.clip(np.floor((t_event - times[k]) / h).astype(np.int64), 0, sps - 1)
+    for _ in range(2):  # the floor's rounding: at most one step either way, moved to the grid's own start times
+        start = np.where(j > 0, times[k] + j * h, times[k])
+        j = np.where((start >= t_event) & (j > 0), j - 1, j)
+        nxt = times[k] + (j + 1) * h
+        j = np.where((nxt < t_event) & (j + 1 < sps), j + 1, j)
+    return k * sps + j + 1
 
 
 def steady_omega(frame):

@@ -90,7 +90,7 @@ frame_attitude, frame_terms
         s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                    origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                    samples=samples, omega_dot=omega_dot, jit=True, max_events=256, device=None,
-                   frame_terms=frame_terms, inline=None if inline is True else inline)
+                   frame_terms=frame_terms, inline=None if inline is True else inline, fixed_steady=False)
         self.setup = s
         self._omega = omega
         #: the frame's attitude, checked once (refused even where no force reads it, as simulate refuses it)
@@ -264,7 +264,7 @@ class _SteadyLoop:
             s = self._s
             if N > s.r.shape[0]:  # more particles than the set-up's: their samples within the limits
                 check_arrays(N, s.times.size, s.D, 1, 2)
-            model, q = s.steady
+            model, q = s.steady.model, s.steady.q
             pr = self._runs[N] = PreparedRun(model, "dop853", s.duration, rtol=s.rtol, atol=self._atol,
                                              samples=s.times.size - 1, n=N, steady=q)
         return pr

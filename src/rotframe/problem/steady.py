@@ -1,4 +1,5 @@
-"""The engine's steady specialisation: DOP853 on a steady frame with uniform gravity and a string, compiled once.
+"""The engine's steady specialisations: DOP853 on a steady frame with uniform gravity and a string, compiled once;
+RK4 and the rotation splitting on a steady frame with uniform gravity and the Coriolis term, on the scenes' drivers.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -34,15 +35,57 @@ A problem qualifies (`steady_model`) where:
   particle-steps, a tenth of a second): a call ends with a step cut to land on its last sample, which
   the engine's loop never cuts, so a longer run goes to the engine's loop
   (`rotframe.particles.chunked.RunNeedsCuts`, `rotframe.problem.particles`), as a failure does.
+
+The fixed-step specialisation runs the scenes' fixed-step drivers (`rotframe.particles.drivers`, in the calls of
+`rotframe.particles.chunked`), which keep a particle's six numbers in registers and test a built-in crossing in
+place, where the engine's loop reaches its event function through the problem's glue. Each of their steps starts
+on its sample interval's grid as the engine's does (`rotframe.particles.kernels.grid_time`), and on the problems
+below their arithmetic is the engine's, so they give its samples, event times and states, statuses and step
+counts to the bit (``tests/test_steady_route.py``, random problems against ``inline=False``; 376 more, every one
+the same, 2026-11-30), in the scenes' time: the tower drop's ensemble (20,000 particles, the ground event, one
+thread) took 0.75 of the engine's inlined loop's time under the splitting and 0.96 under RK4
+(``python tools/ensembles_on_engine.py 20000 1``, "simulate's own choice", 2026-11-30). A problem qualifies where:
+
+- the method is ``rk4`` or ``rotation-splitting`` (`FIXED_STEADY`), on the CPU, compiled, ``inline`` not given;
+- the frame turns at a constant rate, its origin does not accelerate, and the scenes' model keeps its omega to
+  the bit (`omega_kept`: its axis and rate are the engine's, and their product is omega again; most vectors,
+  the Earth's at a latitude among them);
+- the terms are at most one force with a constant linear form, no string, and the centrifugal term does not act
+  (the drivers group the centrifugal term's and the string's arithmetic otherwise: round-off apart);
+- there is at most one event, a built-in crossing (`rotframe.events.crossing`), not zero at any particle's start
+  (the drivers take the sign after a zero start from derivatives, the engine from re-steps).
+
+A run that fails on the drivers (a state not finite, their guard on a speed that grows under no force) runs again
+on the engine's loop, which names the cause (`rotframe.problem.tiers.SteadyLoopFailed`). The counts reported are
+the engine's: each particle's steps to the end or to the step of its terminal event, the most any took; the
+force evaluations, the drivers' own.
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
 from rotframe.problem.terms import Force, StringConstraint, energy_by_numpy
 
-__all__ = ["steady_model"]
+__all__ = ["steady_model", "FIXED_STEADY", "SteadyProblem", "omega_kept"]
+
+#: the fixed-step methods whose steps, samples and event times the scenes' fixed-step drivers
+#: (`rotframe.particles.drivers`) take as the engine's loop takes them, to the bit, on a steady problem of
+#: uniform gravity and the Coriolis term (`steady_model`). ``rotation-splitting4`` is not one: its state at an
+#: event (the re-step of the crossing's length) differs in the last bits.
+FIXED_STEADY = ("rk4", "rotation-splitting")
+
+
+class SteadyProblem(NamedTuple):
+    """A run that a steady loop runs (`steady_model`): the problem as the scenes'
+    `rotframe.particles.model.ParticleModel`, the DOP853 steady loop's parameters ``q`` (None for a fixed-step
+    method, which the scenes' drivers run) and the events as the drivers' rows (`rotframe.particles.trajectory.Event`)."""
+
+    model: object
+    q: object
+    rows: tuple
 
 
 def _constant_acceleration(f):
@@ -55,15 +98,56 @@ def _constant_acceleration(f):
     return np.array(b, dtype=float)
 
 
-def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms):
-    """``(model, q)`` of a run that the steady loop runs, or None where the run does not qualify (the module
+def _event_rows(events, names, r, v):
+    """The drivers' rows of the run's ``events`` (named ``names``), or None where the scenes' drivers would not
+    locate them as the engine does: more than one event, one that is no built-in crossing
+    (`rotframe.problem.exact.event_row`), or one that is zero at a particle's start, which the drivers' start rule
+    (the sign from the derivatives) and the engine's (from re-steps) may read apart."""
+    from rotframe.problem.exact import event_row
+
+    if len(events) > 1:
+        return None
+    rows = tuple(event_row(g, name) for g, name in zip(events, names))
+    for row in rows:
+        if row is None or np.any((r if row.kind == "r" else v)[:, row.component] == row.value):
+            return None
+    return rows
+
+
+def omega_kept(w):
+    """Whether the scenes' model keeps the frame's ``w`` (3,) to the bit: its unit axis and rate
+    (`rotframe.particles.model.OmegaSchedule.constant`, numpy's norm) are the engine's (the norm summed in order,
+    `rotframe.problem.models.turn_axis`), and their product is ``w`` again (the drivers' Coriolis term reads it)."""
+    import math
+
+    from rotframe.particles.model import OmegaSchedule
+
+    n = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    kept = OmegaSchedule.constant(w)
+    axis, rate = kept.axis, float(kept.values[0])
+    return n > 0.0 and rate == n and np.array_equal(axis, w / n) and np.array_equal(axis * rate, w)
+
+
+def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r=None, v=None,
+                 event_names=(), fixed=True):
+    """The `SteadyProblem` of a run that a steady loop runs, or None where the run does not qualify (the module
     docstring): ``terms`` the run's forces and string as `set_up` reads them, ``frame_terms`` those of the frame's
-    terms that act. ``q`` is the loop's parameters (`rotframe.particles.dop853_steady.steady_parameters`: the
-    frame's omega as given, so the engine's arithmetic to the bit), ``model`` the same problem as the scenes'
-    `rotframe.particles.model.ParticleModel`, which the calls' driver (`rotframe.particles.chunked`) reads for its
-    work limits."""
-    if (method != "dop853" or on_gpu or not jit or inline is not None or events or frame.kind != "constant"
-            or origin.kind != "zero"):
+    terms that act, ``r``, ``v`` (N, 3) the start states and ``event_names`` the events' names (a fixed-step
+    method's; ``fixed`` False takes DOP853's loop alone). Its ``q`` is the DOP853 loop's parameters
+    (`rotframe.particles.dop853_steady.steady_parameters`: the frame's omega as given, so the engine's arithmetic
+    to the bit), ``model`` the same problem as the scenes' `rotframe.particles.model.ParticleModel`, which the
+    calls' driver (`rotframe.particles.chunked`) reads for its work limits and the fixed-step drivers run."""
+    fixed_step = fixed and method in FIXED_STEADY
+    if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
+            or (events and not fixed_step) or frame.kind != "constant" or origin.kind != "zero"):
+        return None
+    if fixed_step:  # the drivers' arithmetic is the engine's for uniform gravity and the Coriolis term alone
+        w = np.asarray(frame.data[0], dtype=float)
+        if ("centrifugal" in frame_terms or any(isinstance(f, StringConstraint) for f in terms)
+                or (np.any(w) and not omega_kept(w))):
+            return None
+    rows = _event_rows(events, event_names, r, v) if fixed_step else ()
+    if rows is None:
         return None
     g = string = None
     for f in terms:
@@ -88,6 +172,8 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         pivot, length = np.array(string.pivot, dtype=float), float(string.length)
         extra.update(pendulum_length=length, pivot=pivot)
     model = ParticleModel(names, omega=OmegaSchedule.constant(omega), **extra)
+    if fixed_step:
+        return SteadyProblem(model, None, rows)
     q = steady_parameters(np.zeros(3) if g is None else g, omega, pivot, length, "coriolis" in frame_terms,
                           "centrifugal" in frame_terms)
-    return model, q
+    return SteadyProblem(model, q, ())
