@@ -42,9 +42,10 @@ place, where the engine's loop reaches its event function through the problem's 
 on its sample interval's grid as the engine's does (`rotframe.particles.kernels.grid_time`), and on the problems
 below their arithmetic is the engine's, so they give its samples, event times and states, statuses and step
 counts to the bit (``tests/test_steady_route.py``, random problems against ``inline=False``; 376 more, every one
-the same, 2026-11-30), in the scenes' time: the tower drop's ensemble (20,000 particles, the ground event, one
-thread) took 0.75 of the engine's inlined loop's time under the splitting and 0.96 under RK4
-(``python tools/ensembles_on_engine.py 20000 1``, "simulate's own choice", 2026-11-30). A problem qualifies where:
+the same, 2026-11-30), in the scenes' time: on the tower drop's ensemble (20,000 particles, the ground event, one
+thread) ``simulate`` took 1.10 times the scenes' kernels' time under the splitting and 1.05 under RK4, its Python
+around them included, where the engine's inlined loop took 1.66 and 1.12 (``python tools/ensembles_on_engine.py
+20000 1``, 2026-11-30). A problem qualifies where:
 
 - the method is ``rk4`` or ``rotation-splitting`` (`FIXED_STEADY`), on the CPU, compiled, ``inline`` not given;
 - the frame turns at a constant rate, its origin does not accelerate, and the scenes' model keeps its omega to
