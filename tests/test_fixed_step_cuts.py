@@ -63,3 +63,30 @@ def test_a_varying_rate_gives_the_same_samples_however_the_run_is_cut(monkeypatc
     whole, *cut = _runs(monkeypatch, model, method)
     for other in cut:
         assert np.array_equal(whole.r, other.r) and np.array_equal(whole.v, other.v)
+
+
+@pytest.mark.parametrize("method", ["rk4", "rotation-splitting"])
+def test_the_tower_drops_ensemble_lands_where_the_engines_loop_does(method):
+    # the sweeps' vectorised ensemble (`rotframe.particles.ensemble`, the scenes' drivers) and the engine's own loop
+    # (inline=False) on the tower drop's problem, on the same sample grid (a sweep's, `ENSEMBLE_SAMPLES`): the same
+    # landing times and states, to the bit
+    import math
+
+    from rotframe import earth, forces
+    from rotframe.events import crossing
+    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.problem.particles import simulate_particles
+
+    lat = math.radians(50.88)
+    g, w = float(earth.normal_gravity(lat)), earth.omega_enu(lat)
+    model = ParticleModel(("gravity", "coriolis"), omega=OmegaSchedule.constant(w), g=np.array([0.0, 0.0, -g]))
+    r0 = np.zeros((9, 3))
+    r0[:, 2] = np.linspace(3.0, 110.0, 9)
+    ens = integrate_ensemble(model, r0, np.zeros_like(r0), 8.0, GROUND, method=method,
+                             run={"step": 1e-3, "samples": 16})
+    engine = simulate_particles(omega=w, r0=r0, v0=np.zeros_like(r0), duration=8.0, method=method, step=1e-3,
+                                samples=16, forces=[forces.gravity([0.0, 0.0, -g])], frame_terms=("coriolis",),
+                                events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")], inline=False)
+    t = np.array([times[0] for times in engine.trajectory.event_times["ground"]])
+    states = np.array([s[0] for s in engine.trajectory.event_states["ground"]])
+    assert np.array_equal(ens.t_event, t) and np.array_equal(ens.state, states)
