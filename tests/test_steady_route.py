@@ -176,7 +176,8 @@ def test_the_fixed_step_drivers_are_the_engines_loop_to_the_bit(seed):
 
 
 @pytest.mark.parametrize("change", [{"frame_terms": ("coriolis", "centrifugal")}, {"method": "rotation-splitting4"},
-                                    {"forces": [forces.gravity([0.0, 0.0, -9.81]), forces.pendulum(20.0, [0, 0, 25.0])]},
+                                    {"forces": [forces.gravity([0.0, 0.0, -9.81]),
+                                                forces.pendulum(20.0, [0, 0, 25.0])]},
                                     {"omega": [1e-3, 2e-3, 2e-3]}])
 def test_fixed_step_runs_outside_the_drivers_arithmetic_take_the_engines_loop(change):
     # terms whose arithmetic the drivers group otherwise (centrifugal, the string, the fourth-order splitting's

@@ -82,7 +82,8 @@ FIXED_STEADY = ("rk4", "rotation-splitting")
 class SteadyProblem(NamedTuple):
     """A run that a steady loop runs (`steady_model`): the problem as the scenes'
     `rotframe.particles.model.ParticleModel`, the DOP853 steady loop's parameters ``q`` (None for a fixed-step
-    method, which the scenes' drivers run) and the events as the drivers' rows (`rotframe.particles.trajectory.Event`)."""
+    method, which the scenes' drivers run) and the events as the drivers' rows
+    (`rotframe.particles.trajectory.Event`)."""
 
     model: object
     q: object
