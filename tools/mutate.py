@@ -43,7 +43,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:position_acceleration,state_acceleration,drag_coefficients,string_normal",
                    "src/rotframe/particles/accelerations.py:altitude_gravity,central_gravity,air_density,drag_rate,"
-                   "centrifugal_about_axis,coriolis_about_axis,string_tension"]
+                   "centrifugal,coriolis_about_axis,string_tension"]
 DEFAULT_TESTS = "tests/test_i11b_forces.py -k 'not projectile'"
 
 

@@ -33,7 +33,7 @@ import math
 
 from rotframe.numerics.compiled import jit_inline
 
-__all__ = ["altitude_gravity", "central_gravity", "spring_pull", "air_density", "drag_rate", "centrifugal_about_axis",
+__all__ = ["altitude_gravity", "central_gravity", "spring_pull", "air_density", "drag_rate",
            "coriolis_about_axis", "euler_about_axis", "centrifugal", "coriolis", "euler", "string_tension"]
 
 
@@ -79,14 +79,6 @@ def drag_rate(vx, vy, vz, k1, k2):
     term, at fixed position, is `rotframe.particles.forces.drag_flow`.
     """
     return k1 + k2 * math.sqrt(vx * vx + vy * vy + vz * vz)
-
-
-@jit_inline
-def centrifugal_about_axis(x, y, z, ux, uy, uz, w):
-    """``-w x (w x r) = w^2 (r - (u . r) u)``, omega ``= w u`` about the unit axis ``u`` (rad/s)."""
-    d = ux * x + uy * y + uz * z
-    w2 = w * w
-    return w2 * (x - d * ux), w2 * (y - d * uy), w2 * (z - d * uz)
 
 
 @jit_inline

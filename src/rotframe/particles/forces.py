@@ -22,8 +22,8 @@ import math
 
 from numba import njit
 
-from rotframe.particles.accelerations import (air_density, altitude_gravity, central_gravity, centrifugal_about_axis,
-                                              drag_rate, euler_about_axis, spring_pull, string_tension)
+from rotframe.particles.accelerations import (air_density, altitude_gravity, central_gravity, centrifugal, drag_rate,
+                                              euler_about_axis, spring_pull, string_tension)
 from rotframe.particles.packed import jit_internal, jit_kernel, unpack
 from rotframe.particles.schedule import rates
 
@@ -53,7 +53,10 @@ def position_acceleration(x, y, z, m, w, wd):
         ay += sy
     ux, uy, uz = m.axis
     if m.centrifugal:
-        cx, cy, cz = centrifugal_about_axis(x, y, z, ux, uy, uz, w)
+        # the vector form of any omega, the engine's (`rotframe.problem.models`): on a steady frame whose axis
+        # times its rate is omega again, the rotation splitting on these drivers is the engine's to the bit
+        # (`rotframe.problem.steady`)
+        cx, cy, cz = centrifugal(x, y, z, ux * w, uy * w, uz * w)
         ax += cx
         ay += cy
         az += cz

@@ -1,5 +1,5 @@
 """The engine's steady specialisations: DOP853 on a steady frame with uniform gravity and a string, compiled once;
-RK4 and the rotation splitting on a steady frame with uniform gravity and the Coriolis term, on the scenes' drivers.
+RK4 and the rotation splitting on a steady frame with uniform gravity and the frame's terms, on the scenes' drivers.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -51,8 +51,10 @@ around them included, where the engine's inlined loop took 1.66 and 1.12 (``pyth
 - the frame turns at a constant rate, its origin does not accelerate, and the scenes' model keeps its omega to
   the bit (`omega_kept`: its axis and rate are the engine's, and their product is omega again; most vectors,
   the Earth's at a latitude among them);
-- the terms are at most one force with a constant linear form, no string, and the centrifugal term does not act
-  (the drivers group the centrifugal term's and the string's arithmetic otherwise: round-off apart);
+- the terms are at most one force with a constant linear form and no string, and under RK4 the centrifugal term
+  does not act (the drivers' RK4 sums the frame's terms in another order, and their string's tension is grouped
+  otherwise: round-off apart; the splitting kicks with the centrifugal term as the engine does,
+  `rotframe.particles.forces.position_acceleration`);
 - there is at most one event, a built-in crossing (`rotframe.events.crossing`), not zero at any particle's start
   (the drivers take the sign after a zero start from derivatives, the engine from re-steps).
 
@@ -74,7 +76,7 @@ __all__ = ["steady_model", "FIXED_STEADY", "SteadyProblem", "omega_kept"]
 
 #: the fixed-step methods whose steps, samples and event times the scenes' fixed-step drivers
 #: (`rotframe.particles.drivers`) take as the engine's loop takes them, to the bit, on a steady problem of
-#: uniform gravity and the Coriolis term (`steady_model`). ``rotation-splitting4`` is not one: its state at an
+#: uniform gravity and the frame's terms (`steady_model`). ``rotation-splitting4`` is not one: its state at an
 #: event (the re-step of the crossing's length) differs in the last bits.
 FIXED_STEADY = ("rk4", "rotation-splitting")
 
@@ -143,9 +145,9 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
     if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
             or (events and not fixed_step) or frame.kind != "constant" or origin.kind != "zero"):
         return None
-    if fixed_step:  # the drivers' arithmetic is the engine's for uniform gravity and the Coriolis term alone
+    if fixed_step:  # the drivers' arithmetic is the engine's: uniform gravity, the frame's terms (module docstring)
         w = np.asarray(frame.data[0], dtype=float)
-        if ("centrifugal" in frame_terms or any(isinstance(f, StringConstraint) for f in terms)
+        if (("centrifugal" in frame_terms and method == "rk4") or any(isinstance(f, StringConstraint) for f in terms)
                 or (np.any(w) and not omega_kept(w))):
             return None
     rows = _event_rows(events, event_names, r, v) if fixed_step else ()
