@@ -37,8 +37,8 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
-__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "start_short_of", "own_tolerances",
-           "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "grid_time", "start_short_of",
+           "own_tolerances", "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
 SAFE = 0.9  # dop853.f's safety factor
@@ -82,6 +82,18 @@ def next_step(h, h_ctrl, err, rejected):
     if h < h_ctrl and h_next < h_ctrl:  # a step cut to land: go on with the controller's
         h_next = h_ctrl
     return True, h_next
+
+
+@jit_inline
+def grid_time(times, s, j, h):
+    """The start of step ``j`` of sample interval ``s`` of a fixed step ``h``: ``times[s] + j h``.
+
+    The one rule of every fixed-step loop (the engine's, `rotframe.problem.fixed_step`; the scenes' drivers,
+    `rotframe.particles.drivers`): a step's time is counted on its own sample interval's grid, so it does not
+    depend on the call the step falls in, and a run cut into calls anywhere takes its steps, plans and event
+    times at the same times to the bit (``t0 + k h`` from each call's own start did not).
+    """
+    return times[s] + j * h if j > 0 else times[s]
 
 
 @jit_inline

@@ -217,7 +217,7 @@ class KernelSetup:
         of particle 0). ``j0`` (steps of the interval made before) and ``sps`` (default
         `sps`) let a fixed-step call start inside a sample interval and take part
         of it (`one_sample_in_pieces`): a fixed step starts on its interval's grid, ``T[s] + j h``, whatever
-        the call (`rotframe.particles.kernels.grid_time`). ``t0`` (adaptive only: default the sample time
+        the call (`rotframe.numerics.step_control.grid_time`). ``t0`` (adaptive only: default the sample time
         ``first``) and ``times`` (adaptive only) replace the start and the sample times the call lands on: the
         probe's short spans, or the pieces of a long sample interval (`run_chunked`).
 

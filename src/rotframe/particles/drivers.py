@@ -27,7 +27,8 @@ from rotframe.numerics.compiled import inlined
 from rotframe.particles.dop853_ensemble import run_particles
 from rotframe.particles.dop853_particles import particle_rhs, particle_trajectory, particle_trajectory_events, start_events
 from rotframe.particles.events import crossed, event_row, event_value, watch_steps, locate_event, record_event, start_value
-from rotframe.particles.kernels import advance, free_step, grid_time, loop_code, make_plan, method_steps, rk4_step_of, sphere_step
+from rotframe.numerics.step_control import grid_time
+from rotframe.particles.kernels import advance, free_step, loop_code, make_plan, method_steps, rk4_step_of, sphere_step
 from rotframe.particles.packed import NFEV, is_finite, jit_internal, jit_kernel, store, store_particle, unpack
 from rotframe.particles.schedule import rates
 
@@ -128,7 +129,7 @@ def run_fixed(method, r, v, alive, times, j0, h, steps_per_sample, n_samples, P,
         `rotframe.particles.chunked.KernelSetup.one_sample_in_pieces`).
     h : float
         Step (s). Samples are stored every ``steps_per_sample`` steps. Step ``j`` of sample interval ``s``
-        starts at ``times[s] + j h`` (`grid_time`), however the run is cut into calls: the engine's rule
+        starts at ``times[s] + j h`` (`rotframe.numerics.step_control.grid_time`), however the run is cut into calls: the engine's rule
         (`rotframe.problem.fixed_step`).
     events : None
         No event table (an array raises `ValueError`): a run with one calls
@@ -171,7 +172,7 @@ def run_fixed(method, r, v, alive, times, j0, h, steps_per_sample, n_samples, P,
         for s in range(n_samples):
             if alive[p]:
                 # a varying rate: the whole sample interval in one call
-                state = _advance(method, state, times[s], j0 if s == 0 else 0, steps_per_sample, h, m, wt, wv, wint,
+                state = _advance(method, state, times, s, j0 if s == 0 else 0, steps_per_sample, h, m, wt, wv, wint,
                                  plan, rk4, sphere)
                 if p == 0:
                     nfev0 += nfev_step * steps_per_sample

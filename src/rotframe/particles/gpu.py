@@ -258,7 +258,7 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     The step is the CPU ensemble's for the same run settings: ``run["step"]`` (default
     1/20 of the sample interval) shortened to divide the sample interval of
     ``run["samples"]`` samples, and the steps counted from t = 0: step k starts at ``k h``, where the CPU's
-    drivers start it on its sample interval's grid, ``T[s] + j h`` (`rotframe.particles.kernels.grid_time`), so
+    drivers start it on its sample interval's grid, ``T[s] + j h`` (`rotframe.numerics.step_control.grid_time`), so
     event times agree to round-off (and the GPU may fuse a multiply and an add).
 
     Raises

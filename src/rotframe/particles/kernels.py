@@ -24,6 +24,7 @@ from rotframe.numerics.composition import YOSHIDA4_INNER, YOSHIDA4_OUTER
 from rotframe.numerics.rk4 import rk4_particle_step
 from rotframe.numerics.rotation import rodrigues_rotate
 from rotframe.numerics.sphere import great_circle, kick_across
+from rotframe.numerics.step_control import grid_time
 from rotframe.particles.forces import (drag_coefficients, drag_flow, position_acceleration, state_acceleration,
                                        string_normal)
 from rotframe.particles.packed import NFEV, jit_internal, jit_kernel, unpack
@@ -47,7 +48,7 @@ def loop_code(name: str) -> int:
     """The code the compiled loops know the fixed-step method ``name`` by (-1: not one of theirs, dop853)."""
     return _LOOP_CODES.get(name, -1)
 
-__all__ = ["loop_code", "EVALS_PER_STEP", "make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "rk4_step_of", "grid_time", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
+__all__ = ["loop_code", "EVALS_PER_STEP", "make_plan", "method_steps", "one_step", "free_step", "sphere_step", "rk4_step", "rk4_step_of", "advance", "step_splitting", "step_sphere", "step_splitting4", "step_rk4",
            "select_step"]
 
 # numba compiles a separate version of a function for every constant it is called with
@@ -310,21 +311,10 @@ def one_step(method, state, h, m, plan, rk4, sphere):
     return free_step(state, method, h, m, plan)
 
 
-@_inline
-def grid_time(times, s, j, h):
-    """The start of step ``j`` of sample interval ``s``: ``times[s] + j h``, on the interval's own grid.
-
-    The engine's rule (`rotframe.problem.fixed_step`): a step's time does not depend on the call it
-    falls in, so a run cut into calls anywhere (`rotframe.particles.chunked`) takes its steps, plans and
-    event times at the same times to the bit; ``t0 + k h`` from each call's own start did not.
-    """
-    return times[s] + j * h if j > 0 else times[s]
-
-
 @jit_internal
-def advance(method, state, ts, k0, n, h, m, wt, wv, wint, plan, rk4, sphere):
-    """Steps k0 .. k0 + n - 1 of size h of the sample interval that starts at ts (step k starts at ts + k h,
-    `grid_time`).
+def advance(method, state, times, s, k0, n, h, m, wt, wv, wint, plan, rk4, sphere):
+    """Steps k0 .. k0 + n - 1 of size h of sample interval ``s`` of the sample ``times`` (step k starts at
+    ``times[s] + k h``, `rotframe.numerics.step_control.grid_time`).
 
     ``plan`` is the `make_plan` of every step when the rate is steady; a
     varying schedule is sampled here, once per step, so that the step
@@ -336,8 +326,8 @@ def advance(method, state, ts, k0, n, h, m, wt, wv, wint, plan, rk4, sphere):
     if m.steady:
         return method_steps(method, state, n, h, m, plan, rk4, sphere)
     for k in range(k0, k0 + n):
-        state = method_steps(method, state, int(1), h, m, make_plan(method, ts + k * h if k > 0 else ts, h, m, wt, wv,
-                                                                    wint), rk4, sphere)
+        state = method_steps(method, state, int(1), h, m, make_plan(method, grid_time(times, s, k, h), h, m, wt,
+                                                                    wv, wint), rk4, sphere)
     return state
 
 

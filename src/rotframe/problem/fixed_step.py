@@ -32,7 +32,7 @@ import math
 
 from rotframe.numerics.bisection import crossed
 from rotframe.numerics.compiled import bound, jit_inline
-from rotframe.numerics.step_control import start_short_of
+from rotframe.numerics.step_control import grid_time, start_short_of
 from rotframe.problem.calls import RAISED, call_event
 from rotframe.problem.loop_state import (all_finite, load_particle, save_particle, store_state, store_tuple,
                                          tuple_finite, watcher_context)
@@ -122,9 +122,8 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
             at_knot = stop < T[idx]
             if per < 0.0:
                 per = math.floor((T[idx] - T[idx - 1]) / hfix + 0.5)
-            t0 = T[idx - 1]
             t_end = T[idx]
-            on_grid = t == (t0 + sub * hfix if sub > 0 else t0)
+            on_grid = t == grid_time(T, idx - 1, sub, hfix)
             # on the grid with no stop before the sample, the rest of the interval is a run of steps of hfix, each
             # ending on the grid (the last on the sample): decided here once, not at every step
             regular = on_grid and not at_knot
@@ -134,18 +133,18 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                 # the substeps counted (hfix divides the interval: `run_grid`), not lengths compared: the interval's
                 # own rounding (2e-12 of 5e-4 s at t = 4 s) took a step short of each sample and a sliver to it
                 last = sub + 1 >= per
-                grid_next = t_end if last else t0 + (sub + 1) * hfix
+                grid_next = t_end if last else grid_time(T, idx - 1, sub + 1, hfix)
                 if at_knot and stop < grid_next:
                     hh = stop - t  # to the knot; the grid goes on from there
                     t_new = stop
                 else:
                     hh = hfix if on_grid else grid_next - t
                     sub += 1
-                    t_new = t_end if last else t0 + sub * hfix
+                    t_new = t_end if last else grid_time(T, idx - 1, sub, hfix)
             while True:
                 if regular:
                     sub += 1
-                    t_new = t_end if sub >= per else t0 + sub * hfix
+                    t_new = t_end if sub >= per else grid_time(T, idx - 1, sub, hfix)
                 t_stages = t
                 if METHOD == RK4 and stop <= t_new:  # the step ends on a knot: its last stage just before it
                     t_stages = start_short_of(t, hh, t_new)

@@ -237,11 +237,12 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
+    slots = max_events if events else 1  # event records: none are kept without events
     steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r, v,
                           uf.event_names(events), fixed_steady) if steady else None
     if steady is not None:  # the steady loop, compiled once for every such problem: nothing of this one is built
         return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
-                     frame_terms, on_gpu, slots=max_events if events else 1, steady=steady)
+                     frame_terms, on_gpu, slots=slots, steady=steady)
     if frame.kind == "function":
         frame.vector_at([0.0])  # checked in frame_spec; the derivative's form too
     roles = function_roles(frame, origin, forces, events, labels)
@@ -266,7 +267,6 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
         raise
     prob = problem_tuple(model_constants(constraint, next((f for f in forces if f.flow), None) if splitting else None,
                                          frame_terms), flatten_params(params), frame, origin)
-    slots = max_events if events else 1  # event records: none are kept without events
     stops = stop_times((frame, origin), duration)
     check_arrays(N, times.size, D, slots, stops.size)
     settings = [check_event(g, k) for k, g in enumerate(events)]

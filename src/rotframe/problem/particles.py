@@ -490,7 +490,7 @@ def _steady_fixed_run(s, progress) -> ProblemRun:
 
 def _steps_to(t_event, times, sps, h):
     """The steps each particle took to the one in which its terminal event at ``t_event`` fell: step ``j`` of sample
-    interval ``k`` runs from ``times[k] + j h`` (`rotframe.particles.kernels.grid_time`) to the next step's start
+    interval ``k`` runs from ``times[k] + j h`` (`rotframe.numerics.step_control.grid_time`) to the next step's start
     (``times[k + 1]`` for the last), and the event is in ``(start, end]``."""
     k = np.clip(np.searchsorted(times, t_event, side="left") - 1, 0, times.size - 2)
     j = np.clip(np.floor((t_event - times[k]) / h).astype(np.int64), 0, sps - 1)

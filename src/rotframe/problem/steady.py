@@ -39,7 +39,7 @@ A problem qualifies (`steady_model`) where:
 The fixed-step specialisation runs the scenes' fixed-step drivers (`rotframe.particles.drivers`, in the calls of
 `rotframe.particles.chunked`), which keep a particle's six numbers in registers and test a built-in crossing in
 place, where the engine's loop reaches its event function through the problem's glue. Each of their steps starts
-on its sample interval's grid as the engine's does (`rotframe.particles.kernels.grid_time`), and on the problems
+on its sample interval's grid as the engine's does (`rotframe.numerics.step_control.grid_time`), and on the problems
 below their arithmetic is the engine's, so they give its samples, event times and states, statuses and step
 counts to the bit (``tests/test_steady_route.py``, random problems against ``inline=False``; 376 more, every one
 the same, 2026-11-30), in the scenes' time: on the tower drop's ensemble (20,000 particles, the ground event, one
