@@ -73,3 +73,36 @@ def test_a_hop_from_the_level_inside_the_first_step_returns_through_it(method):
                             forces=[forces.gravity([0.0, 0.0, -G])], events=[crossing(2, LEVEL, name="level")],
                             method=method, step=0.01, samples=5)
     np.testing.assert_allclose(res.trajectory.event_times["level"][0], [2.0 * v_hop / G], rtol=0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("method", METHODS + ["dop853"])
+def test_two_terminal_events_in_one_step_keep_the_earliest(method):
+    """Every event terminal: a particle keeps one record an event (`rotframe.problem.particle_setup.event_slots`),
+    and the step that crosses both levels keeps the earlier crossing, the second event's, though the first event
+    is recorded first. One step of 0.5 s takes the throw from 0.5 m through 3 m and 4 m (closed form, both rising)."""
+    low, high = crossing(2, LEVEL, direction=1, terminal=True, name="low"), crossing(2, LEVEL + 1.0, direction=1,
+                                                                                     terminal=True, name="high")
+    res = rotframe.simulate(omega=[0.0, 0.0, 0.0], r0=[0.0, 0.0, 0.5], v0=[0.0, 0.0, V0], duration=2.0,
+                            forces=[forces.gravity([0.0, 0.0, -G])], events=[high, low], method=method, step=0.5,
+                            samples=4)
+    d = math.sqrt(V0 * V0 - 2.0 * G * (LEVEL - 0.5))
+    np.testing.assert_allclose(res.trajectory.event_times["low"][0], [(V0 - d) / G], rtol=0.0, atol=1e-9)
+    assert len(res.trajectory.event_times["high"][0]) == 0
+    assert res.trajectory.r[-1, 0, 2] == pytest.approx(LEVEL, abs=1e-9)
+
+
+def test_an_ensemble_to_a_terminal_event_keeps_one_record_a_particle():
+    """A terminal event's records are counted against the memory limit one a particle: 100,000 particles under a
+    limit of 0.1 GB, which 256 records each (``max_events``' default, 64 bytes each) would exceed 16 times over."""
+    from rotframe.limits import DEFAULT, applied
+
+    n = 100_000
+    r0 = np.zeros((n, 3))
+    r0[:, 2] = np.linspace(1.0, 2.0, n)
+    with applied(DEFAULT.with_overrides(max_memory=1e8)):
+        res = rotframe.simulate(omega=[0.0, 0.0, 7.29e-5], r0=r0, v0=np.zeros((n, 3)), duration=0.7,
+                                forces=[forces.gravity([0.0, 0.0, -G])], frame_terms=("coriolis",),
+                                events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")],
+                                method="rk4", step=0.01, samples=1)
+    fall = np.array([t[0] for t in res.trajectory.event_times["ground"]])
+    np.testing.assert_allclose(fall, np.sqrt(2.0 * r0[:, 2] / G), rtol=1e-6)

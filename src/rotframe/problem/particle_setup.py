@@ -237,7 +237,8 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     inertial = any(f.axes == "inertial" for f in forces)
     D = 10 if inertial else 6
     _check_functions(forces, events, params, r[0], v[0], 0.0, labels)
-    slots = max_events if events else 1  # event records: none are kept without events
+    settings = [check_event(g, k) for k, g in enumerate(events)]  # (direction, terminal) of each
+    slots = event_slots([terminal for _, terminal in settings], max_events)
     steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r, v,
                           uf.event_names(events), fixed_steady) if steady else None
     if steady is not None:  # the steady loop, compiled once for every such problem: nothing of this one is built
@@ -269,7 +270,6 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
                                          frame_terms), flatten_params(params), frame, origin)
     stops = stop_times((frame, origin), duration)
     check_arrays(N, times.size, D, slots, stops.size)
-    settings = [check_event(g, k) for k, g in enumerate(events)]
     EDIR = np.array([float(d) for d, _ in settings], dtype=float)
     ETERM = np.array([bool(t) for _, t in settings], dtype=bool)
 
@@ -280,6 +280,19 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
                  frame_terms, on_gpu, driver, prob, driver.functions(prob), slots, stops, EDIR, ETERM, cache_notes, t0,
                  plain_driver if jit else None)
+
+
+def event_slots(terminal, max_events) -> int:
+    """The event records kept per particle, from the events' ``terminal`` flags.
+
+    One where there are no events (the arrays' shapes). One per event where every event is terminal: a particle's
+    first crossing ends it, and the step that ends it records each event at most once before the records after the
+    earliest terminal crossing are dropped, so an ensemble to the ground keeps N records, not N times ``max_events``
+    (at 20,000 particles its arrays took a tenth of `simulate`'s time). Else ``max_events``. Never more than
+    ``max_events``."""
+    if not terminal:
+        return 1
+    return min(max_events, len(terminal)) if all(terminal) else max_events
 
 
 def check_arrays(N, n, D, slots, knots):
