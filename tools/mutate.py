@@ -41,7 +41,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:position_acceleration,state_acceleration,drag_coefficients,string_normal",
+DEFAULT_TARGETS = ["src/rotframe/particles/forces.py:_forces_of_position,_frame_terms_of_position,state_acceleration,"
+                   "drag_coefficients,string_normal",
                    "src/rotframe/particles/accelerations.py:altitude_gravity,central_gravity,air_density,drag_rate,"
                    "centrifugal,coriolis_about_axis,string_tension"]
 DEFAULT_TESTS = "tests/test_i11b_forces.py -k 'not projectile'"

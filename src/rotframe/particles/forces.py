@@ -31,12 +31,8 @@ __all__ = ["position_acceleration", "state_acceleration", "acceleration", "drag_
            "string_normal"]
 
 
-@jit_internal
-def position_acceleration(x, y, z, m, w, wd):
-    """Forces that depend on position and time only: gravity, spring, centrifugal, Euler.
-
-    ``w`` and ``wd`` are the rotation rate and its derivative at the time of evaluation.
-    """
+def _forces_of_position(x, y, z, m):
+    """The forces of position alone: gravity (uniform, with altitude or central) and the spring."""
     mode = m.gmode
     if mode == 1.0:
         ax = 0.0
@@ -51,11 +47,15 @@ def position_acceleration(x, y, z, m, w, wd):
         sx, sy, _ = spring_pull(x, y, 0.0, k)
         ax += sx
         ay += sy
+    return ax, ay, az
+
+
+def _frame_terms_of_position(ax, ay, az, x, y, z, m, w, wd):
+    """``(ax, ay, az)`` with the frame's terms of position added: centrifugal, then Euler."""
     ux, uy, uz = m.axis
     if m.centrifugal:
         # the vector form of any omega, the engine's (`rotframe.problem.models`): on a steady frame whose axis
-        # times its rate is omega again, the rotation splitting on these drivers is the engine's to the bit
-        # (`rotframe.problem.steady`)
+        # times its rate is omega again, these drivers are the engine's to the bit (`rotframe.problem.steady`)
         cx, cy, cz = centrifugal(x, y, z, ux * w, uy * w, uz * w)
         ax += cx
         ay += cy
@@ -68,16 +68,37 @@ def position_acceleration(x, y, z, m, w, wd):
     return ax, ay, az
 
 
-#: `position_acceleration` inlined into `state_acceleration` (a call would pass the
-#: packed model, some 30 scalars, at every force evaluation)
-_position_acceleration = njit(inline="always", error_model="numpy", nogil=True)(position_acceleration.py_func)
+#: the two parts of `position_acceleration`, inlined into it and into `state_acceleration`
+_forces_of = njit(inline="always", error_model="numpy", nogil=True)(_forces_of_position)
+_frame_terms_of = njit(inline="always", error_model="numpy", nogil=True)(_frame_terms_of_position)
+
+
+@jit_internal
+def position_acceleration(x, y, z, m, w, wd):
+    """Forces that depend on position and time only: gravity, spring, centrifugal, Euler (the splittings' kick).
+
+    ``w`` and ``wd`` are the rotation rate and its derivative at the time of evaluation.
+    """
+    ax, ay, az = _forces_of(x, y, z, m)
+    return _frame_terms_of(ax, ay, az, x, y, z, m, w, wd)
 
 
 @jit_internal
 def state_acceleration(state, m, w, wd):
-    """Total acceleration in the rotating frame at ``state``; see `acceleration`."""
+    """Total acceleration in the rotating frame at ``state``; see `acceleration`.
+
+    Summed in the order of the engine's right-hand side (`rotframe.problem.models`): the forces (gravity, the
+    spring, drag), then the frame's terms (Coriolis, centrifugal, Euler), then the string's tension. So on a steady
+    problem of gravity and the frame's terms RK4 on these drivers is the engine's RK4 to the bit
+    (`rotframe.problem.steady`)."""
     x, y, z, vx, vy, vz = state
-    ax, ay, az = _position_acceleration(x, y, z, m, w, wd)
+    ax, ay, az = _forces_of(x, y, z, m)
+    if m.drag:
+        k1, k2 = drag_coefficients(z, m)
+        k = drag_rate(vx, vy, vz, k1, k2)
+        ax -= k * vx
+        ay -= k * vy
+        az -= k * vz
     if m.coriolis:
         # -2 w x v written in place, the arithmetic of accelerations.coriolis_about_axis: called (inlined), it made
         # the RK4 ensemble with the ground event 7 to 9 % slower (3 interleaved runs a tree, 2026-11-29)
@@ -88,12 +109,7 @@ def state_acceleration(state, m, w, wd):
         ax -= uy * vz - uz * vy
         ay -= uz * vx - ux * vz
         az -= ux * vy - uy * vx
-    if m.drag:
-        k1, k2 = drag_coefficients(z, m)
-        k = drag_rate(vx, vy, vz, k1, k2)
-        ax -= k * vx
-        ay -= k * vy
-        az -= k * vz
+    ax, ay, az = _frame_terms_of(ax, ay, az, x, y, z, m, w, wd)
     L = m.length
     if L > 0.0:
         ax, ay, az = string_tension(ax, ay, az, x, y, z, vx, vy, vz, m.pivot[0], m.pivot[1], m.pivot[2], L)

@@ -1,5 +1,6 @@
 """The engine's steady specialisations: DOP853 on a steady frame with uniform gravity and a string, compiled once;
-RK4 and the rotation splitting on a steady frame with uniform gravity and the frame's terms, on the scenes' drivers.
+RK4 and the rotation splitting on a steady frame with uniform gravity, air drag and the frame's terms, on the scenes'
+drivers.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -51,10 +52,14 @@ around them included, where the engine's inlined loop took 1.66 and 1.12 (``pyth
 - the frame turns at a constant rate, its origin does not accelerate, and the scenes' model keeps its omega to
   the bit (`omega_kept`: its axis and rate are the engine's, and their product is omega again; most vectors,
   the Earth's at a latitude among them);
-- the terms are at most one force with a constant linear form and no string, and under RK4 the centrifugal term
-  does not act (the drivers' RK4 sums the frame's terms in another order, and their string's tension is grouped
-  otherwise: round-off apart; the splitting kicks with the centrifugal term as the engine does,
-  `rotframe.particles.forces.position_acceleration`);
+- the terms are at most one force with a constant linear form, at most one air drag (`rotframe.forces.drag`, in
+  any air: the drivers' drag is the engine's, its exact flow under the splitting, since 2026-11-30: 130 of the 400
+  random problems below) and no string (the drivers group the string's tension otherwise: round-off apart). Any
+  of the frame's terms may act: the drivers' RK4 sums the forces, then
+  Coriolis, then the centrifugal term, as the engine's right-hand side does (`rotframe.particles.forces.
+  state_acceleration`, since 2026-11-30: 400 more random problems, 109 of them RK4 with the centrifugal term,
+  every one the same), and the splitting kicks with the centrifugal term as the engine does
+  (`rotframe.particles.forces.position_acceleration`);
 - there is at most one event, a built-in crossing (`rotframe.events.crossing`), not zero at any particle's start
   (the drivers take the sign after a zero start from derivatives, the engine from re-steps).
 
@@ -102,6 +107,13 @@ def _constant_acceleration(f):
     return np.array(b, dtype=float)
 
 
+def _drag_flow(f):
+    """``(k1, k2, H)`` of the built-in drag (`rotframe.forces.drag`: its exact flow's data) in frame axes; None for
+    any other term."""
+    flow = getattr(f, "flow", None) if isinstance(f, Force) and f.axes == "frame" else None
+    return tuple(float(x) for x in flow[1:]) if flow and flow[0] == "drag" else None
+
+
 def _event_rows(events, names, r, v):
     """The drivers' rows of the run's ``events`` (named ``names``), or None where the scenes' drivers would not
     locate them as the engine does: more than one event, one that is no built-in crossing
@@ -147,22 +159,24 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         return None
     if fixed_step:  # the drivers' arithmetic is the engine's: uniform gravity, the frame's terms (module docstring)
         w = np.asarray(frame.data[0], dtype=float)
-        if (("centrifugal" in frame_terms and method == "rk4") or any(isinstance(f, StringConstraint) for f in terms)
-                or (np.any(w) and not omega_kept(w))):
+        if any(isinstance(f, StringConstraint) for f in terms) or (np.any(w) and not omega_kept(w)):
             return None
     rows = _event_rows(events, event_names, r, v) if fixed_step else ()
     if rows is None:
         return None
-    g = string = None
+    g = string = drag = None
     for f in terms:
         if isinstance(f, StringConstraint) and string is None:
             string = f
+            continue
+        if fixed_step and drag is None and _drag_flow(f) is not None:  # the drivers' drag is the engine's
+            drag = _drag_flow(f)
             continue
         b = _constant_acceleration(f) if g is None else None
         if b is None:
             return None
         g = b
-    if not energy_by_numpy([f for f in terms if isinstance(f, Force)]):
+    if not energy_by_numpy([f for f in terms if isinstance(f, Force) and f.potential is not None]):
         return None
     from rotframe.particles.dop853_steady import steady_parameters
     from rotframe.particles.model import OmegaSchedule, ParticleModel
@@ -175,6 +189,10 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         names += ("pendulum",)
         pivot, length = np.array(string.pivot, dtype=float), float(string.length)
         extra.update(pendulum_length=length, pivot=pivot)
+    if drag is not None:
+        k1, k2, H = drag
+        names += (("linear-drag",) if k1 > 0.0 else ()) + (("quadratic-drag",) if k2 > 0.0 else ())
+        extra.update(k_linear=k1, k_quadratic=k2, scale_height=H)
     model = ParticleModel(names, omega=OmegaSchedule.constant(omega), **extra)
     if fixed_step:
         return SteadyProblem(model, None, rows)
