@@ -231,8 +231,12 @@ def _sphere_step(state, h, m, sub):
         k1, k2 = drag_coefficients(z, m)
         vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)
     if m.coriolis:
-        wn = m.axis[0] * nx + m.axis[1] * ny + m.axis[2] * nz
-        angle = -2.0 * wn * sub[2]
+        if m.steady:  # -2 (w . n) h, the engine's arithmetic (`rotframe.problem.models.sphere_strang`)
+            w = sub[0]
+            angle = -2.0 * ((m.axis[0] * w) * nx + (m.axis[1] * w) * ny + (m.axis[2] * w) * nz) * h
+        else:  # the turn integrated over the sub-step: exact for the schedule's piecewise-linear rate
+            wn = m.axis[0] * nx + m.axis[1] * ny + m.axis[2] * nz
+            angle = -2.0 * wn * sub[2]
         vx, vy, vz = rodrigues_rotate(vx, vy, vz, nx, ny, nz, math.cos(angle), math.sin(angle))
     if m.drag:
         vx, vy, vz = drag_flow(vx, vy, vz, k1, k2, hh)

@@ -481,7 +481,7 @@ def _steady_fixed_run(s, progress) -> ProblemRun:
     traj.extras["status"] = status
     diagnostics = {}
     notes = list(s.frame.notes) + [f"method {s.method}: the scenes' fixed-step drivers (a constant rotation rate, "
-                                   "uniform gravity, air drag, the frame's terms, one built-in crossing: "
+                                   "uniform gravity, air drag, a string, the frame's terms, one built-in crossing: "
                                    "rotframe.problem.steady), the engine's steps to the bit"]
     _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
                         s.forces, diagnostics, notes, s.frame_terms)

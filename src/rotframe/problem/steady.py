@@ -1,6 +1,6 @@
 """The engine's steady specialisations: DOP853 on a steady frame with uniform gravity and a string, compiled once;
-RK4 and the rotation splitting on a steady frame with uniform gravity, air drag and the frame's terms, on the scenes'
-drivers.
+RK4 and the rotation splitting on a steady frame with uniform gravity, air drag, a string and the frame's terms, on
+the scenes' drivers.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -54,8 +54,9 @@ around them included, where the engine's inlined loop took 1.66 and 1.12 (``pyth
   the Earth's at a latitude among them);
 - the terms are at most one force with a constant linear form, at most one air drag (`rotframe.forces.drag`, in
   any air: the drivers' drag is the engine's, its exact flow under the splitting, since 2026-11-30: 130 of the 400
-  random problems below) and no string (the drivers group the string's tension otherwise: round-off apart). Any
-  of the frame's terms may act: the drivers' RK4 sums the forces, then
+  random problems below) and at most one string (`rotframe.forces.pendulum`: the drivers' splitting on the sphere
+  turns the velocity by the engine's angle, -2 (w . n) h, on a steady frame, since 2026-11-30: 231 random pendulums
+  on the drivers, every one the same). Any of the frame's terms may act: the drivers' RK4 sums the forces, then
   Coriolis, then the centrifugal term, as the engine's right-hand side does (`rotframe.particles.forces.
   state_acceleration`, since 2026-11-30: 400 more random problems, 109 of them RK4 with the centrifugal term,
   every one the same), and the splitting kicks with the centrifugal term as the engine does
@@ -157,9 +158,9 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
     if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
             or (events and not fixed_step) or frame.kind != "constant" or origin.kind != "zero"):
         return None
-    if fixed_step:  # the drivers' arithmetic is the engine's: uniform gravity, the frame's terms (module docstring)
+    if fixed_step:  # the drivers take the engine's steps where their model keeps omega (module docstring)
         w = np.asarray(frame.data[0], dtype=float)
-        if any(isinstance(f, StringConstraint) for f in terms) or (np.any(w) and not omega_kept(w)):
+        if np.any(w) and not omega_kept(w):
             return None
     rows = _event_rows(events, event_names, r, v) if fixed_step else ()
     if rows is None:
