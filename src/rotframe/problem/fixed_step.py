@@ -175,7 +175,9 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                     if not quiet_step(wctx, ctx, i, t, t_new, yn):  # a crossing (or a NaN, or the run's start)
                         if CARRIED:  # the watcher re-steps from the step's start
                             store_state(y, s)
-                        stop_now, tau = WATCH(wctx, ctx, i, t, t_new - t, t_new, y, yn, K)
+                        # the locator's bracket is the step's own length hh (its re-step of hh is this step), not
+                        # t_new - t, which the grid's rounding may leave an ulp or two apart from it
+                        stop_now, tau = WATCH(wctx, ctx, i, t, hh, t_new, y, yn, K)
                     if stop_now:
                         if not tau > 0.0:  # an event function gave NaN or raised: stop here, Python names it
                             status = 5

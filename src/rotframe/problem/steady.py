@@ -48,7 +48,8 @@ thread) ``simulate`` took 1.10 times the scenes' kernels' time under the splitti
 around them included, where the engine's inlined loop took 1.66 and 1.12 (``python tools/ensembles_on_engine.py
 20000 1``, 2026-11-30). A problem qualifies where:
 
-- the method is ``rk4`` or ``rotation-splitting`` (`FIXED_STEADY`), on the CPU, compiled, ``inline`` not given;
+- the method is ``rk4``, ``rotation-splitting`` or ``rotation-splitting4`` (`FIXED_STEADY`), on the CPU, compiled,
+  ``inline`` not given;
 - the frame turns at a constant rate, its origin does not accelerate, and the scenes' model keeps its omega to
   the bit (`omega_kept`: its axis and rate are the engine's, and their product is omega again; most vectors,
   the Earth's at a latitude among them);
@@ -82,9 +83,10 @@ __all__ = ["steady_model", "FIXED_STEADY", "SteadyProblem", "omega_kept"]
 
 #: the fixed-step methods whose steps, samples and event times the scenes' fixed-step drivers
 #: (`rotframe.particles.drivers`) take as the engine's loop takes them, to the bit, on a steady problem of
-#: uniform gravity and the frame's terms (`steady_model`). ``rotation-splitting4`` is not one: its state at an
-#: event (the re-step of the crossing's length) differs in the last bits.
-FIXED_STEADY = ("rk4", "rotation-splitting")
+#: uniform gravity, drag, a string and the frame's terms (`steady_model`). ``rotation-splitting4`` joined on
+#: 2026-11-30, when the engine's locator took the step's own length as its bracket (`rotframe.problem.fixed_step`),
+#: as the drivers' does: its state at an event had differed in the last bits.
+FIXED_STEADY = ("rk4", "rotation-splitting", "rotation-splitting4")
 
 
 class SteadyProblem(NamedTuple):
