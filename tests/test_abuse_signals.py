@@ -118,11 +118,12 @@ def test_a_signal_in_every_phase_of_a_sweep(tmp_path, attr, nth, sig):
 
 
 @pytest.mark.parametrize("target,attr,nth,argv", [
-    # the engine: 1e9 steps of the pendulum (foucault) in one sample interval, its loop called in paced pieces; 5.7e8
-    # of the tower drop, which runs on the scenes' fixed-step drivers (`rotframe.problem.steady`), a sample interval
-    # in pieces of a tenth of a second (`KernelSetup.one_sample_in_pieces`)
-    ("rotframe.problem.particles", "advance_blocks", 2, ["foucault", "--set", "step=1e-8", "--set", "duration=10"]),
+    # the engine: 1e9 steps of the pendulum (foucault) in one sample interval, 5.7e8 of the tower drop, both on the
+    # scenes' fixed-step drivers (`rotframe.problem.steady`), a sample interval in pieces of a tenth of a second
+    # (`KernelSetup.one_sample_in_pieces`); the engine's own loop, called in paced pieces, is the turntable's below
+    ("rotframe.particles.chunked", "KernelSetup.call", 3, ["foucault", "--set", "step=1e-8", "--set", "duration=10"]),
     ("rotframe.particles.chunked", "KernelSetup.call", 3, ["tower-drop", "--set", "step=1e-8"]),
+    ("rotframe.problem.particles", "advance_blocks", 2, ["turntable", "--set", "step=1e-8", "--set", "duration=10"]),
 ])
 def test_a_signal_from_outside_stops_a_long_compiled_loop(tmp_path, target, attr, nth, argv):
     # a single sample interval of many steps (tens of seconds of compiled splitting): the loop is called in pieces,
