@@ -3,8 +3,11 @@
 
 mutmut and cosmic-ray rewrite functions into Python trampolines, which numba's
 ``@njit`` kernels cannot compile; this script instead mutates a copy of ``src/``
-and runs a chosen test subset against it with ``NUMBA_DISABLE_JIT=1`` (the
-kernels then run as plain Python: slower per step, but no compile per mutant).
+and runs a chosen test subset against it, each mutant compiled by numba (its own
+cache). ``--no-jit`` runs them with ``NUMBA_DISABLE_JIT=1`` instead, which once
+saved the compiles; rotframe no longer imports so (a kernel for compiled code
+only, `rotframe.numerics.compiled.jit_internal`, needs numba's dispatcher), so
+every mutant would be an error.
 
 Mutations, inside the chosen functions only:
 
@@ -171,7 +174,8 @@ def main(argv=None):
     ap.add_argument("--tests", default=DEFAULT_TESTS, help="pytest arguments (one string)")
     ap.add_argument("-j", "--jobs", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=600.0)
-    ap.add_argument("--jit", action="store_true", help="keep numba on (compiles every mutant)")
+    ap.add_argument("--no-jit", dest="jit", action="store_false",
+                    help="NUMBA_DISABLE_JIT=1 (rotframe does not import so: see the module docstring)")
     ap.add_argument("--list", action="store_true", help="list the mutants and exit")
     ap.add_argument("--sample", type=int, default=0, help="run only N mutants drawn at random (seed 0)")
     ap.add_argument("--strict", action="store_true", help="exit 1 when a mutant survives")

@@ -172,8 +172,9 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         if isinstance(f, StringConstraint) and string is None:
             string = f
             continue
-        if fixed_step and drag is None and _drag_flow(f) is not None:  # the drivers' drag is the engine's
-            drag = _drag_flow(f)
+        flow = _drag_flow(f) if fixed_step and drag is None else None
+        if flow is not None:  # the drivers' drag is the engine's
+            drag = flow
             continue
         b = _constant_acceleration(f) if g is None else None
         if b is None:
