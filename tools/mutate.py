@@ -156,7 +156,9 @@ def _run(src_copy, tests, timeout, jit):
     env = dict(os.environ, PYTHONPATH=str(src_copy), PYTHONDONTWRITEBYTECODE="1")
     if not jit:
         env["NUMBA_DISABLE_JIT"] = "1"
-    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *shlex.split(tests)]
+    # -n 0: in one process, so that -x's first failure exits 1 (under pytest-xdist, the suite's default, it exits 2,
+    # which read as an error here: every killed mutant was reported so)
+    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-n", "0", "-p", "no:cacheprovider", *shlex.split(tests)]
     try:
         proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
