@@ -105,4 +105,6 @@ def test_an_ensemble_to_a_terminal_event_keeps_one_record_a_particle():
                                 events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")],
                                 method="rk4", step=0.01, samples=1)
     fall = np.array([t[0] for t in res.trajectory.event_times["ground"]])
-    np.testing.assert_allclose(fall, np.sqrt(2.0 * r0[:, 2] / G), rtol=1e-6)
+    # omega along z: the Coriolis term acts on horizontal velocity alone, none here, so the fall is the vertical
+    # closed form, which RK4 integrates exactly (a quadratic) and the locator finds to round-off
+    np.testing.assert_allclose(fall, np.sqrt(2.0 * r0[:, 2] / G), rtol=1e-12)

@@ -129,8 +129,8 @@ def run_fixed(method, r, v, alive, times, j0, h, steps_per_sample, n_samples, P,
         `rotframe.particles.chunked.KernelSetup.one_sample_in_pieces`).
     h : float
         Step (s). Samples are stored every ``steps_per_sample`` steps. Step ``j`` of sample interval ``s``
-        starts at ``times[s] + j h`` (`rotframe.numerics.step_control.grid_time`), however the run is cut into calls: the engine's rule
-        (`rotframe.problem.fixed_step`).
+        starts at ``times[s] + j h`` (`rotframe.numerics.step_control.grid_time`), however the run is cut into
+        calls: the engine's rule (`rotframe.problem.fixed_step`).
     events : None
         No event table (an array raises `ValueError`): a run with one calls
         `run_fixed_events`, with the same arguments (each kernel compiles only

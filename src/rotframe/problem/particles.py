@@ -223,9 +223,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         raise RunInterrupted(traj) from None
     if D == 10:
         traj.extras["frame_q"] = OUT[:, 0, 6:10].copy()
-    dropped = int(np.sum(np.maximum(state["EVN"] - max_events, 0)))
-    if dropped:
-        warnings.append(f"{dropped} event crossings beyond {max_events} per particle were located but not kept")
+    warnings += _dropped_records(state["EVN"], state["EVT"].shape[1])
     compile_s += inlining.seconds_mid_run + tier.seconds_mid_run  # loops made after the first call: compile time too
     traj.extras["compile_s"] = compile_s
     if method == "dop853":  # the rows the loop took: a particle's own filled in where it began (`rotframe.problem.engine`)
@@ -469,9 +467,7 @@ def _steady_fixed_run(s, progress) -> ProblemRun:
     evb = traj.extras.pop("event_records", None)
     if rows:
         evb.attach(traj, rows)
-        dropped = int(np.sum(np.maximum(evb.count - evb.max_events, 0)))
-        if dropped:
-            warnings.append(f"{dropped} event crossings beyond {evb.max_events} per particle were located but not kept")
+        warnings += _dropped_records(evb.count, evb.max_events)
         if rows[0].terminal:
             stopped = evb.count > 0
             status[stopped] = 2
@@ -486,6 +482,13 @@ def _steady_fixed_run(s, progress) -> ProblemRun:
     _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
                         s.forces, diagnostics, notes, s.frame_terms)
     return ProblemRun(traj, diagnostics, warnings, notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
+
+
+def _dropped_records(counts, kept) -> list:
+    """The warning of a run whose particles located more event crossings (``counts``, (N,)) than the ``kept`` records
+    each (`rotframe.problem.particle_setup.event_slots`) hold; none where every crossing was kept."""
+    dropped = int(np.sum(np.maximum(counts - kept, 0)))
+    return [f"{dropped} event crossings beyond {kept} per particle were located but not kept"] if dropped else []
 
 
 def _steps_to(t_event, times, sps, h):

@@ -160,10 +160,9 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
     if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
             or (events and not fixed_step) or frame.kind != "constant" or origin.kind != "zero"):
         return None
-    if fixed_step:  # the drivers take the engine's steps where their model keeps omega (module docstring)
-        w = np.asarray(frame.data[0], dtype=float)
-        if np.any(w) and not omega_kept(w):
-            return None
+    omega = np.asarray(frame.data[0], dtype=float)
+    if fixed_step and np.any(omega) and not omega_kept(omega):  # the drivers take the engine's steps (docstring)
+        return None
     rows = _event_rows(events, event_names, r, v) if fixed_step else ()
     if rows is None:
         return None
@@ -185,7 +184,6 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
     from rotframe.particles.dop853_steady import steady_parameters
     from rotframe.particles.model import OmegaSchedule, ParticleModel
 
-    omega = np.asarray(frame.data[0], dtype=float)
     names = (("gravity",) if g is not None else ()) + tuple(t for t in frame_terms if t != "euler")
     extra = {"g": g} if g is not None else {}
     pivot, length = np.zeros(3), 0.0
