@@ -193,6 +193,18 @@ def test_resume_over_a_damaged_table_is_one_line(tmp_path, capsys, damage):
     assert code == 2 and "--resume" in one_line(err)
 
 
+def test_a_sweeps_plots_do_not_depend_on_pyplots_open_figures(tmp_path):
+    # pyplot warns once a process holds more than 20 figures (an error in this suite): a sweep's pictures are
+    # Figures of their own, so a notebook or an earlier test that left pyplot's figures open does not fail it
+    plt = pytest.importorskip("matplotlib.pyplot")
+    figures = [plt.figure() for _ in range(20)]  # the most pyplot holds without a warning
+    try:
+        assert main(["sweep", "tower-drop", "--grid", "latitude=0:90:3", "--out", str(tmp_path / "s.parquet")]) == 0
+    finally:
+        for fig in figures:
+            plt.close(fig)
+
+
 def test_json_stdout_is_guarded_at_the_file_descriptor(tmp_path):
     # LAPACK's xerbla writes to fd 1 (a NaN fit): with --json it must land on stderr, not in the JSON
     code = ("import numpy as np\nfrom rotframe.app.cli import _JsonStdout\nwith _JsonStdout(True):\n"

@@ -21,10 +21,9 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
     is overlaid when present; log-grid keys get a log x axis. A Monte Carlo sweep adds
     the metric's histogram (its dispersion: mean and standard deviation in the legend).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # a pyplot-free Figure (as `rotframe.app.plot.new_figure`): pyplot keeps every figure it makes in a process-wide
+    # list, and once a process has more than 20 open it warns, which the suite makes an error
+    from matplotlib.figure import Figure
 
     paths = []
     for metric in metric_columns(table, spec):
@@ -33,7 +32,8 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
             continue
         theory = column(table, "theory_" + metric) if "theory_" + metric in table.column_names else None
         panels = len(spec.keys) + (1 if spec.vary else 0)
-        fig, axs = plt.subplots(1, panels, figsize=(5.5 * panels, 4.2), squeeze=False)
+        fig = Figure(figsize=(5.5 * panels, 4.2))
+        axs = fig.subplots(1, panels, squeeze=False)
         for ax, key in zip(axs[0], spec.keys):
             _plot_one(ax, column(table, key), y, theory, key, metric, spec)
         if spec.vary:
@@ -43,11 +43,8 @@ def write_plots(table, spec: SweepSpec, stem) -> list:
         path = Path(f"{stem}-{_safe(metric)}.png")
         from rotframe.app.outputs import atomic_path
 
-        try:
-            with atomic_path(path, "plot") as tmp:
-                fig.savefig(tmp, dpi=110, format="png")
-        finally:
-            plt.close(fig)
+        with atomic_path(path, "plot") as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
         paths.append(path)
     return paths
 
