@@ -51,11 +51,20 @@ def _random_problem(seed):
     rng.shuffle(terms)
     atol = None if rng.random() < 0.6 else float(10.0 ** rng.uniform(-12, -7))
     rtol = float(10.0 ** rng.uniform(-12, -5))
-    return dict(omega=w, r0=r0, v0=v0, duration=float(rng.uniform(1.0, 40.0)), samples=int(rng.integers(1, 30)),
-                forces=terms, frame_terms=frame_terms, rtol=rtol, atol=atol)
+    kw = dict(omega=w, r0=r0, v0=v0, duration=float(rng.uniform(1.0, 40.0)), samples=int(rng.integers(1, 30)),
+              forces=terms, frame_terms=frame_terms, rtol=rtol, atol=atol)
+    if seed >= 8:  # a built-in crossing of a coordinate of r or v, zero at no start: crossed by some, terminal or not
+        from rotframe.events import crossing
+
+        c, of = int(rng.integers(0, 3)), (r0, v0)[int(rng.integers(0, 2))]
+        level = float(np.mean(of[:, c]) + 0.3 * rng.normal() * (1.0 + np.std(of[:, c])))
+        kw["events"] = [crossing(c, level, of="r" if of is r0 else "v", direction=int(rng.integers(-1, 2)),
+                                 terminal=bool(rng.random() < 0.5), name="level")]
+        kw["max_events"] = int(rng.integers(1, 4))  # some crossings not kept: the same warning
+    return kw
 
 
-@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("seed", range(20))
 def test_the_steady_loop_is_the_engines_loop_to_the_bit(seed):
     kw = _random_problem(seed)
     steady = simulate_particles(**kw)
@@ -67,6 +76,13 @@ def test_the_steady_loop_is_the_engines_loop_to_the_bit(seed):
     assert a.steps == b.steps > 0 and 0 < a.nfev <= b.nfev
     assert np.array_equal(a.times, b.times)
     assert np.array_equal(a.r, b.r) and np.array_equal(a.v, b.v)
+    assert a.event_times.keys() == b.event_times.keys()
+    for name in a.event_times:  # each crossing located on the same re-steps: times and states to the bit
+        for x, y in zip(a.event_times[name], b.event_times[name]):
+            assert np.array_equal(x, y)
+        for x, y in zip(a.event_states[name], b.event_states[name]):
+            assert np.array_equal(x, y)
+    assert np.array_equal(a.extras["status"], b.extras["status"]) and steady.warnings == general.warnings
     # the tolerances each records (for Result.sol's restarts): the calls' driver's rows and the rows the engine's
     # loop filled in place, the same
     assert a.extras["atol"].shape == (a.r.shape[1], 6) and np.array_equal(a.extras["atol"], b.extras["atol"])

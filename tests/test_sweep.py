@@ -92,28 +92,28 @@ def test_foucault_latitude_sweep_matches_omega_sin_latitude(tmp_path, monkeypatc
 
 
 def test_tower_drop_monte_carlo_is_one_ensemble_call(tmp_path, monkeypatch, capsys):
-    from rotframe.particles import integrators
+    from rotframe.problem import particles as engine
     monkeypatch.chdir(tmp_path)
     sizes = []
-    real = integrators.integrate_particles
+    real = engine.simulate_particles
 
-    def counting(model, r0, *args, **kwargs):
-        sizes.append(len(np.atleast_2d(r0)))
-        return real(model, r0, *args, **kwargs)
+    def counting(**kwargs):
+        sizes.append(len(np.atleast_2d(kwargs["r0"])))
+        return real(**kwargs)
 
-    monkeypatch.setattr(integrators, "integrate_particles", counting)
+    monkeypatch.setattr(engine, "simulate_particles", counting)
     t0 = time.perf_counter()
     out = sweep_json(capsys, "tower-drop", "--samples", "100000", "--vary", "height=normal(158.5,1)", "--seed", "7")
     elapsed = time.perf_counter() - t0
     assert out["path"] == "ensemble" and out["rows"] == 100000 and out["failed"] == 0 and out["batches"] == 1
-    # the Monte Carlo in vectorised calls of the compiled core, one per fixed chunk of rows (and fall-time class),
+    # the Monte Carlo in vectorised calls of the engine, one per fixed chunk of rows (and fall-time class),
     # each particle once (and the recorded ones again, for their paths)
     assert 100000 <= sum(sizes) <= 100000 + sweep.MAX_TRACKS and max(sizes) <= sweep.batch.ENSEMBLE_CHUNK
     assert elapsed < 45, elapsed
     table = pq.read_table(out["out"]).to_pydict()
     heights = np.array(table["height"])
     assert np.array_equal(heights, np.random.default_rng(7).normal(158.5, 1, 100000))
-    monkeypatch.setattr(integrators, "integrate_particles", real)
+    monkeypatch.setattr(engine, "simulate_particles", real)
     for i in (0, 31415, 99999):
         single, _ = runner.run("tower-drop", {"height": heights[i]})
         for key, value in single["metrics"].items():

@@ -160,9 +160,9 @@ class KernelSetup:
         if kernel is not None:
             return kernel
         if self.steady_args is not None:
-            from rotframe.particles.dop853_steady import run_dop853_steady
+            from rotframe.particles.dop853_steady import run_dop853_steady, steady_events_kernel
 
-            kernel = run_dop853_steady
+            kernel = run_dop853_steady if self.ev_tab is None else steady_events_kernel()
         else:
             from rotframe.particles import drivers
 
@@ -260,8 +260,11 @@ class KernelSetup:
             q = self.steady_args
 
             def one(r, v, alive, ev_t, ev_r, ev_v, ev_count, ev_which, h_state, atol, out_r, out_v):
-                return kernel(r, v, start, times, q, self.rtol, atol, span, np.empty((WORK_ROWS, 6)), out_r, out_v,
-                              h_state)
+                work = np.empty((WORK_ROWS, 6))
+                if self.ev_tab is None:
+                    return kernel(r, v, start, times, q, self.rtol, atol, span, work, out_r, out_v, h_state)
+                return kernel(r, v, alive, start, times, q, self.rtol, atol, span, self.ev_tab, work, out_r, out_v,
+                              h_state, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, np.empty((13, 6)))
 
             return run_blocks(one, r.shape[0], per_particle, (out_r, out_v), most=True)  # its count: the engine's
 

@@ -7,7 +7,7 @@ run DOP853 need much less (`rotframe.problem.steady` chooses them from their ter
 - a **steady** rotation rate (omega a constant vector, so no frame table and no Euler term);
 - **uniform** gravity (a constant vector, or none);
 - any of **Coriolis**, **centrifugal** and a **pendulum** string;
-- no drag, no spring, no events.
+- no drag, no spring, and at most one event, a crossing of a coordinate (`steady_events_kernel`).
 
 For such a problem `run_dop853_steady` runs the same loop (`rotframe.particles.dop853_ensemble.run_particles`
 on `rotframe.numerics.dop853_loop`) with a force of its own (`_acceleration`: the terms of
@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from rotframe.numerics.compiled import jit_internal, jit_kernel, jit_llvm_inline
+from rotframe.numerics.compiled import bound, jit_internal, jit_kernel, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_trajectory
 from rotframe.particles.accelerations import centrifugal, coriolis, string_tension
 from rotframe.particles.dop853_ensemble import run_particles, store_sample
 
-__all__ = ["steady_parameters", "run_dop853_steady"]
+__all__ = ["steady_parameters", "run_dop853_steady", "steady_events_kernel"]
 
 # The force sums the terms of rotframe.particles.accelerations (each term's arithmetic, written once) over the
 # steady vector, rather than running the engine's right-hand side: that would compile the problem's functions and
@@ -86,7 +86,8 @@ def _steady_rhs(q, t, z, K, s):
     K[s, 2] = z[5]
 
 
-_steady_trajectory = dop853_trajectory("steady", dop853_stages("steady", _steady_rhs, 6), store_sample, 6)
+_steady_stages = dop853_stages("steady", _steady_rhs, 6)
+_steady_trajectory = dop853_trajectory("steady", _steady_stages, store_sample, 6)
 
 
 @jit_kernel
@@ -99,3 +100,52 @@ def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, 
     """
     return run_particles(_steady_rhs, _steady_trajectory, None, q, r, v, None, t0, sample_times, rtol, atol, span,
                          out_r, out_v, h_state, work, None, True)
+
+
+_EVENTS_KERNEL = []
+
+
+def steady_events_kernel():
+    """`run_dop853_steady` with event rows (`rotframe.particles.trajectory.Event`: crossings of a coordinate of r or
+    v), made when first asked for: ``kernel(r, v, alive, t0, sample_times, q, rtol, atol, span, events, work, out_r,
+    out_v, h_state, ev_t, ev_r, ev_v, ev_count, ev_which, max_events, Kt)``.
+
+    The events are watched after each accepted step and located on the steady loop's own DOP853 re-steps
+    (`rotframe.particles.dop853_particles.dop853_watcher`: rotframe's one locator), as the engine's loop locates
+    them; a terminal event clears the particle's ``alive``. Each event's value at the start is the function's own:
+    the engine's rule for a function that is zero there (its sign just after, from re-steps) is not this loop's, so
+    `rotframe.problem.steady` sends no such run here.
+    """
+    if not _EVENTS_KERNEL:  # imported here: a run without events imports none of the events' code
+        from rotframe.particles.dop853_particles import dop853_watcher
+        from rotframe.particles.events import event_value
+        from rotframe.particles.packed import as_state
+
+        watch = dop853_watcher("steady", _steady_stages)[3]
+        trajectory = dop853_trajectory("steady_events", _steady_stages, store_sample, 6, watch)
+        start = jit_internal(bound(_start_values, "steady_start_values", EVENT_VALUE=event_value, AS_STATE=as_state))
+        _EVENTS_KERNEL.append(jit_kernel(bound(_run_with_events, "run_dop853_steady_events", TRAJECTORY=trajectory,
+                                               START=start)))
+    return _EVENTS_KERNEL[0]
+
+
+# the names `steady_events_kernel` binds in its copies: the events' trajectory loop and start values, the event rows'
+# function and the state's view; None in the templates, which are never compiled
+TRAJECTORY = START = EVENT_VALUE = AS_STATE = None
+
+
+def _start_values(wctx, q, t, y):
+    """The template of the events' start values: each event row's value at ``(t, y)`` into ``g_old = wctx[1]``."""
+    events, g_old = wctx[0], wctx[1]
+    for e in range(g_old.shape[0]):
+        g_old[e] = EVENT_VALUE(events, e, AS_STATE(y), 0.0)
+
+
+def _run_with_events(r, v, alive, t0, sample_times, q, rtol, atol, span, events, work, out_r, out_v, h_state, ev_t,
+                     ev_r, ev_v, ev_count, ev_which, max_events, Kt):
+    """The template of `steady_events_kernel`'s kernel."""
+    g_old = np.empty(events.shape[0])
+    # the locator's scratch states are the loop's (free while it watches: rotframe.particles.dop853_particles)
+    wctx = (events, g_old, 0.0, Kt, work[18], work[19], ev_t, ev_r, ev_v, ev_count, ev_which, max_events)
+    return run_particles(_steady_rhs, TRAJECTORY, START, q, r, v, alive, t0, sample_times, rtol, atol, span,
+                         out_r, out_v, h_state, work, wctx, True)

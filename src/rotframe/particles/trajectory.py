@@ -9,11 +9,13 @@ adaptive, exact); a run cut short keeps what it computed in
 from __future__ import annotations
 
 import math
+import operator
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Event", "Trajectory", "RunInterrupted", "EventBuffers", "event_table", "per_particle"]
+__all__ = ["Event", "Trajectory", "RunInterrupted", "EventBuffers", "event_table", "per_particle", "PerParticle"]
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,23 @@ class Trajectory:
     event_times: dict = field(default_factory=dict)
     event_states: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
+
+    def first_events(self, name):
+        """``(t, state)``: each particle's first ``name`` event, its time (N,) and its state (N, 6) (r, v); NaN and
+        the state at the last sample where a particle had none."""
+        t = np.full(self.r.shape[1], math.nan)
+        state = np.concatenate([self.r[-1], self.v[-1]], axis=1)
+        times, states = self.event_times.get(name, ()), self.event_states.get(name, ())
+        if isinstance(times, PerParticle) and isinstance(states, PerParticle):
+            hit, first = times.firsts()
+            t[hit] = first
+            state[hit] = states.firsts()[1]
+            return t, state
+        hit = [i for i, ts in enumerate(times) if len(ts)]
+        if hit:
+            t[hit] = [times[i][0] for i in hit]
+            state[hit] = [states[i][0] for i in hit]
+        return t, state
 
     def truncated(self, n: int) -> Trajectory:
         return Trajectory(self.times[:n], self.r[:n], self.v[:n], self.method, self.steps, self.nfev,
@@ -125,23 +144,51 @@ class EventBuffers:
 
 
 def per_particle(records, counts):
-    """``records`` (grouped by particle, in particle order) cut into a list of one array per particle.
+    """``records`` (grouped by particle, in particle order) as one array per particle: a `PerParticle`.
 
     ``counts[i]`` rows are particle i's. Each particle's array is a slice (a view) of
-    ``records``; the particles with none share one empty slice, so that an ensemble of a
-    million particles with few events costs a list, not a million arrays (``np.split`` made
-    each anew: 0.7 s a million on the 2-core development machine; a slice for each particle
-    0.06 s; where few particles have events, a slice for each of those, 0.01 s).
+    ``records``, made when it is asked for, so that an ensemble of a million particles costs
+    two arrays, not a million (``np.split`` made each anew: 0.7 s a million on the 2-core
+    development machine; a list of slices 0.06 s).
     """
-    counts = np.asarray(counts)
-    empty = records[:0]
-    some = np.flatnonzero(counts)
-    ends = np.cumsum(counts)
-    if 4 * some.size > counts.size:  # most particles have events: one pass over them all
-        ends = ends.tolist()
-        return [records[a:b] if b > a else empty for a, b in zip([0] + ends[:-1], ends)]
-    out = [empty] * counts.size
-    ends = ends[some]
-    for i, a, b in zip(some.tolist(), (ends - counts[some]).tolist(), ends.tolist()):
-        out[i] = records[a:b]
-    return out
+    return PerParticle(records, counts)
+
+
+class PerParticle(Sequence):
+    """Each particle's records, a read-only sequence of arrays (slices of one array): what `per_particle` returns.
+
+    ``seq[i]`` is particle i's records in their order (an empty slice where it has none); ``len(seq)`` the
+    number of particles. `firsts` reads every particle's first record at once.
+    """
+
+    def __init__(self, records, counts):
+        self.records = records
+        self.counts = np.asarray(counts, dtype=np.int64)
+        self.ends = np.cumsum(self.counts)
+
+    def __len__(self):
+        return self.counts.size
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        i = operator.index(i)
+        n = len(self)
+        if i < 0:
+            i += n
+        if not 0 <= i < n:
+            raise IndexError(f"particle {i} of {n}")
+        end = int(self.ends[i])
+        return self.records[end - int(self.counts[i]):end]
+
+    def __iter__(self):
+        ends = self.ends.tolist()
+        return (self.records[a:b] for a, b in zip([0] + ends[:-1], ends))
+
+    def firsts(self):
+        """``(hit, rows)``: which particles have a record (N,) and, for those, their first records."""
+        hit = self.counts > 0
+        return hit, self.records[(self.ends - self.counts)[hit]]
+
+    def __repr__(self):
+        return repr(list(self))

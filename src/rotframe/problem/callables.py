@@ -18,6 +18,7 @@ and what they read; numba's version too. A value that cannot be hashed by value 
 from __future__ import annotations
 
 import enum
+import functools
 import hashlib
 import inspect
 import re
@@ -106,11 +107,17 @@ def reads_argument(f, index: int) -> bool:
     >>> reads_argument(lambda t, r, v: (0.0, 0.0, -r[2]), 2), reads_argument(lambda t, r, v: v, 2)
     (False, True)
     """
-    import dis
-
     code = getattr(plain_function(f), "__code__", None)
     if code is None or index >= code.co_argcount:
         return True
+    return _code_reads(code, index)
+
+
+@functools.lru_cache(maxsize=1024)
+def _code_reads(code, index: int) -> bool:
+    """`reads_argument` of a function's ``code``, read once per code object (a run's set-up asks for each force)."""
+    import dis
+
     name = code.co_varnames[index]
     if name in code.co_cellvars:
         return True

@@ -89,7 +89,7 @@ def simulate_particles(**kwargs) -> ProblemRun:
 def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
                         method=None, rtol=None, step=None, samples=None, omega_dot=None, atol=None,
                         frame_attitude=None, jit=True, progress=None, max_events=256, device=None,
-                        frame_terms=None, inline=None, plain_tier=True, steady=True) -> ProblemRun:
+                        frame_terms=None, inline=None, plain_tier=True, steady=True, energy=True) -> ProblemRun:
     """Integrate particles of the user's problem; see `rotframe.simulate` for the arguments.
 
     Returns
@@ -98,7 +98,8 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         ``trajectory`` (a [`rotframe.particles.trajectory.Trajectory`][rotframe.particles.trajectory.Trajectory]: ``times`` (n,),
         ``r``, ``v`` (n, N, 3), ``event_times``/``event_states`` by event name, ``extras``
         with ``frame_q`` (n, 4) where the attitude was integrated and ``energy`` (n, N) where
-        it is conserved), ``diagnostics``, ``warnings``, ``notes``.
+        it is conserved), ``diagnostics``, ``warnings``, ``notes``. ``energy=False`` (a caller that reads the
+        samples and events alone: a sweep's ensemble) measures no energy and notes none.
     """
     s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
@@ -108,11 +109,11 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     attitude = None if frame_attitude is None else checked_attitude(frame_attitude)  # refused even where unread
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
-                          progress)
+                          progress, energy)
     if s.steady is not None:  # a steady loop: chosen from the terms, compiled once for every such problem
         if s.method != "dop853":
-            return _steady_fixed_run(s, progress)
-        return _steady_run(s, checked_atol(atol), progress)
+            return _steady_fixed_run(s, progress, energy)
+        return _steady_run(s, checked_atol(atol), progress, energy)
     method, duration, times, rtol, hfix, D, N = s.method, s.duration, s.times, s.rtol, s.hfix, s.D, r.shape[0]
     frame, origin, forces, events = s.frame, s.origin, s.forces, s.events
     driver, prob, fns, slots, n, t0, on_gpu = s.driver, s.prob, s.fns, s.slots, s.times.size, s.t0, s.on_gpu
@@ -215,7 +216,8 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         return tier.driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, tier.fns,
                                     tier.driver.potential(), rotating)
 
-    _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)
+    if energy:
+        _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)
     try:
         frame_interpolation(tier.driver.advance, frame, origin, y0_first, times, after, OUT, duration, rtol, diagnostics,
                             warnings, notes, lambda spec: problem_tuple(prob[1], prob[2], spec, origin))
@@ -390,7 +392,7 @@ def exact_model(terms, frame, origin, events, frame_terms):
     return linear_problem(terms, [f"forces[{k}]" for k in range(len(terms))], frame, origin, events, frame_terms)
 
 
-def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress) -> ProblemRun:
+def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, samples, progress, energy=True) -> ProblemRun:
     """``method="exact"``: the exact flow of the run's linear problem (`rotframe.problem.exact`), the scenes' own
     (`rotframe.particles.integrators.integrate_exact`); the energy diagnostic from the forces' potentials."""
     from rotframe.particles.integrators import integrate_exact
@@ -407,16 +409,17 @@ def _exact_run(terms, frame, origin, events, frame_terms, r, v, duration, sample
                                  "method exact: the inertial straight line turned into the frame by the exact "
                                  "integral of its piecewise-linear rate, to round-off"]
 
-    _energy_diagnostics(lambda rotating: array_energies(traj, forces, frame, rotating), traj, frame, origin, forces,
-                        diagnostics, notes, frame_terms)
+    if energy:
+        _energy_diagnostics(lambda rotating: array_energies(traj, forces, frame, rotating), traj, frame, origin,
+                            forces, diagnostics, notes, frame_terms)
     return ProblemRun(traj, diagnostics, [], notes, frame, 0.0, frame_terms)
 
 
-def _steady_run(s, atol, progress) -> ProblemRun:
+def _steady_run(s, atol, progress, energy=True) -> ProblemRun:
     """DOP853 on the steady loop (`rotframe.problem.steady`: `rotframe.particles.dop853_steady`, run in calls by
-    `rotframe.particles.chunked`) for the set-up ``s``: the engine's loop's steps and numbers, each particle's own
-    tolerances where ``atol`` is None; the energy diagnostic numpy's. The trajectory's ``steps`` and ``nfev`` are
-    the most any particle took, as the engine's loop counts them.
+    `rotframe.particles.chunked`) for the set-up ``s``: the engine's loop's steps, numbers and event records, each
+    particle's own tolerances where ``atol`` is None; the energy diagnostic numpy's. The trajectory's ``steps`` and
+    ``nfev`` are the most any particle took, as the engine's loop counts them.
 
     A run that fails (a state not finite, the step collapsed, a speed that grew without a force) raises
     `SteadyLoopFailed`: `simulate_particles` runs it again on the engine's loop, which meets the failure at the same
@@ -426,25 +429,23 @@ def _steady_run(s, atol, progress) -> ProblemRun:
     from rotframe.particles.chunked import KernelSetup, RunNeedsCuts, run_chunked
     from rotframe.particles.integrators import METHODS, check_work
 
-    model, q = s.steady.model, s.steady.q
+    model, q, rows = s.steady.model, s.steady.q, s.steady.rows
     info, samples = METHODS["dop853"], s.times.size - 1
     check_work(info, s.duration, None, samples, s.r.shape[0], model)
     setup = KernelSetup(model, info, s.duration, samples, rtol=s.rtol,
-                        atol="own" if atol is None else tuple(atol.tolist()), steady=q)
+                        atol="own" if atol is None else tuple(atol.tolist()), events=rows, steady=q)
     try:
-        traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, owned=True)
+        traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, s.slots, records=True, owned=True)
     except (IntegrationError, RunNeedsCuts):
         raise SteadyLoopFailed from None
-    traj.extras["status"] = np.ones(s.r.shape[0], dtype=np.int64)  # the engine's status: every particle reached the end
-    diagnostics = {}
+    warnings, _ = _records_of(traj, rows)
     notes = list(s.frame.notes) + ["method dop853: the engine's steady loop (a constant rotation rate, uniform "
-                                   "gravity, a string: rotframe.problem.steady), compiled once for every such problem"]
-    _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
-                        s.forces, diagnostics, notes, s.frame_terms)
-    return ProblemRun(traj, diagnostics, [], notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
+                                   "gravity, a string, one built-in crossing: rotframe.problem.steady), compiled once "
+                                   "for every such problem"]
+    return _steady_result(s, traj, warnings, notes, energy)
 
 
-def _steady_fixed_run(s, progress) -> ProblemRun:
+def _steady_fixed_run(s, progress, energy=True) -> ProblemRun:
     """A fixed-step method on a steady problem (`rotframe.problem.steady`): the scenes' fixed-step drivers
     (`rotframe.particles.drivers`, run in calls by `rotframe.particles.chunked`), which take the engine's loop's
     steps, samples and event times to the bit, its one event a row of theirs. The counts are the engine's: each
@@ -461,26 +462,44 @@ def _steady_fixed_run(s, progress) -> ProblemRun:
         traj = run_chunked(setup, model, s.r.copy(), s.v.copy(), progress, s.slots, records=True, owned=True)
     except (IntegrationError, ScenarioError):
         raise SteadyLoopFailed from None
-    warnings = []
-    status = np.ones(N, dtype=np.int64)
+    warnings, t_stop = _records_of(traj, rows)
     steps = np.full(N, samples * setup.sps, dtype=np.int64)
+    stopped = np.isfinite(t_stop)
+    steps[stopped] = _steps_to(t_stop[stopped], s.times, setup.sps, setup.h)
+    traj.steps = int(steps.max()) if N else 0
+    traj.nfev = traj.steps * setup.evals_per_step
+    notes = list(s.frame.notes) + [f"method {s.method}: the scenes' fixed-step drivers (a constant rotation rate, "
+                                   "uniform gravity, air drag, a string, the frame's terms, one built-in crossing: "
+                                   "rotframe.problem.steady), the engine's steps to the bit"]
+    return _steady_result(s, traj, warnings, notes, energy)
+
+
+def _records_of(traj, rows):
+    """The event records a steady run left (``traj.extras["event_records"]``, of its drivers' ``rows``) attached to
+    ``traj`` as the engine's lists, and the engine's status of each particle (``traj.extras["status"]``: 2 where a
+    terminal event stopped it, else 1). Returns the warnings of records not kept (`_dropped_records`) and each
+    particle's stop time (NaN where none stopped it)."""
+    N = traj.r.shape[1]
     evb = traj.extras.pop("event_records", None)
+    status, t_stop, warnings = np.ones(N, dtype=np.int64), np.full(N, math.nan), []
     if rows:
         evb.attach(traj, rows)
         warnings += _dropped_records(evb.count, evb.max_events)
         if rows[0].terminal:
             stopped = evb.count > 0
             status[stopped] = 2
-            steps[stopped] = _steps_to(evb.t[stopped, 0], s.times, setup.sps, setup.h)
-    traj.steps = int(steps.max()) if N else 0
-    traj.nfev = traj.steps * setup.evals_per_step
+            t_stop[stopped] = evb.t[stopped, 0]
     traj.extras["status"] = status
+    return warnings, t_stop
+
+
+def _steady_result(s, traj, warnings, notes, energy):
+    """The `ProblemRun` of a steady run (`_steady_run`, `_steady_fixed_run`) of the set-up ``s``: its trajectory,
+    warnings and notes, and the energy diagnostic (numpy's) where ``energy``."""
     diagnostics = {}
-    notes = list(s.frame.notes) + [f"method {s.method}: the scenes' fixed-step drivers (a constant rotation rate, "
-                                   "uniform gravity, air drag, a string, the frame's terms, one built-in crossing: "
-                                   "rotframe.problem.steady), the engine's steps to the bit"]
-    _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame, s.origin,
-                        s.forces, diagnostics, notes, s.frame_terms)
+    if energy:
+        _energy_diagnostics(lambda rotating: array_energies(traj, s.forces, s.frame, rotating), traj, s.frame,
+                            s.origin, s.forces, diagnostics, notes, s.frame_terms)
     return ProblemRun(traj, diagnostics, warnings, notes, s.frame, traj.extras.get("compile_s", 0.0), s.frame_terms)
 
 

@@ -1,6 +1,6 @@
-"""The engine's steady specialisations: DOP853 on a steady frame with uniform gravity and a string, compiled once;
-RK4 and the rotation splitting on a steady frame with uniform gravity, air drag, a string and the frame's terms, on
-the scenes' drivers.
+"""The engine's steady specialisations: DOP853 on a steady frame with uniform gravity, a string and one built-in
+crossing, compiled once; RK4 and the rotation splitting on a steady frame with uniform gravity, air drag, a string,
+the frame's terms and one built-in crossing, on the scenes' drivers.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -31,7 +31,11 @@ A problem qualifies (`steady_model`) where:
 - the terms are at most one force with a constant linear form (``Force.linear`` with ``K = C = 0``:
   `rotframe.forces.gravity`) and at most one string (`rotframe.forces.pendulum`), in frame axes, their
   potentials numpy's where given (`rotframe.problem.terms.energy_by_numpy`);
-- there are no events;
+- there is at most one event, a built-in crossing (`rotframe.events.crossing`) not zero at any particle's start,
+  and the run is not a prepared problem's (`rotframe.problem.prepared`): the steady loop watches it after each
+  accepted step and locates a crossing on its own DOP853 re-steps with rotframe's one locator, as the engine's
+  loop does (`rotframe.particles.dop853_steady.steady_events_kernel`, since 2026-12-01: the tower drop's sweep
+  ensembles run there);
 - and, seen by the calls' driver's probe before the run, the work fits one call (some 2e5
   particle-steps, a tenth of a second): a call ends with a step cut to land on its last sample, which
   the engine's loop never cuts, so a longer run goes to the engine's loop
@@ -151,19 +155,20 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
                  event_names=(), fixed=True):
     """The `SteadyProblem` of a run that a steady loop runs, or None where the run does not qualify (the module
     docstring): ``terms`` the run's forces and string as `set_up` reads them, ``frame_terms`` those of the frame's
-    terms that act, ``r``, ``v`` (N, 3) the start states and ``event_names`` the events' names (a fixed-step
-    method's; ``fixed`` False takes DOP853's loop alone). Its ``q`` is the DOP853 loop's parameters
-    (`rotframe.particles.dop853_steady.steady_parameters`: the frame's omega as given, so the engine's arithmetic
-    to the bit), ``model`` the same problem as the scenes' `rotframe.particles.model.ParticleModel`, which the
-    calls' driver (`rotframe.particles.chunked`) reads for its work limits and the fixed-step drivers run."""
+    terms that act, ``r``, ``v`` (N, 3) the start states and ``event_names`` the events' names; ``fixed`` False
+    takes DOP853's loop alone, and no events (a prepared problem's runs, `rotframe.problem.prepared`). Its ``q``
+    is the DOP853 loop's parameters (`rotframe.particles.dop853_steady.steady_parameters`: the frame's omega as
+    given, so the engine's arithmetic to the bit), ``model`` the same problem as the scenes'
+    `rotframe.particles.model.ParticleModel`, which the calls' driver (`rotframe.particles.chunked`) reads for its
+    work limits and the fixed-step drivers run."""
     fixed_step = fixed and method in FIXED_STEADY
     if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
-            or (events and not fixed_step) or frame.kind != "constant" or origin.kind != "zero"):
+            or (events and not fixed) or frame.kind != "constant" or origin.kind != "zero"):
         return None
     omega = np.asarray(frame.data[0], dtype=float)
     if fixed_step and np.any(omega) and not omega_kept(omega):  # the drivers take the engine's steps (docstring)
         return None
-    rows = _event_rows(events, event_names, r, v) if fixed_step else ()
+    rows = _event_rows(events, event_names, r, v)
     if rows is None:
         return None
     g = string = drag = None
@@ -200,4 +205,4 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         return SteadyProblem(model, None, rows)
     q = steady_parameters(np.zeros(3) if g is None else g, omega, pivot, length, "coriolis" in frame_terms,
                           "centrifugal" in frame_terms)
-    return SteadyProblem(model, q, ())
+    return SteadyProblem(model, q, rows)

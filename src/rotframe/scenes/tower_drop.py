@@ -25,7 +25,7 @@ from rotframe.particles.integrators import Event, default_method
 from rotframe.particles.model import OmegaSchedule, ParticleModel
 from rotframe.scenes.base import (SceneResult, engine_remarks, earth_model_constants, jacobi_energy, landing,
                                   method_rel_error, particle_methods, reject_subnormal, rel_drift, resolve_terms,
-                                  run_on_engine, scene_parameters, UNDERFLOW, with_parameters)
+                                  run_on_engine, scene_parameters, UNDERFLOW, until_event, with_parameters)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -207,8 +207,8 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     Points that differ only in ``height`` (and ``magnify``, which is for display) share
     latitude, drag and gravity, hence the model; those whose fall needs the same
     simulated time (`ensemble_duration`, from each point alone, never from the
-    others in the call) are one ``integrate_particles`` call with one particle per
-    point and the ground event (`rotframe.particles.ensemble.integrate_ensemble`). The metrics are those of
+    others in the call) are one run of the engine (`_on_engine`: every point a particle,
+    the ground the terminal event of the single run). The metrics are those of
     `analyse`; they agree with single runs to the method's accuracy (to round-off
     for ``exact``).
 
@@ -227,9 +227,10 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
     list of dict
         ``analyse(...)["metrics"]`` per point, in order.
     """
-    from rotframe.particles.ensemble import integrate_ensemble
+    from rotframe.particles.threads import device_in_force
 
     metrics = [None] * len(values_list)
+    on_gpu = device_in_force() == "gpu"
     for members in _duration_groups(values_list, terms):
         heights = np.array([values_list[i]["height"] for i in members], dtype=float)
         model, _, _, duration, _ = build(values_list[members[0]], terms)
@@ -237,15 +238,50 @@ def simulate_ensemble(values_list, terms, method, run, tracks=None):
         r0 = np.zeros((len(members), 3))
         r0[:, 2] = heights
         keep = [k for k, i in enumerate(members) if tracks is not None and i in tracks]
-        ens = integrate_ensemble(model, r0, np.zeros_like(r0), duration, GROUND,
-                                 method=METHODS.canonical(method or run.get("method") or default_method(model)),
-                                 run=run, keep=keep)
+        name = METHODS.canonical(method or run.get("method") or default_method(model))
+        t_event, state, paths = (_on_gpu if on_gpu else _on_engine)(model, r0, duration, name, run, keep)
         for k, i in enumerate(members):
-            metrics[i] = {"east_deflection_m": float(ens.state[k, 0]), "north_deflection_m": float(ens.state[k, 1]),
-                          "fall_time_s": float(ens.t_event[k])}
+            metrics[i] = {"east_deflection_m": float(state[k, 0]), "north_deflection_m": float(state[k, 1]),
+                          "fall_time_s": float(t_event[k])}
         for k in keep:
-            tracks[members[k]] = ens.paths[k]
+            tracks[members[k]] = paths[k]
     return metrics
+
+
+def _on_engine(model, r0, duration, method, run, keep):
+    """``(t_event, state, paths)`` of drops from rest at ``r0`` (N, 3): each one's landing time (NaN where it did not
+    land in ``duration``) and state there (else at the end), and the paths of the indices ``keep`` up to the landing.
+
+    The engine runs them as the single run does (`simulate`: `run_on_engine` with the ground event), every drop a
+    particle integrated alone, on the samples of a kept path (the run's ``samples``, 16 to
+    `rotframe.particles.ensemble.MAX_TRACK_SAMPLES`) whatever the number of drops, in calls of at most
+    `rotframe.particles.ensemble.PATH_BUDGET` particle-samples: a drop's numbers never depend on the others.
+    """
+    from rotframe.particles.ensemble import MAX_TRACK_SAMPLES, PATH_BUDGET
+
+    n = len(r0)
+    samples = max(16, min(int(run.get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
+    per_call = max(1, PATH_BUDGET // (samples + 1))
+    t_event, state, paths = np.full(n, math.nan), np.empty((n, 6)), {}
+    for lo in range(0, n, per_call):
+        hi = min(n, lo + per_call)
+        traj = run_on_engine(model, r0[lo:hi], np.zeros((hi - lo, 3)), duration, method, dict(run, samples=samples),
+                             None, lambda res: getattr(res, "trajectory", res), events=[GROUND_EVENT], energy=False)
+        t_event[lo:hi], state[lo:hi] = traj.first_events("ground")
+        for k in keep:
+            if lo <= k < hi:
+                times, r, _ = until_event(traj, "ground", k - lo)
+                paths[k] = (times, r)
+    return t_event, state, paths
+
+
+def _on_gpu(model, r0, duration, method, run, keep):
+    """`_on_engine` on the GPU: the scenes' GPU kernels (`rotframe.particles.ensemble.integrate_ensemble`), where the
+    engine's GPU loop (``simulate(device="gpu")``) ran at 0.08 to 0.16 of their speed when last measured (2026-11)."""
+    from rotframe.particles.ensemble import integrate_ensemble
+
+    ens = integrate_ensemble(model, r0, np.zeros_like(r0), duration, GROUND, method=method, run=run, keep=keep)
+    return ens.t_event, ens.state, ens.paths
 
 
 def ensemble_duration(duration):

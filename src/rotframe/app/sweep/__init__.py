@@ -16,8 +16,8 @@ with one PNG per metric against each swept parameter and a rerun recording of
 the ensemble next to it.
 
 Execution. A scene module with ``simulate_ensemble(values_list, terms, method,
-run, tracks=None)`` integrates the rows in vectorised calls of the compiled core
-(`rotframe.particles.ensemble.integrate_ensemble` helps it), one call per fixed
+run, tracks=None)`` integrates the rows in vectorised calls of the engine (every
+row a particle of one ``rotframe.simulate`` run, as the tower drop's), one call per fixed
 chunk of `ENSEMBLE_CHUNK` rows of the whole sweep;
 otherwise each point goes through `rotframe.app.runner.run`. Points are cut
 into batches (about 0.2 s to 30 s of work each, at most about four per worker;
