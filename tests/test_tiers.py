@@ -323,3 +323,36 @@ def test_a_run_that_fails_in_the_plain_tier_fails_as_compiled(monkeypatch):
     assert str(errors["plain"]) == str(errors["compiled"])
     assert "ZeroDivisionError" not in str(errors["plain"])
     np.testing.assert_array_equal(errors["plain"].partial.r, errors["compiled"].partial.r)
+
+
+def _well(t, r, k):
+    """A potential of the user's own (not numpy's arrays): the energy diagnostic reads it state by state."""
+    return 0.5 * k * (r[0] * r[0] + r[1] * r[1]) + k * math.cosh(0.1 * r[2])
+
+
+def _well_force(t, r, v, k):
+    return -k * r[0], -k * r[1], -0.1 * k * math.sinh(0.1 * r[2])
+
+
+def test_a_first_runs_energy_of_a_few_states_is_the_plain_remakes_and_the_compiled_ones_to_the_bit(monkeypatch):
+    # the compiled `energies` neither made nor cached (a fresh dispatcher, the cache said empty): a run whose states
+    # are few evaluates its diagnostic by the plain remake, compiles nothing for it, and gives the compiled numbers
+    from numba import njit
+
+    import rotframe.numerics.compiled as compiled
+
+    kw = dict(omega=[0.0, 0.2, 0.9], r0=[[1.0, 0.5, 0.2], [0.3, -0.2, 1.0]], v0=[[0.0, 0.4, 0.1], [0.2, 0.0, 0.0]],
+              duration=30.0, forces=[Force(_well_force, potential=_well)], params=(1.7,), samples=400,
+              plain_tier=False)
+    compiled_run = simulate_particles(**kw)
+    real = engine.energies
+    fresh = njit(cache=False, error_model="numpy", nogil=True, no_cfunc_wrapper=True)(real.py_func)
+    monkeypatch.setattr(engine, "energies", fresh)
+    monkeypatch.setitem(engine.SIGNATURES, fresh, engine.SIGNATURES[real])
+    monkeypatch.setattr(compiled, "load_cached", lambda kernel, signature: False)
+    first = simulate_particles(**dict(kw, plain_tier=True))
+    assert not fresh.signatures  # nothing compiled for the diagnostic
+    assert first.diagnostics["jacobi_rel_drift"] == compiled_run.diagnostics["jacobi_rel_drift"] > 0.0
+    assert np.array_equal(first.trajectory.extras["energy"], compiled_run.trajectory.extras["energy"])
+    many = simulate_particles(**dict(kw, plain_tier=True, samples=tiers.PLAIN_ENERGIES))  # more states: compiled
+    assert fresh.signatures and np.isfinite(many.diagnostics["jacobi_rel_drift"])

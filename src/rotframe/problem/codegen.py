@@ -215,6 +215,11 @@ def jit(signature):
     # called by address alone (rotframe.problem.calls): no CPython or C entry point to build
     return njit(signature, cache={cache}, error_model="numpy", nogil=True, no_cpython_wrapper=True,
                 no_cfunc_wrapper=True, forceinline=True)
+
+
+# compiled where first asked for (the potential: only the compiled energy diagnostic reads it, `Driver._own`)
+jit_lazy = njit(cache={cache}, error_model="numpy", nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                forceinline=True)
 """
 
 _HEADER_PLAIN = """\
@@ -227,6 +232,10 @@ from rotframe.problem.signatures import TERMS_SIG, EVENT_SIG, POTENTIAL_SIG, VEC
 
 def jit(signature):
     return lambda f: f
+
+
+def jit_lazy(f):
+    return f
 
 """
 

@@ -104,7 +104,7 @@ def particle_source(forces, events, params, *, splitting: bool, omega: str, orig
         src += [f"    if k == {k}:\n        return float(event_{k}(t, r, v{args}))\n" for k in range(len(events))]
         src.append("    return 0.0\n")
     if any(f.potential is not None for f in forces) and not energy_by_numpy(forces):  # else numpy's energies
-        src += ["\n@jit(POTENTIAL_SIG)\ndef potential(t, y, p):\n", "    r = readonly(y[0:3])\n", unpack, "    u = 0.0\n"]
+        src += ["\n@jit_lazy\ndef potential(t, y, p):\n", "    r = readonly(y[0:3])\n", unpack, "    u = 0.0\n"]
         src += [f"    u += float(potential_{k}(t, r{args if f.takes_params else ''}))\n" for k, f in enumerate(forces)
                 if f.potential is not None]
         src.append("    return u\n")

@@ -210,11 +210,12 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         warnings.append("jit=False: the forces and the integrator ran as plain Python, some 100 to 1000 times "
                         "slower than compiled")
 
-    def energies(rotating):  # numpy's where it can; else by the loop that ran the run's end (plain: nothing compiled)
+    def energies(rotating):  # numpy's where it can; else compiled, or plain where few and not compiled yet (`Tier`)
         if energy_by_numpy(forces):
             return array_energies(traj, forces, frame, rotating)
-        return tier.driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, tier.fns,
-                                    tier.driver.potential(), rotating)
+        driver, fns = tier.energy_driver(traj.times.size * N)
+        return driver.energies(traj.times, np.ascontiguousarray(OUT[: traj.times.size]), prob, fns,
+                               driver.potential(), rotating)
 
     if energy:
         _energy_diagnostics(energies, traj, frame, origin, forces, diagnostics, notes, frame_terms)

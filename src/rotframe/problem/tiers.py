@@ -52,12 +52,16 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES"]
+__all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES",
+           "PLAIN_ENERGIES"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
 #: against 4 to 5 s to compile its loop
 PLAIN_FEVS = 20_000
+#: the most states whose energy a run evaluates by the plain remake where `energies` is not compiled yet
+#: (`Tier.energy_driver`): some 15 us each on the reference machine, 0.15 s, against some 0.5 s to compile it
+PLAIN_ENERGIES = 10_000
 #: the steps per particle of each call in the plain tier (a count, not a time: the same run switches at the same step)
 PLAIN_STEPS = 8
 #: the most particles a run may have to begin in the plain tier (a first call of PLAIN_STEPS DOP853 steps each: some
@@ -145,6 +149,7 @@ class Tier:
         self.driver = driver
         self.fns = fns
         self.variant = variant
+        self._make_plain, self._prob = plain, prob
         #: whether the calls run as plain Python now
         self.plain = (plain is not None and particles <= PLAIN_PARTICLES
                       and not loop_is_compiled(variant))
@@ -202,6 +207,23 @@ class Tier:
         self.plain = False
         self._switched_at = self._plain_steps
         return True
+
+    def energy_driver(self, states):
+        """``(driver, fns)`` that evaluate the run's energy at ``states`` states (`rotframe.problem.engine.energies`):
+        the plain remake's where the compiled `energies` is neither made in this process nor in numba's cache and the
+        states are at most `PLAIN_ENERGIES` (a first run of a problem with a potential of its own, as `cr3bp`'s,
+        compiled `energies` and the potential's glue for its diagnostic alone), else the run's own. The numbers are
+        the compiled ones (the module docstring)."""
+        if self.plain or self._make_plain is None or states > PLAIN_ENERGIES:
+            return self.driver, self.fns
+        from rotframe.numerics.compiled import load_cached
+        from rotframe.problem import engine
+
+        kernel = engine.energies
+        if kernel.signatures or load_cached(kernel, engine.SIGNATURES[kernel]):
+            return self.driver, self.fns
+        plain = self._make_plain()
+        return plain, plain.functions(self._prob)
 
     @property
     def note(self):
