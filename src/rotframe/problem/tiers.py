@@ -38,6 +38,10 @@ may round a transcendental differently from the C library numba calls, by an ulp
 is decided on counts of steps and simulated time, not on the clock, so a run begins and switches
 the same way every time its loop is cold. Each run says in its notes which tier ran it.
 
+The energy diagnostic of a run with a potential of the user's own (not numpy's arrays) follows the same rule
+(`Tier.energy_driver`): where the compiled `rotframe.problem.engine.energies` is neither made nor cached and the run
+has at most `PLAIN_ENERGIES` states, the plain remake evaluates them, and nothing is compiled for a diagnostic.
+
 Only runs on the CPU of at most `PLAIN_PARTICLES` particles (or one rigid body:
 `rotframe.problem.body`), with ``inline`` not True, begin in the plain tier: a large ensemble's
 first call alone would be too long as Python.
@@ -213,7 +217,8 @@ class Tier:
         the plain remake's where the compiled `energies` is neither made in this process nor in numba's cache and the
         states are at most `PLAIN_ENERGIES` (a first run of a problem with a potential of its own, as `cr3bp`'s,
         compiled `energies` and the potential's glue for its diagnostic alone), else the run's own. The numbers are
-        the compiled ones (the module docstring)."""
+        the compiled ones where the potential gives the same numbers in Python (the module docstring): `cr3bp`'s
+        Jacobi integral differs in its last bit at some samples, its drift not at all (2026-12-01)."""
         if self.plain or self._make_plain is None or states > PLAIN_ENERGIES:
             return self.driver, self.fns
         from rotframe.numerics.compiled import load_cached
