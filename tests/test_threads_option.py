@@ -149,7 +149,9 @@ def test_bench_ensemble_honours_threads_and_reports_the_ceiling(capsys):
     captured = capsys.readouterr()
     assert code == 0, captured.err
     rows = [r for r in json.loads(captured.out) if r["scenario"] == "ensemble"]
-    assert len(rows) == 24 and {r["threads"] for r in rows} == {1}  # 3 methods x (event, none) x 4 rows
+    # 3 methods x (event, none) x 4 rows, and the engine's door (the sweeps') beside the two fixed-step event cases
+    assert len(rows) == 28 and {r["threads"] for r in rows} == {1}
+    assert sum(r["method"].startswith("rotframe simulate (N, 3)") for r in rows) == 4
     assert {(r["integrator"], r["event"]) for r in rows} == {(m, e) for m in ("rotation-splitting", "rk4", "dop853")
                                                              for e in (True, False)}
     for r in rows:

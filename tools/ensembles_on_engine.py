@@ -1,8 +1,8 @@
 """How the engine runs the tower drop's sweep ensembles, beside the scenes' kernels that run them today (issue 32).
 
-The sweeps' vectorised ensembles (`rotframe.scenes.tower_drop.simulate_ensemble`) call
-`rotframe.particles.ensemble.integrate_ensemble` on the scenes' kernels. Moving them onto the engine
-must keep their ratio to the hand-written ceiling (`rotframe bench ensemble`: 0.7 or more). This
+The sweeps' vectorised ensembles (`rotframe.scenes.tower_drop.simulate_ensemble`) run on the engine since
+2026-12-01 (before, `rotframe.particles.ensemble.integrate_ensemble` on the scenes' kernels, which the bench's
+ensemble rows still measure against the hand-written ceiling, `rotframe bench ensemble`: 0.7 or more). This
 tool times the same ensemble (gravity and Coriolis, the ground as a terminal event that no particle
 reaches in the run, so both take the same steps) both ways, best of three after a first run that
 compiles or loads every loop, and prints the engine's time over the scenes' kernels': by address

@@ -91,6 +91,9 @@ def table(rows, speed) -> str:
                           f"({r['goal_ratio']:.2f} of the 0.7 goal; the ceiling's scaling x {r['scaling_vs_ceiling']:.2f}), "
                           f"{r['of_ceiling']:.2f} of the ceiling, "
                           f"bitwise identical to 1 thread: {r['bitwise_identical_to_1_thread']}")
+            if "of_integrate_ensemble" in r:  # the engine's door (the sweeps'), beside the scenes' kernels' door
+                extra += (f", {r['of_ceiling']:.2f} of the ceiling, {r['of_integrate_ensemble']:.2f} of "
+                          f"integrate_ensemble's rate")
             if "of_ceiling" in r and "ceiling_goal" in r:
                 jax = r.get("vs_jax_vmap")
                 alone = r.get("kernel_of_ceiling")

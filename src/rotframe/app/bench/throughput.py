@@ -26,7 +26,10 @@ def ensemble_rows(quick):
     ensemble path). Each case has four rows: rotframe with ``threads=1`` and with every
     core (or ``--threads N``), the hand-written loop of the same steps
     (`rotframe.app.bench.ceiling`) on one core and with ``prange`` on as many
-    numba threads (the ceiling). ``of_ceiling``: rotframe's rate over the hand-written
+    numba threads (the ceiling); the fixed-step cases with the event have two more, the
+    engine's door that the tower drop's sweeps run (``rotframe.simulate``'s core with the
+    built-in ground crossing, on the steady specialisation: `rotframe.problem.steady`), at one
+    thread and every core, with ``of_ceiling`` and ``of_integrate_ensemble``. ``of_ceiling``: rotframe's rate over the hand-written
     loop's at the same thread count (the goal is 0.7 or more). The all-core row of
     each case also has ``parallel_efficiency`` (N-core rate over ``N x`` one core),
     ``goal_ratio`` (that over 0.7), ``scaling_vs_ceiling`` (over the ceiling's own
@@ -154,11 +157,24 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
     atol = rtol * ensemble_scale(r0, v0)  # the ensemble's own rule
     run = {"step": h or None, "samples": 1, "rtol": rtol}
 
+    from rotframe.particles.ensemble import threads_in_force, threads_scope
+
+    def engine(threads):  # the sweeps' door: one simulate run, the ground a built-in crossing (rotframe.problem.steady)
+        from rotframe import forces
+        from rotframe.events import crossing
+        from rotframe.problem.particles import simulate_particles
+
+        with threads_scope(threads if threads is not None else threads_in_force()):
+            res = simulate_particles(omega=w, r0=r0, v0=v0, duration=duration, forces=[forces.gravity(g)],
+                                     frame_terms=("coriolis",), method=method, step=h, samples=16, energy=False,
+                                     events=[crossing(2, 0.0, direction=-1, terminal=True, name="ground")])
+        t_event, state = res.trajectory.first_events("ground")
+        return state, int(np.sum(np.isfinite(t_event))), None
+
     def ours(threads):
         if event and not dop:
             res = integrate_ensemble(model, r0, v0, duration, ground, method=method, run=run, threads=threads)
             return res.state, int(np.sum(np.isfinite(res.t_event))), None
-        from rotframe.particles.ensemble import threads_in_force, threads_scope
 
         with threads_scope(threads if threads is not None else threads_in_force()):
             # DOP853 with the event: the ensemble's own call with one sample (an ensemble this small asks
@@ -222,6 +238,11 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
              (f"rotframe {door} {label}, {cores} threads", cores, lambda: ours(None)),
              (f"hand-written {label}, 1 core", 1, serial),
              (f"hand-written prange {label}, {prange_threads} threads (ceiling)", prange_threads, parallel)]
+    if event and not dop:  # and the engine's door, which the tower drop's sweeps run (since 2026-12-01)
+        e = engine(1)
+        same_engine, rel_engine, _ = same_state(e[0], e[1], ref, tol)
+        cases += [(f"rotframe simulate (N, 3) {label}, 1 thread", 1, lambda: engine(1)),
+                  (f"rotframe simulate (N, 3) {label}, {cores} threads", cores, lambda: engine(None))]
     walls = best_interleaved([fn for _, _, fn in cases], budget=budget, max_rounds=3 if quick else 15)
     for (name, threads, fn), wall in zip(cases, walls):
         total = n * per_particle
@@ -238,6 +259,10 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
     rows[0]["of_ceiling"] = single / rows[2]["particle_steps_per_s"]
     for r in rows:
         r.update(same_work=same and same_steps, same_work_max_rel=rel, same_work_note=note, same_steps=same_steps)
+    for r, hand_row in zip(rows[4:], rows[2:4]):  # the engine's door beside the same ceiling
+        r.update(of_ceiling=r["particle_steps_per_s"] / hand_row["particle_steps_per_s"],
+                 of_integrate_ensemble=r["particle_steps_per_s"] / rows[r["threads"] != 1]["particle_steps_per_s"],
+                 same_work=same_engine and same_steps, same_work_max_rel=rel_engine)
     return rows
 
 
