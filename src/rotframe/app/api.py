@@ -287,7 +287,7 @@ class TrajectoryArrays:
         Rigid bodies: unit quaternions (x, y, z, w), scalar last, rotating body
         components into space components (scipy's ``Rotation.from_quat``).
     event_times : dict
-        Event name -> list (per particle) of arrays of times, s.
+        Event name -> a sequence (per particle: index it, iterate it, ``len``) of arrays of times, s.
     units : dict
         Array name -> unit string.
     frame : str

@@ -49,8 +49,8 @@ class Trajectory:
     ----------
     times : (n,) array, s
     r, v : (n, N, 3) arrays, m and m/s
-    event_times : dict name -> list (per particle) of arrays of event times
-    event_states : dict name -> list (per particle) of (k, 6) arrays (r, v)
+    event_times : dict name -> sequence (per particle: a `PerParticle`, or a list) of arrays of event times
+    event_states : dict name -> sequence (per particle) of (k, 6) arrays (r, v)
     method, steps, nfev : what was run and what it cost (one trajectory)
     complete : False when the run stopped early; ``t_reached`` says where.
     """
