@@ -440,9 +440,9 @@ def _steady_run(s, atol, progress, energy=True) -> ProblemRun:
     except (IntegrationError, RunNeedsCuts):
         raise SteadyLoopFailed from None
     warnings, _ = _records_of(traj, rows)
-    notes = list(s.frame.notes) + ["method dop853: the engine's steady loop (a constant rotation rate, uniform "
-                                   "gravity, a string, one built-in crossing: rotframe.problem.steady), compiled once "
-                                   "for every such problem"]
+    notes = list(s.frame.notes) + ["method dop853: the engine's steady loop (what it takes: a constant rotation "
+                                   "rate, uniform gravity, a string, one built-in crossing; rotframe.problem.steady), "
+                                   "compiled once for every such problem"]
     return _steady_result(s, traj, warnings, notes, energy)
 
 
