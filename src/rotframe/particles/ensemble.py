@@ -177,25 +177,18 @@ def _first_events(traj, event):
     """(t, state) of each particle's first ``event`` found by the kernel; the end state where none.
 
     Read from the kernels' record arrays where the run left them there (vectorised, so
-    that little time is spent holding the GIL), else from the per-particle lists.
+    that little time is spent holding the GIL), else from the per-particle sequences
+    (`rotframe.particles.trajectory.Trajectory.first_events`).
     """
-    n = traj.r.shape[1]
-    state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
-    t_event = np.full(n, math.nan)
     evb = traj.extras.get("event_records")
-    if evb is not None:
-        hit = evb.count > 0  # one event: every record is of it, the first in column 0
-        t_event[hit] = evb.t[hit, 0]
-        state[hit, :3] = evb.r[hit, 0]
-        state[hit, 3:] = evb.v[hit, 0]
-        return t_event, state
-    times, states = traj.event_times[event.name], traj.event_states[event.name]
-    counts = np.fromiter(map(len, times), dtype=np.int64, count=n)
-    hit = counts > 0
-    if hit.any():
-        first = (np.cumsum(counts) - counts)[hit]  # where each particle's records start in the concatenation
-        t_event[hit] = np.concatenate(times)[first]
-        state[hit] = np.concatenate(states)[first]
+    if evb is None:
+        return traj.first_events(event.name)
+    state = np.concatenate([traj.r[-1], traj.v[-1]], axis=1)
+    t_event = np.full(traj.r.shape[1], math.nan)
+    hit = evb.count > 0  # one event: every record is of it, the first in column 0
+    t_event[hit] = evb.t[hit, 0]
+    state[hit, :3] = evb.r[hit, 0]
+    state[hit, 3:] = evb.v[hit, 0]
     return t_event, state
 
 
