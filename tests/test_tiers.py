@@ -95,18 +95,29 @@ CASES = {
 }
 
 
+def _tiers(m, tier_mode, budget):
+    """``tier_mode`` set on ``tiers`` with the monkeypatch context ``m`` (`_run`)."""
+    if tier_mode == "compiled":  # never the plain tier, whether or not this process has compiled the loop yet
+        m.setattr(tiers, "PLAIN_PARTICLES", 0)
+    elif tier_mode == "trajectory":  # the whole loop cold, DOP853's trajectory tier made: the run begins there
+        m.setattr(tiers, "loop_is_compiled", lambda variant: len(variant) == 5 and variant[4] == engine.TRAJECTORY_TIER)
+    else:
+        m.setattr(tiers, "loop_is_compiled", lambda variant: False)
+        m.setattr(tiers, "PLAIN_FEVS", 10**12 if tier_mode == "plain" else budget)
+        if tier_mode == "switch-whole":  # DOP853 too switches to the whole loop, not to its trajectory tier
+            m.setattr(tiers, "TRAJECTORY_CALLS", 0)
+
+
 def _run(case, tier_mode, monkeypatch, budget=None):
     """The case's run: ``compiled`` (the loop as this process has it), ``plain`` (the plain tier throughout),
-    ``switch`` (the plain tier for its first calls, then compiled)."""
+    ``switch`` (the plain tier for its first calls, then compiled: DOP853's trajectory tier, the whole loop for the
+    others), ``switch-whole`` (the same, the whole loop for DOP853 too), ``trajectory`` (DOP853's trajectory tier
+    throughout)."""
     kw = dict(case)
     kw.setdefault("r0", R0)
     kw.setdefault("v0", V0)
     with monkeypatch.context() as m:
-        if tier_mode == "compiled":  # never the plain tier, whether or not this process has compiled the loop yet
-            m.setattr(tiers, "PLAIN_PARTICLES", 0)
-        else:
-            m.setattr(tiers, "loop_is_compiled", lambda variant: False)
-            m.setattr(tiers, "PLAIN_FEVS", 10**12 if tier_mode == "plain" else budget)
+        _tiers(m, tier_mode, budget)
         return simulate_particles(**kw)
 
 
@@ -139,8 +150,17 @@ def test_plain_tier_and_the_switch_give_the_compiled_numbers(name, monkeypatch):
     # switched after the first plain call (the budget a single right-hand side): the rest compiled
     switched = _run(case, "switch", monkeypatch, budget=1)
     assert any("remake ran the first" in n and "then the loop compiled" in n for n in switched.notes), switched.notes
+    stepped = case["method"] == "dop853"  # DOP853 switches to its trajectory tier: its trajectories compiled alone
+    assert any("its trajectories alone" in n for n in switched.notes) == stepped, switched.notes
     assert 0 < switched.trajectory.steps
     _same(switched, compiled)
+    if stepped:
+        whole = _run(case, "switch-whole", monkeypatch, budget=1)
+        assert any("then the loop compiled (" in n for n in whole.notes), whole.notes
+        _same(whole, compiled)
+        trajectory = _run(case, "trajectory", monkeypatch)
+        assert not trajectory.notes or not any("plain-Python" in n for n in trajectory.notes), trajectory.notes
+        _same(trajectory, compiled)
 
 
 def _torque(t, L, q, c):
@@ -169,11 +189,7 @@ def _body(case, tier_mode, monkeypatch, budget=None):
     kw = dict(dict(inertia=[1.0, 2.0, 3.0], L0=[0.1, 1.0, 0.2], q0=[0.0, 0.0, 0.0, 1.0], duration=6.0, samples=24),
               **case)
     with monkeypatch.context() as m:
-        if tier_mode == "compiled":
-            m.setattr(tiers, "PLAIN_PARTICLES", 0)
-        else:
-            m.setattr(tiers, "loop_is_compiled", lambda variant: False)
-            m.setattr(tiers, "PLAIN_FEVS", 10**12 if tier_mode == "plain" else budget)
+        _tiers(m, tier_mode, budget)
         return simulate_rigid_body(**kw)
 
 
@@ -185,7 +201,13 @@ def test_a_body_in_the_plain_tier_and_switched_gives_the_compiled_numbers(name, 
     assert not any("plain-Python remake" in n for n in compiled.notes)
     assert any("short enough for its plain-Python remake" in n for n in plain.notes), plain.notes
     assert any("then the loop compiled" in n for n in switched.notes), switched.notes
-    for run in (plain, switched):
+    stepped = BODIES[name]["method"] == "dop853"
+    assert any("its trajectories alone" in n for n in switched.notes) == stepped, switched.notes
+    runs = [plain, switched]
+    if stepped:
+        runs += [_body(BODIES[name], "switch-whole", monkeypatch, budget=1),
+                 _body(BODIES[name], "trajectory", monkeypatch)]
+    for run in runs:
         np.testing.assert_array_equal(run.trajectory.L, compiled.trajectory.L)
         np.testing.assert_array_equal(run.trajectory.q, compiled.trajectory.q)
         assert run.diagnostics == compiled.diagnostics
@@ -272,14 +294,15 @@ def spring(t, r, v):
 run = simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=float(sys.argv[1]),
                          forces=[spring], samples=10)
 print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
-                  "compiled": engine.variant(0, "dop853", False, load_only=True) is not None}))
+                  "compiled": engine.variant(0, "dop853", False, load_only=True) is not None,
+                  "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None}))
 """
 
 
 def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
-    one switches and compiles it; the next short one, in another process, finds it in the cache and runs compiled.
-    The final states agree to the bit."""
+    one switches and compiles DOP853's trajectory tier, not the whole loop; the next short one, in another process,
+    finds the tier in the cache and runs there, compiling nothing. The final states agree to the bit."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
 
     def child(duration):
@@ -290,12 +313,13 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
 
     short = child(10.0)
     assert any("short enough for its plain-Python remake" in n for n in short["notes"]), short["notes"]
-    assert not short["compiled"]
+    assert not short["compiled"] and not short["trajectory"]
     long = child(400.0)
-    assert any("then the loop compiled" in n for n in long["notes"]), long["notes"]
+    assert any("then the loop compiled, its trajectories alone" in n for n in long["notes"]), long["notes"]
+    assert long["trajectory"] and not long["compiled"]
     again = child(10.0)
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
-    assert again["compiled"]
+    assert again["trajectory"] and not again["compiled"]
     assert again["r"] == short["r"]
 
 
@@ -356,3 +380,22 @@ def test_a_first_runs_energy_of_a_few_states_is_the_plain_remakes_and_the_compil
     assert np.array_equal(first.trajectory.extras["energy"], compiled_run.trajectory.extras["energy"])
     many = simulate_particles(**dict(kw, plain_tier=True, samples=tiers.PLAIN_ENERGIES))  # more states: compiled
     assert fresh.signatures and np.isfinite(many.diagnostics["jacobi_rel_drift"])
+
+
+def test_many_trajectory_calls_a_call_compile_the_whole_loop(monkeypatch):
+    """A first run whose calls would make more than TRAJECTORY_CALLS calls of the trajectory loop (its particles times
+    its knots and end) compiles the whole loop instead, where the loop over them is compiled too; the numbers are the
+    same. The table frame's knots end steps: its 3 particles make 3 calls a call for each knot and the end, a frame
+    without knots 3 in all."""
+    case = CASES["dop853, a frame turning by a function, an accelerating origin"]
+    table = CASES["dop853, a table frame, a force in inertial axes"]
+    compiled = _run(table, "compiled", monkeypatch)
+    with monkeypatch.context() as m:
+        m.setattr(tiers, "TRAJECTORY_CALLS", 3)
+        switched = _run(table, "switch", monkeypatch, budget=1)
+        assert any("then the loop compiled (" in n for n in switched.notes), switched.notes
+        assert tiers.trajectory_tier_fits("dop853", 3, 0) and not tiers.trajectory_tier_fits("dop853", 3, 1)
+        stepped = _run(case, "switch", monkeypatch, budget=1)
+        assert any("its trajectories alone" in n for n in stepped.notes), stepped.notes
+    _same(switched, compiled)
+    assert not tiers.trajectory_tier_fits("rk4", 1, 0)

@@ -23,6 +23,7 @@ With ``jit=False`` the same source runs as plain Python (no numba at all), with 
 
 from __future__ import annotations
 
+import copy
 import functools
 import hashlib
 import importlib.util
@@ -137,6 +138,15 @@ class Driver:
         self.compiled = compiled
         # the variant of the engine's loop that a problem needs is chosen (and compiled, once) at its first call
         self.advance = engine.advance if compiled else functools.partial(engine.advance, compiled=False)
+
+    def trajectory_tier(self):
+        """This driver with the engine's trajectory tier as its loop (`rotframe.problem.engine.trajectory_tier`: each
+        trajectory compiled, the loop over the particles as Python), its functions' addresses the same."""
+        from rotframe.problem import engine
+
+        made = copy.copy(self)
+        made.advance = functools.partial(engine.advance, compiled=engine.TRAJECTORY_TIER)
+        return made
 
     def _entry(self, name):
         """The engine's entry point ``name``, compiled when first needed (or its plain Python remake)."""

@@ -68,7 +68,8 @@ from rotframe.problem.loop_state import load_particle, save_particle, watcher_co
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
 from rotframe.problem.stops import next_stop
 
-__all__ = ["advance", "variant", "variant_loop", "scratch", "start_events", "energies", "ready"]
+__all__ = ["advance", "variant", "variant_loop", "trajectory_tier", "TRAJECTORY_TIER", "scratch", "start_events",
+           "energies", "ready"]
 
 #: the entry points Python calls (no C entry point: nothing calls them from C)
 _entry = njit(cache=True, error_model="numpy", nogil=True, no_cfunc_wrapper=True)
@@ -275,20 +276,27 @@ def _watcher(kind, step, body, method, cold=False):
     return jit_uncounted(made) if cold else jit_inline(made)
 
 
-def _dop853_loop(name, body, events, D):
-    """The DOP853 variant's loop: `rotframe.numerics.dop853_loop`'s trajectory, per particle, from stop to stop.
-
-    The system is the model's right-hand side (`particle_system`, `body_system`) with ``ctx =
-    (prob, fns, W)``; the events are `_watch_events`; a user function that raised ends the
-    trajectory at the step (`raised`). A call takes at most ``budget`` accepted steps per particle
-    and ends after an accepted step, so the steps do not depend on where the budget cut the calls.
-    The template `_dop853_advance` reads the system's functions as globals (`rotframe.numerics.compiled.bound`).
-    """
+def _dop853_parts(body, events, D, entry=False):
+    """The DOP853 variant's system and trajectory loop: the model's right-hand side (`particle_system`,
+    `body_system`) with ``ctx = (prob, fns, W)``, and `rotframe.numerics.dop853_loop`'s trajectory compiled for it,
+    the events watched by `_watch_events`, a user function that raised ending the trajectory at the step (`raised`).
+    ``entry``: the trajectory callable from Python too (the trajectory tier, `trajectory_tier`), cached apart."""
     system = particle_system if body is None else body_system
     kind = f"engine_{'particle' if body is None else 'body'}{D}"
     stages = stepper(body, DOP853, D)
     watch = _watcher(kind, stages, body, DOP853) if events else None
-    trajectory = dop853_trajectory(kind + ("_events" if events else ""), stages, store_rows, D, watch, aborted=raised)
+    name = kind + ("_events" if events else "") + ("_entry" if entry else "")
+    return system, dop853_trajectory(name, stages, store_rows, D, watch, entry=entry, aborted=raised)
+
+
+def _dop853_loop(name, body, events, D):
+    """The DOP853 variant's loop: `rotframe.numerics.dop853_loop`'s trajectory, per particle, from stop to stop.
+
+    The system and the trajectory are `_dop853_parts`'. A call takes at most ``budget`` accepted steps per particle
+    and ends after an accepted step, so the steps do not depend on where the budget cut the calls. The template
+    `_dop853_advance` reads the system's functions as globals (`rotframe.numerics.compiled.bound`).
+    """
+    system, trajectory = _dop853_parts(body, events, D)
     return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D), EVENTS=bool(events))
 
 
@@ -355,34 +363,93 @@ METHOD_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "
 METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4", SPLITTING6: "splitting6",
                 SPLITTING8: "splitting8"}
 _VARIANTS: dict = {}
+#: `variant`'s third form of a DOP853 loop beside compiled (True) and plain Python (False), `trajectory_tier`; the fifth
+#: of a variant where `rotframe.problem.tiers` asks whether it is made
+TRAJECTORY_TIER = "trajectory"
 
 
 def variant(model, method, events, compiled=True, D=None, load_only=False):
     """The loop of ``model`` (`PARTICLE`, `BODY`), ``method`` (a name of `METHOD_CODES`) and
     ``events`` (whether the problem has any): compiled for `VARIANT_SIGNATURE` (or loaded from numba's cache)
-    when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`). ``D``, the
-    length of the state, is a constant of the loop's code (default the model's, `STATE_LENGTH`). With
+    when first asked for; with ``compiled=False`` its plain Python remake (`rotframe.numerics.plain`); with
+    ``compiled=TRAJECTORY_TIER`` (DOP853 alone) its trajectories compiled and the rest plain (`trajectory_tier`). ``D``,
+    the length of the state, is a constant of the loop's code (default the model's, `STATE_LENGTH`). With
     ``load_only``: None where the loop would have to compile (neither made in this process nor in the cache), what
     tells a run to begin in the plain tier (`rotframe.problem.tiers`)."""
     from rotframe.numerics.compiled import load_cached
 
     D = STATE_LENGTH[int(model)] if D is None else int(D)
-    key = (int(model), method, bool(events), D, bool(compiled))
+    key = (int(model), method, bool(events), D, compiled if compiled == TRAJECTORY_TIER else bool(compiled))
     kernel = _VARIANTS.get(key)
     if kernel is None:
-        kernel = _variant_kernel(*key[:4])
-        if compiled:
-            if not load_cached(kernel, VARIANT_SIGNATURE):
-                if load_only:
-                    return None
-                kernel.compile(VARIANT_SIGNATURE)
-            kernel.disable_compile()
+        if key[-1] == TRAJECTORY_TIER:
+            kernel = trajectory_tier(*key[:4], load_only=load_only)
+            if kernel is None:
+                return None
         else:
-            from rotframe.numerics.plain import plain
+            kernel = _variant_kernel(*key[:4])
+            if compiled:
+                if not load_cached(kernel, VARIANT_SIGNATURE):
+                    if load_only:
+                        return None
+                    kernel.compile(VARIANT_SIGNATURE)
+                kernel.disable_compile()
+            else:
+                from rotframe.numerics.plain import plain
 
-            kernel = plain(kernel)
+                kernel = plain(kernel)
         _VARIANTS[key] = kernel
     return kernel
+
+
+def _system_call(ctx, t, z, K, s):
+    """The template of the trajectory tier's right-hand side, an entry point: ``K[s] = f(t, z)`` (``SYSTEM``)."""
+    SYSTEM(ctx, t, z, K, s)
+
+
+def _python_call(kernel):
+    """The compiled entry point ``kernel`` behind a Python function, which `rotframe.numerics.plain` keeps as it is."""
+
+    def call(*args):
+        return kernel(*args)
+
+    return call
+
+
+def trajectory_tier(model, method, events, D, load_only=False):
+    """The DOP853 loop of ``model`` and ``events`` with its trajectories compiled and the rest as Python.
+
+    The template of the compiled loop (`_dop853_advance`) remade as plain Python
+    (`rotframe.numerics.plain`) but for its two callees, each compiled on its own as an entry point
+    for its one signature (`TRAJECTORY_ARGS`, `SYSTEM_ARGS`) and cached: the trajectory loop
+    (`_dop853_parts`: every step of a run, from stop to stop) and the right-hand side (each particle's
+    first f and Hairer's starting step). The loop over the particles and the stops, each particle's
+    loading, tolerances and saving run as Python: some 50 us a particle and call, and a call of the
+    trajectory a stop. Compiling it took 0.58 of the whole loop's time on the 2-core reference machine,
+    numba's start included (4.2 s against 7.3 s, 2026-12-01): the whole loop compiles the trajectory
+    again inside its own code, and an entry point that unboxes thirty arguments. The same code runs, so
+    the numbers are the whole loop's to the bit (``tests/test_tiers.py``). ``load_only``: None where
+    either callee would have to compile. `rotframe.problem.tiers` runs a first run of a few particles
+    on it. ``method`` is DOP853's (the fixed-step loops have no such tier).
+    """
+    from rotframe.numerics.compiled import load_cached
+    from rotframe.numerics.plain import plain
+
+    if method != "dop853":
+        raise ValueError(f"the trajectory tier is DOP853's, not {method}'s")
+    body = None if model == PARTICLE else True
+    system, trajectory = _dop853_parts(body, events, D, entry=True)
+    kind = f"{'particle' if body is None else 'body'}{D}"
+    system_entry = _uncounted_entry(bound(_system_call, f"dop853_system_engine_{kind}", SYSTEM=system))
+    for kernel, args in ((trajectory, TRAJECTORY_ARGS[bool(events)]), (system_entry, SYSTEM_ARGS)):
+        if not load_cached(kernel, args):
+            if load_only:
+                return None
+            kernel.compile(args)
+        kernel.disable_compile()
+    return plain(bound(_dop853_advance, f"advance_{kind}_dop853{'_events' if events else ''}_trajectory_tier",
+                       SYSTEM=_python_call(system_entry), TRAJECTORY=_python_call(trajectory), DIM=int(D),
+                       EVENTS=bool(events)))
 
 
 def scratch(D):
@@ -442,6 +509,13 @@ def energies(T, OUT, prob, fns, potential, rotating):
 #: problem
 VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
                                B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
+#: the trajectory tier's entry points' arguments (`trajectory_tier`): the trajectory loop's, without and with events
+#: (``wctx``, `rotframe.problem.loop_state.watcher_context`'s tuple), and the right-hand side's
+_CTX = types.Tuple((PROBLEM, FUNCTIONS, A1))
+TRAJECTORY_ARGS = {events: (_CTX, F8, A1, F8, F8, F8, A1, I8, A3, I8, F8, A1, A2, A1, A1, A1, A2,
+                            types.Tuple((A2, A2, A3, I2, I1, A1, B1, F8, A2, A1, A1, A1)) if events else I8, I8)
+                   for events in (False, True)}
+SYSTEM_ARGS = (_CTX, F8, A1, A2, I8)
 #: the one signature of each other entry point
 SIGNATURES = {
     start_events: types.void(F8, A2, A2, PROBLEM, FUNCTIONS),

@@ -138,7 +138,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                         inline if jit and not on_gpu else False)
     # a first run whose loop is not compiled yet begins as the loop's plain-Python remake (`rotframe.problem.tiers`)
     tier = Tier(driver, fns, s.plain_driver if gpu is None and inline is not True and plain_tier else None,
-                (prob[0], method, bool(events), D), prob, N)
+                (prob[0], method, bool(events), D), prob, N, stops.size)
 
     def advance(*args):  # the plain tier's loop, the engine's, or the inlined one once the run has switched to it
         tier.driver.advance(*args, kernel=None if tier.plain else inlining.kernel)

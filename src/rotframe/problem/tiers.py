@@ -12,8 +12,10 @@ numba's cache (`loop_is_compiled`) therefore begins in the *plain tier*:
 * it runs calls of `PLAIN_STEPS` steps per particle as plain Python;
 * after each, it projects the run's right-hand sides (summed over the particles): each running
   particle's so far, times the run's span over the span it has covered. Where the projection
-  exceeds `PLAIN_FEVS`, the loop is compiled, as the run would have compiled it at its start, and the run goes on compiled from where it is (the loop keeps
-  everything a step needs in its arrays, as between any two calls);
+  exceeds `PLAIN_FEVS`, the loop is compiled, as the run would have compiled it at its start,
+  and the run goes on compiled from where it is (the loop keeps everything a step needs in its
+  arrays, as between any two calls). A DOP853 run compiles its *trajectory tier* instead of the
+  whole loop (below) where it fits;
 * a run that ends first never compiles the loop; the next run's loop is then still cold, and it
   begins in the plain tier too. The right-hand sides of the runs of a loop that ended plain count
   against the same `PLAIN_FEVS` in the process (`plain_fevs_spent`): many short runs of one problem
@@ -45,6 +47,20 @@ has at most `PLAIN_ENERGIES` states, the plain remake evaluates them, and nothin
 Only runs on the CPU of at most `PLAIN_PARTICLES` particles (or one rigid body:
 `rotframe.problem.body`), with ``inline`` not True, begin in the plain tier: a large ensemble's
 first call alone would be too long as Python.
+
+**The trajectory tier.** A DOP853 run of so few particles compiles less than the whole loop
+(`rotframe.problem.engine.trajectory_tier`): the loop's trajectory from stop to stop, where every
+step is taken, and its right-hand side, each compiled on its own and cached; the loop over the
+particles and the stops stays the plain remake's Python, some 30 to 50 us a call of the
+trajectory. The whole loop compiles the trajectory a second time inside its own code, and an
+entry point of thirty arguments: the tier compiled in 0.58 of its time on the 2-core reference
+machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01; a first long run
+of a spring, 0.81 of its time, its glue and first plain calls beside). A run begins there where
+the whole loop is not compiled but the tier is (`loop_is_compiled` of the variant with
+`rotframe.problem.engine.TRAJECTORY_TIER` fifth), and compiles it, not the whole loop, where it
+switches; the whole loop is compiled by a run of more particles, or of more calls of the
+trajectory a call than `TRAJECTORY_CALLS` (a frame's table of many knots: `trajectory_tier_fits`).
+It is the same code, so the same numbers to the bit (`tests/test_tiers.py`).
 """
 
 from __future__ import annotations
@@ -56,8 +72,9 @@ import warnings
 
 import numpy as np
 
-__all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent", "projected_fevs", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES",
-           "PLAIN_ENERGIES"]
+__all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent",
+           "projected_fevs", "trajectory_tier_fits", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES", "PLAIN_ENERGIES",
+           "TRAJECTORY_CALLS"]
 
 #: the most right-hand sides (summed over the particles) a run may take in the plain tier, as projected: some
 #: 0.6 s of DOP853 as plain Python (30 us each on the reference machine; RK4's and the splittings' 8 to 15 us),
@@ -71,6 +88,19 @@ PLAIN_STEPS = 8
 #: the most particles a run may have to begin in the plain tier (a first call of PLAIN_STEPS DOP853 steps each: some
 #: 3,300 right-hand sides, 0.1 s)
 PLAIN_PARTICLES = 32
+
+
+#: the most calls of the trajectory loop a call of the trajectory tier makes, a particle's for each stop in the run (the
+#: knots of a frame's table) and the end: some 30 us of Python each, where the whole loop (`trajectory_tier_fits`) makes
+#: them compiled
+TRAJECTORY_CALLS = 2_000
+
+
+def trajectory_tier_fits(method, particles, stops) -> bool:
+    """Whether a first run of ``particles`` particles (at most `PLAIN_PARTICLES`) and ``stops`` knots, whose whole loop
+    is not compiled yet, compiles DOP853's trajectory tier instead (`rotframe.problem.engine.trajectory_tier`; the
+    module docstring): DOP853's, and at most `TRAJECTORY_CALLS` calls of the trajectory loop in a call."""
+    return method == "dop853" and particles * (stops + 1) <= TRAJECTORY_CALLS
 
 
 #: the right-hand sides the plain tier has spent in this process on the runs of each loop variant that ended plain
@@ -109,11 +139,13 @@ def run_falling_back(run, kwargs):
 
 
 def loop_is_compiled(variant) -> bool:
-    """Whether the engine's loop of ``variant`` (`rotframe.problem.engine.variant`'s arguments) is made in this process
-    or in numba's disk cache (then it is loaded): whether a run may begin compiled without compiling it."""
+    """Whether the engine's loop of ``variant`` (`rotframe.problem.engine.variant`'s ``(model, method, events, D)``,
+    and `rotframe.problem.engine.TRAJECTORY_TIER` fifth for DOP853's trajectory tier) is made in this process or in
+    numba's disk cache (then it is loaded): whether a run may begin there without compiling it."""
     from rotframe.problem import engine
 
-    return engine.variant(*variant, load_only=True) is not None
+    model, method, events, D, *tier = variant
+    return engine.variant(model, method, events, tier[0] if tier else True, D=D, load_only=True) is not None
 
 
 def projected_fevs(NFEV, TC, ST, span) -> float:
@@ -149,14 +181,20 @@ class Tier:
         The run's particles (at most `PLAIN_PARTICLES` to begin in the plain tier).
     """
 
-    def __init__(self, driver, fns, plain, variant, prob, particles):
+    def __init__(self, driver, fns, plain, variant, prob, particles, stops=0):
         self.driver = driver
         self.fns = fns
         self.variant = variant
         self._make_plain, self._prob = plain, prob
+        from rotframe.problem.engine import TRAJECTORY_TIER
+
+        cold = plain is not None and particles <= PLAIN_PARTICLES and not loop_is_compiled(variant)
+        #: whether the loop the run compiles, if it compiles one, is DOP853's trajectory tier (`trajectory_tier_fits`)
+        self._stepped = cold and trajectory_tier_fits(variant[1], particles, stops)
+        #: whether the calls run on DOP853's trajectory tier now (its callees compiled, the loop over particles Python)
+        self.trajectory = self._stepped and loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,))
         #: whether the calls run as plain Python now
-        self.plain = (plain is not None and particles <= PLAIN_PARTICLES
-                      and not loop_is_compiled(variant))
+        self.plain = cold and not self.trajectory
         #: whether the run began in the plain tier (its first call then integrates: no compile to count)
         self.began_plain = self.plain
         self._compiled = (driver, fns)
@@ -165,7 +203,9 @@ class Tier:
         self.seconds_mid_run = 0.0
         self._plain_steps = 0
         self._switched_at = None  # the steps (all particles) the plain tier ran before the switch
-        if self.plain:
+        if self.trajectory:
+            self.driver = driver.trajectory_tier()
+        elif self.plain:
             self.driver = plain()
             self.fns = self.driver.functions(prob)
 
@@ -204,10 +244,15 @@ class Tier:
             return False
         from rotframe.problem import engine
 
+        model, method, events, D = self.variant
         t0 = time.perf_counter()
-        engine.variant(*self.variant)  # the compile the run would have begun with
+        # the compile the run would have begun with: DOP853's trajectory tier where it fits, else the whole loop
+        engine.variant(model, method, events, engine.TRAJECTORY_TIER if self._stepped else True, D=D)
         self.seconds_mid_run = time.perf_counter() - t0
         self.driver, self.fns = self._compiled
+        if self._stepped:
+            self.driver = self.driver.trajectory_tier()
+            self.trajectory = True
         self.plain = False
         self._switched_at = self._plain_steps
         return True
@@ -239,7 +284,8 @@ class Tier:
                     f"its plain-Python remake, which ran all {self._plain_steps} steps (the same code and "
                     "numbers; rotframe.problem.tiers); a longer run compiles the loop, once")
         if self._switched_at is not None:
+            what = "then the loop compiled" + (", its trajectories alone (" if self.trajectory else " (")
             return (f"the engine's {method} loop was not compiled yet (a first run): its plain-Python remake ran the "
-                    f"first {self._switched_at} steps, then the loop compiled ({self.seconds_mid_run:.2g} s, once) and "
-                    "ran the rest (the same code and numbers; rotframe.problem.tiers)")
+                    f"first {self._switched_at} steps, {what}{self.seconds_mid_run:.2g} s, once) and ran the rest (the "
+                    "same code and numbers; rotframe.problem.tiers)")
         return None
