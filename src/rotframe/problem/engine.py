@@ -16,7 +16,9 @@ from numba's cache; no problem ever compiles the loop again.
   particles and rigid bodies run too), compiled for the model's right-hand side: Hairer's step
   control and starting step, a step that lands on the run's end and on the stops, the samples
   inside a step from Hairer's dense output of order 7, the events watched after each accepted
-  step (`_watch_events`), a budget of accepted steps per call (`_dop853_loop`).
+  step (`_watch_events`), a budget of accepted steps per call (`_dop853_loop`). Its *trajectory
+  tier* (`trajectory_tier`, a first run of a few particles: `rotframe.problem.tiers`) compiles
+  that trajectory loop and the right-hand side alone, the loop over the particles plain Python.
 * RK4 (method ``RK4``) and the model's own fixed-step methods (`rotframe.problem.models.own_step`,
   ``SPLITTING`` and its compositions ``SPLITTING4``, ``SPLITTING6``, ``SPLITTING8``): a fixed step that
   divides each sample interval.
@@ -424,8 +426,8 @@ def trajectory_tier(model, method, events, D, load_only=False):
     for its one signature (`TRAJECTORY_ARGS`, `SYSTEM_ARGS`) and cached: the trajectory loop
     (`_dop853_parts`: every step of a run, from stop to stop) and the right-hand side (each particle's
     first f and Hairer's starting step). The loop over the particles and the stops, each particle's
-    loading, tolerances and saving run as Python: some 50 us a particle and call, and a call of the
-    trajectory a stop. Compiling it took 0.58 of the whole loop's time on the 2-core reference machine,
+    loading, tolerances and saving run as Python: some 25 to 45 us a particle and call, and a call of
+    the trajectory a stop. Compiling it took 0.58 of the whole loop's time on the 2-core reference machine,
     numba's start included (4.2 s against 7.3 s, 2026-12-01): the whole loop compiles the trajectory
     again inside its own code, and an entry point that unboxes thirty arguments. The same code runs, so
     the numbers are the whole loop's to the bit (``tests/test_tiers.py``). ``load_only``: None where

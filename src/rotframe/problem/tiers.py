@@ -51,11 +51,14 @@ first call alone would be too long as Python.
 **The trajectory tier.** A DOP853 run of so few particles compiles less than the whole loop
 (`rotframe.problem.engine.trajectory_tier`): the loop's trajectory from stop to stop, where every
 step is taken, and its right-hand side, each compiled on its own and cached; the loop over the
-particles and the stops stays the plain remake's Python, some 30 to 50 us a call of the
+particles and the stops stays the plain remake's Python, some 25 to 45 us a call of the
 trajectory. The whole loop compiles the trajectory a second time inside its own code, and an
 entry point of thirty arguments: the tier compiled in 0.58 of its time on the 2-core reference
-machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01; a first long run
-of a spring, 0.81 of its time, its glue and first plain calls beside). A run begins there where
+machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01). Side by side with
+the tree before, fresh caches, three runs each, the same day: a first run of 1,000 s of a spring
+5.0 to 5.9 s against 6.3 to 8.9 s (medians 5.8 and 7.7), `rotframe run cr3bp` 5.5 to 8.0 s
+against 7.1 to 9.2 s (medians 6.2 and 8.4), a new problem after them 0.56 to 0.67 s against
+0.49 to 0.57 s (two entry points loaded where one was). A run begins there where
 the whole loop is not compiled but the tier is (`loop_is_compiled` of the variant with
 `rotframe.problem.engine.TRAJECTORY_TIER` fifth), and compiles it, not the whole loop, where it
 switches; the whole loop is compiled by a run of more particles, or of more calls of the
@@ -90,10 +93,13 @@ PLAIN_STEPS = 8
 PLAIN_PARTICLES = 32
 
 
-#: the most calls of the trajectory loop a call of the trajectory tier makes, a particle's for each stop in the run (the
-#: knots of a frame's table) and the end: some 30 us of Python each, where the whole loop (`trajectory_tier_fits`) makes
-#: them compiled
-TRAJECTORY_CALLS = 2_000
+#: the most calls of the trajectory loop a call of the trajectory tier makes: a particle's for each stop in the run (the
+#: knots of a frame's table) and the end, each with its particle's loading and saving as Python, where the whole loop
+#: makes them compiled (`trajectory_tier_fits`). A run stays in the tier, warm runs too, until a larger one compiles the
+#: whole loop. Measured warm against the whole loop (a spring, 2026-12-01): 10 s of 1, 8 and 32 particles, 1.15 ms
+#: -> 1.28, 0.95 -> 1.38 and 1.91 -> 3.63 ms; 1,000 s, 3 to 4 % longer. So 16: at most some 0.8 ms a short run;
+#: `tumbling-ball`'s body frame of 200 knots a second compiles the whole loop
+TRAJECTORY_CALLS = 16
 
 
 def trajectory_tier_fits(method, particles, stops) -> bool:

@@ -8,8 +8,9 @@ running, as the goals are stated beyond imports):
   The run is short: the engine's loop is not compiled yet, and the run is answered by its
   plain-Python remake (`rotframe.problem.tiers`), the problem's own functions compiled;
 - ``first problem ever, long``: the caches empty again, the same problem run 100 times as long
-  (1,000 s): seen to be long after its first plain call, it compiles the engine's loop, as every
-  first run did before the plain tier;
+  (1,000 s): seen to be long after its first plain call, it compiles the engine's loop, its
+  trajectory tier (`rotframe.problem.engine.trajectory_tier`: the trajectory and the right-hand
+  side, the loop over the particle Python);
 - ``new problem``: the caches filled by that long run, the force a new function (its fingerprint
   is new, so nothing of it is cached);
 - ``changed force``: in the process of the new problem, the force edited once more (a notebook
@@ -149,11 +150,15 @@ def _how(setting, tier):
         return ("answered by the engine's plain-Python remake, its loop not compiled yet (rotframe.problem.tiers)"
                 if "short enough" in tier else "the engine's loop compiled in the run")
     if setting == "first problem ever, long":
+        if "its trajectories alone" in tier:
+            return (f"{LONG_S:g} s of the same problem: its first plain call, then the engine's loop compiled, its "
+                    "trajectory tier (rotframe.problem.engine.trajectory_tier)")
         return (f"{LONG_S:g} s of the same problem: its first plain call, then the engine's loop compiled"
                 if "then the loop compiled" in tier else "the engine's loop compiled in the run")
     if tier:
         return "the plain tier ran it (the engine's loop was not in the cache)"
-    return ("the engine's loop loaded from numba's cache" if setting == "new problem" else
+    return ("the engine's loop loaded from numba's cache (its trajectory tier, as the long run compiled it)"
+            if setting == "new problem" else
             "the engine's loop as the new problem loaded it, the force's glue compiled anew")
 
 
