@@ -1,0 +1,65 @@
+"""First runs of two source trees side by side, every cache empty: how the README's trajectory-tier figures were made.
+
+For each tree, alternately, in new processes with empty numba and rotframe caches:
+
+* ``long``: the start-up bench's first problem ever, long (`rotframe.app.bench.problem_startup`: 1,000 s of a spring
+  in a rotating frame, DOP853, the ``simulate`` call alone);
+* ``new``: then a new problem in the caches that run left (10 s, another spring constant);
+* ``cr3bp``: ``python -m rotframe run cr3bp --no-record`` in caches of its own (wall time, imports included).
+
+Usage, with the tree before checked out beside this one::
+
+    git worktree add /tmp/old <rev>
+    python tools/startup_side_by_side.py /tmp/old/src src 3
+
+Runs on one machine drift (its speed changes by tens of percent over minutes), so compare medians of runs made
+alternately, never numbers from different days.
+"""
+from __future__ import annotations
+
+import json
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def _simulate(src, cache, drivers, k, span):
+    from rotframe.app.bench.problem_startup import _CHILD
+
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(src), NUMBA_CACHE_DIR=cache, ROTFRAME_CACHE_DIR=drivers)
+    res = subprocess.run([sys.executable, "-c", _CHILD, json.dumps([(k, span)])], env=env, capture_output=True,
+                         text=True, check=True, timeout=600)
+    return json.loads(res.stdout.strip().splitlines()[-1])[0]["wall"]
+
+
+def _scene(src, name):
+    with (tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers,
+          tempfile.TemporaryDirectory() as folder):
+        env = dict(os.environ, PYTHONPATH=os.path.abspath(src), NUMBA_CACHE_DIR=cache, ROTFRAME_CACHE_DIR=drivers)
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "rotframe", "run", name, "--no-record"], env=env, cwd=folder,
+                       capture_output=True, text=True, check=True, timeout=600)
+        return time.perf_counter() - t0
+
+
+def main(old, new, reps):
+    trees = {"before": old, "after": new}
+    rows = {tree: {"long": [], "new": [], "cr3bp": []} for tree in trees}
+    for _ in range(reps):
+        for tree, src in trees.items():
+            with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers:
+                rows[tree]["long"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 1000.0))
+                rows[tree]["new"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 10.0))
+            rows[tree]["cr3bp"].append(_scene(src, "cr3bp"))
+            print(tree, {key: round(v[-1], 2) for key, v in rows[tree].items()}, flush=True)
+    for key in ("long", "new", "cr3bp"):
+        b, a = (statistics.median(rows[tree][key]) for tree in trees)
+        print(f"{key:6s} median before {b:.2f} s, after {a:.2f} s, after / before {a / b:.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 3)
