@@ -57,8 +57,8 @@ entry point of thirty arguments: the tier compiled in 0.58 of its time on the 2-
 machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01). Side by side with
 the tree before, fresh caches, three runs each, the same day: a first run of 1,000 s of a spring
 5.0 to 5.9 s against 6.3 to 8.9 s (medians 5.8 and 7.7), `rotframe run cr3bp` 5.5 to 8.0 s
-against 7.1 to 9.2 s (medians 6.2 and 8.4), a new problem after them 0.56 to 0.67 s against
-0.49 to 0.57 s (two entry points loaded where one was). A run begins there where
+against 7.1 to 9.2 s (medians 6.2 and 8.4), a new problem after them the same within the day's
+noise (0.5 to 0.8 s in both: loading a loop is mostly numba's own start). A run begins there where
 the whole loop is not compiled but the tier is (`loop_is_compiled` of the variant with
 `rotframe.problem.engine.TRAJECTORY_TIER` fifth), and compiles it, not the whole loop, where it
 switches; the whole loop is compiled by a run of more particles, or of more calls of the
@@ -185,6 +185,8 @@ class Tier:
         The problem's data (`rotframe.problem.signatures.PROBLEM`).
     particles : int
         The run's particles (at most `PLAIN_PARTICLES` to begin in the plain tier).
+    stops : int
+        The run's stops, the knots of its frame's or origin's table (`trajectory_tier_fits`).
     """
 
     def __init__(self, driver, fns, plain, variant, prob, particles, stops=0):
