@@ -121,6 +121,22 @@ def _run(case, tier_mode, monkeypatch, budget=None):
         return simulate_particles(**kw)
 
 
+def _record_trajectory_tiers(monkeypatch):
+    """A list that receives "trajectory" each time a run's driver is made the trajectory tier's
+    (`rotframe.problem.codegen.Driver.trajectory_tier`)."""
+    from rotframe.problem.codegen import Driver
+
+    chosen = []
+    made = Driver.trajectory_tier
+
+    def recorded(self):
+        chosen.append("trajectory")
+        return made(self)
+
+    monkeypatch.setattr(Driver, "trajectory_tier", recorded)
+    return chosen
+
+
 def _same(a, b):
     ta, tb = a.trajectory, b.trajectory
     np.testing.assert_array_equal(ta.times, tb.times)
@@ -142,6 +158,7 @@ def _same(a, b):
 def test_plain_tier_and_the_switch_give_the_compiled_numbers(name, monkeypatch):
     case = CASES[name]
     monkeypatch.setattr(tiers, "TRAJECTORY_CALLS", 10**6)  # every DOP853 case fits the trajectory tier (its limit: below)
+    tiers_chosen = _record_trajectory_tiers(monkeypatch)
     compiled = _run(case, "compiled", monkeypatch)
     assert not any("plain-Python remake" in n for n in compiled.notes)
     assert np.all(compiled.trajectory.extras["status"] >= 1)
@@ -153,14 +170,18 @@ def test_plain_tier_and_the_switch_give_the_compiled_numbers(name, monkeypatch):
     assert any("remake ran the first" in n and "then the loop compiled" in n for n in switched.notes), switched.notes
     stepped = case["method"] == "dop853"  # DOP853 switches to its trajectory tier: its trajectories compiled alone
     assert any("its trajectories alone" in n for n in switched.notes) == stepped, switched.notes
+    assert tiers_chosen == (["trajectory"] if stepped else []), tiers_chosen
     assert 0 < switched.trajectory.steps
     _same(switched, compiled)
     if stepped:
+        tiers_chosen.clear()
         whole = _run(case, "switch-whole", monkeypatch, budget=1)
         assert any("then the loop compiled (" in n for n in whole.notes), whole.notes
+        assert tiers_chosen == [], tiers_chosen
         _same(whole, compiled)
         trajectory = _run(case, "trajectory", monkeypatch)
-        assert not trajectory.notes or not any("plain-Python" in n for n in trajectory.notes), trajectory.notes
+        assert not any("plain-Python" in n for n in trajectory.notes), trajectory.notes
+        assert tiers_chosen == ["trajectory"], tiers_chosen  # begun there, not in the whole loop
         _same(trajectory, compiled)
 
 

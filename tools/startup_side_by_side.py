@@ -17,7 +17,6 @@ alternately, never numbers from different days.
 """
 from __future__ import annotations
 
-import json
 import os
 import random
 import statistics
@@ -28,12 +27,11 @@ import time
 
 
 def _simulate(src, cache, drivers, k, span):
-    from rotframe.app.bench.problem_startup import _CHILD
+    """The start-up bench's own child run (`rotframe.app.bench.problem_startup`) of the tree ``src``: its wall time."""
+    from rotframe.app.bench.problem_startup import _child
 
     env = dict(os.environ, PYTHONPATH=os.path.abspath(src), NUMBA_CACHE_DIR=cache, ROTFRAME_CACHE_DIR=drivers)
-    res = subprocess.run([sys.executable, "-c", _CHILD, json.dumps([(k, span)])], env=env, capture_output=True,
-                         text=True, check=True, timeout=600)
-    return json.loads(res.stdout.strip().splitlines()[-1])[0]["wall"]
+    return _child(env, [(k, span)])[0]["wall"]
 
 
 def _scene(src, name):

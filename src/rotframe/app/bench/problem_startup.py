@@ -157,7 +157,7 @@ def _how(setting, tier):
                 if "then the loop compiled" in tier else "the engine's loop compiled in the run")
     if tier:
         return "the plain tier ran it (the engine's loop was not in the cache)"
-    return ("the engine's loop loaded from numba's cache (its trajectory tier, as the long run compiled it)"
+    return ("the engine's loop loaded from numba's cache (the loop the long run compiled)"
             if setting == "new problem" else
             "the engine's loop as the new problem loaded it, the force's glue compiled anew")
 

@@ -259,9 +259,9 @@ def _ensemble_case(method, rk4, event, n, steps, cores, prange_threads, budget, 
     rows[0]["of_ceiling"] = single / rows[2]["particle_steps_per_s"]
     for r in rows:
         r.update(same_work=same and same_steps, same_work_max_rel=rel, same_work_note=note, same_steps=same_steps)
-    for r, hand_row in zip(rows[4:], rows[2:4]):  # the engine's door beside the same ceiling
+    for r, door_row, hand_row in zip(rows[4:], rows[0:2], rows[2:4]):  # the engine's door beside the same ceiling
         r.update(of_ceiling=r["particle_steps_per_s"] / hand_row["particle_steps_per_s"],
-                 of_integrate_ensemble=r["particle_steps_per_s"] / rows[r["threads"] != 1]["particle_steps_per_s"],
+                 of_integrate_ensemble=r["particle_steps_per_s"] / door_row["particle_steps_per_s"],
                  same_work=same_engine and same_steps, same_work_max_rel=rel_engine)
     return rows
 
