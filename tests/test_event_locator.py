@@ -79,7 +79,7 @@ def test_every_locator_is_the_one_template():
     from rotframe.particles import dop853_particles, events
     from rotframe.problem import engine
 
-    watch = engine._watcher("test_locator", None, None, engine.METHOD_CODES["rk4"])
+    watch = engine._watcher("test_locator", None, None, engine.METHOD_CODES["rk4"], None)
     engine_locate = watch.py_func.__globals__["LOCATE"]
     for located in (events.locate_fixed, dop853_particles.locate_dop853, engine_locate):
         assert located.py_func.__code__ is bisection._locate.__code__

@@ -307,8 +307,12 @@ def test_a_user_function_that_raises_in_the_plain_tier_is_named(monkeypatch):
 
 _CHILD = r"""
 import json, sys
+from rotframe.numerics import compile_apart
 from rotframe.problem import engine
 from rotframe.problem.particles import simulate_particles
+
+made, load = [], compile_apart.CompiledApart.load  # how each second process of a compile was made
+compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or load(self, *args)
 
 def spring(t, r, v):
     return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
@@ -317,14 +321,16 @@ run = simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0
                          forces=[spring], samples=10)
 print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
                   "compiled": engine.variant(0, "dop853", False, load_only=True) is not None,
-                  "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None}))
+                  "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None,
+                  "apart": made}))
 """
 
 
 def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
-    one switches and compiles DOP853's trajectory tier, not the whole loop; the next short one, in another process,
-    finds the tier in the cache and runs there, compiling nothing. The final states agree to the bit."""
+    one switches and compiles DOP853's trajectory tier, not the whole loop, its trajectory in a forked process where
+    there are two cores (`rotframe.numerics.compile_apart`); the next short one, in another process, finds the tier in
+    the cache and runs there, compiling nothing. The final states agree to the bit."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
 
     def child(duration):
@@ -339,9 +345,11 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     long = child(400.0)
     assert any("then the loop compiled, its trajectories alone" in n for n in long["notes"]), long["notes"]
     assert long["trajectory"] and not long["compiled"]
+    two = len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux")
+    assert long["apart"] == (["fork"] if two else [None]) and short["apart"] == []
     again = child(10.0)
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
-    assert again["trajectory"] and not again["compiled"]
+    assert again["trajectory"] and not again["compiled"] and again["apart"] == []
     assert again["r"] == short["r"]
 
 

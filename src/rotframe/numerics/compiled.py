@@ -119,6 +119,9 @@ def jit_internal(func):
 
 _jit_without_reference_counts = njit(cache=True, error_model="numpy", nogil=True, no_cpython_wrapper=True,
                                      no_cfunc_wrapper=True, _nrt=False)
+#: numba's options of a kernel called from Python without reference counts (its caller owns every array): the
+#: engine's loops and the trajectory tier's entry points (`rotframe.problem.engine`, `rotframe.numerics.dop853_loop`)
+ENTRY_OPTIONS = {"cache": True, "error_model": "numpy", "nogil": True, "_nrt": False, "no_cfunc_wrapper": True}
 
 
 def jit_uncounted(func):

@@ -37,7 +37,7 @@ import math
 
 from numba import njit
 
-from rotframe.numerics.compiled import bound, inlined, jit_inline, jit_uncounted
+from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, inlined, jit_inline, jit_uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
@@ -54,7 +54,7 @@ REACHED, STOPPED, COLLAPSED, NONFINITE, PAUSED, WATCH_FAILED, ABORTED, DIVERGED 
 UNLIMITED = 1 << 62
 
 #: a loop called from Python: an entry point without reference counts (its caller owns every array)
-_uncounted_entry = njit(cache=True, error_model="numpy", nogil=True, _nrt=False, no_cfunc_wrapper=True)
+_uncounted_entry = njit(**ENTRY_OPTIONS)
 
 A, C, DW = extended_tableau()
 E3, E5 = coefficients()[3:]
@@ -90,7 +90,7 @@ def dop853_stages(name, rhs, D):
 
 # the names a system binds (`rotframe.numerics.compiled.bound`): its right-hand side, the length of its state, its
 # stage function, sample writer, watcher and check; None or 0 in the templates themselves, which are never compiled
-RHS = STAGES = STORE = WATCH = CHECK = None
+RHS = STAGES = STORE = WATCH = CHECK = ENTER = None
 DIM = 0
 WATCHED = CHECKED = False
 
@@ -122,7 +122,13 @@ def dop853_start(rhs, ctx, t, y, K, yt, rtol, atol, h_max):
     return first_step(y, K[0], K[1], h0, rtol, atol, h_max)
 
 
-def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=None):
+@jit_inline
+def _same(ctx):
+    """The system's data as the trajectory loop was given it (`dop853_trajectory`'s default ``enter``)."""
+    return ctx
+
+
+def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=None, enter=_same):
     """The trajectory loop of one system, compiled for it (cached on disk as ``dop853_trajectory_<name>``).
 
     ``stages`` the system's (`dop853_stages`), ``D`` the length of its state; ``store(out, k, p, y)`` writes sample ``k`` of
@@ -133,6 +139,8 @@ def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=N
     code. ``aborted(ctx) -> bool``, checked after each try's stages and the dense output's, ends the
     trajectory at the step's start (`ABORTED`: a function of the system failed); None compiles no
     check. With ``entry`` the loop is also callable from Python (a kernel of its own, not only a callee).
+    ``enter(ctx)`` is the system's data that the loop hands on, made once a call from the ``ctx`` it was given
+    (the default hands on ``ctx`` itself).
 
     The loop, ``trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new,
     tmp, yt, F, wctx, budget)``, integrates one trajectory from ``(t, y)``, ``K[0] = f(t, y)``, to ``t_end``:
@@ -156,11 +164,13 @@ def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=N
     """
     compile = _uncounted_entry if entry else jit_uncounted
     return compile(bound(_trajectory, f"dop853_trajectory_{name}", STAGES=stages, STORE=store, WATCH=watch,
-                         CHECK=aborted, DIM=int(D), WATCHED=watch is not None, CHECKED=aborted is not None))
+                         CHECK=aborted, ENTER=enter, DIM=int(D), WATCHED=watch is not None,
+                         CHECKED=aborted is not None))
 
 
 def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
     """The template of `dop853_trajectory`."""
+    ctx = ENTER(ctx)
     # the stage ranges as int64 values, not literals: one compiled `stages` for every range
     _FIRST, _END, _DENSE, _DENSE_END = int(1), int(13), int(13), int(16)
     n_out = times.shape[0]

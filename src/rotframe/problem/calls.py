@@ -30,9 +30,11 @@ from numba import types
 from numba.extending import intrinsic
 
 from rotframe.numerics.compiled import jit_inline
-from rotframe.problem.signatures import EVENT_SIG, POTENTIAL_SIG, TERMS_SIG, VARYING_SIG, VECTOR_SIG
+from rotframe.problem.signatures import (EVENT_SIG, POTENTIAL_SIG, STAGES_SIG, SYSTEM_SIG, TERMS_SIG, VARYING_SIG,
+                                         VECTOR_SIG)
 
-__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "RAISED",
+__all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector", "call_varying", "call_system",
+           "call_stages", "by_reference", "dereference", "RAISED",
            "direct_terms", "direct_event", "direct_vector", "direct_varying", "direct_functions", "direct_calls",
            "OMEGA_TAG", "ORIGIN_TAG"]
 
@@ -90,6 +92,42 @@ def _varying(typingctx, addr, kind, T, C, fn, t, out):
     return _codegen(VARYING_SIG)
 
 
+@intrinsic
+def _system(typingctx, addr, ref, t, z, K, s):
+    return _codegen(SYSTEM_SIG)
+
+
+@intrinsic
+def _stages(typingctx, addr, ref, first, last, t, y, h, K, z, z12, t12):
+    return _codegen(STAGES_SIG)
+
+
+@intrinsic
+def by_reference(typingctx, value):
+    """The address of a copy of ``value`` on the caller's stack (`dereference` reads it), valid for the caller's
+    call: how the trajectory tier hands its right-hand side the problem's data, once a call (`call_system`)."""
+
+    def codegen(context, builder, sig, args):
+        from numba.core import cgutils
+
+        slot = cgutils.alloca_once(builder, context.get_value_type(sig.args[0]))
+        builder.store(args[0], slot)
+        return builder.ptrtoint(slot, context.get_value_type(types.int64))
+
+    return types.int64(value), codegen
+
+
+@intrinsic
+def dereference(typingctx, ref):
+    """The context ``(prob, fns, W)`` at the address ``ref`` that `by_reference` gave (`SYSTEM_SIG`)."""
+    from rotframe.problem.signatures import CONTEXT
+
+    def codegen(context, builder, sig, args):
+        return builder.load(builder.inttoptr(args[0], context.get_value_type(CONTEXT).as_pointer()))
+
+    return CONTEXT(types.int64), codegen
+
+
 #: the slot of the engine's scratch ``W`` (the ``out`` of the terms and the vectors) set to 1 when a user
 #: function raised
 RAISED = 6
@@ -132,6 +170,26 @@ def call_varying(addr, kind, T, C, fn, t, out):
         for k in range(6):
             out[k] = math.nan
         out[RAISED] = 1.0
+
+
+@jit_inline
+def call_system(addr, ref, t, z, K, s):
+    """The engine's right-hand side at ``addr``, compiled on its own (`rotframe.problem.engine.trajectory_tier`):
+    ``K[s] = f(t, z)``, the problem's data ``(prob, fns, W)`` at ``ref`` (`by_reference`); NaN in ``K[s]`` where it
+    failed (a user function's failure is the right-hand side's own to flag, `call_terms`)."""
+    if _system(addr, ref, t, z, K, s):
+        for j in range(K.shape[1]):
+            K[s, j] = math.nan
+
+
+@jit_inline
+def call_stages(addr, ref, first, last, t, y, h, K, z, z12, t12):
+    """The engine's DOP853 stages at ``addr``, compiled on its own with the right-hand side in them
+    (`rotframe.problem.engine.trajectory_tier`), the problem's data at ``ref``: stages ``first .. last - 1`` of the
+    step ``(t, y, h)`` (`rotframe.numerics.dop853_loop.dop853_stages`); NaN in ``K[first]`` where they failed."""
+    if _stages(addr, ref, first, last, t, y, h, K, z, z12, t12):
+        for j in range(K.shape[1]):
+            K[first, j] = math.nan
 
 
 def _plain_terms(f, t, y, p, out):

@@ -57,14 +57,16 @@ import numpy as np
 from numba import njit, types
 
 from rotframe.numerics.bisection import MAX_HALVINGS, crossed, locator
-from rotframe.numerics.compiled import bound, jit_inline, jit_uncounted
+from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, jit_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
 from rotframe.numerics.step_control import own_tolerances
-from rotframe.problem.calls import RAISED, call_event, direct_functions
+from rotframe.problem.by_address import stages_at, system_at, tier_callees, with_reference
+from rotframe.problem.calls import RAISED, address, call_event, direct_functions
 from rotframe.problem.models import (DOP853, RK4, SCRATCH, SPLITTING, SPLITTING4, SPLITTING6, SPLITTING8,
-                                     particle_energy, rhs)
-from rotframe.problem.signatures import A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE, POTENTIAL, PROBLEM
+                                     particle_energy)
+from rotframe.problem.signatures import (A1, A2, A3, B1, BODY, F8, FUNCTIONS, I1, I2, I8, PARTICLE,
+                                         POTENTIAL, PROBLEM, STAGES_SIG, SYSTEM_SIG)
 from rotframe.problem.fixed_step import fixed_step_loop
 from rotframe.problem.loop_state import load_particle, save_particle, watcher_context
 from rotframe.problem.steps import body_system, particle_system, stepper, take_step
@@ -75,9 +77,8 @@ __all__ = ["advance", "variant", "variant_loop", "trajectory_tier", "TRAJECTORY_
 
 #: the entry points Python calls (no C entry point: nothing calls them from C)
 _entry = njit(cache=True, error_model="numpy", nogil=True, no_cfunc_wrapper=True)
-#: the options of the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.jit_uncounted`),
-#: their work arrays made by the caller (`scratch`); a problem's inlined loop too (`rotframe.problem.inlined`)
-ENTRY_OPTIONS = {"cache": True, "error_model": "numpy", "nogil": True, "_nrt": False, "no_cfunc_wrapper": True}
+#: the variants' loops: entry points without reference counts (`rotframe.numerics.compiled.ENTRY_OPTIONS`), their
+#: work arrays made by the caller (`scratch`); a problem's inlined loop too (`rotframe.problem.inlined`)
 _uncounted_entry = njit(**ENTRY_OPTIONS)
 #: the length of the state of each model, a constant of its DOP853 loop (a particle whose forces act in inertial
 #: axes carries the frame's attitude too: 10)
@@ -106,14 +107,14 @@ EVENTS = False
 def _event_trial(tctx, tau):
     """The template of a variant's event trial: event k's value after a re-step of length ``tau``.
 
-    ``tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)``: the re-step is the variant's method from
+    ``tctx = (k, t, y, Kb, ytb, ybuf, ctx)``: the re-step is the variant's method from
     ``(t, y)`` (`take_step` with the variant's ``STEPPER``, ``BODY_FLAG`` and ``METHOD``; ``Kb[0]`` is
     f(t, y)), its state left in ``ybuf``. The trial of rotframe's one event locator
     (`rotframe.numerics.bisection.locator`) and of `_start_sign`.
     """
-    k, t, y, Kb, ytb, ybuf, prob, fns, W = tctx
-    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, prob, fns, W)
-    return call_event(fns[1], k, t + tau, ybuf, prob[2])
+    k, t, y, Kb, ytb, ybuf, ctx = tctx
+    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, ctx)
+    return call_event(ctx[1][1], k, t + tau, ybuf, ctx[0][2])
 
 
 def _start_sign(tctx, h):
@@ -163,7 +164,8 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
 
     ``wctx = (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf)``: each event's value
     at ``t`` (updated), the records, the directions and terminal flags, the run's start and the
-    locator's scratch; ``ctx = (prob, fns, W)``. A crossing (with its direction) is located by
+    locator's scratch; ``ctx`` the system's (``(prob, fns, W)``, `rotframe.problem.steps.take_step`), ``SYSTEM`` its
+    right-hand side (f at ``t`` for the re-steps). A crossing (with its direction) is located by
     rotframe's one event locator (``LOCATE``, `rotframe.numerics.bisection.locator`) on re-steps by
     the variant's method (``TRIAL``, `_event_trial`), a zero at the start by ``START_SIGN``
     (`_start_sign`); the state at a crossing is the re-step there (the step's own end where the
@@ -175,7 +177,7 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
     each step.
     """
     GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf = wctx
-    prob, fns, W = ctx
+    prob, fns = ctx[0], ctx[1]
     D = y.shape[0]
     stop = False
     tau_stop = h
@@ -185,15 +187,15 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
         if not math.isfinite(g_new):  # NaN, or the event function raised
             return True, math.nan
         g_old = GPREV[p, k]
-        tctx = (k, t, y, Kb, ytb, ybuf, prob, fns, W)
+        tctx = (k, t, y, Kb, ytb, ybuf, ctx)
         if g_old == 0.0 and t == t0:  # zero at the start: the sign just after it (_start_sign)
             if not started:
-                rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+                SYSTEM(ctx, t, y, Kb, 0)
                 started = True
             g_old = START_SIGN(tctx, h)
         if crossed(EDIR[k], g_old, g_new):
             if not started:
-                rhs(BODY_FLAG, t, y, Kb[0], prob, fns, W)
+                SYSTEM(ctx, t, y, Kb, 0)
                 started = True
             tau = LOCATE(tctx, h, g_old)
             if tau < h:  # the state there: the trial that set the bracket's end, made again
@@ -258,14 +260,17 @@ def variant_loop(model, method, events, D=None):
     if method == DOP853:
         return _dop853_loop(name, body, events, D)
     step = stepper(body, method, D)
-    return fixed_step_loop(name, body, method, D, step, _watcher(name, step, body, method, cold=True) if events else None)
+    system = particle_system if body is None else body_system
+    return fixed_step_loop(name, body, method, D, step,
+                           _watcher(name, step, body, method, system, cold=True) if events else None)
 
 
-def _watcher(kind, step, body, method, cold=False):
+def _watcher(kind, step, body, method, system, cold=False):
     """The events' watcher of a variant (`_watch_events`) with its trial, locator and start rule, bound to them.
 
     ``kind`` names the variant's copies; ``step`` (the variant's `stepper`), ``body`` and ``method``
-    are constants of its trial (`_event_trial`), so numba prunes the other methods' steps from it.
+    are constants of its trial (`_event_trial`), so numba prunes the other methods' steps from it;
+    ``system`` is the right-hand side the stages call (`_dop853_parts`).
     Inlined into the DOP853 loop; ``cold``, a function of its own that the fixed-step loop calls only
     where a step may cross (`rotframe.problem.fixed_step.quiet_step`): inlined, its locator's
     re-steps took the registers of the loop's state (the tower drop's ensemble with the ground
@@ -273,7 +278,7 @@ def _watcher(kind, step, body, method, cold=False):
     """
     trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STEPPER=step, BODY_FLAG=body, METHOD=method))
     start_sign = jit_inline(bound(_start_sign, f"start_sign_{kind}", TRIAL=trial))
-    made = bound(_watch_events, f"watch_{kind}", BODY_FLAG=body, TRIAL=trial, LOCATE=locator(kind, trial),
+    made = bound(_watch_events, f"watch_{kind}", SYSTEM=system, TRIAL=trial, LOCATE=locator(kind, trial),
                  START_SIGN=start_sign)
     return jit_uncounted(made) if cold else jit_inline(made)
 
@@ -282,13 +287,19 @@ def _dop853_parts(body, events, D, entry=False):
     """The DOP853 variant's system and trajectory loop: the model's right-hand side (`particle_system`,
     `body_system`) with ``ctx = (prob, fns, W)``, and `rotframe.numerics.dop853_loop`'s trajectory compiled for it,
     the events watched by `_watch_events`, a user function that raised ending the trajectory at the step (`raised`).
-    ``entry``: the trajectory callable from Python too (the trajectory tier, `trajectory_tier`), cached apart."""
+    ``entry``: the trajectory tier's (`trajectory_tier`), callable from Python, which calls the stages and the
+    right-hand side at their addresses (`rotframe.problem.by_address`), cached apart."""
     system = particle_system if body is None else body_system
     kind = f"engine_{'particle' if body is None else 'body'}{D}"
-    stages = stepper(body, DOP853, D)
-    watch = _watcher(kind, stages, body, DOP853) if events else None
+    if entry:
+        kind += "_by_address"
+        stages, system = stages_at, system_at
+    else:
+        stages = stepper(body, DOP853, D)
+    watch = _watcher(kind, stages, body, DOP853, system) if events else None
     name = kind + ("_events" if events else "") + ("_entry" if entry else "")
-    return system, dop853_trajectory(name, stages, store_rows, D, watch, entry=entry, aborted=raised)
+    return dop853_trajectory(name, stages, store_rows, D, watch, entry=entry, aborted=raised,
+                             **({"enter": with_reference} if entry else {}))
 
 
 def _dop853_loop(name, body, events, D):
@@ -298,7 +309,8 @@ def _dop853_loop(name, body, events, D):
     and ends after an accepted step, so the steps do not depend on where the budget cut the calls. The template
     `_dop853_advance` reads the system's functions as globals (`rotframe.numerics.compiled.bound`).
     """
-    system, trajectory = _dop853_parts(body, events, D)
+    system = particle_system if body is None else body_system
+    trajectory = _dop853_parts(body, events, D)
     return bound(_dop853_advance, name, SYSTEM=system, TRAJECTORY=trajectory, DIM=int(D), EVENTS=bool(events))
 
 
@@ -404,11 +416,6 @@ def variant(model, method, events, compiled=True, D=None, load_only=False):
     return kernel
 
 
-def _system_call(ctx, t, z, K, s):
-    """The template of the trajectory tier's right-hand side, an entry point: ``K[s] = f(t, z)`` (``SYSTEM``)."""
-    SYSTEM(ctx, t, z, K, s)
-
-
 def _python_call(kernel):
     """The compiled entry point ``kernel`` behind a Python function, which `rotframe.numerics.plain` keeps as it is."""
 
@@ -422,36 +429,66 @@ def trajectory_tier(model, method, events, D, load_only=False):
     """The DOP853 loop of ``model`` and ``events`` with its trajectories compiled and the rest as Python.
 
     The template of the compiled loop (`_dop853_advance`) remade as plain Python
-    (`rotframe.numerics.plain`) but for its two callees, each compiled on its own as an entry point
-    for its one signature (`TRAJECTORY_ARGS`, `SYSTEM_ARGS`) and cached: the trajectory loop
-    (`_dop853_parts`: every step of a run, from stop to stop) and the right-hand side (each particle's
-    first f and Hairer's starting step). The loop over the particles and the stops, each particle's
-    loading, tolerances and saving run as Python: some 25 to 45 us a particle and call, and a call of
-    the trajectory a stop. Compiling it took 0.58 of the whole loop's time on the 2-core reference machine,
-    numba's start included (4.2 s against 7.3 s, 2026-12-01): the whole loop compiles the trajectory
-    again inside its own code, and an entry point that unboxes thirty arguments. The same code runs, so
-    the numbers are the whole loop's to the bit (``tests/test_tiers.py``). ``load_only``: None where
-    either callee would have to compile. `rotframe.problem.tiers` runs a first run of a few particles
-    on it. ``method`` is DOP853's (the fixed-step loops have no such tier).
+    (`rotframe.numerics.plain`) but for its callees, each compiled on its own as an entry point for
+    its one signature and cached: the trajectory loop (`_dop853_parts`: every step of a run, from
+    stop to stop, `TRAJECTORY_ARGS`), which calls the stages and the right-hand side at their
+    addresses, and those (`rotframe.problem.by_address.tier_callees`), with the right-hand side that
+    Python calls for each particle's first f and Hairer's starting step. The loop over the particles
+    and the stops, each particle's loading, tolerances and saving run as Python: some 25 to 45 us a
+    particle and call, and a call of the trajectory a stop. The same code runs, so the numbers are the
+    whole loop's to the bit (``tests/test_tiers.py``).
+
+    Where none is cached, the trajectory compiles in a second process while this one compiles the
+    callees (`rotframe.numerics.compile_apart`). Measured on the 2-core reference machine (a first long
+    run, 2026-12-01): 2.1 to 2.7 s, where the whole loop took 7.3 s (it compiles the trajectory again
+    inside its own code, and an entry point that unboxes thirty arguments) and the tier with its stages
+    inside the trajectory, in one process, 3.4 s. ``load_only``: None where anything would have to
+    compile. `rotframe.problem.tiers` runs a first run of a few particles on it. ``method`` is DOP853's
+    (the fixed-step loops have no such tier).
     """
+    from rotframe.numerics.compile_apart import CompiledApart
     from rotframe.numerics.compiled import load_cached
     from rotframe.numerics.plain import plain
 
     if method != "dop853":
         raise ValueError(f"the trajectory tier is DOP853's, not {method}'s")
     body = None if model == PARTICLE else True
-    system, trajectory = _dop853_parts(body, events, D, entry=True)
-    kind = f"{'particle' if body is None else 'body'}{D}"
-    system_entry = _uncounted_entry(bound(_system_call, f"dop853_system_engine_{kind}", SYSTEM=system))
-    for kernel, args in ((trajectory, TRAJECTORY_ARGS[bool(events)]), (system_entry, SYSTEM_ARGS)):
-        if not load_cached(kernel, args):
-            if load_only:
-                return None
-            kernel.compile(args)
+    trajectory = _dop853_parts(body, events, D, entry=True)
+    kernels = ((trajectory, TRAJECTORY_ARGS[bool(events)]),) + tier_callees(body, D)
+    cached = [load_cached(kernel, args) for kernel, args in kernels]
+    if not all(cached):
+        if load_only:
+            return None
+        if not any(cached):  # the callees here, the trajectory in a second process (compile_apart)
+            with CompiledApart(__name__, "compile_tier_trajectory", model, int(bool(events)), D) as apart:
+                for kernel, args in kernels[1:]:
+                    kernel.compile(args)
+            apart.load(*kernels[0])
+        else:
+            for (kernel, args), done in zip(kernels, cached):
+                if not done:
+                    kernel.compile(args)
+    for kernel, _ in kernels:
         kernel.disable_compile()
+    (_, _), (stages, _), (system, _), (system_call, _) = kernels
+    at = (address(stages, STAGES_SIG), address(system, SYSTEM_SIG))
+
+    def trajectory_call(ctx, *rest):
+        """The trajectory with the addresses of its stages and right-hand side in its ``ctx`` (`with_reference`)."""
+        return trajectory((ctx[0], ctx[1], ctx[2]) + at, *rest)
+
+    trajectory_call.kernels = kernels  # the addresses live as long as the compiled functions
+    kind = f"{'particle' if body is None else 'body'}{D}"
     return plain(bound(_dop853_advance, f"advance_{kind}_dop853{'_events' if events else ''}_trajectory_tier",
-                       SYSTEM=_python_call(system_entry), TRAJECTORY=_python_call(trajectory), DIM=int(D),
-                       EVENTS=bool(events)))
+                       SYSTEM=_python_call(system_call), TRAJECTORY=trajectory_call, DIM=int(D), EVENTS=bool(events)))
+
+
+def compile_tier_trajectory(model, events, D):
+    """Compile the trajectory tier's trajectory loop for model code ``model``, ``events`` (0 or 1) and ``D`` numbers
+    into numba's cache: the second process of a first tier compile (`trajectory_tier`,
+    `rotframe.numerics.compile_apart`)."""
+    events = bool(int(events))
+    _dop853_parts(None if int(model) == PARTICLE else True, events, int(D), entry=True).compile(TRAJECTORY_ARGS[events])
 
 
 def scratch(D):
@@ -511,13 +548,13 @@ def energies(T, OUT, prob, fns, potential, rotating):
 #: problem
 VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
                                B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
-#: the trajectory tier's entry points' arguments (`trajectory_tier`): the trajectory loop's, without and with events
-#: (``wctx``, `rotframe.problem.loop_state.watcher_context`'s tuple), and the right-hand side's
-_CTX = types.Tuple((PROBLEM, FUNCTIONS, A1))
-TRAJECTORY_ARGS = {events: (_CTX, F8, A1, F8, F8, F8, A1, I8, A3, I8, F8, A1, A2, A1, A1, A1, A2,
+#: the trajectory tier's trajectory loop's arguments (`trajectory_tier`), without and with events (``ctx = (prob, fns, W,
+#: stages, system)``, `rotframe.problem.by_address.with_reference`; ``wctx``, `rotframe.problem.loop_state.watcher_context`'s tuple)
+TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, I8, I8)), F8, A1, F8, F8, F8, A1, I8, A3, I8, F8, A1, A2,
+                            A1, A1, A1, A2,
                             types.Tuple((A2, A2, A3, I2, I1, A1, B1, F8, A2, A1, A1, A1)) if events else I8, I8)
                    for events in (False, True)}
-SYSTEM_ARGS = (_CTX, F8, A1, A2, I8)
+
 #: the one signature of each other entry point
 SIGNATURES = {
     start_events: types.void(F8, A2, A2, PROBLEM, FUNCTIONS),

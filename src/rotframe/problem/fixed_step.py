@@ -154,7 +154,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                     else:
                         sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
                 else:
-                    take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, prob, fns, W)
+                    take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, ctx)
                 steps += 1
                 nfev += EVALUATIONS_PER_STEP[METHOD]
                 if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
@@ -184,7 +184,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                             break
                         # the state at the terminal event: the step of that length from the step's start (the
                         # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                        take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, prob, fns, W)
+                        take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, ctx)
                         t = t + tau
                         for j in range(D):
                             y[j] = yev[j]

@@ -34,8 +34,8 @@ from __future__ import annotations
 
 from numba import types
 
-__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "TERMS_SIG", "EVENT_SIG", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE",
-           "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
+__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "CONTEXT", "SYSTEM_SIG", "STAGES_SIG", "TERMS_SIG", "EVENT_SIG", "POTENTIAL_SIG",
+           "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
 
 F8 = types.float64
 I8 = types.int64
@@ -62,6 +62,16 @@ POTENTIAL = types.int64
 
 #: (model, M, p, FK, FT, FC, OK, OT, OC)
 PROBLEM = types.Tuple((I8, A1, A1, I8, A1, A3, I8, A1, A3))
+
+#: what the engine's right-hand side reads besides the state, ``ctx = (prob, fns, W)``: the problem, the addresses of
+#: its functions and the engine's scratch (`rotframe.problem.steps.particle_system`)
+CONTEXT = types.Tuple((PROBLEM, FUNCTIONS, A1))
+#: the engine's right-hand side and DOP853 stages as the trajectory tier calls them by address
+#: (`rotframe.problem.calls.call_system`, `rotframe.problem.calls.call_stages`), the context at an address
+#: (`rotframe.problem.calls.by_reference`): ``K[s] = f(t, z)``; stages ``first .. last - 1`` of the step ``(t, y, h)``
+#: (`rotframe.numerics.dop853_loop.dop853_stages`)
+SYSTEM_SIG = types.void(I8, F8, A1, A2, I8)
+STAGES_SIG = types.void(I8, I8, I8, F8, A1, F8, A2, A1, A1, F8)
 
 #: model codes (``PROBLEM[0]``)
 PARTICLE = 0

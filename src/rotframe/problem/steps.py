@@ -104,16 +104,18 @@ def stepper(body, method, D):
 
 
 @jit_inline
-def take_step(step, body, method, t, y, h, K, yt, yn, prob, fns, W):
+def take_step(step, body, method, t, y, h, K, yt, yn, ctx):
     """One step of ``method`` of length ``h`` from (t, y), K[0] = f(t, y): ``yn``.
 
     ``step`` is the variant's `stepper`: DOP853's step is the one DOP853 loop's
     (`rotframe.numerics.dop853_loop.dop853_step` with the system's stages), RK4's the one RK4
     step (`rotframe.numerics.rk4`); a splitting is the model's own (`rotframe.problem.models.own_step`).
+    ``ctx`` is the system's: ``(prob, fns, W)``, and the address of the right-hand side after them in the
+    trajectory tier's (`rotframe.problem.engine.trajectory_tier`).
     """
     if method == DOP853:  # only the event locators' trials (the DOP853 loop steps on its own)
-        dop853_step(step, (prob, fns, W), t, y, h, K, yn, yt)
+        dop853_step(step, ctx, t, y, h, K, yn, yt)
     elif method == RK4:
-        step((prob, fns, W), t, y, h, K, yt, yn)
+        step(ctx, t, y, h, K, yt, yn)
     else:  # the model's own splitting, of order 2 or 4
-        own_step(body, method, t, y, h, yn, prob, fns, W)
+        own_step(body, method, t, y, h, yn, ctx[0], ctx[1], ctx[2])

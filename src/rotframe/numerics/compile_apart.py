@@ -1,0 +1,181 @@
+"""A kernel compiled in a second process while this one compiles another: a first compile on two cores.
+
+numba compiles one function at a time in a process (its compiler lock, and the GIL). Where a first
+run must compile two kernels that do not call each other (the trajectory tier's trajectory loop,
+and its stages and right-hand side, which the loop calls at their addresses:
+`rotframe.problem.engine.trajectory_tier`), `CompiledApart` has a second process compile one of
+them into numba's disk cache while this process compiles the other; this process then loads it
+from the cache (`rotframe.numerics.compiled.load_cached`), as any later process would.
+
+The second process is made only where this one may run on two cores or more
+(``os.sched_getaffinity``), in one of two ways:
+
+* **forked** (``os.fork``) where that is safe: on Linux, from the main thread, with no other
+  Python thread in the process, and numba's compiler lock held across the fork (so no lock that
+  the child's compile takes is held by a thread that the child lacks). The child has this
+  process's modules and numba already started, so it compiles at once; it writes nothing but
+  numba's cache (its standard output and error go to ``os.devnull``) and ends with ``os._exit``.
+  Measured on the 2-core reference machine (a first long run, 2026-12-01): the tier's compile
+  took 2.1 s where a new interpreter took 2.9 s (its imports and numba's start, 0.75 s) and one
+  process 3.8 s.
+* **a new interpreter** (``sys.executable``) otherwise (a notebook's kernel, a Dask worker, other
+  threads): it imports rotframe from the same place as this process, inherits the environment and
+  so writes to the same caches (``NUMBA_CACHE_DIR``).
+
+Whatever goes wrong there (no spare core, no process to start, a failure in the child, a child
+that takes longer than `TIMEOUT_S`, a cache that cannot be written) ends in this process
+compiling the kernel itself: the same machine code, later.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+import time
+
+__all__ = ["CompiledApart", "spare_core", "TIMEOUT_S"]
+
+#: seconds the second process may take, from its start, before this one compiles the kernel itself
+TIMEOUT_S = 120.0
+#: a new interpreter's work: ``function(*args)`` of ``module``, each argument a string
+_CHILD = "import importlib, sys; getattr(importlib.import_module(sys.argv[1]), sys.argv[2])(*sys.argv[3:])"
+
+
+def spare_core() -> bool:
+    """Whether this process may run on two cores or more (a second process would compile beside it)."""
+    try:
+        return len(os.sched_getaffinity(0)) >= 2
+    except AttributeError:  # no affinity on this platform
+        return (os.cpu_count() or 1) >= 2
+
+
+def _may_fork() -> bool:
+    """Whether this process may fork its compiler (module docstring): Linux, the main thread, no other Python thread."""
+    return (sys.platform.startswith("linux") and hasattr(os, "fork") and threading.active_count() == 1
+            and threading.current_thread() is threading.main_thread())
+
+
+class CompiledApart:
+    """``module.function(*args)`` run in a second process, which compiles a kernel into numba's cache.
+
+    Use it around this process's own compile, then `load` the kernel::
+
+        with CompiledApart("rotframe.problem.engine", "compile_tier_trajectory", 0, 0, 6) as apart:
+            stages.compile(signature)  # this process's share
+        apart.load(trajectory, TRAJECTORY_ARGS[False])  # the other's: from the cache, or compiled here
+
+    ``args`` are passed as strings. Leaving the block by an exception stops the second process.
+    ``how`` says how it was made: ``"fork"``, ``"interpreter"``, or None (none was).
+    """
+
+    def __init__(self, module, function, *args):
+        self.call = (module, function, tuple(map(str, args)))
+        self.how = None
+        self._pid = None
+        self._child = None
+        self._started = 0.0
+
+    def __enter__(self):
+        if spare_core():
+            self._started = time.monotonic()
+            if _may_fork():
+                self._fork()
+            elif sys.executable:
+                self._spawn()
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        if kind is not None:
+            self.stop()
+        return False
+
+    def _fork(self):
+        import warnings
+
+        from numba.core.compiler_lock import global_compiler_lock
+
+        with global_compiler_lock, warnings.catch_warnings():
+            # Python 3.12 and later warn of a fork from a process with threads, counting the native ones (numpy's
+            # BLAS pool): those take no part in the child's compile, and no other Python thread runs (`_may_fork`)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            pid = os.fork()
+        if pid == 0:  # the child: compile, and end without running this process's exit handlers
+            code = 1
+            try:
+                quiet = os.open(os.devnull, os.O_RDWR)
+                os.dup2(quiet, 1)
+                os.dup2(quiet, 2)
+                module, function, args = self.call
+                _run(module, function, *args)
+                code = 0
+            finally:
+                os._exit(code)
+        self._pid, self.how = pid, "fork"
+
+    def _spawn(self):
+        import rotframe
+
+        env = dict(os.environ)
+        here = os.path.dirname(os.path.dirname(os.path.abspath(rotframe.__file__)))
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
+        module, function, args = self.call
+        try:
+            self._child = subprocess.Popen([sys.executable, "-c", _CHILD, module, function, *args], env=env,
+                                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                           stderr=subprocess.DEVNULL)
+        except OSError:
+            return
+        self.how = "interpreter"
+
+    def _wait(self) -> bool:
+        """Wait for the second process until `TIMEOUT_S` from its start: whether it ended well."""
+        deadline = self._started + TIMEOUT_S
+        if self._child is not None:
+            try:
+                return self._child.wait(timeout=max(0.0, deadline - time.monotonic())) == 0
+            except subprocess.TimeoutExpired:
+                return False
+        while time.monotonic() < deadline:
+            pid, status = os.waitpid(self._pid, os.WNOHANG)
+            if pid:
+                self._pid = None
+                return os.waitstatus_to_exitcode(status) == 0
+            time.sleep(0.005)
+        return False
+
+    def stop(self):
+        """Stop the second process, if it still runs."""
+        if self._child is not None and self._child.poll() is None:
+            self._child.kill()
+            self._child.wait()
+        if self._pid is not None:
+            import signal
+
+            try:
+                os.kill(self._pid, signal.SIGKILL)
+                os.waitpid(self._pid, 0)
+            except (ProcessLookupError, ChildProcessError):
+                pass
+            self._pid = None
+
+    def load(self, dispatcher, signature) -> bool:
+        """``dispatcher`` for ``signature``: loaded from the cache the second process wrote, else compiled here.
+
+        Returns whether the second process's compile was used.
+        """
+        from rotframe.numerics.compiled import load_cached
+
+        done = self.how is not None and self._wait()
+        self.stop()
+        if done and load_cached(dispatcher, signature):
+            return True
+        dispatcher.compile(signature)
+        return False
+
+
+def _run(module, function, *args):
+    import importlib
+
+    getattr(importlib.import_module(module), function)(*args)

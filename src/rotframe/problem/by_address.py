@@ -1,0 +1,83 @@
+"""The trajectory tier's stages and right-hand side, compiled apart from its loop and called at their addresses.
+
+The trajectory tier (`rotframe.problem.engine.trajectory_tier`) compiles its DOP853 trajectory loop
+without the model's right-hand side in it: the loop calls the engine's stages, compiled on their own
+with the right-hand side in them, at their address (`stages_at`), one call a step; an event's re-steps
+take f at the step's start from the right-hand side at its address (`system_at`). So the two compile
+in two processes at once on a first run (`rotframe.numerics.compile_apart`), and what runs is the
+same code as the engine's whole loop, to the bit.
+
+The callees take the problem's data ``(prob, fns, W)`` at an address (`rotframe.problem.calls.by_reference`),
+made once a call of the trajectory (`with_reference`): passed by value, its some sixty numbers a call cost
+more than a spring's arithmetic. Measured on the 2-core reference machine (2026-12-01, a spring, warm):
+a run in the tier takes the time it took with the stages in the loop, within 3 %.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, jit_inline, jit_llvm_inline
+from rotframe.problem.calls import by_reference, call_stages, call_system, dereference
+from rotframe.problem.models import DOP853
+from rotframe.problem.signatures import A1, A2, CONTEXT, F8, I8, STAGES_SIG, SYSTEM_SIG
+from rotframe.problem.steps import body_system, particle_system, stepper
+
+__all__ = ["stages_at", "system_at", "with_reference", "tier_callees"]
+
+_uncounted_entry = njit(**ENTRY_OPTIONS)
+
+# the names a callee binds (`rotframe.numerics.compiled.bound`): None in the templates, which are never compiled
+SYSTEM = STAGES = None
+
+
+@jit_llvm_inline  # not numba's inlining: take_step passes a variant's step to the other method's (pruned) branch too
+def stages_at(ctx, first, last, t, y, h, K, z, z12, t12):
+    """The trajectory tier's DOP853 stages, ``ctx = (prob, fns, W, ref, stages, system)`` (`with_reference`): the
+    engine's (`rotframe.problem.steps.stepper`), compiled on their own with the right-hand side in them, called at
+    their address with the problem's data at ``ref`` (`rotframe.problem.calls.call_stages`): one call a step."""
+    call_stages(ctx[4], ctx[3], first, last, t, y, h, K, z, z12, t12)
+
+
+@jit_llvm_inline
+def system_at(ctx, t, z, K, s):
+    """The trajectory tier's right-hand side (`stages_at`): f at a step's start for an event's re-steps."""
+    call_system(ctx[5], ctx[3], t, z, K, s)
+
+
+@jit_inline
+def with_reference(ctx):
+    """The trajectory tier's ``ctx = (prob, fns, W, stages, system)``, the addresses of its compiled stages and
+    right-hand side, as the loop hands it on: the problem's data also at an address, ``ref``, before them (made once a
+    call of the trajectory, `rotframe.problem.calls.by_reference`)."""
+    data = (ctx[0], ctx[1], ctx[2])
+    return ctx[0], ctx[1], ctx[2], by_reference(data), ctx[3], ctx[4]
+
+
+def _system_call(ctx, t, z, K, s):
+    """The template of the right-hand side that Python calls, an entry point: ``K[s] = f(t, z)`` (``SYSTEM``)."""
+    SYSTEM(ctx, t, z, K, s)
+
+
+def _system_by_reference(ref, t, z, K, s):
+    """`_system_call` with the problem's data ``(prob, fns, W)`` at the address ``ref`` (`system_at`)."""
+    SYSTEM(dereference(ref), t, z, K, s)
+
+
+def _stages_by_reference(ref, first, last, t, y, h, K, z, z12, t12):
+    """The template of the stages, an entry point (``STAGES``), the problem's data at ``ref`` (`stages_at`)."""
+    STAGES(dereference(ref), first, last, t, y, h, K, z, z12, t12)
+
+
+def tier_callees(body, D):
+    """The trajectory tier's callees for the model (``body``: None, a particle) and ``D`` numbers, entry points of
+    their own, each with its arguments: the stages and the right-hand side that its trajectory calls at their
+    addresses, and the right-hand side that Python calls (each particle's first f and Hairer's starting step)."""
+    kind = f"{'particle' if body is None else 'body'}{D}"
+    system = particle_system if body is None else body_system
+    return ((_uncounted_entry(bound(_stages_by_reference, f"dop853_stages_by_reference_{kind}",
+                                    STAGES=stepper(body, DOP853, D))), STAGES_SIG.args),
+            (_uncounted_entry(bound(_system_by_reference, f"dop853_system_by_reference_{kind}", SYSTEM=system)),
+             SYSTEM_SIG.args),
+            (_uncounted_entry(bound(_system_call, f"dop853_system_engine_{kind}", SYSTEM=system)),
+             (CONTEXT, F8, A1, A2, I8)))

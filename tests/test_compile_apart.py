@@ -1,0 +1,107 @@
+"""A kernel compiled in a second process (`rotframe.numerics.compile_apart`): forked, or a new interpreter where other
+threads run, loaded from the cache it wrote; compiled here where there is no second core, where the child fails or
+runs past its time; stopped where this process's own compile fails. Each case runs in a new process with an empty
+numba cache, as a first run does."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+_KERNEL = textwrap.dedent('''
+    import time
+    from numba import njit
+
+    @njit(cache=True)
+    def kernel(x):
+        return x * 2.0 + 1.0
+
+    def compile_kernel():
+        from numba import types
+        kernel.compile((types.float64,))
+
+    def fail():
+        raise RuntimeError("the child fails")
+
+    def sleep():
+        time.sleep(60.0)
+''')
+
+_DRIVER = textwrap.dedent('''
+    import json, sys, threading, time
+    from numba import types
+    import apart_kernel
+    from rotframe.numerics import compile_apart
+
+    mode = sys.argv[1]
+    if mode == "thread":  # another Python thread: no fork
+        stop = threading.Event()
+        threading.Thread(target=stop.wait, daemon=True).start()
+    if mode == "one core":
+        compile_apart.spare_core = lambda: False
+    if mode == "time-out":
+        compile_apart.TIMEOUT_S = 0.5
+    function = {"fail": "fail", "time-out": "sleep", "raise": "sleep"}.get(mode, "compile_kernel")
+    t0 = time.perf_counter()
+    out = {}
+    try:
+        with compile_apart.CompiledApart("apart_kernel", function) as apart:
+            if mode == "raise":
+                raise KeyError("this process's own compile failed")
+    except KeyError:
+        out["stopped"] = apart._pid is None and (apart._child is None or apart._child.poll() is not None)
+    else:
+        out["used"] = apart.load(apart_kernel.kernel, (types.float64,))
+        out["value"] = apart_kernel.kernel(3.0)
+    out.update(how=apart.how, seconds=time.perf_counter() - t0)
+    print(json.dumps(out))
+''')
+
+
+def _run(tmp_path, mode):
+    (tmp_path / "apart_kernel.py").write_text(_KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), PYTHONPATH=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", _DRIVER, mode], env=env, capture_output=True, text=True, timeout=300,
+                         cwd=tmp_path)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+needs_two_cores = pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="one core: no second process is made")
+linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks on Linux only")
+
+
+@needs_two_cores
+@linux
+def test_a_single_threaded_process_forks_and_loads_what_the_child_compiled(tmp_path):
+    out = _run(tmp_path, "fork")
+    assert out == dict(out, how="fork", used=True, value=7.0)
+
+
+@needs_two_cores
+def test_with_other_threads_a_new_interpreter_compiles_it(tmp_path):
+    out = _run(tmp_path, "thread")
+    assert out == dict(out, how="interpreter", used=True, value=7.0)
+
+
+def test_on_one_core_this_process_compiles_it(tmp_path):
+    out = _run(tmp_path, "one core")
+    assert out == dict(out, how=None, used=False, value=7.0)
+
+
+@needs_two_cores
+@pytest.mark.parametrize("mode", ["fail", "time-out"])
+def test_a_child_that_fails_or_runs_past_its_time_is_replaced_by_a_compile_here(tmp_path, mode):
+    out = _run(tmp_path, mode)
+    assert out["how"] is not None and out["used"] is False and out["value"] == 7.0
+    assert out["seconds"] < 30.0  # the time-out's child sleeps 60 s: it was stopped
+
+
+@needs_two_cores
+def test_a_failure_of_this_processs_compile_stops_the_child(tmp_path):
+    out = _run(tmp_path, "raise")
+    assert out["how"] is not None and out["stopped"] is True and out["seconds"] < 30.0
