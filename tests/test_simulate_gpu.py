@@ -123,15 +123,17 @@ def test_the_gpu_kernel_is_the_engine_loop_with_the_problems_calls_made_direct()
 
 
 def test_a_function_inlined_by_numba_on_the_cpu_is_inlined_by_numba_on_the_gpu(monkeypatch):
-    """`take_step` types only the branch of its variant's method where numba inlines it (``inline="always"``).
+    """A step of `take_step` (RK4's here) is inlined by numba on the GPU, as on the CPU (``inline="always"``).
 
-    Compiled for a GPU as a function of its own, it typed every branch with one method's step and
-    failed at the first launch on an H200, which the simulator (Python) never showed. Here the
-    GPU's options are read off `device_function` with numba's CUDA ``jit`` recording them.
+    Compiled for a GPU as a function of its own, `take_step` (then one function with every method's
+    branch) typed every branch with one method's step and failed at the first launch on an H200,
+    which the simulator (Python) never showed. Here the GPU's options are read off `device_function`
+    with numba's CUDA ``jit`` recording them.
     """
     from numba import cuda
 
     from rotframe.problem import steps
+    from rotframe.problem.models import RK4
 
     seen = {}
 
@@ -143,11 +145,12 @@ def test_a_function_inlined_by_numba_on_the_cpu_is_inlined_by_numba_on_the_gpu(m
 
     monkeypatch.setattr(cuda, "jit", recording_jit)
     monkeypatch.setattr(gpu, "inline_options", lambda: {"forceinline": True})  # a real GPU's numba-cuda
-    gpu.device_function(steps.take_step, {})
+    take = steps.take_step(RK4)
+    gpu.device_function(take, {})
     gpu.device_function(steps.particle_rk4, {})
-    assert seen["take_step"] == {"device": True, "forceinline": True, "inline": "always"}
+    assert seen[take.py_func.__name__] == {"device": True, "forceinline": True, "inline": "always"}
     assert seen["particle_rk4"] == {"device": True, "forceinline": True}  # LLVM's inlining only, as on the CPU
-    assert steps.take_step.targetoptions["inline"] == "always"  # what the rule reads: jit_inline's option
+    assert take.targetoptions["inline"] == "always"  # what the rule reads: jit_inline's option
 
 
 @pytest.mark.skipif(os.environ.get("NUMBA_ENABLE_CUDASIM") == "1" or "NVIDIA" not in

@@ -91,10 +91,10 @@ def device_function(kernel, made=None):
 
     A function that numba inlines into its callers on the CPU (``inline="always"``,
     `rotframe.numerics.compiled.jit_inline`) is inlined the same way on the GPU: a caller may
-    rely on it to drop the branches that its constants rule out before they are typed
-    (`rotframe.problem.steps.take_step` gets one method's step and types only that method's
-    branch). Compiled on its own, every branch is typed, and a branch with another method's step
-    fails to compile on a real GPU. The simulator runs Python and never types them.
+    rely on it to drop the branches that its constants rule out before they are typed. Compiled
+    on its own, every branch is typed, and a branch with another method's step fails to compile on
+    a real GPU (as `rotframe.problem.steps.take_step` did when it held every method's step). The
+    simulator runs Python and never types them.
     """
     from numba import cuda
     from numba.core.dispatcher import Dispatcher

@@ -31,7 +31,7 @@ _uncounted_entry = njit(**ENTRY_OPTIONS)
 SYSTEM = STAGES = None
 
 
-@jit_llvm_inline  # not numba's inlining: take_step passes a variant's step to the other method's (pruned) branch too
+@jit_llvm_inline  # compiled once, inlined by LLVM at each of its call sites (the step, an event's trials)
 def stages_at(ctx, first, last, t, y, h, K, z, z12, t12):
     """The trajectory tier's DOP853 stages, ``ctx = (prob, fns, W, ref, stages, system)`` (`with_reference`): the
     engine's (`rotframe.problem.steps.stepper`), compiled on their own with the right-hand side in them, called at

@@ -99,7 +99,7 @@ def raised(ctx):
 
 
 # the names a variant binds (`variant_loop`): None, 0 or False in the templates themselves, which are never compiled
-SYSTEM = TRAJECTORY = STEPPER = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
+SYSTEM = TRAJECTORY = STEPPER = TAKE = BODY_FLAG = TRIAL = LOCATE = START_SIGN = WATCH = None
 METHOD = DIM = 0
 EVENTS = False
 
@@ -107,13 +107,13 @@ EVENTS = False
 def _event_trial(tctx, tau):
     """The template of a variant's event trial: event k's value after a re-step of length ``tau``.
 
-    ``tctx = (k, t, y, Kb, ytb, ybuf, ctx)``: the re-step is the variant's method from
-    ``(t, y)`` (`take_step` with the variant's ``STEPPER``, ``BODY_FLAG`` and ``METHOD``; ``Kb[0]`` is
-    f(t, y)), its state left in ``ybuf``. The trial of rotframe's one event locator
+    ``tctx = (k, t, y, Kb, ytb, ybuf, ctx)``: the re-step is the variant's method from ``(t, y)``
+    (``TAKE``, the method's step of `take_step`, with the variant's ``STEPPER`` and ``BODY_FLAG``;
+    ``Kb[0]`` is f(t, y)), its state left in ``ybuf``. The trial of rotframe's one event locator
     (`rotframe.numerics.bisection.locator`) and of `_start_sign`.
     """
     k, t, y, Kb, ytb, ybuf, ctx = tctx
-    take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, ytb, ybuf, ctx)
+    TAKE(STEPPER, BODY_FLAG, t, y, tau, Kb, ytb, ybuf, ctx)
     return call_event(ctx[1][1], k, t + tau, ybuf, ctx[0][2])
 
 
@@ -164,7 +164,7 @@ def _watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
 
     ``wctx = (GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, t0, Kb, ytb, yhi, ybuf)``: each event's value
     at ``t`` (updated), the records, the directions and terminal flags, the run's start and the
-    locator's scratch; ``ctx`` the system's (``(prob, fns, W)``, `rotframe.problem.steps.take_step`), ``SYSTEM`` its
+    locator's scratch; ``ctx`` the system's (``(prob, fns, W)``, more in the trajectory tier's), ``SYSTEM`` its
     right-hand side (f at ``t`` for the re-steps). A crossing (with its direction) is located by
     rotframe's one event locator (``LOCATE``, `rotframe.numerics.bisection.locator`) on re-steps by
     the variant's method (``TRIAL``, `_event_trial`), a zero at the start by ``START_SIGN``
@@ -276,7 +276,8 @@ def _watcher(kind, step, body, method, system, cold=False):
     re-steps took the registers of the loop's state (the tower drop's ensemble with the ground
     event, 1.65 to 1.52 times the scenes' kernels' time, 2026-11-30).
     """
-    trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STEPPER=step, BODY_FLAG=body, METHOD=method))
+    trial = jit_inline(bound(_event_trial, f"event_trial_{kind}", STEPPER=step, BODY_FLAG=body,
+                             TAKE=take_step(method)))
     start_sign = jit_inline(bound(_start_sign, f"start_sign_{kind}", TRIAL=trial))
     made = bound(_watch_events, f"watch_{kind}", SYSTEM=system, TRIAL=trial, LOCATE=locator(kind, trial),
                  START_SIGN=start_sign)
@@ -548,10 +549,11 @@ def energies(T, OUT, prob, fns, potential, rotating):
 #: problem
 VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
                                B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
-#: the trajectory tier's trajectory loop's arguments (`trajectory_tier`), without and with events (``ctx = (prob, fns, W,
-#: stages, system)``, `rotframe.problem.by_address.with_reference`; ``wctx``, `rotframe.problem.loop_state.watcher_context`'s tuple)
-TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, I8, I8)), F8, A1, F8, F8, F8, A1, I8, A3, I8, F8, A1, A2,
-                            A1, A1, A1, A2,
+#: the trajectory tier's trajectory loop's arguments (`trajectory_tier`), without and with events (``ctx = (prob,
+#: fns, W, stages, system)``, `rotframe.problem.by_address.with_reference`; ``wctx``,
+#: `rotframe.problem.loop_state.watcher_context`'s tuple)
+TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, I8, I8)), F8, A1, F8, F8, F8, A1, I8, A3, I8, F8,
+                            A1, A2, A1, A1, A1, A2,
                             types.Tuple((A2, A2, A3, I2, I1, A1, B1, F8, A2, A1, A1, A1)) if events else I8, I8)
                    for events in (False, True)}
 

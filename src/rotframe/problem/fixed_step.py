@@ -12,8 +12,8 @@ step takes and returns them (`rotframe.problem.models.particle_split`), RK4's to
 acceleration at the step's start beside them (`rotframe.problem.steps.carried_rk4`); they are
 written to the arrays only where they are read: at a sample, for the events' watcher, where the
 call ends. The arrays' round trips on the state's path were half of a splitting's step. The
-numbers are those of the array steps to the bit (`rotframe.problem.steps.take_step`, which the
-events' re-steps take, calls the same functions).
+numbers are those of the array steps to the bit (the method's step of `rotframe.problem.steps.take_step`,
+which the events' re-steps take, calls the same functions).
 
 What a step costs beyond its arithmetic is decided as seldom as it can be: the sample grid once a
 run of steps (on the grid, with no stop before the sample, the rest of the interval is steps of
@@ -53,8 +53,8 @@ def fixed_step_loop(name, body, method, D, step, watch):
     as its globals (`rotframe.numerics.compiled.bound`): ``body`` (None: a particle), the ``method``'s code, the
     length of the state ``D``, the method's ``step`` (`rotframe.problem.steps.stepper`) and the events' ``watch``
     (None: no events, none of the watching compiled). A particle of six numbers carries its state (``CARRIED``)."""
-    return bound(_fixed_step_advance, name, STEPPER=step, BODY_FLAG=body, METHOD=method, EVENTS=watch is not None,
-                 WATCH=watch, DIM=int(D), CARRIED=body is None and D == 6)
+    return bound(_fixed_step_advance, name, STEPPER=step, TAKE=take_step(method), BODY_FLAG=body, METHOD=method,
+                 EVENTS=watch is not None, WATCH=watch, DIM=int(D), CARRIED=body is None and D == 6)
 
 
 @jit_inline
@@ -154,7 +154,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                     else:
                         sn = particle_split(METHOD, t, s, hh, yt, prob, fns, W)
                 else:
-                    take_step(STEPPER, BODY_FLAG, METHOD, t_stages, y, hh, K, yt, yn, ctx)
+                    TAKE(STEPPER, BODY_FLAG, t_stages, y, hh, K, yt, yn, ctx)
                 steps += 1
                 nfev += EVALUATIONS_PER_STEP[METHOD]
                 if W[RAISED] != 0.0:  # a user function raised in this step: stop here, Python names it
@@ -184,7 +184,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
                             break
                         # the state at the terminal event: the step of that length from the step's start (the
                         # locator's last trial; Kb[0] is f(t, y)); the samples after it keep it
-                        take_step(STEPPER, BODY_FLAG, METHOD, t, y, tau, Kb, V[4], yev, ctx)
+                        TAKE(STEPPER, BODY_FLAG, t, y, tau, Kb, V[4], yev, ctx)
                         t = t + tau
                         for j in range(D):
                             y[j] = yev[j]

@@ -4,8 +4,8 @@ A model's right-hand side (`rotframe.problem.models.rhs`) is a *system* of rotfr
 loop (`rotframe.numerics.dop853_loop`) and its one RK4 step (`rotframe.numerics.rk4`): a
 compiled function ``f(ctx, t, z, K, s)`` writing ``K[s]``, with ``ctx = (prob, fns, W)``
 (`particle_system`, `body_system`). `stepper` compiles the method's step for a system and a
-length of state; `take_step` takes one step of any method with it: the engine's fixed-step
-loop steps with it, and its event locators re-step with it (`rotframe.problem.engine`).
+length of state; `take_step` is the method's step with it: the engine's fixed-step loop steps
+with it, and its event locators re-step with it (`rotframe.problem.engine`).
 
 A particle's RK4 step (6 numbers) is the one RK4 step of a particle, the scenes' too
 (`rotframe.numerics.rk4.rk4_particle_step`), with its stages in registers; it writes each stage's
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import functools
 
-from rotframe.numerics.compiled import jit_inline, jit_llvm_inline
+from rotframe.numerics.compiled import bound, jit_inline, jit_llvm_inline
 from rotframe.numerics.dop853_loop import dop853_stages, dop853_step
 from rotframe.numerics.rk4 import rk4_particle_step, rk4_step
 from rotframe.problem.models import DOP853, RK4, own_step, rhs
@@ -104,18 +104,42 @@ def stepper(body, method, D):
 
 
 @jit_inline
-def take_step(step, body, method, t, y, h, K, yt, yn, ctx):
-    """One step of ``method`` of length ``h`` from (t, y), K[0] = f(t, y): ``yn``.
+def _dop853_take(step, body, t, y, h, K, yt, yn, ctx):
+    """DOP853's step of `take_step`: the one DOP853 loop's (`rotframe.numerics.dop853_loop.dop853_step`)."""
+    dop853_step(step, ctx, t, y, h, K, yn, yt)
+
+
+@jit_inline
+def _rk4_take(step, body, t, y, h, K, yt, yn, ctx):
+    """RK4's step of `take_step`: the one RK4 step (`rotframe.numerics.rk4`)."""
+    step(ctx, t, y, h, K, yt, yn)
+
+
+# the splitting's order that a copy of `_own_take` binds (`rotframe.numerics.compiled.bound`); 0 in the template
+METHOD = 0
+
+
+def _own_take(step, body, t, y, h, K, yt, yn, ctx):
+    """A splitting's step of `take_step`, the template: the model's own (`rotframe.problem.models.own_step`) of order
+    ``METHOD``."""
+    own_step(body, METHOD, t, y, h, yn, ctx[0], ctx[1], ctx[2])
+
+
+@functools.lru_cache(maxsize=None)
+def take_step(method):
+    """``take(step, body, t, y, h, K, yt, yn, ctx)``: one step of ``method`` of length ``h`` from (t, y), with
+    K[0] = f(t, y): ``yn``.
 
     ``step`` is the variant's `stepper`: DOP853's step is the one DOP853 loop's
     (`rotframe.numerics.dop853_loop.dop853_step` with the system's stages), RK4's the one RK4
     step (`rotframe.numerics.rk4`); a splitting is the model's own (`rotframe.problem.models.own_step`).
-    ``ctx`` is the system's: ``(prob, fns, W)``, and the address of the right-hand side after them in the
-    trajectory tier's (`rotframe.problem.engine.trajectory_tier`).
+    ``ctx`` is the system's: ``(prob, fns, W)``, and more after them in the trajectory tier's
+    (`rotframe.problem.by_address`). Chosen here, in Python, for the method: numba would inline every method's
+    step into each caller before it pruned the others (the event locator's trials call it at several sites:
+    an events variant's first compile took some 8 s for it).
     """
-    if method == DOP853:  # only the event locators' trials (the DOP853 loop steps on its own)
-        dop853_step(step, ctx, t, y, h, K, yn, yt)
-    elif method == RK4:
-        step(ctx, t, y, h, K, yt, yn)
-    else:  # the model's own splitting, of order 2 or 4
-        own_step(body, method, t, y, h, yn, ctx[0], ctx[1], ctx[2])
+    if method == DOP853:
+        return _dop853_take
+    if method == RK4:
+        return _rk4_take
+    return jit_inline(bound(_own_take, f"own_take_{method}", METHOD=method))
