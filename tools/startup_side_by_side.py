@@ -12,8 +12,8 @@ Usage, with the tree before checked out beside this one::
     git worktree add /tmp/old <rev>
     python tools/startup_side_by_side.py /tmp/old/src src 3
 
-Runs on one machine drift (its speed changes by tens of percent over minutes), so compare medians of runs made
-alternately, never numbers from different days.
+Runs on one machine drift (its speed changes by tens of percent over minutes), so compare the ratios of runs made
+in pairs (each pair's order by chance), never numbers from different days.
 """
 from __future__ import annotations
 
@@ -48,7 +48,9 @@ def main(old, new, reps):
     trees = {"before": old, "after": new}
     rows = {tree: {"long": [], "new": [], "cr3bp": []} for tree in trees}
     for _ in range(reps):
-        for tree, src in trees.items():
+        order = list(trees.items())
+        random.shuffle(order)  # which tree runs first in a pair, by chance: the machine's drift falls on both
+        for tree, src in order:
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers:
                 rows[tree]["long"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 1000.0))
                 rows[tree]["new"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 10.0))
@@ -56,7 +58,9 @@ def main(old, new, reps):
             print(tree, {key: round(v[-1], 2) for key, v in rows[tree].items()}, flush=True)
     for key in ("long", "new", "cr3bp"):
         b, a = (statistics.median(rows[tree][key]) for tree in trees)
-        print(f"{key:6s} median before {b:.2f} s, after {a:.2f} s, after / before {a / b:.2f}")
+        ratios = [x / y for x, y in zip(rows["after"][key], rows["before"][key])]
+        print(f"{key:6s} median before {b:.2f} s, after {a:.2f} s; after / before in each pair: median "
+              f"{statistics.median(ratios):.2f}, {min(ratios):.2f} to {max(ratios):.2f}")
 
 
 if __name__ == "__main__":
