@@ -104,8 +104,15 @@ def _stages(typingctx, addr, ref, first, last, t, y, h, K, z, z12, t12):
 
 @intrinsic
 def by_reference(typingctx, value):
-    """The address of a copy of ``value`` on the caller's stack (`dereference` reads it), valid for the caller's
-    call: how the trajectory tier hands its right-hand side the problem's data, once a call (`call_system`)."""
+    """The address of a copy of the context ``value`` (`CONTEXT`) on the caller's stack (`dereference` reads it),
+    valid for the caller's call: how the trajectory tier hands its right-hand side the problem's data, once a call
+    (`call_system`). Any other type is refused where it is typed."""
+    from numba.core.errors import TypingError
+
+    from rotframe.problem.signatures import CONTEXT
+
+    if value != CONTEXT:
+        raise TypingError(f"by_reference takes the context {CONTEXT}, not {value}")
 
     def codegen(context, builder, sig, args):
         from numba.core import cgutils

@@ -268,8 +268,8 @@ def variant_loop(model, method, events, D=None):
 def _watcher(kind, step, body, method, system, cold=False):
     """The events' watcher of a variant (`_watch_events`) with its trial, locator and start rule, bound to them.
 
-    ``kind`` names the variant's copies; ``step`` (the variant's `stepper`), ``body`` and ``method``
-    are constants of its trial (`_event_trial`), so numba prunes the other methods' steps from it;
+    ``kind`` names the variant's copies; ``step`` (the variant's `stepper`), ``body`` and the
+    ``method``'s step (`rotframe.problem.steps.take_step`) are constants of its trial (`_event_trial`);
     ``system`` is the right-hand side the stages call (`_dop853_parts`).
     Inlined into the DOP853 loop; ``cold``, a function of its own that the fixed-step loop calls only
     where a step may cross (`rotframe.problem.fixed_step.quiet_step`): inlined, its locator's
@@ -285,9 +285,9 @@ def _watcher(kind, step, body, method, system, cold=False):
 
 
 def _dop853_parts(body, events, D, entry=False):
-    """The DOP853 variant's system and trajectory loop: the model's right-hand side (`particle_system`,
-    `body_system`) with ``ctx = (prob, fns, W)``, and `rotframe.numerics.dop853_loop`'s trajectory compiled for it,
-    the events watched by `_watch_events`, a user function that raised ending the trajectory at the step (`raised`).
+    """The DOP853 variant's trajectory loop: `rotframe.numerics.dop853_loop`'s trajectory compiled for the model's
+    right-hand side (`particle_system`, `body_system`, ``ctx = (prob, fns, W)``), the events watched by
+    `_watch_events`, a user function that raised ending the trajectory at the step (`raised`).
     ``entry``: the trajectory tier's (`trajectory_tier`), callable from Python, which calls the stages and the
     right-hand side at their addresses (`rotframe.problem.by_address`), cached apart."""
     system = particle_system if body is None else body_system
