@@ -105,3 +105,55 @@ def test_a_child_that_fails_or_runs_past_its_time_is_replaced_by_a_compile_here(
 def test_a_failure_of_this_processs_compile_stops_the_child(tmp_path):
     out = _run(tmp_path, "raise")
     assert out["how"] is not None and out["stopped"] is True and out["seconds"] < 30.0
+
+
+_KERNELS_CHILD = r"""
+import json
+from numba.core import event
+from rotframe.numerics import compile_apart
+
+made, load = [], compile_apart.CompiledApart.load  # each second process of a compile, as it was made
+compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or load(self, *args)
+compiled = []
+
+
+class Listener(event.Listener):
+    def on_start(self, ev):
+        compiled.append(ev.data["dispatcher"].py_func.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Listener())
+from rotframe.particles import dop853_steady
+from rotframe.problem import engine
+from rotframe.problem.signatures import PARTICLE
+
+dop853_steady.run_dop853_steady._make()
+engine.variant(PARTICLE, "dop853", False)
+print(json.dumps({"apart": made, "compiled": compiled}))
+"""
+
+
+def test_kernels_compiled_apart_load_from_the_cache_in_the_next_process(tmp_path):
+    """The steady loop (`rotframe.particles.dop853_steady.SteadyDriver`) and the engine's whole DOP853 loop
+    (`rotframe.problem.dop853_split.whole_loop`) compile apart in a fresh install, and the next process loads every
+    one of their kernels from numba's cache: no compile, no second process (numba keys its cache on the signature as it was
+    compiled, `rotframe.numerics.compiled.load_cached`)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+
+    def child():
+        out = subprocess.run([sys.executable, "-c", _KERNELS_CHILD], env=env, capture_output=True, text=True,
+                             timeout=900)
+        assert out.returncode == 0, out.stderr[-2000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first = child()
+    assert "_run_at" in first["compiled"] and "dop853_stages_by_reference_particle6" in first["compiled"], first
+    if len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux"):
+        # the steady trajectory; then the engine's trajectory and its whole loop, beside its stages compiled here
+        assert first["apart"] == ["fork"] * 3, first
+    else:
+        assert "advance_particle6_dop853_at" in first["compiled"], first
+    assert child() == {"apart": [], "compiled": []}

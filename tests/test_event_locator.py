@@ -77,9 +77,9 @@ def test_every_locator_is_the_one_template():
     """The scenes' two locators and the engine's are copies of one code object, bound to their own trials."""
     from rotframe.numerics import bisection
     from rotframe.particles import dop853_particles, events
-    from rotframe.problem import engine
+    from rotframe.problem import engine, event_watch
 
-    watch = engine._watcher("test_locator", None, None, engine.METHOD_CODES["rk4"], None)
+    watch = event_watch.watcher("test_locator", None, None, engine.METHOD_CODES["rk4"], None)
     engine_locate = watch.py_func.__globals__["LOCATE"]
     for located in (events.locate_fixed, dop853_particles.locate_dop853, engine_locate):
         assert located.py_func.__code__ is bisection._locate.__code__

@@ -5,12 +5,14 @@ For each tree, alternately, in new processes with empty numba and rotframe cache
 * ``long``: the start-up bench's first problem ever, long (`rotframe.app.bench.problem_startup`: 1,000 s of a spring
   in a rotating frame, DOP853, the ``simulate`` call alone);
 * ``new``: then a new problem in the caches that run left (10 s, another spring constant);
-* ``cr3bp``: ``python -m rotframe run cr3bp --no-record`` in caches of its own (wall time, imports included).
+* each scene named (default ``cr3bp``): ``python -m rotframe run NAME --no-record`` in caches of its own (wall time,
+  imports included).
 
 Usage, with the tree before checked out beside this one::
 
     git worktree add /tmp/old <rev>
     python tools/startup_side_by_side.py /tmp/old/src src 3
+    python tools/startup_side_by_side.py /tmp/old/src src 3 foucault,tumbling-ball,cr3bp
 
 Runs on one machine drift (its speed changes by tens of percent over minutes), so compare the ratios of runs made
 in pairs (each pair's order by chance), never numbers from different days.
@@ -44,9 +46,9 @@ def _scene(src, name):
         return time.perf_counter() - t0
 
 
-def main(old, new, reps):
+def main(old, new, reps, scenes=("cr3bp",)):
     trees = {"before": old, "after": new}
-    rows = {tree: {"long": [], "new": [], "cr3bp": []} for tree in trees}
+    rows = {tree: {"long": [], "new": [], **{name: [] for name in scenes}} for tree in trees}
     for _ in range(reps):
         order = list(trees.items())
         random.shuffle(order)  # which tree runs first in a pair, by chance: the machine's drift falls on both
@@ -54,14 +56,16 @@ def main(old, new, reps):
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers:
                 rows[tree]["long"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 1000.0))
                 rows[tree]["new"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 10.0))
-            rows[tree]["cr3bp"].append(_scene(src, "cr3bp"))
+            for name in scenes:
+                rows[tree][name].append(_scene(src, name))
             print(tree, {key: round(v[-1], 2) for key, v in rows[tree].items()}, flush=True)
-    for key in ("long", "new", "cr3bp"):
+    for key in rows["after"]:
         b, a = (statistics.median(rows[tree][key]) for tree in trees)
         ratios = [x / y for x, y in zip(rows["after"][key], rows["before"][key])]
-        print(f"{key:6s} median before {b:.2f} s, after {a:.2f} s; after / before in each pair: median "
+        print(f"{key:13s} median before {b:.2f} s, after {a:.2f} s; after / before in each pair: median "
               f"{statistics.median(ratios):.2f}, {min(ratios):.2f} to {max(ratios):.2f}")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 3)
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 3,
+         tuple(sys.argv[4].split(",")) if len(sys.argv) > 4 else ("cr3bp",))

@@ -3,7 +3,7 @@
 numba compiles one function at a time in a process (its compiler lock, and the GIL). Where a first
 run must compile two kernels that do not call each other (the trajectory tier's trajectory loop,
 and its stages and right-hand side, which the loop calls at their addresses:
-`rotframe.problem.engine.trajectory_tier`), `CompiledApart` has a second process compile one of
+`rotframe.problem.dop853_split.trajectory_tier`), `CompiledApart` has a second process compile one of
 them into numba's disk cache while this process compiles the other; this process then loads it
 from the cache (`rotframe.numerics.compiled.load_cached`), as any later process would.
 
@@ -62,7 +62,7 @@ class CompiledApart:
 
     Use it around this process's own compile, then `load` the kernel::
 
-        with CompiledApart("rotframe.problem.engine", "compile_tier_trajectory", 0, 0, 6) as apart:
+        with CompiledApart("rotframe.problem.dop853_split", "compile_tier_trajectory", 0, 0, 6) as apart:
             stages.compile(signature)  # this process's share
         apart.load(trajectory, TRAJECTORY_ARGS[False])  # the other's: from the cache, or compiled here
 

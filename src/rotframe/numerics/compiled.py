@@ -218,6 +218,10 @@ def load_cached(dispatcher, signature) -> bool:
     (numba's own calls), so that a caller can tell a loop it may load from one it would have to
     compile: a long run's inlined loop (`rotframe.problem.inlined`), the engine's loop before a
     first run (`rotframe.problem.tiers`). Any failure reads as "not in the cache".
+
+    ``signature`` is the one the kernel was compiled with: numba keys its cache on it as given, so a
+    signature with its return type (``float64(int64)``) and its argument types alone (``(int64,)``) are
+    two entries.
     """
     from numba.core.compiler_lock import global_compiler_lock
 

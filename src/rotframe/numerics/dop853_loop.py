@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, types
 
 from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, inlined, jit_inline, jit_uncounted
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
@@ -43,7 +43,7 @@ from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, exte
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
 
 __all__ = ["dop853_stages", "dop853_trajectory", "dop853_step", "dop853_start", "REACHED", "STOPPED", "COLLAPSED",
-           "NONFINITE", "PAUSED", "WATCH_FAILED", "ABORTED", "DIVERGED", "UNLIMITED"]
+           "NONFINITE", "PAUSED", "WATCH_FAILED", "ABORTED", "DIVERGED", "UNLIMITED", "TRAJECTORY_RETURNS"]
 
 #: how `dop853_trajectory` ended: ``t_end`` reached; a terminal event; the step size collapsed (finite errors); an
 #: accepted step's state not finite; the budget of steps spent (``t < t_end``); the watcher could not tell (NaN); the
@@ -52,6 +52,10 @@ __all__ = ["dop853_stages", "dop853_trajectory", "dop853_step", "dop853_start", 
 REACHED, STOPPED, COLLAPSED, NONFINITE, PAUSED, WATCH_FAILED, ABORTED, DIVERGED = 0, 1, 2, 3, 4, 5, 6, 7
 #: the step budget of a call that runs to its end (a caller that bounds its calls by their samples)
 UNLIMITED = 1 << 62
+
+#: what `dop853_trajectory`'s loop returns, ``(t, h, k_out, status, nfev, steps)``: the return type of its signature where
+#: it is an entry point called at its address (`rotframe.numerics.at_address`)
+TRAJECTORY_RETURNS = types.Tuple((types.float64, types.float64, types.int64, types.int64, types.int64, types.int64))
 
 #: a loop called from Python: an entry point without reference counts (its caller owns every array)
 _uncounted_entry = njit(**ENTRY_OPTIONS)

@@ -15,18 +15,31 @@ on `rotframe.numerics.dop853_loop`) with a force of its own (`_acceleration`: th
 engine's right-hand side (`rotframe.problem.models`), so that its results are bitwise those of
 the engine's loop (``tests/test_steady_route.py`` checks this on random problems).
 `steady_parameters` packs a problem for it.
+
+The loop without events compiles as two kernels (`SteadyDriver`): the trajectory, an entry point of
+its own, and the driver over the particles, which calls the trajectory at its address
+(`rotframe.numerics.at_address`). numba links a callee into its caller and optimises it again there;
+apart, the trajectory compiles once, and on a first run in a second process while this one compiles
+the driver (`rotframe.numerics.compile_apart`): `rotframe run foucault`'s first run takes about a
+third of its time before. The call at an address costs one call a particle, not a step.
 """
 
 from __future__ import annotations
 
-import numpy as np
+import threading
 
-from rotframe.numerics.compiled import bound, jit_internal, jit_kernel, jit_llvm_inline
-from rotframe.numerics.dop853_loop import dop853_stages, dop853_trajectory
+import numpy as np
+from numba import njit, types
+
+from rotframe.numerics.at_address import address, caller
+from rotframe.numerics.compiled import (ENTRY_OPTIONS, bound, jit_inline, jit_internal, jit_kernel, jit_llvm_inline,
+                                        load_cached)
+from rotframe.numerics.dop853_loop import TRAJECTORY_RETURNS, dop853_stages, dop853_trajectory
 from rotframe.particles.accelerations import centrifugal, coriolis, string_tension
 from rotframe.particles.dop853_ensemble import run_particles, store_sample
 
-__all__ = ["steady_parameters", "run_dop853_steady", "steady_events_kernel"]
+__all__ = ["steady_parameters", "run_dop853_steady", "steady_events_kernel", "SteadyDriver",
+           "TRAJECTORY_SIG", "DRIVER_SIG"]
 
 # The force sums the terms of rotframe.particles.accelerations (each term's arithmetic, written once) over the
 # steady vector, rather than running the engine's right-hand side: that would compile the problem's functions and
@@ -87,19 +100,99 @@ def _steady_rhs(q, t, z, K, s):
 
 
 _steady_stages = dop853_stages("steady", _steady_rhs, 6)
-_steady_trajectory = dop853_trajectory("steady", _steady_stages, store_sample, 6)
+
+# the loop's trajectory, an entry point of its own for one signature, which `run_dop853_steady`'s driver calls at its
+# address (`rotframe.numerics.at_address`): the two compile apart (module docstring)
+_F8, _I8 = types.float64, types.int64
+_A1, _A2, _A3 = types.float64[::1], types.float64[:, ::1], types.float64[:, :, ::1]
+#: the trajectory's signature (`rotframe.numerics.dop853_loop.dop853_trajectory`: ``ctx`` is ``q``, no watcher)
+TRAJECTORY_SIG = TRAJECTORY_RETURNS(
+    _A1, _F8, _A1, _F8, _F8, _F8, _A1, _I8, types.Tuple((_A3, _A3)), _I8, _F8, _A1, _A2, _A1, _A1, _A1, _A2,
+    types.none, _I8)
+#: the driver's signature: `run_dop853_steady`'s arguments, then the trajectory's address
+DRIVER_SIG = types.UniTuple(_I8, 4)(_A2, _A2, _F8, _A1, _A1, _F8, _A2, _F8, _A2, _A3, _A3, _A1, _I8)
+_steady_trajectory = dop853_trajectory("steady", _steady_stages, store_sample, 6, entry=True)
+_call_trajectory = caller(TRAJECTORY_SIG)
 
 
-@jit_kernel
-def run_dop853_steady(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, out_v, h_state):
-    """Adaptive DOP853 for an ensemble under a steady model (see the module docstring).
+@jit_inline
+def _trajectory_at(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
+    """The steady trajectory at its address, ``ctx = (q, address)``."""
+    return _call_trajectory(ctx[1], ctx[0], t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp,
+                            yt, F, wctx, budget)
 
-    Parameters and results as `rotframe.particles.drivers.run_dop853`, with ``q`` from
-    `steady_parameters`. There are no events, so every particle stays alive. Returns
-    ``(n_done, bad, nfev, steps)``, the cost the most any particle took (as the engine's loop counts it).
-    """
-    return run_particles(_steady_rhs, _steady_trajectory, None, q, r, v, None, t0, sample_times, rtol, atol, span,
+
+@jit_llvm_inline
+def _rhs_at(ctx, t, z, K, s):
+    """`_steady_rhs` with ``ctx = (q, address)``: each particle's first f and Hairer's starting step."""
+    _steady_rhs(ctx[0], t, z, K, s)
+
+
+@njit(**ENTRY_OPTIONS)
+def _run_at(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, out_v, h_state, at):
+    """`run_dop853_steady`'s driver: the trajectory at the address ``at``."""
+    return run_particles(_rhs_at, _trajectory_at, None, (q, at), r, v, None, t0, sample_times, rtol, atol, span,
                          out_r, out_v, h_state, work, None, True)
+
+
+def compile_steady_trajectory():
+    """Compile the steady trajectory into numba's cache: the second process of a first compile
+    (`rotframe.numerics.compile_apart`, `SteadyDriver`)."""
+    _steady_trajectory.compile(TRAJECTORY_SIG)
+
+
+class SteadyDriver:
+    """Adaptive DOP853 for an ensemble under a steady model (see the module docstring): `run_dop853_steady`.
+
+    ``driver(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, out_v, h_state)``, with the parameters and
+    results of `rotframe.particles.drivers.run_dop853` and ``q`` from `steady_parameters`. There are no events,
+    so every particle stays alive. Returns ``(n_done, bad, nfev, steps)``, the cost the most any particle took (as
+    the engine's loop counts it). Every array is C-contiguous.
+
+    Two kernels, each compiled for its one signature and cached: the trajectory loop (`TRAJECTORY_SIG`) and the
+    driver over the particles (`DRIVER_SIG`), which calls the trajectory at its address. Made at the first call:
+    loaded from numba's cache, else the trajectory compiles in a second process while this one compiles the driver
+    (`rotframe.numerics.compile_apart`). ``overloads`` and ``signatures`` are the driver's (what a caller reads to
+    tell a first load or compile, `rotframe.particles.chunked.KernelSetup.warm_up`).
+    """
+
+    def __init__(self):
+        self._made = None
+        self._lock = threading.Lock()
+
+    @property
+    def overloads(self):
+        return _run_at.overloads
+
+    @property
+    def signatures(self):
+        return _run_at.signatures
+
+    def _make(self):
+        from rotframe.numerics.compile_apart import CompiledApart
+
+        with self._lock:
+            if self._made is None:
+                kernels = ((_steady_trajectory, TRAJECTORY_SIG), (_run_at, DRIVER_SIG))
+                cached = [load_cached(kernel, sig) for kernel, sig in kernels]  # numba's cache key: the signature compiled
+                if not any(cached):  # the driver here, the trajectory in a second process
+                    with CompiledApart(__name__, "compile_steady_trajectory") as apart:
+                        _run_at.compile(DRIVER_SIG)
+                    apart.load(_steady_trajectory, TRAJECTORY_SIG)
+                for kernel, sig in kernels:
+                    if not kernel.signatures:
+                        kernel.compile(sig)
+                    kernel.disable_compile()
+                self._made = address(_steady_trajectory, TRAJECTORY_SIG)
+        return self._made
+
+    def __call__(self, r, v, t0, sample_times, q, rtol, atol, span, work, out_r, out_v, h_state):
+        at = self._made if self._made is not None else self._make()
+        return _run_at(r, v, t0, sample_times, q, rtol, atol, span, work, out_r, out_v, h_state, at)
+
+
+#: the steady loop without events (`SteadyDriver`)
+run_dop853_steady = SteadyDriver()
 
 
 _EVENTS_KERNEL = []

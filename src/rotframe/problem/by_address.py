@@ -1,6 +1,6 @@
 """The trajectory tier's stages and right-hand side, compiled apart from its loop and called at their addresses.
 
-The trajectory tier (`rotframe.problem.engine.trajectory_tier`) compiles its DOP853 trajectory loop
+The trajectory tier (`rotframe.problem.dop853_split.trajectory_tier`) compiles its DOP853 trajectory loop
 without the model's right-hand side in it: the loop calls the engine's stages, compiled on their own
 with the right-hand side in them, at their address (`stages_at`), one call a step; an event's re-steps
 take f at the step's start from the right-hand side at its address (`system_at`). So the two compile
@@ -17,18 +17,19 @@ from __future__ import annotations
 
 from numba import njit
 
+from rotframe.numerics.at_address import caller
 from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, jit_inline, jit_llvm_inline
 from rotframe.problem.calls import by_reference, call_stages, call_system, dereference
 from rotframe.problem.models import DOP853
 from rotframe.problem.signatures import A1, A2, CONTEXT, F8, I8, STAGES_SIG, SYSTEM_SIG
 from rotframe.problem.steps import body_system, particle_system, stepper
 
-__all__ = ["stages_at", "system_at", "with_reference", "tier_callees"]
+__all__ = ["stages_at", "system_at", "with_reference", "tier_callees", "trajectory_at", "system_by_address"]
 
 _uncounted_entry = njit(**ENTRY_OPTIONS)
 
 # the names a callee binds (`rotframe.numerics.compiled.bound`): None in the templates, which are never compiled
-SYSTEM = STAGES = None
+SYSTEM = STAGES = CALL = None
 
 
 @jit_llvm_inline  # compiled once, inlined by LLVM at each of its call sites (the step, an event's trials)
@@ -81,3 +82,32 @@ def tier_callees(body, D):
              SYSTEM_SIG.args),
             (_uncounted_entry(bound(_system_call, f"dop853_system_engine_{kind}", SYSTEM=system)),
              (CONTEXT, F8, A1, A2, I8)))
+
+
+@jit_inline
+def _problem_functions(fns):
+    """The problem's five addresses (`rotframe.problem.signatures.FUNCTIONS`) of the whole loop's eight
+    (`rotframe.problem.signatures.FUNCTIONS_AT`)."""
+    return fns[0], fns[1], fns[2], fns[3], fns[4]
+
+
+def _trajectory_at(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
+    """The template of `trajectory_at`."""
+    fns = ctx[1]
+    return CALL(fns[5], (ctx[0], _problem_functions(fns), ctx[2], fns[6], fns[7]), t, y, h, t_end, h_max, times,
+                k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget)
+
+
+def trajectory_at(kind, signature):
+    """The DOP853 whole loop's trajectory (`rotframe.problem.dop853_split.whole_loop`): the trajectory tier's, of
+    ``signature``, called at its address, ``ctx = (prob, fns, W)`` with ``fns`` the whole loop's eight addresses
+    (`rotframe.problem.signatures.FUNCTIONS_AT`: the tier's trajectory, stages and right-hand side after the
+    problem's)."""
+    return jit_inline(bound(_trajectory_at, f"trajectory_at_{kind}", CALL=caller(signature)))
+
+
+@jit_inline
+def system_by_address(ctx, t, z, K, s):
+    """The DOP853 whole loop's right-hand side (each particle's first f and Hairer's starting step): the trajectory
+    tier's at its address (``ctx[1][7]``, `trajectory_at`), the problem's data by reference."""
+    call_system(ctx[1][7], by_reference((ctx[0], _problem_functions(ctx[1]), ctx[2])), t, z, K, s)

@@ -4,11 +4,12 @@ A problem's functions (`rotframe.problem.glue`) are compiled with one fixed sign
 (`rotframe.problem.signatures`); the engine receives the address of each compiled function
 as an integer (`address`) and calls it through numba's own calling convention (`call_terms`,
 `call_event`, `call_potential`, `call_vector`), as numba does for a first-class function. An
-exception raised in the user's function becomes NaN and a flag (`_codegen`, `RAISED`), which ends
-the particle at that step; Python then names the function, calling it again in plain Python. An integer costs
-nothing to hand from function to function, where numba's first-class function values were
-measured at some 20 ns a call they crossed, more than a term's arithmetic; and it is a
-run-time value, so the engine compiled once serves every problem from numba's cache.
+exception raised in the user's function becomes NaN and a flag
+(`rotframe.numerics.at_address.call_codegen`, `RAISED`), which ends the particle at that step;
+Python then names the function, calling it again in plain Python. An integer costs nothing to
+hand from function to function, where numba's first-class function values were measured at
+some 20 ns a call they crossed, more than a term's arithmetic; and it is a run-time value, so
+the engine compiled once serves every problem from numba's cache.
 
 In plain Python (``jit=False``, `rotframe.numerics.plain`) the "address" is the Python function
 itself and each call helper is a plain call (``.plain`` of the helper).
@@ -29,6 +30,7 @@ import math
 from numba import types
 from numba.extending import intrinsic
 
+from rotframe.numerics.at_address import address, call_codegen
 from rotframe.numerics.compiled import jit_inline
 from rotframe.problem.signatures import (EVENT_SIG, POTENTIAL_SIG, STAGES_SIG, SYSTEM_SIG, TERMS_SIG, VARYING_SIG,
                                          VECTOR_SIG)
@@ -39,67 +41,39 @@ __all__ = ["address", "call_terms", "call_event", "call_potential", "call_vector
            "OMEGA_TAG", "ORIGIN_TAG"]
 
 
-def address(dispatcher, signature) -> int:
-    """The address of ``dispatcher`` compiled for ``signature`` (numba's calling convention, not C's)."""
-    compiled = dispatcher.get_compile_result(signature)
-    return int(compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name))
-
-
-def _codegen(signature):
-    """A call of the function at ``args[0]`` of ``signature`` (numba's calling convention), and what it returns.
-
-    An exception raised there is not passed on: the call gives True (a function without a result)
-    or NaN (a function with one) instead, and the engine ends the particle with a non-finite state,
-    which Python then names (`rotframe.problem.particles`). A call that could raise would make numba
-    keep a reference count of every array alive around it, on the hot path: it cost more than the
-    arithmetic of the steps (measured, 4 times the old generated drivers' time a step).
-    """
-    returns = signature.return_type
-
-    def codegen(context, builder, sig, args):
-        fnty = context.call_conv.get_function_type(returns, signature.args)
-        fnptr = builder.inttoptr(args[0], fnty.as_pointer())
-        status, result = context.call_conv.call_function(builder, fnptr, returns, signature.args, args[1:])
-        if returns == types.void:
-            return status.is_error
-        return builder.select(status.is_error, context.get_constant(returns, math.nan), result)
-
-    return (types.boolean if returns == types.void else returns)(types.int64, *signature.args), codegen
-
-
 @intrinsic
 def _terms(typingctx, addr, t, y, p, out):
-    return _codegen(TERMS_SIG)
+    return call_codegen(TERMS_SIG)
 
 
 @intrinsic
 def _event(typingctx, addr, k, t, y, p):
-    return _codegen(EVENT_SIG)
+    return call_codegen(EVENT_SIG)
 
 
 @intrinsic
 def _potential(typingctx, addr, t, y, p):
-    return _codegen(POTENTIAL_SIG)
+    return call_codegen(POTENTIAL_SIG)
 
 
 @intrinsic
 def _vector(typingctx, addr, t, out):
-    return _codegen(VECTOR_SIG)
+    return call_codegen(VECTOR_SIG)
 
 
 @intrinsic
 def _varying(typingctx, addr, kind, T, C, fn, t, out):
-    return _codegen(VARYING_SIG)
+    return call_codegen(VARYING_SIG)
 
 
 @intrinsic
 def _system(typingctx, addr, ref, t, z, K, s):
-    return _codegen(SYSTEM_SIG)
+    return call_codegen(SYSTEM_SIG)
 
 
 @intrinsic
 def _stages(typingctx, addr, ref, first, last, t, y, h, K, z, z12, t12):
-    return _codegen(STAGES_SIG)
+    return call_codegen(STAGES_SIG)
 
 
 @intrinsic
@@ -181,7 +155,7 @@ def call_varying(addr, kind, T, C, fn, t, out):
 
 @jit_inline
 def call_system(addr, ref, t, z, K, s):
-    """The engine's right-hand side at ``addr``, compiled on its own (`rotframe.problem.engine.trajectory_tier`):
+    """The engine's right-hand side at ``addr``, compiled on its own (`rotframe.problem.dop853_split.trajectory_tier`):
     ``K[s] = f(t, z)``, the problem's data ``(prob, fns, W)`` at ``ref`` (`by_reference`); NaN in ``K[s]`` where it
     failed (a user function's failure is the right-hand side's own to flag, `call_terms`)."""
     if _system(addr, ref, t, z, K, s):
@@ -192,8 +166,8 @@ def call_system(addr, ref, t, z, K, s):
 @jit_inline
 def call_stages(addr, ref, first, last, t, y, h, K, z, z12, t12):
     """The engine's DOP853 stages at ``addr``, compiled on its own with the right-hand side in them
-    (`rotframe.problem.engine.trajectory_tier`), the problem's data at ``ref``: stages ``first .. last - 1`` of the
-    step ``(t, y, h)`` (`rotframe.numerics.dop853_loop.dop853_stages`); NaN in ``K[first]`` where they failed."""
+    (`rotframe.problem.dop853_split.trajectory_tier`), the problem's data at ``ref``: stages ``first .. last - 1`` of
+    the step ``(t, y, h)`` (`rotframe.numerics.dop853_loop.dop853_stages`); NaN in ``K[first]`` where they failed."""
     if _stages(addr, ref, first, last, t, y, h, K, z, z12, t12):
         for j in range(K.shape[1]):
             K[first, j] = math.nan

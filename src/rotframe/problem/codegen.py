@@ -140,8 +140,8 @@ class Driver:
         self.advance = engine.advance if compiled else functools.partial(engine.advance, compiled=False)
 
     def trajectory_tier(self):
-        """This driver with the engine's trajectory tier as its loop (`rotframe.problem.engine.trajectory_tier`: each
-        trajectory compiled, the loop over the particles as Python), its functions' addresses the same."""
+        """This driver with the engine's trajectory tier as its loop (`rotframe.problem.dop853_split.trajectory_tier`:
+        each trajectory compiled, the loop over the particles as Python), its functions' addresses the same."""
         from rotframe.problem import engine
 
         made = copy.copy(self)

@@ -22,7 +22,7 @@ asks the watcher (and writes the step's start for its re-steps) only where the s
 the tower drop's ensemble with the ground event (20,000 particles, 2 s at 1 ms, one thread; `python
 tools/ensembles_on_engine.py 20000 1`, 2026-11-30) the inlined loop went from 2.3 to 1.54 times the
 scenes' kernels' time under the splitting (the watcher a function of its own,
-`rotframe.problem.engine._watcher`) and from 1.33 to 1.13 under RK4; without an event, 1.33 and
+`rotframe.problem.event_watch.watcher`) and from 1.33 to 1.13 under RK4; without an event, 1.33 and
 1.12 times the scenes' event-free driver.
 """
 

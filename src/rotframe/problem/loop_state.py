@@ -72,7 +72,7 @@ def store_tuple(OUT, k, i, s):
 
 @jit_inline
 def watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V):
-    """The data of a variant's watcher, ``wctx`` (`rotframe.problem.engine._watch_events`): the events' arrays, the
+    """The data of a variant's watcher, ``wctx`` (`rotframe.problem.event_watch.watch_events`): the events' arrays, the
     run's start, the locator's stages ``Kb`` and states ``V[4:7]`` (the loops keep ``V[0:4]`` for their own). A
     variant without events passes 0 instead (``EVENTS``, a constant of its code): no tuple of twelve to build, type
     and pass on."""

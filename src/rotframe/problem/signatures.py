@@ -34,8 +34,8 @@ from __future__ import annotations
 
 from numba import types
 
-__all__ = ["POTENTIAL", "FUNCTIONS", "PROBLEM", "CONTEXT", "SYSTEM_SIG", "STAGES_SIG", "TERMS_SIG", "EVENT_SIG",
-           "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2",
+__all__ = ["POTENTIAL", "FUNCTIONS", "FUNCTIONS_AT", "PROBLEM", "CONTEXT", "SYSTEM_SIG", "STAGES_SIG", "TERMS_SIG",
+           "EVENT_SIG", "VARIANT_SIGNATURE", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2",
            "B1"]
 
 F8 = types.float64
@@ -58,6 +58,9 @@ VARYING_SIG = types.void(I8, A1, A3, I8, F8, A1)
 #: what the stepping calls, by address (`rotframe.problem.calls`): the terms, the events, omega(t), the
 #: origin's acceleration, and the engine's evaluator of a varying frame or origin (0 where none varies)
 FUNCTIONS = types.UniTuple(types.int64, 5)
+#: what the engine's DOP853 whole loop takes where the others take `FUNCTIONS`: those five addresses, then the addresses
+#: of the trajectory tier's trajectory, stages and right-hand side, which it calls (`rotframe.problem.by_address`)
+FUNCTIONS_AT = types.UniTuple(types.int64, 8)
 #: the potential, by address
 POTENTIAL = types.int64
 
@@ -73,6 +76,10 @@ CONTEXT = types.Tuple((PROBLEM, FUNCTIONS, A1))
 #: (`rotframe.numerics.dop853_loop.dop853_stages`)
 SYSTEM_SIG = types.void(I8, F8, A1, A2, I8)
 STAGES_SIG = types.void(I8, I8, I8, F8, A1, F8, A2, A1, A1, F8)
+#: the one signature of every variant of the engine's loop (`rotframe.problem.engine.variant`): compiled (or loaded
+#: from numba's cache) once, never for a problem
+VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
+                               B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
 
 #: model codes (``PROBLEM[0]``)
 PARTICLE = 0

@@ -49,7 +49,7 @@ Only runs on the CPU of at most `PLAIN_PARTICLES` particles (or one rigid body:
 first call alone would be too long as Python.
 
 **The trajectory tier.** A DOP853 run of so few particles compiles less than the whole loop
-(`rotframe.problem.engine.trajectory_tier`): the loop's trajectory from stop to stop, where every
+(`rotframe.problem.dop853_split.trajectory_tier`): the loop's trajectory from stop to stop, where every
 step is taken, and its right-hand side, each compiled on its own and cached; the loop over the
 particles and the stops stays the plain remake's Python, some 25 to 45 us a call of the
 trajectory. The whole loop compiles the trajectory a second time inside its own code, and an
@@ -104,7 +104,7 @@ TRAJECTORY_CALLS = 16
 
 def trajectory_tier_fits(method, particles, stops) -> bool:
     """Whether a first run of ``particles`` particles (at most `PLAIN_PARTICLES`) and ``stops`` knots, whose whole loop
-    is not compiled yet, compiles DOP853's trajectory tier instead (`rotframe.problem.engine.trajectory_tier`; the
+    is not compiled yet, compiles DOP853's trajectory tier instead (`rotframe.problem.dop853_split.trajectory_tier`; the
     module docstring): DOP853's, and at most `TRAJECTORY_CALLS` calls of the trajectory loop in a call."""
     return method == "dop853" and particles * (stops + 1) <= TRAJECTORY_CALLS
 

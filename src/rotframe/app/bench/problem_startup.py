@@ -9,7 +9,7 @@ running, as the goals are stated beyond imports):
   plain-Python remake (`rotframe.problem.tiers`), the problem's own functions compiled;
 - ``first problem ever, long``: the caches empty again, the same problem run 100 times as long
   (1,000 s): seen to be long after its first plain call, it compiles the engine's loop, its
-  trajectory tier (`rotframe.problem.engine.trajectory_tier`: the trajectory and the right-hand
+  trajectory tier (`rotframe.problem.dop853_split.trajectory_tier`: the trajectory and the right-hand
   side, the loop over the particle Python);
 - ``new problem``: the caches filled by that long run, the force a new function (its fingerprint
   is new, so nothing of it is cached);
@@ -152,7 +152,7 @@ def _how(setting, tier):
     if setting == "first problem ever, long":
         if "its trajectories alone" in tier:
             return (f"{LONG_S:g} s of the same problem: its first plain call, then the engine's loop compiled, its "
-                    "trajectory tier (rotframe.problem.engine.trajectory_tier)")
+                    "trajectory tier (rotframe.problem.dop853_split.trajectory_tier)")
         return (f"{LONG_S:g} s of the same problem: its first plain call, then the engine's loop compiled"
                 if "then the loop compiled" in tier else "the engine's loop compiled in the run")
     if tier:
