@@ -317,12 +317,29 @@ compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or 
 def spring(t, r, v):
     return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
 
-run = simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=float(sys.argv[1]),
-                         forces=[spring], samples=10)
+def spring_run():
+    return simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=float(sys.argv[1]),
+                              forces=[spring], samples=10)
+
+
+run = spring_run()
+from numba.core import caching  # then what a second run loads from numba's disk cache: nothing
+reloaded, load_overload = [], caching.Cache.load_overload
+
+
+def counted(self, *args):
+    found = load_overload(self, *args)
+    if found is not None:
+        reloaded.append(found.fndesc.qualname)
+    return found
+
+
+caching.Cache.load_overload = counted
+spring_run()
 print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
                   "compiled": engine.variant(0, "dop853", False, load_only=True) is not None,
                   "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None,
-                  "apart": made}))
+                  "apart": made, "reloaded": reloaded}))
 """
 
 
@@ -351,6 +368,8 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["trajectory"] and not again["compiled"] and again["apart"] == []
     assert again["r"] == short["r"]
+    # a run in the tier asks whether the whole loop is made: the tier's kernels, once made, are not loaded again
+    assert long["reloaded"] == again["reloaded"] == [], (long["reloaded"], again["reloaded"])
 
 
 def _blows_up(t, r, v):
@@ -429,3 +448,4 @@ def test_many_trajectory_calls_a_call_compile_the_whole_loop(monkeypatch):
         assert any("its trajectories alone" in n for n in stepped.notes), stepped.notes
     _same(switched, compiled)
     assert not tiers.trajectory_tier_fits("rk4", 1, 0)
+

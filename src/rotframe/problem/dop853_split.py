@@ -22,6 +22,8 @@ same code runs in each form, so the numbers agree to the bit (``tests/test_tiers
 
 from __future__ import annotations
 
+import functools
+
 from numba import njit, types
 
 from rotframe.numerics.compiled import ENTRY_OPTIONS, bound
@@ -37,6 +39,7 @@ __all__ = ["trajectory_tier", "whole_loop", "WholeLoop", "compile_tier_trajector
 
 #: the compiled parts: entry points without reference counts (`rotframe.numerics.compiled.ENTRY_OPTIONS`)
 _uncounted_entry = njit(**ENTRY_OPTIONS)
+
 
 def _python_call(kernel):
     """The compiled entry point ``kernel`` behind a Python function, which `rotframe.numerics.plain` keeps as it is."""
@@ -62,8 +65,8 @@ def trajectory_tier(model, method, events, D, load_only=False):
 
     Where none is cached, the trajectory compiles in a second process while this one compiles the
     callees (`rotframe.numerics.compile_apart`). Measured on the 2-core reference machine (a first long
-    run, 2026-12-01): 2.1 to 2.7 s, where the whole loop took 7.3 s (it compiles the trajectory again
-    inside its own code, and an entry point that unboxes thirty arguments) and the tier with its stages
+    run, 2026-12-01): 2.1 to 2.7 s, where the whole loop as one piece took 7.3 s (it compiled the trajectory
+    again inside its own code, and an entry point that unboxes thirty arguments) and the tier with its stages
     inside the trajectory, in one process, 3.4 s. ``load_only``: None where anything would have to
     compile. `rotframe.problem.tiers` runs a first run of a few particles on it. ``method`` is DOP853's
     (the fixed-step loops have no such tier).
@@ -89,15 +92,21 @@ def trajectory_tier(model, method, events, D, load_only=False):
                        SYSTEM=_python_call(system_call), TRAJECTORY=trajectory_call, DIM=int(D), EVENTS=bool(events)))
 
 
+@functools.cache
 def _tier_kernels(body, events, D):
     """The trajectory tier's kernels, each with its signature: the trajectory loop (`dop853_parts`, an entry point
-    of `TRAJECTORY_SIGNATURES`), then its callees (`rotframe.problem.by_address.tier_callees`)."""
+    of `TRAJECTORY_SIGNATURES`), then its callees (`rotframe.problem.by_address.tier_callees`). Made once a process
+    (`_made` loads each once, the whole loop shares them)."""
     return ((dop853_parts(body, events, D, entry=True), TRAJECTORY_SIGNATURES[bool(events)]),) + tier_callees(body, D)
 
 
 def _made(kernels, load_only=False, apart=()) -> bool:
     """Load ``kernels`` (``[(dispatcher, signature), ...]``) from numba's cache, compiling those that are not there;
     False, compiling nothing, where ``load_only`` and one is not.
+
+    A kernel made in this process is not loaded again: a run in the trajectory tier asks whether the whole
+    loop is made (`rotframe.problem.tiers.loop_is_compiled`), which would otherwise load the tier's kernels
+    from the disk again each time (some 10 ms a run).
 
     ``apart`` names, for some of them by index, the call that compiles it in another process
     (``{index: (function of this module, its arguments)}``). Where more than one is to compile, those compile in
@@ -109,7 +118,9 @@ def _made(kernels, load_only=False, apart=()) -> bool:
     from rotframe.numerics.compile_apart import CompiledApart
     from rotframe.numerics.compiled import load_cached
 
-    todo = [k for k, (kernel, sig) in enumerate(kernels) if not load_cached(kernel, sig)]  # the key numba saved under
+    todo = [k for k, (kernel, sig) in enumerate(kernels)
+            if tuple(getattr(sig, "args", sig)) not in kernel.overloads  # made in this process already
+            and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
     if todo and load_only:
         return False
     away = [k for k in todo if k in apart] if len(todo) > 1 else []
@@ -137,9 +148,9 @@ def compile_tier_trajectory(model, events, D):
 
 
 def whole_loop(model, method, events, D, load_only=False):
-    """The compiled DOP853 loop of ``model`` and ``events`` (`variant`): `dop853_advance` compiled with the trajectory
-    tier's trajectory and right-hand side called at their addresses (`rotframe.problem.by_address.trajectory_at`,
-    `rotframe.problem.by_address.system_by_address`), a `WholeLoop`.
+    """The compiled DOP853 loop of ``model`` and ``events`` (`rotframe.problem.engine.variant`): `dop853_advance`
+    compiled with the trajectory tier's trajectory and right-hand side called at their addresses
+    (`rotframe.problem.by_address.trajectory_at`, `rotframe.problem.by_address.system_by_address`), a `WholeLoop`.
 
     numba links each callee into its caller's code and optimises it again there: the loop with its trajectory in it
     compiled the trajectory twice, and on one core (`tumbling-ball`'s first run: 7.1 s of compile, of which the
@@ -160,6 +171,7 @@ def whole_loop(model, method, events, D, load_only=False):
                      kernels)
 
 
+@functools.cache
 def _whole_loop_kernel(body, events, D):
     """The compiled loop of `whole_loop`: `dop853_advance` with the tier's trajectory and right-hand side at their
     addresses."""
