@@ -128,17 +128,19 @@ class Listener(event.Listener):
 event.register("numba:compile", Listener())
 from rotframe.particles import dop853_steady
 from rotframe.problem import engine
-from rotframe.problem.signatures import PARTICLE
+from rotframe.problem.signatures import BODY, PARTICLE
 
 dop853_steady.run_dop853_steady._make()
 engine.variant(PARTICLE, "dop853", False)
+engine.variant(BODY, "lie-poisson6", False)
 print(json.dumps({"apart": made, "compiled": compiled}))
 """
 
 
 def test_kernels_compiled_apart_load_from_the_cache_in_the_next_process(tmp_path):
-    """The steady loop (`rotframe.particles.dop853_steady.SteadyDriver`) and the engine's whole DOP853 loop
-    (`rotframe.problem.dop853_split.whole_loop`) compile apart in a fresh install, and the next process loads every
+    """The steady loop (`rotframe.particles.dop853_steady.SteadyDriver`), the engine's whole DOP853 loop
+    (`rotframe.problem.dop853_split.whole_loop`) and a body's splitting of order 6
+    (`rotframe.problem.body_split_step`) compile apart in a fresh install, and the next process loads every
     one of their kernels from numba's cache: no compile, no second process (numba keys its cache on the signature as it was
     compiled, `rotframe.numerics.compiled.load_cached`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
@@ -152,8 +154,10 @@ def test_kernels_compiled_apart_load_from_the_cache_in_the_next_process(tmp_path
     first = child()
     assert "_run_at" in first["compiled"] and "dop853_stages_by_reference_particle6" in first["compiled"], first
     if len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux"):
-        # the steady trajectory; then the engine's trajectory and its whole loop, beside its stages compiled here
-        assert first["apart"] == ["fork"] * 3, first
+        # the steady trajectory; the engine's trajectory and its whole loop, beside its stages compiled here; the
+        # body's step, beside its loop
+        assert first["apart"] == ["fork"] * 4, first
+        assert "advance_body7_splitting6_step_at" in first["compiled"], first
     else:
-        assert "advance_particle6_dop853_at" in first["compiled"], first
+        assert {"advance_particle6_dop853_at", "body_step_splitting6"} <= set(first["compiled"]), first
     assert child() == {"apart": [], "compiled": []}

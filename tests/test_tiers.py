@@ -202,6 +202,11 @@ BODIES = {
     "a torque of the attitude, lie-poisson4": dict(method="lie-poisson4", torque=Torque(_gravity_torque,
                                                                                        attitude_only=True),
                                                    params=(0.3,), step=0.01),
+    # the compositions of orders 6 and 8 call their step at its address (rotframe.problem.body_split_step)
+    "a torque of the attitude, lie-poisson8": dict(method="lie-poisson8", torque=Torque(_gravity_torque,
+                                                                                       attitude_only=True),
+                                                   params=(0.3,), step=0.02, duration=3.0),
+    "a symmetric body, lie-poisson6": dict(method="lie-poisson6", inertia=[2.0, 2.0, 3.0], step=0.02, duration=3.0),
 }
 
 

@@ -24,7 +24,8 @@ from rotframe.problem.models import DOP853
 from rotframe.problem.signatures import A1, A2, CONTEXT, F8, I8, STAGES_SIG, SYSTEM_SIG
 from rotframe.problem.steps import body_system, particle_system, stepper
 
-__all__ = ["stages_at", "system_at", "with_reference", "tier_callees", "trajectory_at", "system_by_address"]
+__all__ = ["stages_at", "system_at", "with_reference", "tier_callees", "trajectory_at", "system_by_address",
+           "problem_functions"]
 
 _uncounted_entry = njit(**ENTRY_OPTIONS)
 
@@ -85,16 +86,16 @@ def tier_callees(body, D):
 
 
 @jit_inline
-def _problem_functions(fns):
-    """The problem's five addresses (`rotframe.problem.signatures.FUNCTIONS`) of the whole loop's eight
-    (`rotframe.problem.signatures.FUNCTIONS_AT`)."""
+def problem_functions(fns):
+    """The problem's five addresses (`rotframe.problem.signatures.FUNCTIONS`) of a loop's with its parts' after
+    them (`rotframe.problem.in_parts`; the DOP853 whole loop's eight, `rotframe.problem.signatures.FUNCTIONS_AT`)."""
     return fns[0], fns[1], fns[2], fns[3], fns[4]
 
 
 def _trajectory_at(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
     """The template of `trajectory_at`."""
     fns = ctx[1]
-    return CALL(fns[5], (ctx[0], _problem_functions(fns), ctx[2], fns[6], fns[7]), t, y, h, t_end, h_max, times,
+    return CALL(fns[5], (ctx[0], problem_functions(fns), ctx[2], fns[6], fns[7]), t, y, h, t_end, h_max, times,
                 k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget)
 
 
@@ -110,4 +111,4 @@ def trajectory_at(kind, signature):
 def system_by_address(ctx, t, z, K, s):
     """The DOP853 whole loop's right-hand side (each particle's first f and Hairer's starting step): the trajectory
     tier's at its address (``ctx[1][7]``, `trajectory_at`), the problem's data by reference."""
-    call_system(ctx[1][7], by_reference((ctx[0], _problem_functions(ctx[1]), ctx[2])), t, z, K, s)
+    call_system(ctx[1][7], by_reference((ctx[0], problem_functions(ctx[1]), ctx[2])), t, z, K, s)

@@ -15,8 +15,9 @@ which call one another at their addresses (`rotframe.problem.by_address`, `rotfr
   (`WHOLE_LOOP_SIGNATURE`), calling the trajectory at its address.
 
 Where more than one part is to compile, the others compile in second processes while this one
-compiles its share (`_made`, `rotframe.numerics.compile_apart`), then load from numba's cache. The
-same code runs in each form, so the numbers agree to the bit (``tests/test_tiers.py``).
+compiles its share (`rotframe.problem.in_parts.made`, `rotframe.numerics.compile_apart`), then load
+from numba's cache. The same code runs in each form, so the numbers agree to the bit
+(``tests/test_tiers.py``).
 `rotframe.problem.engine.variant` hands out both forms.
 """
 
@@ -31,10 +32,11 @@ from rotframe.numerics.dop853_loop import TRAJECTORY_RETURNS
 from rotframe.problem.by_address import system_by_address, tier_callees, trajectory_at
 from rotframe.problem.calls import address
 from rotframe.problem.dop853_variant import dop853_advance, dop853_parts
+from rotframe.problem.in_parts import LoopWithParts, made
 from rotframe.problem.signatures import (A1, A2, A3, B1, F8, FUNCTIONS, FUNCTIONS_AT, I1, I2, I8, PARTICLE,
                                          PROBLEM, STAGES_SIG, SYSTEM_SIG, VARIANT_SIGNATURE)
 
-__all__ = ["trajectory_tier", "whole_loop", "WholeLoop", "compile_tier_trajectory", "compile_whole_loop",
+__all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop",
            "TRAJECTORY_ARGS", "TRAJECTORY_SIGNATURES", "WHOLE_LOOP_SIGNATURE"]
 
 #: the compiled parts: entry points without reference counts (`rotframe.numerics.compiled.ENTRY_OPTIONS`)
@@ -77,7 +79,7 @@ def trajectory_tier(model, method, events, D, load_only=False):
         raise ValueError(f"the trajectory tier is DOP853's, not {method}'s")
     body = None if model == PARTICLE else True
     kernels = _tier_kernels(body, events, D)
-    if not _made(kernels, load_only, {0: ("compile_tier_trajectory", (model, int(bool(events)), D))}):
+    if not made(kernels, __name__, load_only, {0: ("compile_tier_trajectory", (model, int(bool(events)), D))}):
         return None
     (trajectory, _), (stages, _), (system, _), (system_call, _) = kernels
     at = (address(stages, STAGES_SIG), address(system, SYSTEM_SIG))
@@ -96,46 +98,8 @@ def trajectory_tier(model, method, events, D, load_only=False):
 def _tier_kernels(body, events, D):
     """The trajectory tier's kernels, each with its signature: the trajectory loop (`dop853_parts`, an entry point
     of `TRAJECTORY_SIGNATURES`), then its callees (`rotframe.problem.by_address.tier_callees`). Made once a process
-    (`_made` loads each once, the whole loop shares them)."""
+    (`rotframe.problem.in_parts.made` loads each once, the whole loop shares them)."""
     return ((dop853_parts(body, events, D, entry=True), TRAJECTORY_SIGNATURES[bool(events)]),) + tier_callees(body, D)
-
-
-def _made(kernels, load_only=False, apart=()) -> bool:
-    """Load ``kernels`` (``[(dispatcher, signature), ...]``) from numba's cache, compiling those that are not there;
-    False, compiling nothing, where ``load_only`` and one is not.
-
-    A kernel made in this process is not loaded again: a run in the trajectory tier asks whether the whole
-    loop is made (`rotframe.problem.tiers.loop_is_compiled`), which would otherwise load the tier's kernels
-    from the disk again each time (some 10 ms a run).
-
-    ``apart`` names, for some of them by index, the call that compiles it in another process
-    (``{index: (function of this module, its arguments)}``). Where more than one is to compile, those compile in
-    processes of their own while this one compiles the rest (`rotframe.numerics.compile_apart`), then load them from
-    the cache. Each kernel is then closed to new compiles.
-    """
-    from contextlib import ExitStack
-
-    from rotframe.numerics.compile_apart import CompiledApart
-    from rotframe.numerics.compiled import load_cached
-
-    todo = [k for k, (kernel, sig) in enumerate(kernels)
-            if tuple(getattr(sig, "args", sig)) not in kernel.overloads  # made in this process already
-            and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
-    if todo and load_only:
-        return False
-    away = [k for k in todo if k in apart] if len(todo) > 1 else []
-    if away and len(away) == len(todo):
-        away.pop()  # one compiles here
-    with ExitStack() as stack:
-        children = {k: stack.enter_context(CompiledApart(__name__, apart[k][0], *apart[k][1])) for k in away}
-        for k in todo:
-            if k not in children:
-                kernels[k][0].compile(kernels[k][1])
-        for k, child in children.items():
-            child.load(*kernels[k])
-    for kernel, _ in kernels:
-        kernel.disable_compile()
-    return True
 
 
 def compile_tier_trajectory(model, events, D):
@@ -150,25 +114,27 @@ def compile_tier_trajectory(model, events, D):
 def whole_loop(model, method, events, D, load_only=False):
     """The compiled DOP853 loop of ``model`` and ``events`` (`rotframe.problem.engine.variant`): `dop853_advance`
     compiled with the trajectory tier's trajectory and right-hand side called at their addresses
-    (`rotframe.problem.by_address.trajectory_at`, `rotframe.problem.by_address.system_by_address`), a `WholeLoop`.
+    (`rotframe.problem.by_address.trajectory_at`, `rotframe.problem.by_address.system_by_address`), a
+    `rotframe.problem.in_parts.LoopWithParts`.
 
     numba links each callee into its caller's code and optimises it again there: the loop with its trajectory in it
     compiled the trajectory twice, and on one core (`tumbling-ball`'s first run: 7.1 s of compile, of which the
     trajectory 2.9). This one shares the trajectory tier's kernels (`trajectory_tier`; loaded where a first run
     compiled them) and adds its own small loop over the particles and stops, which compiles beside the trajectory on a
-    first run (`_made`). A step costs one call at an address more than with the stages in the trajectory (some 1 to 3
-    % of a spring's step, `rotframe.problem.by_address`). ``load_only``: None where anything would have to compile.
+    first run (`rotframe.problem.in_parts.made`). A step costs one call at an address more than with the stages in
+    the trajectory (some 1 to 3 % of a spring's step, `rotframe.problem.by_address`). ``load_only``: None where
+    anything would have to compile.
     """
     if method != "dop853":
         raise ValueError(f"the whole loop by address is DOP853's, not {method}'s")
     body = None if model == PARTICLE else True
     kernels = _tier_kernels(body, events, D)[:3] + ((_whole_loop_kernel(body, events, D), WHOLE_LOOP_SIGNATURE),)
     args = (model, int(bool(events)), D)
-    if not _made(kernels, load_only, {0: ("compile_tier_trajectory", args), 3: ("compile_whole_loop", args)}):
+    if not made(kernels, __name__, load_only, {0: ("compile_tier_trajectory", args), 3: ("compile_whole_loop", args)}):
         return None
     (trajectory, signature), (stages, _), (system, _), (loop, _) = kernels
-    return WholeLoop(loop, (address(trajectory, signature), address(stages, STAGES_SIG), address(system, SYSTEM_SIG)),
-                     kernels)
+    return LoopWithParts(loop, (address(trajectory, signature), address(stages, STAGES_SIG),
+                                address(system, SYSTEM_SIG)), kernels)
 
 
 @functools.cache
@@ -186,26 +152,6 @@ def compile_whole_loop(model, events, D):
     cache: a process of a first compile (`rotframe.numerics.compile_apart`)."""
     _whole_loop_kernel(None if int(model) == PARTICLE else True, bool(int(events)), int(D)).compile(
         WHOLE_LOOP_SIGNATURE)
-
-
-class WholeLoop:
-    """`whole_loop`'s kernel behind the variants' call (`advance`): ``loop(lo, hi, T, ..., prob, fns, K, Kb, V, F,
-    W)``, which hands the compiled loop ``fns`` with the addresses of the tier's trajectory, stages and right-hand
-    side after the problem's (`rotframe.problem.signatures.FUNCTIONS_AT`). The compiled loop's attributes
-    (``signatures``, ``stats``) are its own."""
-
-    def __init__(self, loop, at, kernels):
-        self.loop = loop
-        self.at = tuple(int(a) for a in at)
-        self.kernels = kernels  # the addresses live as long as the compiled functions
-
-    def __getattr__(self, name):
-        return getattr(self.__dict__["loop"], name)
-
-    def __call__(self, lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
-                 atol, hfix, EDIR, ETERM, S, prob, fns, K, Kb, V, F, W):
-        return self.loop(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, GPREV, NSTEP, NFEV, budget, rtol,
-                         atol, hfix, EDIR, ETERM, S, prob, tuple(fns) + self.at, K, Kb, V, F, W)
 
 
 #: the trajectory tier's trajectory loop's arguments (`trajectory_tier`), without and with events (``ctx = (prob,

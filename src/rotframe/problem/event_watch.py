@@ -148,7 +148,7 @@ def watch_events(wctx, ctx, p, t, h, t_new, y, y_new, K):
     return stop, tau_stop
 
 
-def watcher(kind, step, body, method, system, cold=False):
+def watcher(kind, step, body, method, system, cold=False, take=None):
     """The events' watcher of a variant (`watch_events`) with its trial, locator and start rule, bound to them.
 
     ``kind`` names the variant's copies; ``step`` (the variant's `rotframe.problem.steps.stepper`), ``body`` and the
@@ -157,10 +157,11 @@ def watcher(kind, step, body, method, system, cold=False):
     Inlined into the DOP853 loop; ``cold``, a function of its own that the fixed-step loop calls only
     where a step may cross (`rotframe.problem.fixed_step.quiet_step`): inlined, its locator's
     re-steps took the registers of the loop's state (the tower drop's ensemble with the ground
-    event, 1.65 to 1.52 times the scenes' kernels' time, 2026-11-30).
+    event, 1.65 to 1.52 times the scenes' kernels' time, 2026-11-30). ``take``: the trial's step where it is
+    not the method's (`rotframe.problem.fixed_step.fixed_step_loop`).
     """
     trial = jit_inline(bound(event_trial, f"event_trial_{kind}", STEPPER=step, BODY_FLAG=body,
-                             TAKE=take_step(method)))
+                             TAKE=take or take_step(method)))
     sign = jit_inline(bound(start_sign, f"start_sign_{kind}", TRIAL=trial))
     made = bound(watch_events, f"watch_{kind}", SYSTEM=system, TRIAL=trial, LOCATE=locator(kind, trial),
                  START_SIGN=sign)

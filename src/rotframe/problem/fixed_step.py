@@ -43,18 +43,28 @@ from rotframe.problem.stops import next_stop
 __all__ = ["fixed_step_loop"]
 
 # the names a loop binds (`fixed_step_loop`): None, 0 or False in the template itself, which is never compiled
-STEPPER = BODY_FLAG = WATCH = None
+STEPPER = BODY_FLAG = WATCH = ENTER = None
 METHOD = DIM = 0
 EVENTS = CARRIED = False
 
 
-def fixed_step_loop(name, body, method, D, step, watch):
+@jit_inline
+def same_context(ctx):
+    """The loop's context as it is: ``(prob, fns, W)`` (`fixed_step_loop`'s ``enter``)."""
+    return ctx
+
+
+def fixed_step_loop(name, body, method, D, step, watch, take=None, enter=None):
     """The loop of a fixed-step variant, as Python: the template `_fixed_step_advance` with the variant's constants
     as its globals (`rotframe.numerics.compiled.bound`): ``body`` (None: a particle), the ``method``'s code, the
     length of the state ``D``, the method's ``step`` (`rotframe.problem.steps.stepper`) and the events' ``watch``
-    (None: no events, none of the watching compiled). A particle of six numbers carries its state (``CARRIED``)."""
-    return bound(_fixed_step_advance, name, STEPPER=step, TAKE=take_step(method), BODY_FLAG=body, METHOD=method,
-                 EVENTS=watch is not None, WATCH=watch, DIM=int(D), CARRIED=body is None and D == 6)
+    (None: no events, none of the watching compiled). A particle of six numbers carries its state (``CARRIED``).
+    ``take`` takes a step (default the method's, `rotframe.problem.steps.take_step`) and ``enter`` makes the context
+    it takes, once a call, from ``(prob, fns, W)`` (default `same_context`): a body's splitting at its address takes
+    the problem's data by reference too (`rotframe.problem.body_split_step`)."""
+    return bound(_fixed_step_advance, name, STEPPER=step, TAKE=take or take_step(method), ENTER=enter or same_context,
+                 BODY_FLAG=body, METHOD=method, EVENTS=watch is not None, WATCH=watch, DIM=int(D),
+                 CARRIED=body is None and D == 6)
 
 
 @jit_inline
@@ -83,7 +93,7 @@ def _fixed_step_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, E
     n = T.shape[0]
     D = DIM
     y, yt, yn, yev = V[0], V[1], V[2], V[3]
-    ctx = (prob, fns, W)
+    ctx = ENTER((prob, fns, W))
     stage = (prob, fns, W, yt, K[1])  # a carried RK4 step's (`rotframe.problem.steps.carried_rk4`)
     wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
     for i in range(lo, hi):

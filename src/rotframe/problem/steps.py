@@ -37,8 +37,7 @@ def particle_system(ctx, t, z, K, s):
 @jit_inline
 def body_system(ctx, t, z, K, s):
     """A rigid body's right-hand side as the one DOP853 loop calls it (`particle_system`)."""
-    prob, fns, W = ctx
-    rhs(True, t, z, K[s], prob, fns, W)
+    rhs(True, t, z, K[s], ctx[0], ctx[1], ctx[2])
 
 
 @jit_llvm_inline  # compiled once: numba's inlining put it, and the right-hand side's call, in the step three times
