@@ -35,7 +35,7 @@ import sys
 import threading
 import time
 
-__all__ = ["CompiledApart", "spare_core", "TIMEOUT_S"]
+__all__ = ["CompiledApart", "made", "spare_core", "TIMEOUT_S"]
 
 #: seconds the second process may take, from its start, before this one compiles the kernel itself
 TIMEOUT_S = 120.0
@@ -179,3 +179,41 @@ def _run(module, function, *args):
     import importlib
 
     getattr(importlib.import_module(module), function)(*args)
+
+
+def made(kernels, module, load_only=False, apart=()) -> bool:
+    """Load ``kernels`` (``[(dispatcher, signature), ...]``) from numba's cache, compiling those that are not there;
+    False, compiling nothing, where ``load_only`` and one is not.
+
+    A kernel made in this process is not loaded again: a run in the engine's trajectory tier asks whether the
+    whole loop is made (`rotframe.problem.tiers.loop_is_compiled`), which would otherwise load the tier's kernels
+    from the disk again each time (some 10 ms a run); the kernels are made once a process for that
+    (``functools.cache`` where they are built, `rotframe.problem.dop853_split`).
+
+    ``apart`` names, for some of them by index, the function of ``module`` that compiles it in another process
+    (``{index: (name, its arguments)}``). Where more than one is to compile, those compile in processes of their
+    own while this one compiles the rest (`rotframe.numerics.compile_apart`), then load them from the cache. Each
+    kernel is then closed to new compiles.
+    """
+    from contextlib import ExitStack
+
+    from rotframe.numerics.compiled import load_cached
+
+    todo = [k for k, (kernel, sig) in enumerate(kernels)
+            if tuple(getattr(sig, "args", sig)) not in kernel.overloads  # made in this process already
+            and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
+    if todo and load_only:
+        return False
+    away = [k for k in todo if k in apart] if len(todo) > 1 else []
+    if away and len(away) == len(todo):
+        away.pop()  # one compiles here
+    with ExitStack() as stack:
+        children = {k: stack.enter_context(CompiledApart(module, apart[k][0], *apart[k][1])) for k in away}
+        for k in todo:
+            if k not in children:
+                kernels[k][0].compile(kernels[k][1])
+        for k, child in children.items():
+            child.load(*kernels[k])
+    for kernel, _ in kernels:
+        kernel.disable_compile()
+    return True

@@ -32,8 +32,7 @@ import numpy as np
 from numba import njit, types
 
 from rotframe.numerics.at_address import address, caller
-from rotframe.numerics.compiled import (ENTRY_OPTIONS, bound, jit_inline, jit_internal, jit_kernel, jit_llvm_inline,
-                                        load_cached)
+from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, jit_inline, jit_internal, jit_kernel, jit_llvm_inline
 from rotframe.numerics.dop853_loop import TRAJECTORY_RETURNS, dop853_stages, dop853_trajectory
 from rotframe.particles.accelerations import centrifugal, coriolis, string_tension
 from rotframe.particles.dop853_ensemble import run_particles, store_sample
@@ -169,20 +168,12 @@ class SteadyDriver:
         return _run_at.signatures
 
     def _make(self):
-        from rotframe.numerics.compile_apart import CompiledApart
+        from rotframe.numerics.compile_apart import made
 
         with self._lock:
-            if self._made is None:
-                kernels = ((_steady_trajectory, TRAJECTORY_SIG), (_run_at, DRIVER_SIG))
-                cached = [load_cached(kernel, sig) for kernel, sig in kernels]  # numba's cache key: the signature compiled
-                if not any(cached):  # the driver here, the trajectory in a second process
-                    with CompiledApart(__name__, "compile_steady_trajectory") as apart:
-                        _run_at.compile(DRIVER_SIG)
-                    apart.load(_steady_trajectory, TRAJECTORY_SIG)
-                for kernel, sig in kernels:
-                    if not kernel.signatures:
-                        kernel.compile(sig)
-                    kernel.disable_compile()
+            if self._made is None:  # the driver here, the trajectory in a second process where both compile
+                made(((_steady_trajectory, TRAJECTORY_SIG), (_run_at, DRIVER_SIG)), __name__,
+                     apart={0: ("compile_steady_trajectory", ())})
                 self._made = address(_steady_trajectory, TRAJECTORY_SIG)
         return self._made
 

@@ -7,7 +7,7 @@ rigid scenes' free step in it). numba links it into the loop and optimises it th
 step is an entry point of its own for the method (`STEP_SIG`), cached, and the compiled loop calls it
 at its address (`rotframe.numerics.at_address`), the address after the problem's five
 (`FUNCTIONS_STEP`): on a first run the step compiles in a second process while this one compiles
-the loop (`rotframe.problem.in_parts.made`). A step costs one call more, the problem's data handed
+the loop (`rotframe.numerics.compile_apart.made`). A step costs one call more, the problem's data handed
 by reference (`_with_reference`): nothing measurable against a step of Kahan & Li's compositions
 (9 and 17 splitting steps), which alone take this route (`rotframe.problem.engine.STEP_APART`);
 the splitting of order 2 on a symmetric body, a step of some 90 ns, took 1.07 to 1.13 of its time
@@ -23,12 +23,13 @@ import functools
 from numba import njit, types
 
 from rotframe.numerics.at_address import address, caller
+from rotframe.numerics.compile_apart import made
 from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, jit_inline
 from rotframe.problem.by_address import problem_functions
 from rotframe.problem.calls import by_reference, dereference
 from rotframe.problem.event_watch import watcher
 from rotframe.problem.fixed_step import fixed_step_loop
-from rotframe.problem.in_parts import LoopWithParts, made
+from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.models import body_split
 from rotframe.problem.signatures import A1, F8, FUNCTIONS, I8, VARIANT_SIGNATURE
 from rotframe.problem.steps import body_system

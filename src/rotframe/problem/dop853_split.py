@@ -15,7 +15,7 @@ which call one another at their addresses (`rotframe.problem.by_address`, `rotfr
   (`WHOLE_LOOP_SIGNATURE`), calling the trajectory at its address.
 
 Where more than one part is to compile, the others compile in second processes while this one
-compiles its share (`rotframe.problem.in_parts.made`, `rotframe.numerics.compile_apart`), then load
+compiles its share (`rotframe.numerics.compile_apart.made`, `rotframe.numerics.compile_apart`), then load
 from numba's cache. The same code runs in each form, so the numbers agree to the bit
 (``tests/test_tiers.py``).
 `rotframe.problem.engine.variant` hands out both forms.
@@ -27,12 +27,13 @@ import functools
 
 from numba import njit, types
 
+from rotframe.numerics.compile_apart import made
 from rotframe.numerics.compiled import ENTRY_OPTIONS, bound
 from rotframe.numerics.dop853_loop import TRAJECTORY_RETURNS
 from rotframe.problem.by_address import system_by_address, tier_callees, trajectory_at
 from rotframe.problem.calls import address
 from rotframe.problem.dop853_variant import dop853_advance, dop853_parts
-from rotframe.problem.in_parts import LoopWithParts, made
+from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.signatures import (A1, A2, A3, B1, F8, FUNCTIONS, FUNCTIONS_AT, I1, I2, I8, PARTICLE,
                                          PROBLEM, STAGES_SIG, SYSTEM_SIG, VARIANT_SIGNATURE)
 
@@ -98,7 +99,7 @@ def trajectory_tier(model, method, events, D, load_only=False):
 def _tier_kernels(body, events, D):
     """The trajectory tier's kernels, each with its signature: the trajectory loop (`dop853_parts`, an entry point
     of `TRAJECTORY_SIGNATURES`), then its callees (`rotframe.problem.by_address.tier_callees`). Made once a process
-    (`rotframe.problem.in_parts.made` loads each once, the whole loop shares them)."""
+    (`rotframe.numerics.compile_apart.made` loads each once, the whole loop shares them)."""
     return ((dop853_parts(body, events, D, entry=True), TRAJECTORY_SIGNATURES[bool(events)]),) + tier_callees(body, D)
 
 
@@ -121,7 +122,7 @@ def whole_loop(model, method, events, D, load_only=False):
     compiled the trajectory twice, and on one core (`tumbling-ball`'s first run: 7.1 s of compile, of which the
     trajectory 2.9). This one shares the trajectory tier's kernels (`trajectory_tier`; loaded where a first run
     compiled them) and adds its own small loop over the particles and stops, which compiles beside the trajectory on a
-    first run (`rotframe.problem.in_parts.made`). A step costs one call at an address more than with the stages in
+    first run (`rotframe.numerics.compile_apart.made`). A step costs one call at an address more than with the stages in
     the trajectory (some 1 to 3 % of a spring's step, `rotframe.problem.by_address`). ``load_only``: None where
     anything would have to compile.
     """
