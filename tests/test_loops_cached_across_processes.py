@@ -33,6 +33,8 @@ class Listener(event.Listener):
 
 case = sys.argv[1]
 import rotframe
+import rotframe.numerics.compile_apart
+rotframe.numerics.compile_apart.spare_core = lambda: False  # every compile in this process, where it is seen
 event.register("numba:compile", Listener())
 if case == "rigid":  # the rigid body's DOP853 loop, an entry point called from Python
     from rotframe.rigid.adaptive import rigid_dop853
