@@ -141,8 +141,8 @@ def test_kernels_compiled_apart_load_from_the_cache_in_the_next_process(tmp_path
     """The steady loop (`rotframe.particles.dop853_steady.SteadyDriver`), the engine's whole DOP853 loop
     (`rotframe.problem.dop853_split.whole_loop`) and a body's splitting of order 6
     (`rotframe.problem.body_split_step`) compile apart in a fresh install, and the next process loads every
-    one of their kernels from numba's cache: no compile, no second process (numba keys its cache on the signature as it was
-    compiled, `rotframe.numerics.compiled.load_cached`)."""
+    one of their kernels from numba's cache: no compile, no second process (numba keys its cache on the signature
+    as it was compiled, `rotframe.numerics.compiled.load_cached`)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
 
     def child():

@@ -144,7 +144,8 @@ def test_a_variant_compiles_only_its_own_model_method_and_events(tmp_path):
                            "lie_poisson_strang",
                            "sphere_strang", "varying_into", "varying_vector", "hermite"}, particle
     # then a body: its own variant and right-hand side, no particle's
-    assert {"advance_body7_dop853_at", "body_rhs", "dop853_stages_engine_body7"} <= body and "particle_rhs" not in body, body
+    assert {"advance_body7_dop853_at", "body_rhs", "dop853_stages_engine_body7"} <= body, body
+    assert "particle_rhs" not in body, body
 
 
 _FIRST_PROBLEM = """

@@ -53,8 +53,8 @@ REACHED, STOPPED, COLLAPSED, NONFINITE, PAUSED, WATCH_FAILED, ABORTED, DIVERGED 
 #: the step budget of a call that runs to its end (a caller that bounds its calls by their samples)
 UNLIMITED = 1 << 62
 
-#: what `dop853_trajectory`'s loop returns, ``(t, h, k_out, status, nfev, steps)``: the return type of its signature where
-#: it is an entry point called at its address (`rotframe.numerics.at_address`)
+#: what `dop853_trajectory`'s loop returns, ``(t, h, k_out, status, nfev, steps)``: the return type of its signature
+#: where it is an entry point called at its address (`rotframe.numerics.at_address`)
 TRAJECTORY_RETURNS = types.Tuple((types.float64, types.float64, types.int64, types.int64, types.int64, types.int64))
 
 #: a loop called from Python: an entry point without reference counts (its caller owns every array)

@@ -49,7 +49,8 @@ def raised(ctx):
 def dop853_parts(body, events, D, entry=False):
     """The DOP853 variant's trajectory loop: `rotframe.numerics.dop853_loop`'s trajectory compiled for the model's
     right-hand side (`particle_system`, `body_system`, ``ctx = (prob, fns, W)``), the events watched by
-    `rotframe.problem.event_watch.watch_events`, a user function that raised ending the trajectory at the step (`raised`).
+    `rotframe.problem.event_watch.watch_events`, a user function that raised ending the trajectory at the step
+    (`raised`).
     ``entry``: the trajectory of the loop compiled in parts (`rotframe.problem.dop853_split`), callable from Python
     and at its address, which calls the stages and the right-hand side at their addresses
     (`rotframe.problem.by_address`), cached apart."""

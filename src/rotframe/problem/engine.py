@@ -96,11 +96,11 @@ def variant_loop(model, method, events, D=None):
     compiles no body, no splitting and no event locator. Each variant is cached on disk apart (its
     name, and its constants in numba's cache key).
 
-    DOP853 runs the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`, `rotframe.problem.dop853_variant.dop853_loop`)
-    for the model's right-hand side, from stop to stop. The fixed-step methods run
-    `rotframe.problem.fixed_step`'s loop, which the GPU compiles too (`rotframe.problem.gpu`). ``D`` (default
-    `STATE_LENGTH`) is the length of the state (a particle's is 10 where a force acts in inertial
-    axes), a constant of the steps' code too (`stepper`).
+    DOP853 runs the one DOP853 loop of rotframe (`rotframe.numerics.dop853_loop`,
+    `rotframe.problem.dop853_variant.dop853_loop`) for the model's right-hand side, from stop to stop. The fixed-step
+    methods run `rotframe.problem.fixed_step`'s loop, which the GPU compiles too (`rotframe.problem.gpu`). ``D``
+    (default `STATE_LENGTH`) is the length of the state (a particle's is 10 where a force acts in inertial axes), a
+    constant of the steps' code too (`stepper`).
     """
     body = None if model == PARTICLE else True
     method = METHOD_CODES[method]

@@ -35,8 +35,8 @@ from __future__ import annotations
 from numba import types
 
 __all__ = ["POTENTIAL", "FUNCTIONS", "FUNCTIONS_AT", "PROBLEM", "CONTEXT", "SYSTEM_SIG", "STAGES_SIG", "TERMS_SIG",
-           "EVENT_SIG", "VARIANT_SIGNATURE", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8", "I8", "A1", "A2", "A3", "I1", "I2",
-           "B1"]
+           "EVENT_SIG", "VARIANT_SIGNATURE", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8",
+           "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
 
 F8 = types.float64
 I8 = types.int64
