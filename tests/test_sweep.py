@@ -353,3 +353,28 @@ def test_resume_refuses_a_changed_scenario_file(tmp_path, monkeypatch):
     path.write_text(text, encoding="utf-8")  # the same text again: the resume goes on
     res = sweep.run_sweep(spec, "gun.parquet", resume=True, batch_rows=2, plots=False, recording=False)
     assert res.computed == 4 and res.rows == 6
+
+
+def test_a_dask_objects_error_at_exit_is_kept_quiet_and_others_are_not(monkeypatch):
+    """A Dask future cut by a signal while it was made raises in its ``__del__`` at exit; a sweep that made a client
+    prints no traceback for it (`execute._quiet_dask_unraisable`), and still passes on any other object's."""
+    import types
+
+    from distributed.client import Future
+
+    from rotframe.app.sweep import execute
+
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: seen.append(unraisable.object))
+    execute._quiet_dask_unraisable()
+    execute._quiet_dask_unraisable()  # once a process: the second call adds nothing
+    error = AttributeError("'Future' object has no attribute '_cleared'")
+
+    def unraisable(obj):
+        return types.SimpleNamespace(exc_type=AttributeError, exc_value=error, exc_traceback=None, err_msg=None,
+                                     object=obj)
+
+    sys.unraisablehook(unraisable(Future.__del__))
+    assert seen == []
+    sys.unraisablehook(unraisable(test_a_dask_objects_error_at_exit_is_kept_quiet_and_others_are_not))
+    assert seen == [test_a_dask_objects_error_at_exit_is_kept_quiet_and_others_are_not]

@@ -474,16 +474,19 @@ def _client_bounded(Client, address, given, timeout=None, scheduler_file=None):
         worker = threading.Thread(target=make, daemon=True, name="rotframe-dask-connect")
         worker.start()
         worker.join(timeout + 2.0)
+    _quiet_dask_unraisable()
     if "client" in box:
         return box["client"]
-    _quiet_dask_unraisable()
     why = _one_line(box["error"])[:200] if "error" in box else f"no Dask handshake within {timeout:g} s"
     option = "--scheduler-file" if scheduler_file else "--scheduler"
     raise ScenarioError(f"{option} {given!r}: not a Dask scheduler or not answering ({why})")
 
 
 def _quiet_dask_unraisable():
-    """A half-made Dask client prints a traceback from its ``__del__`` (at exit): keep that one quiet."""
+    """Keep quiet the tracebacks Dask's objects print from their ``__del__`` at exit: a half-made client's, and a
+    future's that a signal cut while it was made (``'Future' object has no attribute '_cleared'``, seen in CI on
+    2026-12-02). They are the library's own, and nothing a user can act on; the sweep's own message (with its
+    ``--resume`` hint) is what an interrupted run prints. Made once a process, for every client."""
     import sys
 
     previous = sys.unraisablehook
