@@ -31,7 +31,7 @@ from rotframe.problem.event_watch import watcher
 from rotframe.problem.fixed_step import fixed_step_loop
 from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.models import body_split
-from rotframe.problem.signatures import A1, F8, FUNCTIONS, I8, VARIANT_SIGNATURE
+from rotframe.problem.signatures import A1, F8, I8, loop_with_parts
 from rotframe.problem.steps import body_system
 
 __all__ = ["body_split_loop", "compile_body_step", "STEP_SIG", "FUNCTIONS_STEP", "LOOP_SIGNATURE"]
@@ -42,7 +42,7 @@ STEP_SIG = types.void(I8, F8, A1, F8, A1)
 #: the problem's five addresses (`rotframe.problem.signatures.FUNCTIONS`), then the step's
 FUNCTIONS_STEP = types.UniTuple(types.int64, 6)
 #: the loop's signature: a variant's (`rotframe.problem.signatures.VARIANT_SIGNATURE`) with `FUNCTIONS_STEP`
-LOOP_SIGNATURE = types.void(*(FUNCTIONS_STEP if arg == FUNCTIONS else arg for arg in VARIANT_SIGNATURE.args))
+LOOP_SIGNATURE = loop_with_parts(FUNCTIONS_STEP)
 
 _uncounted_entry = njit(**ENTRY_OPTIONS)
 _call_step = caller(STEP_SIG)

@@ -35,7 +35,7 @@ from rotframe.problem.calls import address
 from rotframe.problem.dop853_variant import dop853_advance, dop853_parts
 from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.signatures import (A1, A2, A3, B1, F8, FUNCTIONS, FUNCTIONS_AT, I1, I2, I8, PARTICLE,
-                                         PROBLEM, STAGES_SIG, SYSTEM_SIG, VARIANT_SIGNATURE)
+                                         PROBLEM, STAGES_SIG, SYSTEM_SIG, loop_with_parts)
 
 __all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop",
            "TRAJECTORY_ARGS", "TRAJECTORY_SIGNATURES", "WHOLE_LOOP_SIGNATURE"]
@@ -165,7 +165,7 @@ TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, I8, I8)), F8, A
 #: the trajectory tier's trajectory loop's signatures, what it returns with its arguments (it is called at its address
 #: by the whole loop, `whole_loop`)
 TRAJECTORY_SIGNATURES = {events: TRAJECTORY_RETURNS(*args) for events, args in TRAJECTORY_ARGS.items()}
-#: the DOP853 whole loop's signature (`whole_loop`): `VARIANT_SIGNATURE`'s, the addresses of the tier's kernels after
+#: the DOP853 whole loop's signature (`whole_loop`): a variant's, the addresses of the tier's kernels after
 #: the problem's (`FUNCTIONS_AT`)
-WHOLE_LOOP_SIGNATURE = types.void(*(FUNCTIONS_AT if arg == FUNCTIONS else arg for arg in VARIANT_SIGNATURE.args))
+WHOLE_LOOP_SIGNATURE = loop_with_parts(FUNCTIONS_AT)
 

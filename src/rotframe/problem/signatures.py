@@ -35,7 +35,7 @@ from __future__ import annotations
 from numba import types
 
 __all__ = ["POTENTIAL", "FUNCTIONS", "FUNCTIONS_AT", "PROBLEM", "CONTEXT", "SYSTEM_SIG", "STAGES_SIG", "TERMS_SIG",
-           "EVENT_SIG", "VARIANT_SIGNATURE", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8",
+           "EVENT_SIG", "VARIANT_SIGNATURE", "loop_with_parts", "POTENTIAL_SIG", "VECTOR_SIG", "VARYING_SIG", "PARTICLE", "BODY", "F8",
            "I8", "A1", "A2", "A3", "I1", "I2", "B1"]
 
 F8 = types.float64
@@ -80,6 +80,12 @@ STAGES_SIG = types.void(I8, I8, I8, F8, A1, F8, A2, A1, A1, F8)
 #: from numba's cache) once, never for a problem
 VARIANT_SIGNATURE = types.void(I8, I8, A1, A2, A1, A1, I1, I1, I1, A3, A2, A3, I2, I1, A2, I1, I1, I8, F8, A2, F8, A1,
                                B1, A1, PROBLEM, FUNCTIONS, A2, A2, A2, A2, A1)
+
+
+def loop_with_parts(functions):
+    """`VARIANT_SIGNATURE` of a loop compiled in parts (`rotframe.problem.in_parts.LoopWithParts`), which takes
+    ``functions`` (the problem's five addresses and its parts') where a variant takes `FUNCTIONS`."""
+    return types.void(*(functions if arg == FUNCTIONS else arg for arg in VARIANT_SIGNATURE.args))
 
 #: model codes (``PROBLEM[0]``)
 PARTICLE = 0
