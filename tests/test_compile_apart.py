@@ -161,3 +161,52 @@ def test_kernels_compiled_apart_load_from_the_cache_in_the_next_process(tmp_path
     else:
         assert {"advance_particle6_dop853_at", "body_step_splitting6"} <= set(first["compiled"]), first
     assert child() == {"apart": [], "compiled": []}
+
+
+_BEGUN_DRIVER = textwrap.dedent('''
+    import json, os, sys, time
+    from numba import types
+    import apart_kernel
+    from rotframe.numerics import compile_apart
+
+    mode = sys.argv[1]
+    used, load = [], compile_apart.CompiledApart.load
+    compile_apart.CompiledApart.load = lambda self, *args: used.append(load(self, *args)) or used[-1]
+    t0 = time.perf_counter()
+    began = compile_apart.begin("apart_kernel", "compile_kernel" if mode == "adopted" else "sleep")
+    pid = next(iter(compile_apart._BEGUN.values()))._pid if began else None
+    out = {"began": began}
+    if mode == "adopted":  # one kernel to make: made compiles it here unless it adopts the process begun
+        out["made"] = compile_apart.made([(apart_kernel.kernel, (types.float64,))], "apart_kernel",
+                                         apart={0: ("compile_kernel", ())})
+        out["value"] = apart_kernel.kernel(3.0)
+    else:
+        compile_apart.stop_begun()
+    try:
+        os.kill(pid, 0)
+        out["alive"] = True
+    except (ProcessLookupError, TypeError):
+        out["alive"] = False
+    out.update(used=used, left=len(compile_apart._BEGUN), seconds=time.perf_counter() - t0)
+    print(json.dumps(out))
+''')
+
+
+@needs_two_cores
+@linux
+@pytest.mark.parametrize("mode", ["adopted", "unused"])
+def test_a_process_begun_ahead_is_adopted_by_made_or_stopped_unused(tmp_path, mode):
+    """`compile_apart.begin` starts a kernel's second process before it is asked for: the `made` that asks for it
+    adopts it, loading what it compiled (one kernel to make, which `made` alone would compile here); a run that never
+    asks stops it (`stop_begun`), at once, not after its work."""
+    (tmp_path / "apart_kernel.py").write_text(_KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), PYTHONPATH=str(tmp_path))
+    done = subprocess.run([sys.executable, "-c", _BEGUN_DRIVER, mode], env=env, capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out["began"] is True and out["left"] == 0 and out["alive"] is False
+    if mode == "adopted":
+        assert out["made"] is True and out["used"] == [True] and out["value"] == 7.0
+    else:
+        assert out["used"] == [] and out["seconds"] < 30.0  # its child sleeps 60 s: it was stopped

@@ -318,6 +318,11 @@ from rotframe.problem.particles import simulate_particles
 
 made, load = [], compile_apart.CompiledApart.load  # how each second process of a compile was made
 compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or load(self, *args)
+begun, begin = [], compile_apart.begin  # the kernels begun ahead of a run's functions' compile, and those left unused
+compile_apart.begin = lambda module, function, *args: begun.append(function) or begin(module, function, *args)
+from rotframe.problem import particles
+unused, stop_begun = [], particles.stop_begun
+particles.stop_begun = lambda: unused.append(len(compile_apart._BEGUN)) or stop_begun()
 
 def spring(t, r, v):
     return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
@@ -328,6 +333,7 @@ def spring_run():
 
 
 run = spring_run()
+begun_first, unused_first = list(begun), list(unused)  # the first run's
 from numba.core import caching  # then what a second run loads from numba's disk cache: nothing
 reloaded, load_overload = [], caching.Cache.load_overload
 
@@ -344,15 +350,17 @@ spring_run()
 print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
                   "compiled": engine.variant(0, "dop853", False, load_only=True) is not None,
                   "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None,
-                  "apart": made, "reloaded": reloaded}))
+                  "apart": made, "reloaded": reloaded, "begun": begun_first, "unused": unused_first}))
 """
 
 
 def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
-    one switches and compiles DOP853's trajectory tier, not the whole loop, its trajectory in a forked process where
-    there are two cores (`rotframe.numerics.compile_apart`); the next short one, in another process, finds the tier in
-    the cache and runs there, compiling nothing. The final states agree to the bit."""
+    one switches and compiles DOP853's trajectory tier, not the whole loop, its trajectory and stages in forked
+    processes where there are two cores (`rotframe.numerics.compile_apart`), begun before the run's own functions
+    compiled (`rotframe.problem.tiers.begin_ahead`: the short run begins them too, and stops them unused); the next
+    short one, in another process, finds the tier in the cache and runs there, compiling nothing. The final states
+    agree to the bit."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
 
     def child(duration):
@@ -368,7 +376,10 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     assert any("then the loop compiled, its trajectories alone" in n for n in long["notes"]), long["notes"]
     assert long["trajectory"] and not long["compiled"]
     two = len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux")
-    assert long["apart"] == (["fork"] if two else [None]) and short["apart"] == []
+    assert long["apart"] == (["fork", "fork"] if two else [None, None]) and short["apart"] == []
+    ahead = ["compile_tier_trajectory", "compile_tier_stages"]
+    assert short["begun"] == long["begun"] == ahead and short["unused"] == [2 if two else 0]
+    assert long["unused"] == [0]  # the long run adopted both
     again = child(10.0)
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["trajectory"] and not again["compiled"] and again["apart"] == []
@@ -436,21 +447,23 @@ def test_a_first_runs_energy_of_a_few_states_is_the_plain_remakes_and_the_compil
     assert fresh.signatures and np.isfinite(many.diagnostics["jacobi_rel_drift"])
 
 
-def test_many_trajectory_calls_a_call_compile_the_whole_loop(monkeypatch):
-    """A first run whose calls would make more than TRAJECTORY_CALLS calls of the trajectory loop (its particles times
-    its knots and end) compiles the whole loop instead, where the loop over them is compiled too; the numbers are the
-    same. The table frame's knots end steps: its 3 particles make 3 calls a call for each knot and the end, a frame
-    without knots 3 in all."""
-    case = CASES["dop853, a frame turning by a function, an accelerating origin"]
-    table = CASES["dop853, a table frame, a force in inertial axes"]
+def test_more_particles_than_trajectory_calls_compile_the_whole_loop(monkeypatch):
+    """A first run of more particles than TRAJECTORY_CALLS (a call of the trajectory loop each) compiles the whole
+    loop instead, where the loop over them is compiled too; one of as many fits the trajectory tier, however many knots
+    its frame's table has (the trajectory runs through the stops itself). The numbers are the same in each."""
+    table = CASES["dop853, a table frame, a force in inertial axes"]  # 3 particles, a table's knots
     compiled = _run(table, "compiled", monkeypatch)
     with monkeypatch.context() as m:
-        m.setattr(tiers, "TRAJECTORY_CALLS", 3)
+        m.setattr(tiers, "TRAJECTORY_CALLS", 2)
         switched = _run(table, "switch", monkeypatch, budget=1)
         assert any("then the loop compiled (" in n for n in switched.notes), switched.notes
-        assert tiers.trajectory_tier_fits("dop853", 3, 0) and not tiers.trajectory_tier_fits("dop853", 3, 1)
-        stepped = _run(case, "switch", monkeypatch, budget=1)
+        assert not tiers.trajectory_tier_fits("dop853", 3)
+    with monkeypatch.context() as m:
+        m.setattr(tiers, "TRAJECTORY_CALLS", 3)
+        stepped = _run(table, "switch", monkeypatch, budget=1)
         assert any("its trajectories alone" in n for n in stepped.notes), stepped.notes
+        assert tiers.trajectory_tier_fits("dop853", 3)
     _same(switched, compiled)
-    assert not tiers.trajectory_tier_fits("rk4", 1, 0)
+    _same(stepped, compiled)
+    assert not tiers.trajectory_tier_fits("rk4", 1)
 

@@ -25,6 +25,12 @@ The second process is made only where this one may run on two cores or more
 Whatever goes wrong there (no spare core, no process to start, a failure in the child, a child
 that takes longer than `TIMEOUT_S`, a cache that cannot be written) ends in this process
 compiling the kernel itself: the same machine code, later.
+
+**Begun ahead** (`begin`). A run that will likely compile a kernel later, after work of its own on
+one core (a problem's functions to compile, then a first call as plain Python:
+`rotframe.problem.tiers`), may begin that kernel's second process before that work; the `made` that
+needs it adopts the process instead of starting one. A run that ends without needing it stops it
+(`stop_begun`): a kernel begun ahead and never adopted costs the second core, not this process's time.
 """
 
 from __future__ import annotations
@@ -35,7 +41,7 @@ import sys
 import threading
 import time
 
-__all__ = ["CompiledApart", "made", "spare_core", "TIMEOUT_S"]
+__all__ = ["CompiledApart", "made", "begin", "stop_begun", "spare_core", "TIMEOUT_S"]
 
 #: seconds the second process may take, from its start, before this one compiles the kernel itself
 TIMEOUT_S = 120.0
@@ -181,6 +187,30 @@ def _run(module, function, *args):
     getattr(importlib.import_module(module), function)(*args)
 
 
+#: the second processes begun ahead (`begin`) that no `made` has adopted yet, by ``(module, function, args)``
+_BEGUN: dict = {}
+
+
+def begin(module, function, *args) -> bool:
+    """Begin ``module.function(*args)`` in a second process now, for a later `made` to adopt (module docstring).
+
+    Nothing where this process has no spare core, or where no second process could be made (`CompiledApart`). The
+    caller is sure the kernel is not in numba's cache. Returns whether a process was begun (or had been)."""
+    key = (module, function, tuple(map(str, args)))
+    if key not in _BEGUN:
+        apart = CompiledApart(module, function, *args).__enter__()
+        if apart.how is None:
+            return False
+        _BEGUN[key] = apart
+    return True
+
+
+def stop_begun():
+    """Stop every second process begun ahead (`begin`) that no `made` adopted: the run that began it ended."""
+    while _BEGUN:
+        _BEGUN.popitem()[1].stop()
+
+
 def made(kernels, module, load_only=False, apart=()) -> bool:
     """Load ``kernels`` (``[(dispatcher, signature), ...]``) from numba's cache, compiling those that are not there;
     False, compiling nothing, where ``load_only`` and one is not.
@@ -192,8 +222,9 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
 
     ``apart`` names, for some of them by index, the function of ``module`` that compiles it in another process
     (``{index: (name, its arguments)}``). Where more than one is to compile, those compile in processes of their
-    own while this one compiles the rest (`rotframe.numerics.compile_apart`), then load them from the cache. Each
-    kernel is then closed to new compiles.
+    own while this one compiles the rest (`rotframe.numerics.compile_apart`), then load them from the cache; a
+    process begun ahead for one of them (`begin`) is adopted, however many are to compile. Each kernel is then
+    closed to new compiles.
     """
     from contextlib import ExitStack
 
@@ -204,11 +235,17 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
             and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
     if todo and load_only:
         return False
-    away = [k for k in todo if k in apart] if len(todo) > 1 else []
-    if away and len(away) == len(todo):
+    begun = {k: _BEGUN.pop(key) for k in todo if k in apart
+             and (key := (module, apart[k][0], tuple(map(str, apart[k][1])))) in _BEGUN}
+    rest = [k for k in todo if k not in begun]
+    away = [k for k in rest if k in apart] if len(rest) > 1 else []
+    if away and len(away) == len(rest):
         away.pop()  # one compiles here
     with ExitStack() as stack:
+        for child in begun.values():
+            stack.callback(child.stop)  # stopped where this process's compile fails (`CompiledApart.__exit__`)
         children = {k: stack.enter_context(CompiledApart(module, apart[k][0], *apart[k][1])) for k in away}
+        children.update(begun)
         for k in todo:
             if k not in children:
                 kernels[k][0].compile(kernels[k][1])

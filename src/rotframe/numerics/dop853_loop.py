@@ -41,6 +41,7 @@ from rotframe.numerics.compiled import ENTRY_OPTIONS, bound, inlined, jit_inline
 from rotframe.numerics.dop853 import coefficients, dop853_error_norm
 from rotframe.numerics.dop853_dense import dense_coefficients, dense_value, extended_tableau
 from rotframe.numerics.step_control import first_step, first_step_trial, next_step, step_collapsed
+from rotframe.numerics.stops import next_stop
 
 __all__ = ["dop853_stages", "dop853_trajectory", "dop853_step", "dop853_start", "REACHED", "STOPPED", "COLLAPSED",
            "NONFINITE", "PAUSED", "WATCH_FAILED", "ABORTED", "DIVERGED", "UNLIMITED", "TRAJECTORY_RETURNS"]
@@ -94,9 +95,9 @@ def dop853_stages(name, rhs, D):
 
 # the names a system binds (`rotframe.numerics.compiled.bound`): its right-hand side, the length of its state, its
 # stage function, sample writer, watcher and check; None or 0 in the templates themselves, which are never compiled
-RHS = STAGES = STORE = WATCH = CHECK = ENTER = None
+RHS = STAGES = STORE = WATCH = CHECK = ENTER = STOPS = None
 DIM = 0
-WATCHED = CHECKED = False
+WATCHED = CHECKED = STOPPING = False
 
 
 def _stages(ctx, first, last, t, y, h, K, z, z12, t12):
@@ -132,7 +133,7 @@ def _same(ctx):
     return ctx
 
 
-def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=None, enter=_same):
+def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=None, enter=_same, stops=None):
     """The trajectory loop of one system, compiled for it (cached on disk as ``dop853_trajectory_<name>``).
 
     ``stages`` the system's (`dop853_stages`), ``D`` the length of its state; ``store(out, k, p, y)`` writes sample ``k`` of
@@ -144,7 +145,11 @@ def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=N
     trajectory at the step's start (`ABORTED`: a function of the system failed); None compiles no
     check. With ``entry`` the loop is also callable from Python (a kernel of its own, not only a callee).
     ``enter(ctx)`` is the system's data that the loop hands on, made once a call from the ``ctx`` it was given
-    (the default hands on ``ctx`` itself).
+    (the default hands on ``ctx`` itself). ``stops(ctx)``, of the ``ctx`` given, is a sorted array of times that
+    no step crosses (a table's knots: `rotframe.numerics.stops`): each step that would is cut to end on the stop,
+    and the trajectory goes on from there as a new call would (Hairer's step control starts afresh; samples at
+    the stop are stored), so a trajectory with its stops given takes the steps of one call from stop to stop,
+    to the bit. None compiles no stops.
 
     The loop, ``trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new,
     tmp, yt, F, wctx, budget)``, integrates one trajectory from ``(t, y)``, ``K[0] = f(t, y)``, to ``t_end``:
@@ -168,12 +173,24 @@ def dop853_trajectory(name, stages, store, D, watch=None, entry=False, aborted=N
     """
     compile = _uncounted_entry if entry else jit_uncounted
     return compile(bound(_trajectory, f"dop853_trajectory_{name}", STAGES=stages, STORE=store, WATCH=watch,
-                         CHECK=aborted, ENTER=enter, DIM=int(D), WATCHED=watch is not None,
-                         CHECKED=aborted is not None))
+                         CHECK=aborted, ENTER=enter, STOPS=stops, DIM=int(D), WATCHED=watch is not None,
+                         CHECKED=aborted is not None, STOPPING=stops is not None))
+
+
+@jit_inline
+def _leg_end(S, t, t_end):
+    """The end of the leg from ``t``: the first stop of ``S`` after ``t`` (`rotframe.numerics.stops.next_stop`), or
+    ``t_end`` where that is the nearer."""
+    stop = next_stop(S, t)
+    return stop if stop < t_end else t_end
 
 
 def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
     """The template of `dop853_trajectory`."""
+    final = t_end
+    if STOPPING:  # the first leg's end: the first stop after t, or the end (`_leg_end`)
+        S = STOPS(ctx)
+        t_end = _leg_end(S, t, final)
     ctx = ENTER(ctx)
     # the stage ranges as int64 values, not literals: one compiled `stages` for every range
     _FIRST, _END, _DENSE, _DENSE_END = int(1), int(13), int(13), int(16)
@@ -186,7 +203,15 @@ def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K,
     while k_out < n_out and times[k_out] <= t:
         STORE(out, k_out, p, y)
         k_out += 1
-    while t < t_end:
+    while t < t_end or (STOPPING and t < final):
+        if STOPPING and t >= t_end:
+            # a stop reached: the next leg, begun as a call from the stop would begin it
+            t_end = _leg_end(S, t, final)
+            rejected = False
+            finite_rejection = True
+            while k_out < n_out and times[k_out] <= t:
+                STORE(out, k_out, p, y)
+                k_out += 1
         if steps >= budget:
             status = PAUSED
             break
@@ -225,6 +250,8 @@ def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K,
             break
         if at_end:
             t = t_end
+            if STOPPING:
+                continue  # the next leg, or the end
             break
         if h > h_max:
             h = h_max

@@ -100,7 +100,7 @@ def grid_time(times, s, j, h):
 def start_short_of(t, h, t_end):
     """The start time to hand a step's stages so that its end, ``start + h``, falls just short of ``t_end``.
 
-    For an RK4 step from ``t`` that ends on a knot of the engine's (`rotframe.problem.stops`) at
+    For an RK4 step from ``t`` that ends on a knot of the engine's (`rotframe.numerics.stops`) at
     ``t_end``: its fourth stage is f at ``t + h``, and at the knot itself a table reads the next
     interval (`rotframe.problem.varying.interval`). Where the rate turns there (a piecewise-linear
     table: omega' jumps), f from the wrong side cost the step an error of order h at every knot.

@@ -382,7 +382,7 @@ def _simulate_rigid_body(*, inertia, L0, q0, duration, torque=None, params=(), m
     # the engine's loop, or the same loop with the torque compiled in where the run is long (`rotframe.problem.inlined`)
     inlining = Inlining(driver.module, BODY, method, False, 7, None, inline if jit else False)
     tier = Tier(driver, fns, s.plain_driver if jit and inline is not True and plain_tier else None,
-                (BODY, method, False, 7), prob, 1, a["S"].size)
+                (BODY, method, False, 7), prob, 1)
 
     def call(budget):
         tier.driver.advance(0, 1, times, y, TC, H, st["IDX"], st["SUB"], st["ST"], OUT, EVT, EVY, EVK, st["EVN"], GPREV,

@@ -49,11 +49,11 @@ def system_at(ctx, t, z, K, s):
 
 @jit_inline
 def with_reference(ctx):
-    """The trajectory tier's ``ctx = (prob, fns, W, stages, system)``, the addresses of its compiled stages and
-    right-hand side, as the loop hands it on: the problem's data also at an address, ``ref``, before them (made once a
-    call of the trajectory, `rotframe.problem.calls.by_reference`)."""
+    """The trajectory tier's ``ctx = (prob, fns, W, S, stages, system)``, its stops and the addresses of its compiled
+    stages and right-hand side, as the loop hands it on: the problem's data also at an address, ``ref``, before the
+    addresses (made once a call of the trajectory, `rotframe.problem.calls.by_reference`)."""
     data = (ctx[0], ctx[1], ctx[2])
-    return ctx[0], ctx[1], ctx[2], by_reference(data), ctx[3], ctx[4]
+    return ctx[0], ctx[1], ctx[2], by_reference(data), ctx[4], ctx[5]
 
 
 def _system_call(ctx, t, z, K, s):
@@ -95,13 +95,13 @@ def problem_functions(fns):
 def _trajectory_at(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget):
     """The template of `trajectory_at`."""
     fns = ctx[1]
-    return CALL(fns[5], (ctx[0], problem_functions(fns), ctx[2], fns[6], fns[7]), t, y, h, t_end, h_max, times,
-                k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget)
+    return CALL(fns[5], (ctx[0], problem_functions(fns), ctx[2], ctx[3], fns[6], fns[7]), t, y, h, t_end, h_max,
+                times, k_out, out, p, rtol, atol, K, y_new, tmp, yt, F, wctx, budget)
 
 
 def trajectory_at(kind, signature):
     """The DOP853 whole loop's trajectory (`rotframe.problem.dop853_split.whole_loop`): the trajectory tier's, of
-    ``signature``, called at its address, ``ctx = (prob, fns, W)`` with ``fns`` the whole loop's eight addresses
+    ``signature``, called at its address, ``ctx = (prob, fns, W, S)`` with ``fns`` the whole loop's eight addresses
     (`rotframe.problem.signatures.FUNCTIONS_AT`: the tier's trajectory, stages and right-hand side after the
     problem's)."""
     return jit_inline(bound(_trajectory_at, f"trajectory_at_{kind}", CALL=caller(signature)))

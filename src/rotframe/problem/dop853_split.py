@@ -37,7 +37,7 @@ from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.signatures import (A1, A2, A3, B1, F8, FUNCTIONS, FUNCTIONS_AT, I1, I2, I8, PARTICLE,
                                          PROBLEM, STAGES_SIG, SYSTEM_SIG, loop_with_parts)
 
-__all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop",
+__all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop", "compile_tier_stages", "begin_tier",
            "TRAJECTORY_ARGS", "TRAJECTORY_SIGNATURES", "WHOLE_LOOP_SIGNATURE"]
 
 #: the compiled parts: entry points without reference counts (`rotframe.numerics.compiled.ENTRY_OPTIONS`)
@@ -80,14 +80,15 @@ def trajectory_tier(model, method, events, D, load_only=False):
         raise ValueError(f"the trajectory tier is DOP853's, not {method}'s")
     body = None if model == PARTICLE else True
     kernels = _tier_kernels(body, events, D)
-    if not made(kernels, __name__, load_only, {0: ("compile_tier_trajectory", (model, int(bool(events)), D))}):
+    args = (model, int(bool(events)), D)
+    if not made(kernels, __name__, load_only, {k: (function, args) for k, function in _TIER_APART.items()}):
         return None
     (trajectory, _), (stages, _), (system, _), (system_call, _) = kernels
     at = (address(stages, STAGES_SIG), address(system, SYSTEM_SIG))
 
     def trajectory_call(ctx, *rest):
         """The trajectory with the addresses of its stages and right-hand side in its ``ctx`` (`with_reference`)."""
-        return trajectory((ctx[0], ctx[1], ctx[2]) + at, *rest)
+        return trajectory(ctx + at, *rest)
 
     trajectory_call.kernels = kernels  # the addresses live as long as the compiled functions
     kind = f"{'particle' if body is None else 'body'}{D}"
@@ -110,6 +111,37 @@ def compile_tier_trajectory(model, events, D):
     events = bool(int(events))
     trajectory, signature = _tier_kernels(None if int(model) == PARTICLE else True, events, int(D))[0]
     trajectory.compile(signature)
+
+
+def compile_tier_stages(model, events, D):
+    """Compile the trajectory tier's stages (with the right-hand side in them, `rotframe.problem.by_address.tier_callees`)
+    for model code ``model``, ``events`` (0 or 1) and ``D`` numbers into numba's cache: a second process of a first tier
+    compile begun ahead (`begin_tier`)."""
+    stages, signature = _tier_kernels(None if int(model) == PARTICLE else True, bool(int(events)), int(D))[1]
+    stages.compile(signature)
+
+
+#: the trajectory tier's kernels that compile in second processes, by their index in `_tier_kernels`: the trajectory
+#: loop and the stages, each some 1.2 s of a first compile on the 2-core reference machine (the right-hand sides that
+#: Python calls, some 0.1 s each, compile here)
+_TIER_APART = {0: "compile_tier_trajectory", 1: "compile_tier_stages"}
+
+
+def begin_tier(model, events, D) -> bool:
+    """Begin compiling the trajectory tier's trajectory loop and stages (`_TIER_APART`), each not in numba's cache, in
+    second processes now: for a first run that will likely compile the tier once its own functions are compiled and its
+    first call has run as plain Python (`rotframe.problem.tiers.begin_ahead`,
+    `rotframe.numerics.compile_apart.begin`). Whether any was begun."""
+    from rotframe.numerics.compile_apart import begin
+    from rotframe.numerics.compiled import load_cached
+
+    kernels = _tier_kernels(None if model == PARTICLE else True, bool(events), D)
+    begun = False
+    for k, function in _TIER_APART.items():
+        kernel, signature = kernels[k]
+        if tuple(getattr(signature, "args", signature)) not in kernel.overloads and not load_cached(kernel, signature):
+            begun = begin(__name__, function, model, int(bool(events)), D) or begun
+    return begun
 
 
 def whole_loop(model, method, events, D, load_only=False):
@@ -156,9 +188,9 @@ def compile_whole_loop(model, events, D):
 
 
 #: the trajectory tier's trajectory loop's arguments (`trajectory_tier`), without and with events (``ctx = (prob,
-#: fns, W, stages, system)``, `rotframe.problem.by_address.with_reference`; ``wctx``,
+#: fns, W, S, stages, system)``, `rotframe.problem.by_address.with_reference`; ``wctx``,
 #: `rotframe.problem.loop_state.watcher_context`'s tuple)
-TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, I8, I8)), F8, A1, F8, F8, F8, A1, I8, A3, I8, F8,
+TRAJECTORY_ARGS = {events: (types.Tuple((PROBLEM, FUNCTIONS, A1, A1, I8, I8)), F8, A1, F8, F8, F8, A1, I8, A3, I8, F8,
                             A1, A2, A1, A1, A1, A2,
                             types.Tuple((A2, A2, A3, I2, I1, A1, B1, F8, A2, A1, A1, A1)) if events else I8, I8)
                    for events in (False, True)}

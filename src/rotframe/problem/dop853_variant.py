@@ -23,7 +23,6 @@ from rotframe.problem.event_watch import watcher
 from rotframe.problem.loop_state import load_particle, save_particle, watcher_context
 from rotframe.problem.models import DOP853
 from rotframe.problem.steps import body_system, particle_system, stepper
-from rotframe.problem.stops import next_stop
 
 __all__ = ["dop853_loop", "dop853_parts", "dop853_advance", "store_rows", "raised"]
 
@@ -46,9 +45,23 @@ def raised(ctx):
     return ctx[2][RAISED] != 0.0
 
 
+@jit_inline
+def run_stops(ctx):
+    """The run's stops ``S`` (`rotframe.numerics.stops`), the fourth of the trajectory's ``ctx = (prob, fns, W, S,
+    ...)``: no step crosses one."""
+    return ctx[3]
+
+
+@jit_inline
+def problem_data(ctx):
+    """The problem's data ``(prob, fns, W)`` that the right-hand side takes, of the trajectory's ``ctx``."""
+    return ctx[0], ctx[1], ctx[2]
+
+
 def dop853_parts(body, events, D, entry=False):
     """The DOP853 variant's trajectory loop: `rotframe.numerics.dop853_loop`'s trajectory compiled for the model's
-    right-hand side (`particle_system`, `body_system`, ``ctx = (prob, fns, W)``), the events watched by
+    right-hand side (`particle_system`, `body_system`, ``ctx = (prob, fns, W)``), from stop to stop of the run
+    (its ``ctx = (prob, fns, W, S)``: every stop of ``S`` in one call, `run_stops`), the events watched by
     `rotframe.problem.event_watch.watch_events`, a user function that raised ending the trajectory at the step
     (`raised`).
     ``entry``: the trajectory of the loop compiled in parts (`rotframe.problem.dop853_split`), callable from Python
@@ -64,7 +77,7 @@ def dop853_parts(body, events, D, entry=False):
     watch = watcher(kind, stages, body, DOP853, system) if events else None
     name = kind + ("_events" if events else "") + ("_entry" if entry else "")
     return dop853_trajectory(name, stages, store_rows, D, watch, entry=entry, aborted=raised,
-                             **({"enter": with_reference} if entry else {}))
+                             enter=with_reference if entry else problem_data, stops=run_stops)
 
 
 def dop853_loop(name, body, events, D):
@@ -86,6 +99,7 @@ def dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, G
     t_last = T[n - 1]
     y, yt, yn, tmp = V[0], V[1], V[2], V[3]
     ctx = (prob, fns, W)
+    stepped = (prob, fns, W, S)  # the trajectory's: the run's stops too
     wctx = watcher_context(GPREV, EVT, EVY, EVK, EVN, EDIR, ETERM, T, Kb, V) if EVENTS else 0
     for i in range(lo, hi):
         if ST[i] != 0:
@@ -103,10 +117,10 @@ def dop853_advance(lo, hi, T, Y, TC, H, IDX, SUB, ST, OUT, EVT, EVY, EVK, EVN, G
         end = REACHED
         left = budget
         while idx < n and left > 0:
-            # to the next stop (a knot of a table or a body frame) or the run's end, whichever is first
-            stop = next_stop(S, t)
-            t, h, idx, end, nf, steps = TRAJECTORY(ctx, t, y, h, stop if stop < t_last else t_last, math.inf, T,
-                                                   idx, OUT, i, rtol, atol_i, K, yn, tmp, yt, F, wctx, left)
+            # to the run's end, each step cut to end on a stop (a knot of a table or a body frame) it would cross;
+            # once more where the last step summed to within ulps of the end, to store the samples there
+            t, h, idx, end, nf, steps = TRAJECTORY(stepped, t, y, h, t_last, math.inf, T, idx, OUT, i, rtol,
+                                                   atol_i, K, yn, tmp, yt, F, wctx, left)
             NFEV[i] += nf
             NSTEP[i] += steps
             left -= steps

@@ -38,7 +38,7 @@ from rotframe.problem.loop_state import (all_finite, load_particle, save_particl
                                          tuple_finite, watcher_context)
 from rotframe.problem.models import EVALUATIONS_PER_STEP, RK4, particle_split, rhs
 from rotframe.problem.steps import carried_rk4, particle_acceleration, take_step
-from rotframe.problem.stops import next_stop
+from rotframe.numerics.stops import next_stop
 
 __all__ = ["fixed_step_loop"]
 

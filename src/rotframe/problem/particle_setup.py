@@ -190,7 +190,7 @@ class SetUp:
 
 
 def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, events, method, rtol, step, samples,
-           omega_dot, jit, max_events, device, frame_terms, inline=None, steady=True, fixed_steady=True):
+           omega_dot, jit, max_events, device, frame_terms, inline=None, steady=True, fixed_steady=True, ahead=False):
     """Check a particle problem and build what runs it, from the start states ``r0``, ``v0``: a `SetUp`.
 
     Every argument as `simulate_particles` takes it, checked in its order; the start states are
@@ -198,7 +198,10 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     number sizes the work limits. For method ``exact`` nothing is built: the set-up is returned
     checked, its driver None (the flow is the caller's, `rotframe.problem.exact`). Nor for a run
     that a steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem
-    (``fixed_steady`` False: DOP853's alone, not the scenes' fixed-step drivers).
+    (``fixed_steady`` False: DOP853's alone, not the scenes' fixed-step drivers). With ``ahead`` (the run may begin
+    in the plain tier), a loop the run will compile if it is long begins to compile in a second process before the
+    problem's functions compile (`rotframe.problem.tiers.begin_ahead`; the caller stops it if unused,
+    `rotframe.numerics.compile_apart.stop_begun`).
     """
     import time
 
@@ -256,6 +259,11 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
+    if ahead and jit and not on_gpu and inline is not True:
+        from rotframe.problem.signatures import PARTICLE
+        from rotframe.problem.tiers import begin_ahead
+
+        begin_ahead((PARTICLE, method, bool(events), D), N)
     try:
         driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, labels, jit), glue,
                                      compiled=jit, notes=cache_notes), compiled=jit)

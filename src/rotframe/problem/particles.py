@@ -34,6 +34,7 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint, energy_by_numpy
+from rotframe.numerics.compile_apart import stop_begun
 from rotframe.problem.tiers import PlainTierFailed, SteadyLoopFailed, Tier, run_falling_back
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
@@ -83,7 +84,10 @@ def simulate_particles(**kwargs) -> ProblemRun:
     again compiled from its start (`rotframe.problem.tiers`): a failure is met and reported as the
     compiled loop meets it, whatever the caches held.
     """
-    return run_falling_back(_simulate_particles, kwargs)
+    try:
+        return run_falling_back(_simulate_particles, kwargs)
+    finally:
+        stop_begun()  # a loop begun ahead that the run did not compile (`rotframe.problem.tiers.begin_ahead`)
 
 
 def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),
@@ -104,7 +108,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
     s = set_up(r0, v0, omega=omega, duration=duration, forces=forces, params=params,
                origin_acceleration=origin_acceleration, events=events, method=method, rtol=rtol, step=step,
                samples=samples, omega_dot=omega_dot, jit=jit, max_events=max_events, device=device,
-               frame_terms=frame_terms, inline=inline, steady=steady)
+               frame_terms=frame_terms, inline=inline, steady=steady, ahead=plain_tier)
     r, v = s.r, s.v
     attitude = None if frame_attitude is None else checked_attitude(frame_attitude)  # refused even where unread
     if s.method == "exact":  # the exact flow of a linear problem: chosen from the terms, nothing compiled
@@ -138,7 +142,7 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
                         inline if jit and not on_gpu else False)
     # a first run whose loop is not compiled yet begins as the loop's plain-Python remake (`rotframe.problem.tiers`)
     tier = Tier(driver, fns, s.plain_driver if gpu is None and inline is not True and plain_tier else None,
-                (prob[0], method, bool(events), D), prob, N, stops.size)
+                (prob[0], method, bool(events), D), prob, N)
 
     def advance(*args):  # the plain tier's loop, the engine's, or the inlined one once the run has switched to it
         tier.driver.advance(*args, kernel=None if tier.plain else inlining.kernel)

@@ -51,8 +51,8 @@ first call alone would be too long as Python.
 **The trajectory tier.** A DOP853 run of so few particles compiles less than the whole loop
 (`rotframe.problem.dop853_split.trajectory_tier`): the loop's trajectory from stop to stop, where every
 step is taken, and its right-hand side, each compiled on its own and cached; the loop over the
-particles and the stops stays the plain remake's Python, some 25 to 45 us a call of the
-trajectory. The whole loop compiles the trajectory a second time inside its own code, and an
+particles stays the plain remake's Python, some 25 to 45 us a call of the trajectory, one a
+particle (it runs through the stops itself). The whole loop compiles the trajectory a second time inside its own code, and an
 entry point of thirty arguments: the tier compiled in 0.58 of its time on the 2-core reference
 machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01). Side by side with
 the tree before, fresh caches, three runs each, the same day: a first run of 1,000 s of a spring
@@ -61,8 +61,8 @@ against 7.1 to 9.2 s (medians 6.2 and 8.4), a new problem after them the same wi
 noise (0.5 to 0.8 s in both: loading a loop is mostly numba's own start). A run begins there where
 the whole loop is not compiled but the tier is (`loop_is_compiled` of the variant with
 `rotframe.problem.engine.TRAJECTORY_TIER` fifth), and compiles it, not the whole loop, where it
-switches; the whole loop is compiled by a run of more particles, or of more calls of the
-trajectory a call than `TRAJECTORY_CALLS` (a frame's table of many knots: `trajectory_tier_fits`).
+switches; the whole loop is compiled by a run of more particles than `TRAJECTORY_CALLS`
+(`trajectory_tier_fits`).
 It is the same code, so the same numbers to the bit (`tests/test_tiers.py`).
 """
 
@@ -76,6 +76,7 @@ import warnings
 import numpy as np
 
 __all__ = ["Tier", "PlainTierFailed", "SteadyLoopFailed", "run_falling_back", "loop_is_compiled", "plain_fevs_spent",
+           "begin_ahead",
            "projected_fevs", "trajectory_tier_fits", "PLAIN_FEVS", "PLAIN_STEPS", "PLAIN_PARTICLES", "PLAIN_ENERGIES",
            "TRAJECTORY_CALLS"]
 
@@ -93,20 +94,41 @@ PLAIN_STEPS = 8
 PLAIN_PARTICLES = 32
 
 
-#: the most calls of the trajectory loop a call of the trajectory tier makes: a particle's for each stop in the run (the
-#: knots of a frame's table) and the end, each with its particle's loading and saving as Python, where the whole loop
-#: makes them compiled (`trajectory_tier_fits`). A run stays in the tier, warm runs too, until a larger one compiles the
-#: whole loop. Measured warm against the whole loop (a spring, 2026-12-01): 10 s of 1, 8 and 32 particles, 1.15 ms
-#: -> 1.28, 0.95 -> 1.38 and 1.91 -> 3.63 ms; 1,000 s, 3 to 4 % longer. So 16: at most some 0.8 ms a short run;
-#: `tumbling-ball`'s body frame of 200 knots a second compiles the whole loop
+#: the most particles a call of the trajectory tier takes: one call of the trajectory loop each, from the particle's
+#: time to the run's end through every stop of the run (the knots of a frame's table or a body frame's samples), with
+#: the particle's loading and saving as Python, where the whole loop makes them compiled (`trajectory_tier_fits`). A run
+#: stays in the tier, warm runs too, until a larger one compiles the whole loop. Measured warm against the whole loop
+#: (a spring, 2026-12-01): 10 s of 1, 8 and 32 particles, 1.15 ms -> 1.28, 0.95 -> 1.38 and 1.91 -> 3.63 ms; 1,000 s,
+#: 3 to 4 % longer. So 16: at most some 0.8 ms a short run
 TRAJECTORY_CALLS = 16
 
 
-def trajectory_tier_fits(method, particles, stops) -> bool:
-    """Whether a first run of ``particles`` particles (at most `PLAIN_PARTICLES`) and ``stops`` knots, whose whole loop
-    is not compiled yet, compiles DOP853's trajectory tier instead (`rotframe.problem.dop853_split.trajectory_tier`; the
-    module docstring): DOP853's, and at most `TRAJECTORY_CALLS` calls of the trajectory loop in a call."""
-    return method == "dop853" and particles * (stops + 1) <= TRAJECTORY_CALLS
+def trajectory_tier_fits(method, particles) -> bool:
+    """Whether a first run of ``particles`` particles (at most `PLAIN_PARTICLES`), whose whole loop is not compiled
+    yet, compiles DOP853's trajectory tier instead (`rotframe.problem.dop853_split.trajectory_tier`; the module
+    docstring): DOP853's, and at most `TRAJECTORY_CALLS` calls of the trajectory loop in a call."""
+    return method == "dop853" and particles <= TRAJECTORY_CALLS
+
+
+def begin_ahead(variant, particles) -> bool:
+    """Begin compiling the loop that a first run of ``variant`` (`rotframe.problem.engine.variant`'s ``(model, method,
+    events, D)``) and ``particles`` particles will compile if it is long, in second processes, before the run's own
+    functions compile: DOP853's trajectory tier's trajectory and stages (`rotframe.problem.dop853_split.begin_tier`),
+    where the run may begin in the plain tier (the caller's to say: on the CPU, ``inline`` not True) and would
+    compile the tier.
+
+    A long first run then compiles them beside its functions' compile and its first plain call, on the second core; a
+    run that ends plain stops them unused (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun.
+    """
+    from rotframe.problem.engine import TRAJECTORY_TIER
+
+    model, method, events, D = variant
+    if particles > PLAIN_PARTICLES or not trajectory_tier_fits(method, particles) or loop_is_compiled(variant) \
+            or loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,)):
+        return False
+    from rotframe.problem.dop853_split import begin_tier
+
+    return begin_tier(model, events, D)
 
 
 #: the right-hand sides the plain tier has spent in this process on the runs of each loop variant that ended plain
@@ -185,11 +207,9 @@ class Tier:
         The problem's data (`rotframe.problem.signatures.PROBLEM`).
     particles : int
         The run's particles (at most `PLAIN_PARTICLES` to begin in the plain tier).
-    stops : int
-        The run's stops, the knots of its frame's or origin's table (`trajectory_tier_fits`).
     """
 
-    def __init__(self, driver, fns, plain, variant, prob, particles, stops=0):
+    def __init__(self, driver, fns, plain, variant, prob, particles):
         self.driver = driver
         self.fns = fns
         self.variant = variant
@@ -198,7 +218,7 @@ class Tier:
 
         cold = plain is not None and particles <= PLAIN_PARTICLES and not loop_is_compiled(variant)
         #: whether the loop the run compiles, if it compiles one, is DOP853's trajectory tier (`trajectory_tier_fits`)
-        self._stepped = cold and trajectory_tier_fits(variant[1], particles, stops)
+        self._stepped = cold and trajectory_tier_fits(variant[1], particles)
         #: whether the calls run on DOP853's trajectory tier now (its callees compiled, the loop over particles Python)
         self.trajectory = self._stepped and loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,))
         #: whether the calls run as plain Python now
