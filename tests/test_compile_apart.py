@@ -24,6 +24,10 @@ _KERNEL = textwrap.dedent('''
         from numba import types
         kernel.compile((types.float64,))
 
+    def compile_slowly():  # a compile that cannot have ended when this process asks for the kernel
+        time.sleep(1.0)
+        compile_kernel()
+
     def fail():
         raise RuntimeError("the child fails")
 
@@ -112,8 +116,8 @@ import json
 from numba.core import event
 from rotframe.numerics import compile_apart
 
-made, load = [], compile_apart.CompiledApart.load  # each second process of a compile, as it was made
-compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or load(self, *args)
+made, load = [], compile_apart.CompiledApart.load_all  # each second process of a compile, as it was made
+compile_apart.CompiledApart.load_all = lambda self, *args: made.append(self.how) or load(self, *args)
 compiled = []
 
 
@@ -170,15 +174,15 @@ _BEGUN_DRIVER = textwrap.dedent('''
     from rotframe.numerics import compile_apart
 
     mode = sys.argv[1]
-    used, load = [], compile_apart.CompiledApart.load
-    compile_apart.CompiledApart.load = lambda self, *args: used.append(load(self, *args)) or used[-1]
+    used, load = [], compile_apart.CompiledApart.load_all
+    compile_apart.CompiledApart.load_all = lambda self, *args: used.append(load(self, *args)) or used[-1]
     t0 = time.perf_counter()
-    began = compile_apart.begin("apart_kernel", "compile_kernel" if mode == "adopted" else "sleep")
+    began = compile_apart.begin("apart_kernel", "compile_slowly" if mode == "adopted" else "sleep")
     pid = next(iter(compile_apart._BEGUN.values()))._pid if began else None
     out = {"began": began}
     if mode == "adopted":  # one kernel to make: made compiles it here unless it adopts the process begun
         out["made"] = compile_apart.made([(apart_kernel.kernel, (types.float64,))], "apart_kernel",
-                                         apart={0: ("compile_kernel", ())})
+                                         apart={0: ("compile_slowly", ())})
         out["value"] = apart_kernel.kernel(3.0)
     else:
         compile_apart.stop_begun()

@@ -316,8 +316,8 @@ from rotframe.numerics import compile_apart
 from rotframe.problem import engine
 from rotframe.problem.particles import simulate_particles
 
-made, load = [], compile_apart.CompiledApart.load  # how each second process of a compile was made
-compile_apart.CompiledApart.load = lambda self, *args: made.append(self.how) or load(self, *args)
+made, load = [], compile_apart.CompiledApart.load_all  # how each second process of a compile was made
+compile_apart.CompiledApart.load_all = lambda self, *args: made.append(self.how) or load(self, *args)
 begun, begin = [], compile_apart.begin  # the kernels begun ahead of a run's functions' compile, and those left unused
 compile_apart.begin = lambda module, function, *args: begun.append(function) or begin(module, function, *args)
 from rotframe.problem import particles

@@ -171,14 +171,21 @@ class CompiledApart:
 
         Returns whether the second process's compile was used.
         """
+        return self.load_all([(dispatcher, signature)])
+
+    def load_all(self, kernels) -> bool:
+        """`load` of each ``(dispatcher, signature)`` of ``kernels``, which the second process compiled together:
+        whether its compile was used for every one."""
         from rotframe.numerics.compiled import load_cached
 
         done = self.how is not None and self._wait()
         self.stop()
-        if done and load_cached(dispatcher, signature):
-            return True
-        dispatcher.compile(signature)
-        return False
+        used = True
+        for dispatcher, signature in kernels:
+            if not (done and load_cached(dispatcher, signature)):
+                dispatcher.compile(signature)
+                used = False
+        return used
 
 
 def _run(module, function, *args):
@@ -221,10 +228,11 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
     (``functools.cache`` where they are built, `rotframe.problem.dop853_split`).
 
     ``apart`` names, for some of them by index, the function of ``module`` that compiles it in another process
-    (``{index: (name, its arguments)}``). Where more than one is to compile, those compile in processes of their
-    own while this one compiles the rest (`rotframe.numerics.compile_apart`), then load them from the cache; a
-    process begun ahead for one of them (`begin`) is adopted, however many are to compile. Each kernel is then
-    closed to new compiles.
+    (``{index: (name, its arguments)}``; one function may compile several, which share callees). Where more than one
+    such function or kernel of this process's own is to compile, those functions run in processes of their own while
+    this one compiles the rest (`rotframe.numerics.compile_apart`), then load what they compiled from the cache; a
+    process begun ahead for one of them (`begin`) is adopted, however many are to compile. Each kernel is then closed
+    to new compiles.
     """
     from contextlib import ExitStack
 
@@ -235,22 +243,31 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
             and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
     if todo and load_only:
         return False
-    begun = {k: _BEGUN.pop(key) for k in todo if k in apart
-             and (key := (module, apart[k][0], tuple(map(str, apart[k][1])))) in _BEGUN}
-    rest = [k for k in todo if k not in begun]
-    away = [k for k in rest if k in apart] if len(rest) > 1 else []
-    if away and len(away) == len(rest):
-        away.pop()  # one compiles here
+    key = {k: (module, apart[k][0], tuple(map(str, apart[k][1]))) for k in apart}  # as `begin` keys it
+    groups: dict = {}  # each function of ``module`` to run apart -> the kernels to make that it compiles
+    for k in todo:
+        if k in key:
+            groups.setdefault(key[k], []).append(k)
+    for function in set(key.values()) - set(groups):
+        if function in _BEGUN:  # begun ahead, and what it compiles is made: it has ended, or is about to
+            _BEGUN.pop(function).stop()
+    begun = {function: _BEGUN.pop(function) for function in groups if function in _BEGUN}
+    here = [k for k in todo if k not in apart]
+    rest = [function for function in groups if function not in begun]
+    away = rest if len(here) + len(rest) > 1 else []
+    if away and not here:
+        away = away[:-1]  # one compiles here
     with ExitStack() as stack:
         for child in begun.values():
             stack.callback(child.stop)  # stopped where this process's compile fails (`CompiledApart.__exit__`)
-        children = {k: stack.enter_context(CompiledApart(module, apart[k][0], *apart[k][1])) for k in away}
+        children = {function: stack.enter_context(CompiledApart(function[0], function[1], *function[2]))
+                    for function in away}
         children.update(begun)
         for k in todo:
-            if k not in children:
+            if key.get(k) not in children:
                 kernels[k][0].compile(kernels[k][1])
-        for k, child in children.items():
-            child.load(*kernels[k])
+        for function, child in children.items():
+            child.load_all([kernels[k] for k in groups[function]])
     for kernel, _ in kernels:
         kernel.disable_compile()
     return True

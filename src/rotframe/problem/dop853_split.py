@@ -114,34 +114,34 @@ def compile_tier_trajectory(model, events, D):
 
 
 def compile_tier_stages(model, events, D):
-    """Compile the trajectory tier's stages (with the right-hand side in them, `rotframe.problem.by_address.tier_callees`)
-    for model code ``model``, ``events`` (0 or 1) and ``D`` numbers into numba's cache: a second process of a first tier
-    compile begun ahead (`begin_tier`)."""
-    stages, signature = _tier_kernels(None if int(model) == PARTICLE else True, bool(int(events)), int(D))[1]
-    stages.compile(signature)
+    """Compile the trajectory tier's stages (with the right-hand side in them) and its two right-hand sides
+    (`rotframe.problem.by_address.tier_callees`, which share that right-hand side's compile) for model code ``model``,
+    ``events`` (0 or 1) and ``D`` numbers into numba's cache: a second process of a first tier compile (`_TIER_APART`,
+    `begin_tier`)."""
+    for kernel, signature in _tier_kernels(None if int(model) == PARTICLE else True, bool(int(events)), int(D))[1:]:
+        kernel.compile(signature)
 
 
-#: the trajectory tier's kernels that compile in second processes, by their index in `_tier_kernels`: the trajectory
-#: loop and the stages, each some 1.2 s of a first compile on the 2-core reference machine (the right-hand sides that
-#: Python calls, some 0.1 s each, compile here)
-_TIER_APART = {0: "compile_tier_trajectory", 1: "compile_tier_stages"}
+#: the functions that compile the trajectory tier's kernels in second processes, by the kernels' index in
+#: `_tier_kernels`: the trajectory loop, and its callees (stages and right-hand sides, which share the right-hand
+#: side's compile), each some 1.2 to 1.4 s of a first compile on the 2-core reference machine
+_TIER_APART = {0: "compile_tier_trajectory", 1: "compile_tier_stages", 2: "compile_tier_stages",
+               3: "compile_tier_stages"}
 
 
 def begin_tier(model, events, D) -> bool:
-    """Begin compiling the trajectory tier's trajectory loop and stages (`_TIER_APART`), each not in numba's cache, in
-    second processes now: for a first run that will likely compile the tier once its own functions are compiled and its
+    """Begin compiling the trajectory tier's trajectory loop and its callees (`_TIER_APART`), those not in numba's cache,
+    in second processes now: for a first run that will likely compile the tier once its own functions are compiled and its
     first call has run as plain Python (`rotframe.problem.tiers.begin_ahead`,
     `rotframe.numerics.compile_apart.begin`). Whether any was begun."""
     from rotframe.numerics.compile_apart import begin
     from rotframe.numerics.compiled import load_cached
 
     kernels = _tier_kernels(None if model == PARTICLE else True, bool(events), D)
-    begun = False
-    for k, function in _TIER_APART.items():
-        kernel, signature = kernels[k]
-        if tuple(getattr(signature, "args", signature)) not in kernel.overloads and not load_cached(kernel, signature):
-            begun = begin(__name__, function, model, int(bool(events)), D) or begun
-    return begun
+    todo = dict.fromkeys(function for k, function in _TIER_APART.items()
+                         if tuple(getattr(kernels[k][1], "args", kernels[k][1])) not in kernels[k][0].overloads
+                         and not load_cached(*kernels[k]))
+    return any([begin(__name__, function, model, int(bool(events)), D) for function in todo])
 
 
 def whole_loop(model, method, events, D, load_only=False):
