@@ -12,6 +12,8 @@ import textwrap
 
 import pytest
 
+from rotframe.numerics.compile_apart import AHEAD_NICE
+
 _KERNEL = textwrap.dedent('''
     import time
     from numba import njit
@@ -184,7 +186,12 @@ _BEGUN_DRIVER = textwrap.dedent('''
         out["made"] = compile_apart.made([(apart_kernel.kernel, (types.float64,))], "apart_kernel",
                                          apart={0: ("compile_slowly", ())})
         out["value"] = apart_kernel.kernel(3.0)
-    else:
+    else:  # its niceness relative to this process's (it nices itself once forked: a moment to do so)
+        for _ in range(200):
+            out["nice"] = os.getpriority(os.PRIO_PROCESS, pid) - os.getpriority(os.PRIO_PROCESS, 0)
+            if out["nice"]:
+                break
+            time.sleep(0.005)
         compile_apart.stop_begun()
     try:
         os.kill(pid, 0)
@@ -200,9 +207,9 @@ _BEGUN_DRIVER = textwrap.dedent('''
 @linux
 @pytest.mark.parametrize("mode", ["adopted", "unused"])
 def test_a_process_begun_ahead_is_adopted_by_made_or_stopped_unused(tmp_path, mode):
-    """`compile_apart.begin` starts a kernel's second process before it is asked for: the `made` that asks for it
-    adopts it, loading what it compiled (one kernel to make, which `made` alone would compile here); a run that never
-    asks stops it (`stop_begun`), at once, not after its work."""
+    """`compile_apart.begin` starts a kernel's second process before it is asked for, niced (`AHEAD_NICE`): the `made`
+    that asks for it adopts it, loading what it compiled (one kernel to make, which `made` alone would compile here); a
+    run that never asks stops it (`stop_begun`), at once, not after its work."""
     (tmp_path / "apart_kernel.py").write_text(_KERNEL)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), PYTHONPATH=str(tmp_path))
     done = subprocess.run([sys.executable, "-c", _BEGUN_DRIVER, mode], env=env, capture_output=True, text=True,
@@ -214,3 +221,4 @@ def test_a_process_begun_ahead_is_adopted_by_made_or_stopped_unused(tmp_path, mo
         assert out["made"] is True and out["used"] == [True] and out["value"] == 7.0
     else:
         assert out["used"] == [] and out["seconds"] < 30.0  # its child sleeps 60 s: it was stopped
+        assert out["nice"] == min(AHEAD_NICE, 19 - os.getpriority(os.PRIO_PROCESS, 0))  # nice is at most 19
