@@ -126,6 +126,10 @@ METHOD_CODES = {"dop853": DOP853, "rk4": RK4, "rotation-splitting": SPLITTING, "
 METHOD_NAMES = {DOP853: "dop853", RK4: "rk4", SPLITTING: "splitting", SPLITTING4: "splitting4", SPLITTING6: "splitting6",
                 SPLITTING8: "splitting8"}
 _VARIANTS: dict = {}
+#: the variants that `variant` with ``load_only`` found neither made nor in numba's cache, in this process: not looked
+#: for there again (each run in the trajectory tier asks whether the whole loop is made, and a look in the cache took
+#: some 1 ms of a 1.5 ms run); one that another process compiles meanwhile is found by the next process
+_NOT_CACHED: set = set()
 #: a body's splittings whose compiled loop calls its step at its address (`rotframe.problem.body_split_step`): Kahan
 #: & Li's compositions, of 9 and 17 splitting steps a step, where that call costs nothing measurable (0.91 to 1.01 of
 #: the time with the step inside, 2026-12-02); a step of the splitting of order 2 or 4 is short enough that the call
@@ -152,6 +156,8 @@ def variant(model, method, events, compiled=True, D=None, load_only=False):
     D = STATE_LENGTH[int(model)] if D is None else int(D)
     key = (int(model), method, bool(events), D, compiled if compiled == TRAJECTORY_TIER else bool(compiled))
     kernel = _VARIANTS.get(key)
+    if kernel is None and load_only and key in _NOT_CACHED:
+        return None
     if kernel is None:
         if key[-1] == TRAJECTORY_TIER:
             from rotframe.problem.dop853_split import trajectory_tier
@@ -178,8 +184,10 @@ def variant(model, method, events, compiled=True, D=None, load_only=False):
 
             kernel = plain(_variant_kernel(*key[:4]))
         if kernel is None:  # load_only, and a part is not made
+            _NOT_CACHED.add(key)
             return None
         _VARIANTS[key] = kernel
+        _NOT_CACHED.discard(key)
     return kernel
 
 

@@ -123,8 +123,9 @@ def begin_ahead(variant, particles) -> bool:
     from rotframe.problem.engine import TRAJECTORY_TIER
 
     model, method, events, D = variant
-    if particles > PLAIN_PARTICLES or not trajectory_tier_fits(method, particles) or loop_is_compiled(variant) \
-            or loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,)):
+    # the tier first: once made in this process, it answers without a look in numba's cache (a warm run's case)
+    if particles > PLAIN_PARTICLES or not trajectory_tier_fits(method, particles) \
+            or loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,)) or loop_is_compiled(variant):
         return False
     from rotframe.problem.dop853_split import begin_tier
 
