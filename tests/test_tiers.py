@@ -335,11 +335,12 @@ def spring_run():
 run = spring_run()
 begun_first, unused_first = list(begun), list(unused)  # the first run's
 from numba.core import caching  # then what a second run loads from numba's disk cache: nothing
-reloaded, load_overload = [], caching.Cache.load_overload
+reloaded, looked, load_overload = [], [], caching.Cache.load_overload
 
 
 def counted(self, *args):
     found = load_overload(self, *args)
+    looked.append(self._name)
     if found is not None:
         reloaded.append(found.fndesc.qualname)
     return found
@@ -350,7 +351,8 @@ spring_run()
 print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
                   "compiled": engine.variant(0, "dop853", False, load_only=True) is not None,
                   "trajectory": engine.variant(0, "dop853", False, "trajectory", load_only=True) is not None,
-                  "apart": made, "reloaded": reloaded, "begun": begun_first, "unused": unused_first}))
+                  "apart": made, "reloaded": reloaded, "begun": begun_first, "unused": unused_first,
+                  "looked": looked}))
 """
 
 
@@ -384,8 +386,10 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["trajectory"] and not again["compiled"] and again["apart"] == []
     assert again["r"] == short["r"]
-    # a run in the tier asks whether the whole loop is made: the tier's kernels, once made, are not loaded again
+    # a run in the tier asks whether the whole loop is made: the tier's kernels, once made, are not loaded again, and
+    # the whole loop, once not found in numba's cache, is not looked for there again (`engine._NOT_CACHED`)
     assert long["reloaded"] == again["reloaded"] == [], (long["reloaded"], again["reloaded"])
+    assert long["looked"] == again["looked"] == [], (long["looked"], again["looked"])
 
 
 def _blows_up(t, r, v):
