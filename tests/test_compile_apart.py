@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 
 import pytest
 
@@ -186,6 +187,9 @@ _BEGUN_DRIVER = textwrap.dedent('''
         out["made"] = compile_apart.made([(apart_kernel.kernel, (types.float64,))], "apart_kernel",
                                          apart={0: ("compile_slowly", ())})
         out["value"] = apart_kernel.kernel(3.0)
+    elif mode == "exit":  # left running: this process stops it as it exits
+        print(json.dumps({"pid": pid}))
+        sys.exit(0)
     else:  # its niceness relative to this process's (it nices itself once forked: a moment to do so)
         for _ in range(200):
             out["nice"] = os.getpriority(os.PRIO_PROCESS, pid) - os.getpriority(os.PRIO_PROCESS, 0)
@@ -205,17 +209,27 @@ _BEGUN_DRIVER = textwrap.dedent('''
 
 @needs_two_cores
 @linux
-@pytest.mark.parametrize("mode", ["adopted", "unused"])
+@pytest.mark.parametrize("mode", ["adopted", "unused", "exit"])
 def test_a_process_begun_ahead_is_adopted_by_made_or_stopped_unused(tmp_path, mode):
     """`compile_apart.begin` starts a kernel's second process before it is asked for, niced (`AHEAD_NICE`): the `made`
-    that asks for it adopts it, loading what it compiled (one kernel to make, which `made` alone would compile here); a
-    run that never asks stops it (`stop_begun`), at once, not after its work."""
+    that asks for it adopts it, loading what it compiled (one kernel to make, which `made` alone would compile here);
+    `stop_begun` stops it, at once, not after its work; a process that exits with one still running stops it."""
     (tmp_path / "apart_kernel.py").write_text(_KERNEL)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), PYTHONPATH=str(tmp_path))
     done = subprocess.run([sys.executable, "-c", _BEGUN_DRIVER, mode], env=env, capture_output=True, text=True,
                           timeout=300, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-2000:]
     out = json.loads(done.stdout.strip().splitlines()[-1])
+    if mode == "exit":  # its child sleeps 60 s: gone as the driver ended (killed, then reaped by the system)
+        for _ in range(400):
+            try:
+                os.kill(out["pid"], 0)
+            except ProcessLookupError:
+                break
+            time.sleep(0.005)
+        else:
+            pytest.fail(f"the process begun ahead ({out['pid']}) outlived the process that began it")
+        return
     assert out["began"] is True and out["left"] == 0 and out["alive"] is False
     if mode == "adopted":
         assert out["made"] is True and out["used"] == [True] and out["value"] == 7.0

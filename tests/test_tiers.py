@@ -318,11 +318,8 @@ from rotframe.problem.particles import simulate_particles
 
 made, load = [], compile_apart.CompiledApart.load_all  # how each second process of a compile was made
 compile_apart.CompiledApart.load_all = lambda self, *args: made.append(self.how) or load(self, *args)
-begun, begin = [], compile_apart.begin  # the kernels begun ahead of a run's functions' compile, and those left unused
+begun, begin = [], compile_apart.begin  # the kernels begun ahead of a run's functions' compile
 compile_apart.begin = lambda module, function, *args: begun.append(function) or begin(module, function, *args)
-from rotframe.problem import particles
-unused, stop_begun = [], particles.stop_begun
-particles.stop_begun = lambda: unused.append(len(compile_apart._BEGUN)) or stop_begun()
 
 def spring(t, r, v):
     return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
@@ -333,7 +330,7 @@ def spring_run():
 
 
 run = spring_run()
-begun_first, unused_first = list(begun), list(unused)  # the first run's
+begun_first, unused_first = list(begun), len(compile_apart._BEGUN)  # the first run's, and those it left running
 from numba.core import caching  # then what a second run loads from numba's disk cache: nothing
 reloaded, looked, load_overload = [], [], caching.Cache.load_overload
 
@@ -360,9 +357,9 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
     one switches and compiles DOP853's trajectory tier, not the whole loop, its trajectory and stages in forked
     processes where there are two cores (`rotframe.numerics.compile_apart`), begun before the run's own functions
-    compiled (`rotframe.problem.tiers.begin_ahead`: the short run begins them too, and stops them unused); the next
-    short one, in another process, finds the tier in the cache and runs there, compiling nothing. The final states
-    agree to the bit."""
+    compiled (`rotframe.problem.tiers.begin_ahead`: the short run begins them too, and leaves them, stopped at its
+    process's exit); the next short one, in another process, finds the tier in the cache and runs there, compiling
+    nothing. The final states agree to the bit."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
 
     def child(duration):
@@ -380,8 +377,8 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     two = len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux")
     assert long["apart"] == (["fork", "fork"] if two else [None, None]) and short["apart"] == []
     ahead = ["compile_tier_trajectory", "compile_tier_stages"]
-    assert short["begun"] == long["begun"] == ahead and short["unused"] == [2 if two else 0]
-    assert long["unused"] == [0]  # the long run adopted both
+    assert short["begun"] == long["begun"] == ahead and short["unused"] == (2 if two else 0)
+    assert long["unused"] == 0  # the long run adopted both
     again = child(10.0)
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["trajectory"] and not again["compiled"] and again["apart"] == []

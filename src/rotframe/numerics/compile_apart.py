@@ -29,11 +29,12 @@ compiling the kernel itself: the same machine code, later.
 **Begun ahead** (`begin`). A run that will likely compile a kernel later, after work of its own on
 one core (a problem's functions to compile, then a first call as plain Python:
 `rotframe.problem.tiers`), may begin that kernel's second process before that work; the `made` that
-needs it adopts the process instead of starting one. A run that ends without needing it stops it
-(`stop_begun`). Such a process runs niced (`AHEAD_NICE`), so that it takes the cores this process leaves
-idle and slows this one's own work little: a first short run of a spring, with its two processes
-begun and stopped unused, took 1.09 to 1.26 of its time without them (0.40 to 0.45 s against 0.34 to
-0.39 s; at the same priority 1.35 to 1.59) on the 2-core reference machine, 2026-12-02. Adopted, it is
+needs it adopts the process instead of starting one. A process no `made` adopts runs on, for a later run of
+this process to adopt (a short first run leaves it; a long one after it finds its kernels compiled), or ends
+with its compile; this process stops any still running when it exits (`stop_begun`). Such a process runs niced (`AHEAD_NICE`), so that it takes the cores this process leaves
+idle and slows this one's own work little: a first short run of a spring, which begins two and does
+not use them, took 1.09 to 1.26 of its time without them (0.40 to 0.45 s against 0.34 to 0.39 s; at
+the same priority 1.35 to 1.59) on the 2-core reference machine, 2026-12-02. Adopted, it is
 put back at this process's priority where this one may raise it (`CompiledApart.hurry`).
 """
 
@@ -45,7 +46,7 @@ import sys
 import threading
 import time
 
-__all__ = ["CompiledApart", "made", "begin", "stop_begun", "spare_core", "TIMEOUT_S", "AHEAD_NICE"]
+__all__ = ["CompiledApart", "made", "begin", "begun", "stop_begun", "spare_core", "TIMEOUT_S", "AHEAD_NICE"]
 
 #: seconds the second process may take, from its start, before this one compiles the kernel itself
 TIMEOUT_S = 120.0
@@ -136,8 +137,8 @@ class CompiledApart:
         env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
         module, function, args = self.call
         try:
-            self._child = subprocess.Popen([sys.executable, "-c", _CHILD, str(self.nice), module, function, *args], env=env,
-                                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+            self._child = subprocess.Popen([sys.executable, "-c", _CHILD, str(self.nice), module, function, *args],
+                                           env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                            stderr=subprocess.DEVNULL)
         except OSError:
             return
@@ -229,12 +230,22 @@ def begin(module, function, *args) -> bool:
         apart = CompiledApart(module, function, *args, nice=AHEAD_NICE).__enter__()
         if apart.how is None:
             return False
+        if not _BEGUN:
+            import atexit
+
+            atexit.register(stop_begun)  # once a process (`stop_begun` leaves nothing to stop at a second call)
         _BEGUN[key] = apart
     return True
 
 
+def begun(module, function, *args) -> bool:
+    """Whether a process begun ahead for ``module.function(*args)`` (`begin`) waits for a `made` to adopt it."""
+    return (module, function, tuple(map(str, args))) in _BEGUN
+
+
 def stop_begun():
-    """Stop every second process begun ahead (`begin`) that no `made` adopted: the run that began it ended."""
+    """Stop every second process begun ahead (`begin`) that no `made` adopted, and reap those that ended: at this
+    process's exit."""
     while _BEGUN:
         _BEGUN.popitem()[1].stop()
 

@@ -37,8 +37,8 @@ from rotframe.problem.in_parts import LoopWithParts
 from rotframe.problem.signatures import (A1, A2, A3, B1, F8, FUNCTIONS, FUNCTIONS_AT, I1, I2, I8, PARTICLE,
                                          PROBLEM, STAGES_SIG, SYSTEM_SIG, loop_with_parts)
 
-__all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop", "compile_tier_stages", "begin_tier",
-           "TRAJECTORY_ARGS", "TRAJECTORY_SIGNATURES", "WHOLE_LOOP_SIGNATURE"]
+__all__ = ["trajectory_tier", "whole_loop", "compile_tier_trajectory", "compile_whole_loop", "compile_tier_stages",
+           "begin_tier", "TRAJECTORY_ARGS", "TRAJECTORY_SIGNATURES", "WHOLE_LOOP_SIGNATURE"]
 
 #: the compiled parts: entry points without reference counts (`rotframe.numerics.compiled.ENTRY_OPTIONS`)
 _uncounted_entry = njit(**ENTRY_OPTIONS)
@@ -130,18 +130,20 @@ _TIER_APART = {0: "compile_tier_trajectory", 1: "compile_tier_stages", 2: "compi
 
 
 def begin_tier(model, events, D) -> bool:
-    """Begin compiling the trajectory tier's trajectory loop and its callees (`_TIER_APART`), those not in numba's cache,
-    in second processes now: for a first run that will likely compile the tier once its own functions are compiled and its
-    first call has run as plain Python (`rotframe.problem.tiers.begin_ahead`,
+    """Begin compiling the trajectory tier's trajectory loop and its callees (`_TIER_APART`), those not in numba's
+    cache, in second processes now: for a first run that will likely compile the tier once its own functions are
+    compiled and its first call has run as plain Python (`rotframe.problem.tiers.begin_ahead`,
     `rotframe.numerics.compile_apart.begin`). Whether any was begun."""
-    from rotframe.numerics.compile_apart import begin
+    from rotframe.numerics.compile_apart import begin, begun
     from rotframe.numerics.compiled import load_cached
 
     kernels = _tier_kernels(None if model == PARTICLE else True, bool(events), D)
+    args = (model, int(bool(events)), D)
     todo = dict.fromkeys(function for k, function in _TIER_APART.items()
-                         if tuple(getattr(kernels[k][1], "args", kernels[k][1])) not in kernels[k][0].overloads
+                         if not begun(__name__, function, *args)  # by an earlier run: no look in the cache again
+                         and tuple(getattr(kernels[k][1], "args", kernels[k][1])) not in kernels[k][0].overloads
                          and not load_cached(*kernels[k]))
-    return any([begin(__name__, function, model, int(bool(events)), D) for function in todo])
+    return any([begin(__name__, function, *args) for function in todo])
 
 
 def whole_loop(model, method, events, D, load_only=False):

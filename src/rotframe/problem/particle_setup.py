@@ -199,9 +199,8 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     checked, its driver None (the flow is the caller's, `rotframe.problem.exact`). Nor for a run
     that a steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem
     (``fixed_steady`` False: DOP853's alone, not the scenes' fixed-step drivers). With ``ahead`` (the run may begin
-    in the plain tier), a loop the run will compile if it is long begins to compile in a second process before the
-    problem's functions compile (`rotframe.problem.tiers.begin_ahead`; the caller stops it if unused,
-    `rotframe.numerics.compile_apart.stop_begun`).
+    in the plain tier), a loop the run will compile if it is long begins to compile in second processes before the
+    problem's functions compile (`rotframe.problem.tiers.begin_ahead`).
     """
     import time
 

@@ -34,7 +34,6 @@ from rotframe.problem.pacing import Pacer
 from rotframe.problem.particle_setup import (checked_atol, checked_attitude, function_roles, problem_tuple, run_state,
                                              set_up, start_states)
 from rotframe.problem.terms import FRAME_TERMS, Force, StringConstraint, energy_by_numpy
-from rotframe.numerics.compile_apart import stop_begun
 from rotframe.problem.tiers import PlainTierFailed, SteadyLoopFailed, Tier, run_falling_back
 
 __all__ = ["Force", "StringConstraint", "simulate_particles", "ProblemRun", "advance_blocks", "raise_if_failed",
@@ -84,10 +83,7 @@ def simulate_particles(**kwargs) -> ProblemRun:
     again compiled from its start (`rotframe.problem.tiers`): a failure is met and reported as the
     compiled loop meets it, whatever the caches held.
     """
-    try:
-        return run_falling_back(_simulate_particles, kwargs)
-    finally:
-        stop_begun()  # a loop begun ahead that the run did not compile (`rotframe.problem.tiers.begin_ahead`)
+    return run_falling_back(_simulate_particles, kwargs)
 
 
 def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin_acceleration=None, events=(),

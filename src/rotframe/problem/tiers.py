@@ -49,10 +49,10 @@ Only runs on the CPU of at most `PLAIN_PARTICLES` particles (or one rigid body:
 first call alone would be too long as Python.
 
 **The trajectory tier.** A DOP853 run of so few particles compiles less than the whole loop
-(`rotframe.problem.dop853_split.trajectory_tier`): the loop's trajectory from stop to stop, where every
-step is taken, and its right-hand side, each compiled on its own and cached; the loop over the
-particles stays the plain remake's Python, some 25 to 45 us a call of the trajectory, one a
-particle (it runs through the stops itself). The whole loop compiles the trajectory a second time inside its own code, and an
+(`rotframe.problem.dop853_split.trajectory_tier`): the loop's trajectory, where every step is taken
+(through the run's stops, `rotframe.numerics.stops`), and its right-hand side, each compiled on its own
+and cached; the loop over the particles stays the plain remake's Python, some 25 to 45 us a call of the
+trajectory, one a particle. The whole loop compiles the trajectory a second time inside its own code, and an
 entry point of thirty arguments: the tier compiled in 0.58 of its time on the 2-core reference
 machine (4.2 s against 7.3 s on a slow day, numba's start included, 2026-12-01). Side by side with
 the tree before, fresh caches, three runs each, the same day: a first run of 1,000 s of a spring
@@ -118,7 +118,8 @@ def begin_ahead(variant, particles) -> bool:
     compile the tier.
 
     A long first run then compiles them beside its functions' compile and its first plain call, on the second core; a
-    run that ends plain stops them unused (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun.
+    run that ends plain leaves them to a later run of the process, stopped if still running at its exit
+    (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun.
     """
     from rotframe.problem.engine import TRAJECTORY_TIER
 
