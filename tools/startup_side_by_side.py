@@ -2,6 +2,8 @@
 
 For each tree, alternately, in new processes with empty numba and rotframe caches:
 
+* ``short``: the start-up bench's first problem ever (10 s of the spring: the plain tier answers it) in caches of
+  its own;
 * ``long``: the start-up bench's first problem ever, long (`rotframe.app.bench.problem_startup`: 1,000 s of a spring
   in a rotating frame, DOP853, the ``simulate`` call alone);
 * ``new``: then a new problem in the caches that run left (10 s, another spring constant);
@@ -48,11 +50,13 @@ def _scene(src, name):
 
 def main(old, new, reps, scenes=("cr3bp",)):
     trees = {"before": old, "after": new}
-    rows = {tree: {"long": [], "new": [], **{name: [] for name in scenes}} for tree in trees}
+    rows = {tree: {"short": [], "long": [], "new": [], **{name: [] for name in scenes}} for tree in trees}
     for _ in range(reps):
         order = list(trees.items())
         random.shuffle(order)  # which tree runs first in a pair, by chance: the machine's drift falls on both
         for tree, src in order:
+            with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers:
+                rows[tree]["short"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 10.0))
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as drivers:
                 rows[tree]["long"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 1000.0))
                 rows[tree]["new"].append(_simulate(src, cache, drivers, 1.0 + random.random(), 10.0))
