@@ -33,10 +33,12 @@ needs it adopts the process instead of starting one. A process no `made` adopts 
 run of this process to adopt (a short first run leaves it; a long one after it finds its kernels
 compiled), or ends with its compile; this process stops any still running as it exits
 (`stop_begun`). Such a process runs niced (`AHEAD_NICE`), so that it takes the cores this process
-leaves idle and slows this one's own work little: a first short run of a spring, which begins two
-and does not use them, took 1.09 to 1.26 of its time without them (0.40 to 0.45 s against 0.34 to
-0.39 s; at the same priority 1.35 to 1.59) on the 2-core reference machine, 2026-12-02. Adopted, it
-is put back at this process's priority where this one may raise it (`CompiledApart.hurry`).
+leaves idle and slows this one's own work less: a first short run of a spring, which begins two and
+does not use them, took 1.09 to 1.26 of its time without them in a quiet hour (0.40 to 0.45 s against
+0.34 to 0.39 s; at the same priority 1.35 to 1.59), 1.18 to 1.61 in a busier one, on the 2-core
+reference machine, 2026-12-02. Adopted, it is put back at this process's priority where this one may
+raise it (`CompiledApart.hurry`): under other load a niced process compiles slowly, and an unprivileged
+process may not raise it back.
 """
 
 from __future__ import annotations
