@@ -49,7 +49,7 @@ import sys
 import threading
 import time
 
-__all__ = ["CompiledApart", "made", "begin", "begun", "stop_begun", "spare_core", "TIMEOUT_S", "AHEAD_NICE"]
+__all__ = ["CompiledApart", "made", "is_made", "begin", "begun", "stop_begun", "spare_core", "TIMEOUT_S", "AHEAD_NICE"]
 
 #: seconds the second process may take, from its start, before this one compiles the kernel itself
 TIMEOUT_S = 120.0
@@ -253,6 +253,14 @@ def stop_begun():
         _BEGUN.popitem()[1].stop()
 
 
+def is_made(kernel, signature) -> bool:
+    """Whether ``kernel`` is made for ``signature``: in this process already, or loaded now from numba's cache (under
+    the key numba saved it, the signature as compiled, `rotframe.numerics.compiled.load_cached`)."""
+    from rotframe.numerics.compiled import load_cached
+
+    return tuple(getattr(signature, "args", signature)) in kernel.overloads or load_cached(kernel, signature)
+
+
 def made(kernels, module, load_only=False, apart=()) -> bool:
     """Load ``kernels`` (``[(dispatcher, signature), ...]``) from numba's cache, compiling those that are not there;
     False, compiling nothing, where ``load_only`` and one is not.
@@ -271,11 +279,7 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
     """
     from contextlib import ExitStack
 
-    from rotframe.numerics.compiled import load_cached
-
-    todo = [k for k, (kernel, sig) in enumerate(kernels)
-            if tuple(getattr(sig, "args", sig)) not in kernel.overloads  # made in this process already
-            and not load_cached(kernel, sig)]  # else from the cache, under the key numba saved it (the signature)
+    todo = [k for k, (kernel, sig) in enumerate(kernels) if not is_made(kernel, sig)]
     if todo and load_only:
         return False
     key = {k: (module, apart[k][0], tuple(map(str, apart[k][1]))) for k in apart}  # as `begin` keys it
@@ -286,20 +290,19 @@ def made(kernels, module, load_only=False, apart=()) -> bool:
     for function in set(key.values()) - set(groups):
         if function in _BEGUN:  # begun ahead, and what it compiles is made: it has ended, or is about to
             _BEGUN.pop(function).stop()
-    begun = {function: _BEGUN.pop(function) for function in groups if function in _BEGUN}
+    adopted = {function: _BEGUN.pop(function) for function in groups if function in _BEGUN}
     here = [k for k in todo if k not in apart]
-    rest = [function for function in groups if function not in begun]
+    rest = [function for function in groups if function not in adopted]
     away = rest if len(here) + len(rest) > 1 else []
     if away and not here:
         away = away[:-1]  # one compiles here
     with ExitStack() as stack:
-        for child in begun.values():
+        for child in adopted.values():
             stack.callback(child.stop)  # stopped where this process's compile fails (`CompiledApart.__exit__`)
+            child.hurry()
         children = {function: stack.enter_context(CompiledApart(function[0], function[1], *function[2]))
                     for function in away}
-        children.update(begun)
-        for child in begun.values():
-            child.hurry()
+        children.update(adopted)
         for k in todo:
             if key.get(k) not in children:
                 kernels[k][0].compile(kernels[k][1])

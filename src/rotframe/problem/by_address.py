@@ -24,8 +24,8 @@ from rotframe.problem.models import DOP853
 from rotframe.problem.signatures import A1, A2, CONTEXT, F8, I8, STAGES_SIG, SYSTEM_SIG
 from rotframe.problem.steps import body_system, particle_system, stepper
 
-__all__ = ["stages_at", "system_at", "with_reference", "tier_callees", "trajectory_at", "system_by_address",
-           "problem_functions"]
+__all__ = ["stages_at", "system_at", "problem_data", "with_reference", "tier_callees", "trajectory_at",
+           "system_by_address", "problem_functions"]
 
 _uncounted_entry = njit(**ENTRY_OPTIONS)
 
@@ -48,12 +48,18 @@ def system_at(ctx, t, z, K, s):
 
 
 @jit_inline
+def problem_data(ctx):
+    """The problem's data ``(prob, fns, W)`` that the right-hand side takes, of a trajectory's ``ctx`` (its first three:
+    `with_reference`, `rotframe.problem.dop853_variant.dop853_parts`)."""
+    return ctx[0], ctx[1], ctx[2]
+
+
+@jit_inline
 def with_reference(ctx):
     """The trajectory tier's ``ctx = (prob, fns, W, S, stages, system)``, its stops and the addresses of its compiled
     stages and right-hand side, as the loop hands it on: the problem's data also at an address, ``ref``, before the
     addresses (made once a call of the trajectory, `rotframe.problem.calls.by_reference`)."""
-    data = (ctx[0], ctx[1], ctx[2])
-    return ctx[0], ctx[1], ctx[2], by_reference(data), ctx[4], ctx[5]
+    return ctx[0], ctx[1], ctx[2], by_reference(problem_data(ctx)), ctx[4], ctx[5]
 
 
 def _system_call(ctx, t, z, K, s):

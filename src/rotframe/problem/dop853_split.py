@@ -104,12 +104,17 @@ def _tier_kernels(body, events, D):
     return ((dop853_parts(body, events, D, entry=True), TRAJECTORY_SIGNATURES[bool(events)]),) + tier_callees(body, D)
 
 
+def _tier_kernels_of(model, events, D):
+    """`_tier_kernels` for model code ``model``, ``events`` (0 or 1) and ``D`` numbers, as a second process is given
+    them (strings) or a caller has them."""
+    return _tier_kernels(None if int(model) == PARTICLE else True, bool(int(events)), int(D))
+
+
 def compile_tier_trajectory(model, events, D):
     """Compile the trajectory tier's trajectory loop for model code ``model``, ``events`` (0 or 1) and ``D`` numbers
     into numba's cache: the second process of a first tier compile (`trajectory_tier`, `whole_loop`,
     `rotframe.numerics.compile_apart`)."""
-    events = bool(int(events))
-    trajectory, signature = _tier_kernels(None if int(model) == PARTICLE else True, events, int(D))[0]
+    trajectory, signature = _tier_kernels_of(model, events, D)[0]
     trajectory.compile(signature)
 
 
@@ -118,7 +123,7 @@ def compile_tier_stages(model, events, D):
     (`rotframe.problem.by_address.tier_callees`, which share that right-hand side's compile) for model code ``model``,
     ``events`` (0 or 1) and ``D`` numbers into numba's cache: a second process of a first tier compile (`_TIER_APART`,
     `begin_tier`)."""
-    for kernel, signature in _tier_kernels(None if int(model) == PARTICLE else True, bool(int(events)), int(D))[1:]:
+    for kernel, signature in _tier_kernels_of(model, events, D)[1:]:
         kernel.compile(signature)
 
 
@@ -134,15 +139,13 @@ def begin_tier(model, events, D) -> bool:
     cache, in second processes now: for a first run that will likely compile the tier once its own functions are
     compiled and its first call has run as plain Python (`rotframe.problem.tiers.begin_ahead`,
     `rotframe.numerics.compile_apart.begin`). Whether any was begun."""
-    from rotframe.numerics.compile_apart import begin, begun
-    from rotframe.numerics.compiled import load_cached
+    from rotframe.numerics.compile_apart import begin, begun, is_made
 
-    kernels = _tier_kernels(None if model == PARTICLE else True, bool(events), D)
     args = (model, int(bool(events)), D)
+    kernels = _tier_kernels_of(*args)
     todo = dict.fromkeys(function for k, function in _TIER_APART.items()
                          if not begun(__name__, function, *args)  # by an earlier run: no look in the cache again
-                         and tuple(getattr(kernels[k][1], "args", kernels[k][1])) not in kernels[k][0].overloads
-                         and not load_cached(*kernels[k]))
+                         and not is_made(*kernels[k]))
     return any([begin(__name__, function, *args) for function in todo])
 
 

@@ -17,7 +17,7 @@ from rotframe.numerics.compiled import bound, jit_inline
 from rotframe.numerics.dop853_loop import (ABORTED, COLLAPSED, DIVERGED, NONFINITE, PAUSED, REACHED, STOPPED,
                                            WATCH_FAILED, dop853_start, dop853_trajectory)
 from rotframe.numerics.step_control import own_tolerances
-from rotframe.problem.by_address import stages_at, system_at, with_reference
+from rotframe.problem.by_address import problem_data, stages_at, system_at, with_reference
 from rotframe.problem.calls import RAISED
 from rotframe.problem.event_watch import watcher
 from rotframe.problem.loop_state import load_particle, save_particle, watcher_context
@@ -50,12 +50,6 @@ def run_stops(ctx):
     """The run's stops ``S`` (`rotframe.numerics.stops`), the fourth of the trajectory's ``ctx = (prob, fns, W, S,
     ...)``: no step crosses one."""
     return ctx[3]
-
-
-@jit_inline
-def problem_data(ctx):
-    """The problem's data ``(prob, fns, W)`` that the right-hand side takes, of the trajectory's ``ctx``."""
-    return ctx[0], ctx[1], ctx[2]
 
 
 def dop853_parts(body, events, D, entry=False):
