@@ -207,8 +207,7 @@ def _trajectory(ctx, t, y, h, t_end, h_max, times, k_out, out, p, rtol, atol, K,
         if STOPPING and t >= t_end:
             # a stop reached: the next leg, begun as a call from the stop would begin it
             t_end = _leg_end(S, t, final)
-            rejected = False
-            finite_rejection = True
+            finite_rejection = True  # (``rejected`` is False: a step ends on a stop on its first try, or accepted)
             while k_out < n_out and times[k_out] <= t:
                 STORE(out, k_out, p, y)
                 k_out += 1
