@@ -101,6 +101,47 @@ def test_sweep_device_gpu_on_the_simulator_gives_the_cpu_rows(tmp_path):
         assert len(a) == 3 and all(abs(x - y) <= 1e-12 * max(1.0, abs(x)) for x, y in zip(a, b)), key
 
 
+SWEEP_SCRIPT = textwrap.dedent("""
+    import json
+    import numpy as np
+    from numba import config
+    assert config.ENABLE_CUDASIM
+    from rotframe.particles import gpu
+    from rotframe.particles.threads import device_scope
+    from rotframe.scenes import tower_drop
+
+    points = [dict(height=h, latitude=50.9, drag=d, g_model="wgs84", magnify=1000.0)
+              for h in (20.0, 45.0, 130.0) for d in (0.0, 2e-3)]
+    out = []
+    for terms in (["gravity", "coriolis"], ["gravity", "coriolis", "altitude-gravity", "centrifugal"]):
+        for method in ("rk4", "rotation-splitting", "rotation-splitting4"):
+            before = gpu.launches()
+            on_gpu, on_cpu = {2: None, 5: None}, {2: None, 5: None}
+            with device_scope("gpu"):
+                a = tower_drop.simulate_ensemble(points, terms, method, {"step": 0.03}, tracks=on_gpu)
+            launched = gpu.launches() - before
+            b = tower_drop.simulate_ensemble(points, terms, method, {"step": 0.03}, tracks=on_cpu)
+            out.append({"terms": terms, "method": method, "launched": launched,
+                        "metrics": max(abs(x[k] - y[k]) / max(1e-300, abs(y[k])) for x, y in zip(a, b) for k in y),
+                        "tracks": max(float(np.max(np.abs(on_gpu[k][1] - on_cpu[k][1]))) for k in on_cpu)})
+    print(json.dumps(out))
+""")
+
+
+def test_a_gpu_sweep_runs_the_engine_which_gives_the_scenes_gpu_kernel_the_cpu_sweeps_steps():
+    """The tower drop's sweep on the GPU is one run of the engine a group (`tower_drop._on_gpu`), which keeps each
+    drop's end alone and so runs on the scenes' GPU kernel (`rotframe.problem.steady`; the kernel's launches are
+    counted), altitude gravity, drag and the centrifugal term among the terms: every metric and kept path that of the
+    CPU's sweep on the engine's loops, to round-off, each drop taking the CPU's steps."""
+    res = _simulated(["-c", SWEEP_SCRIPT])
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = json.loads(res.stdout.strip().splitlines()[-1])
+    assert len(rows) == 6
+    for row in rows:
+        assert row["launched"] >= 2, row  # the scenes' kernel, not the engine's own GPU loop (which it does not count)
+        assert row["metrics"] <= 1e-12 and row["tracks"] == 0.0, row  # the tracks: the CPU's, both
+
+
 @pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
 def test_device_gpu_without_a_gpu_exits_2_in_one_line(capsys):
     code = cli.main(["run", "tower-drop", "--device", "gpu", "--no-record"])
@@ -202,6 +243,9 @@ def test_bench_gpu_on_the_simulator_does_the_same_work_as_the_hand_written_kerne
     # the user's own problem (rotframe.simulate(device="gpu")) beside the scenes' ensemble of the same terms
     users = [r for r in rows if "of_scene_gpu" in r]
     assert len(users) == 4 and all(r["same_work"] and r["of_scene_gpu"] > 0 for r in users)
+    # the same with the built-in terms and one sample: the engine's steady specialisation, the scenes' kernel
+    builtins = [r for r in rows if "builtin_of_scene_gpu" in r]
+    assert len(builtins) == 4 and all(r["same_work"] and r["builtin_of_scene_gpu"] > 0 for r in builtins)
     for r in doors:
         assert r["of_ceiling"] > 0 and r["kernel_of_ceiling"] > 0 and r["ceiling_goal"] == 0.5
     timed_from_host = [r for r in rows if "same_work" in r]

@@ -98,6 +98,90 @@ def test_the_gpu_refuses_what_it_does_not_run_in_one_line_each_and_names_a_raisi
     assert int(raised[0].split()[-1]) >= 2  # the samples before the failure are kept
 
 
+STEADY_ON_THE_GPU = textwrap.dedent("""
+    import json
+    import numpy as np
+    from numba import config
+    assert config.ENABLE_CUDASIM
+    from rotframe import forces as rf
+    from rotframe.events import crossing
+    from rotframe.problem.particles import simulate_particles  # simulate's core: the counts and statuses kept
+    from rotframe.problem.terms import StringConstraint
+
+    rng = np.random.default_rng(5)
+    N = 7
+    r0 = np.zeros((N, 3))
+    r0[:, 2] = rng.uniform(5.0, 60.0, N)
+    r0[-1, 2] = 1e4  # never lands
+    v0 = rng.normal(size=(N, 3))
+    g = rf.gravity([0.0, 0.0, -9.8])
+    ground = crossing(2, 0.0, direction=-1, terminal=True, name="ground")
+    apex = crossing(2, 0.0, of="v", direction=-1, name="apex")
+    cases = [
+        ("rk4", [g, rf.drag(quadratic=2e-3)], ("coriolis", "centrifugal"), [ground], 1),
+        ("rotation-splitting", [g], ("coriolis",), [ground], 1),  # every particle lands (below): its counts are theirs
+        ("rotation-splitting4", [rf.altitude_gravity(9.8, 6.4e6), rf.drag(linear=0.1)], ("coriolis", "centrifugal"),
+         [ground], 1),
+        ("rotation-splitting", [rf.pendulum(70.0, (0.0, 0.0, 70.0)), g], ("coriolis",), [], 1),
+        ("rk4", [g], ("coriolis",), [ground], 3),  # samples between: the engine's own loop
+        ("rk4", [g], ("coriolis",), [apex], 1),  # an event that does not end the run: the engine's own loop
+    ]
+    out = []
+    for method, forces, frame_terms, events, samples in cases:
+        kw = dict(omega=[0.0, 4e-3, 5e-3], v0=v0, duration=4.0, forces=forces, frame_terms=frame_terms, events=events,
+                  method=method, step=0.01, samples=samples)
+        kw["r0"] = r0[:-1] if len(out) == 1 else r0
+        if isinstance(forces[0], StringConstraint):  # the pendulum's string: its particles on its sphere, at rest
+            x = 70.0 * np.sin(rng.uniform(0.1, 0.5, N))
+            kw["r0"] = np.stack([x, np.zeros(N), 70.0 - np.sqrt(70.0 ** 2 - x * x)], axis=1)
+            kw["v0"] = np.zeros((N, 3))
+        elif len(out) == 1:
+            kw["v0"] = v0[:-1]
+        gpu = simulate_particles(**kw, device="gpu")
+        cpu = simulate_particles(**kw, inline=False)  # the engine's own loop on the CPU: no code of the scenes'
+        counted = simulate_particles(**kw)  # the CPU's choice: the scenes' drivers count as the GPU's kernel
+        a, b = gpu.trajectory, cpu.trajectory
+        scale = max(1.0, float(np.max(np.abs(np.nan_to_num(b.r)))), float(np.max(np.abs(np.nan_to_num(b.v)))))
+        row = {"method": method, "kernel": any("scenes' GPU kernel" in n for n in gpu.notes),
+               "times": bool(np.array_equal(a.times, b.times)),
+               "nan": bool(np.array_equal(np.isnan(a.r), np.isnan(b.r))),
+               "drv": float(max(np.nanmax(np.abs(a.r - b.r)), np.nanmax(np.abs(a.v - b.v))) / scale),
+               "counts": [a.steps, b.steps, a.nfev, counted.trajectory.nfev,
+                          any("scenes' fixed-step drivers" in n for n in counted.notes)],
+               "status": bool(np.array_equal(a.extras["status"], b.extras["status"])), "events": []}
+        for name in b.event_times:
+            ta, tb = a.event_times[name], b.event_times[name]
+            row["events"].append([[len(x) for x in ta] == [len(x) for x in tb],
+                                  max((float(np.max(np.abs(x - y), initial=0.0)) for x, y in zip(ta, tb)), default=0.0),
+                                  max((float(np.max(np.abs(x - y), initial=0.0)) / scale
+                                       for x, y in zip(a.event_states[name], b.event_states[name])), default=0.0),
+                                  sum(len(x) for x in tb)])
+        out.append(row)
+    print(json.dumps(out))
+""")
+
+
+def test_a_steady_problem_that_keeps_its_end_alone_runs_the_scenes_gpu_kernel_with_the_engines_numbers():
+    """`rotframe.problem.steady` gives a fixed-step run on the GPU that keeps its end alone (``samples=1``), its one
+    event terminal, to the scenes' GPU kernel: against the engine's own loop on the CPU (``inline=False``, which runs
+    none of the scenes' code), the same samples, event times and states, statuses and counts, drag, a string and
+    altitude gravity among the terms. A run with samples between, or an event that does not end it, is the engine's
+    own loop's on the GPU."""
+    import json
+
+    res = _simulated(["-c", STEADY_ON_THE_GPU])
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = json.loads(res.stdout.strip().splitlines()[-1])
+    assert [row["kernel"] for row in rows] == [True] * 4 + [False] * 2, rows
+    for row in rows:
+        assert row["times"] and row["nan"] and row["status"], row
+        assert row["drv"] <= 1e-13, row  # round-off (the simulator runs the GPU's arithmetic in Python)
+        steps_gpu, steps_cpu, nfev_gpu, nfev_drivers, on_drivers = row["counts"]
+        assert steps_gpu == steps_cpu and (nfev_gpu == nfev_drivers or not (on_drivers and row["kernel"])), row
+        for same_counts, dt, dstate, located in row["events"]:
+            assert same_counts and located > 0 and dt <= 1e-13 and dstate <= 1e-13, row
+
+
 @pytest.mark.skipif(gpu.available(), reason="a GPU (or the simulator) is here")
 def test_device_gpu_without_a_gpu_is_refused_in_one_line():
     with pytest.raises(ScenarioError, match="no CUDA GPU") as err:

@@ -54,6 +54,17 @@ def table(rows) -> str:
             lines.append(f"| {u['integrator']}{' + ground event' if u['event'] else ''} | "
                          f"{u['particle_steps_per_s']:.3g} | {twin['particle_steps_per_s']:.3g} | "
                          f"{u['of_scene_gpu']:.2f} | {u['same_work']} ({u['same_work_max_rel']:.1e}) |")
+    builtins = [r for r in body if "builtin_of_scene_gpu" in r]
+    if builtins:
+        lines += ["", "The same problem with the built-in terms (`rotframe.forces.gravity`, the built-in crossing) and "
+                  "one sample, `rotframe.simulate(device='gpu', samples=1)`: the engine gives it to the scenes' GPU "
+                  "kernel (`rotframe.problem.steady`).", "",
+                  "| case | rotframe.simulate, built-in terms | ratio to integrate_ensemble | same work |",
+                  "|---|---|---|---|"]
+        for b in builtins:
+            lines.append(f"| {b['integrator']}{' + ground event' if b['event'] else ''} | "
+                         f"{b['particle_steps_per_s']:.3g} | {b['builtin_of_scene_gpu']:.2f} | "
+                         f"{b['same_work']} ({b['same_work_max_rel']:.1e}) |")
     notes = sorted({r["notes"] for r in body if r.get("notes")})
     lines.extend(f"Note: {n}." for n in notes)
     return "\n".join(lines) + "\n"

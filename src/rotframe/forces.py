@@ -122,7 +122,8 @@ def altitude_gravity(g0, radius) -> Force:
     def potential(t, r):
         return -g0 * R * R / (R + r[2])
 
-    return Force(gravity, potential=potential, name="altitude-gravity", takes_params=False, array_potential=True)
+    return Force(gravity, potential=potential, name="altitude-gravity", takes_params=False, array_potential=True,
+                 scene=("altitude-gravity", g0, R))
 
 
 def central_gravity(gm, centre) -> Force:

@@ -37,7 +37,7 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
-__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "grid_time", "start_short_of",
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "grid_time", "steps_to_event", "start_short_of",
            "own_tolerances", "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
@@ -94,6 +94,22 @@ def grid_time(times, s, j, h):
     times at the same times to the bit (``t0 + k h`` from each call's own start did not).
     """
     return times[s] + j * h if j > 0 else times[s]
+
+
+def steps_to_event(t_event, times, sps, h):
+    """The steps each particle took to the one in which its terminal event at ``t_event`` fell: step ``j`` of sample
+    interval ``k`` runs from ``times[k] + j h`` (`grid_time`) to the next step's start
+    (``times[k + 1]`` for the last), and the event is in ``(start, end]``: the counts that the steady runs of the
+    fixed-step methods report (`rotframe.problem.particles`, `rotframe.problem.steady_gpu`), as the engine's loop
+    counts them."""
+    k = np.clip(np.searchsorted(times, t_event, side="left") - 1, 0, times.size - 2)
+    j = np.clip(np.floor((t_event - times[k]) / h).astype(np.int64), 0, sps - 1)
+    for _ in range(2):  # the floor's rounding: at most one step either way, moved to the grid's own start times
+        start = np.where(j > 0, times[k] + j * h, times[k])
+        j = np.where((start >= t_event) & (j > 0), j - 1, j)
+        nxt = times[k] + (j + 1) * h
+        j = np.where((nxt < t_event) & (j + 1 < sps), j + 1, j)
+    return k * sps + j + 1
 
 
 @jit_inline

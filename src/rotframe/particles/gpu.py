@@ -9,6 +9,8 @@ kernel's ``py_func`` and rebinds every compiled function that it calls to that
 function's own GPU version, recursively. So there is one source of the physics,
 compiled for two targets, and a fix to a force is a fix on both.
 
+The engine reaches this kernel from the terms: a fixed-step run of ``rotframe.simulate(device="gpu")`` on a steady
+problem that keeps its end alone (`rotframe.problem.steady`), the tower drop's GPU sweeps among them.
 [`integrate_ensemble_gpu`][rotframe.particles.gpu.integrate_ensemble_gpu] runs one GPU thread per particle through the
 fixed-step methods (``rotation-splitting``, ``rotation-splitting4``, ``rk4``),
 watching one event as the CPU driver does (the same crossing rule and
@@ -266,17 +268,7 @@ def integrate_ensemble_gpu(model, r0, v0, duration, event, *, method, run):
     ScenarioError
         No GPU ([`require`][rotframe.particles.gpu.require]), or a method the GPU does not run (`GPU_METHODS`).
     """
-    from numba import cuda
-
-    launch = GpuLaunch(model, duration, event, method=method, run=run)
-    r0 = np.ascontiguousarray(r0, dtype=np.float64)
-    v0 = np.ascontiguousarray(v0, dtype=np.float64)
-    n = r0.shape[0]
-    if n == 0:
-        return np.full(0, math.nan), np.empty((0, 6))
-    d_out, d_t = cuda.device_array((n, 6)), cuda.device_array(n)  # written by every thread: no upload
-    launch(cuda.to_device(r0), cuda.to_device(v0), d_out, d_t)
-    return d_t.copy_to_host(), d_out.copy_to_host()
+    return GpuLaunch(model, duration, event, method=method, run=run).from_host(r0, v0)
 
 
 class GpuLaunch:
@@ -311,6 +303,21 @@ class GpuLaunch:
         self.kernel = _kernel(loop_code(info.name), True if info.name == "rk4" else None, True if host.length > 0.0 else None,
                               event is not None, bool(host.steady), _structure_source(host))
         self.settings = [cuda.to_device(a) for a in (P, wt, wv, wint, table)]
+
+    def from_host(self, r0, v0):
+        """``(t_event, state)`` of the particles starting at the host arrays ``r0``, ``v0`` (N, 3), brought back to
+        the host (`integrate_ensemble_gpu`, and the engine's steady specialisation on the GPU,
+        `rotframe.problem.steady`)."""
+        from numba import cuda
+
+        r0 = np.ascontiguousarray(r0, dtype=np.float64)
+        v0 = np.ascontiguousarray(v0, dtype=np.float64)
+        n = r0.shape[0]
+        if n == 0:
+            return np.full(0, math.nan), np.empty((0, 6))
+        d_out, d_t = cuda.device_array((n, 6)), cuda.device_array(n)  # written by every thread: no upload
+        self(cuda.to_device(r0), cuda.to_device(v0), d_out, d_t)
+        return d_t.copy_to_host(), d_out.copy_to_host()
 
     def __call__(self, r, v, out, ev_t):
         blocks, threads = launch_shape(r.shape[0])

@@ -242,7 +242,7 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     settings = [check_event(g, k) for k, g in enumerate(events)]  # (direction, terminal) of each
     slots = event_slots([terminal for _, terminal in settings], max_events)
     steady = steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r, v,
-                          uf.event_names(events), fixed_steady) if steady else None
+                          uf.event_names(events), fixed_steady, samples) if steady else None
     if steady is not None:  # the steady loop, compiled once for every such problem: nothing of this one is built
         return SetUp(r, v, method, duration, times, rtol, hfix, D, frame, origin, terms, forces, labels, events, params,
                      frame_terms, on_gpu, slots=slots, steady=steady)

@@ -111,6 +111,11 @@ def _simulate_particles(*, omega, r0, v0, duration, forces=(), params=(), origin
         return _exact_run(s.terms, s.frame, s.origin, s.events, s.frame_terms, r, v, s.duration, s.times.size - 1,
                           progress, energy)
     if s.steady is not None:  # a steady loop: chosen from the terms, compiled once for every such problem
+        if s.on_gpu:
+            from rotframe.problem.steady_gpu import steady_gpu_trajectory
+
+            traj, note = steady_gpu_trajectory(s, progress)
+            return _steady_result(s, traj, [], list(s.frame.notes) + [note], energy)
         if s.method != "dop853":
             return _steady_fixed_run(s, progress, energy)
         return _steady_run(s, checked_atol(atol), progress, energy)
@@ -452,6 +457,7 @@ def _steady_fixed_run(s, progress, energy=True) -> ProblemRun:
     steps, samples and event times to the bit, its one event a row of theirs. The counts are the engine's: each
     particle's steps up to the end or to the step of its terminal event, the most any took; the force evaluations
     are the drivers' own (``evals_per_step`` a step). A run that fails raises `SteadyLoopFailed`, as `_steady_run`."""
+    from rotframe.numerics.step_control import steps_to_event
     from rotframe.particles.chunked import KernelSetup, run_chunked
     from rotframe.particles.integrators import METHODS
 
@@ -466,7 +472,7 @@ def _steady_fixed_run(s, progress, energy=True) -> ProblemRun:
     warnings, t_stop = _records_of(traj, rows)
     steps = np.full(N, samples * setup.sps, dtype=np.int64)
     stopped = np.isfinite(t_stop)
-    steps[stopped] = _steps_to(t_stop[stopped], s.times, setup.sps, setup.h)
+    steps[stopped] = steps_to_event(t_stop[stopped], s.times, setup.sps, setup.h)
     traj.steps = int(steps.max()) if N else 0
     traj.nfev = traj.steps * setup.evals_per_step
     notes = list(s.frame.notes) + [f"method {s.method}: the scenes' fixed-step drivers (a constant rotation rate, "
@@ -509,20 +515,6 @@ def _dropped_records(counts, kept) -> list:
     each (`rotframe.problem.particle_setup.event_slots`) hold; none where every crossing was kept."""
     dropped = int(np.sum(np.maximum(counts - kept, 0)))
     return [f"{dropped} event crossings beyond {kept} per particle were located but not kept"] if dropped else []
-
-
-def _steps_to(t_event, times, sps, h):
-    """The steps each particle took to the one in which its terminal event at ``t_event`` fell: step ``j`` of sample
-    interval ``k`` runs from ``times[k] + j h`` (`rotframe.numerics.step_control.grid_time`) to the next step's start
-    (``times[k + 1]`` for the last), and the event is in ``(start, end]``."""
-    k = np.clip(np.searchsorted(times, t_event, side="left") - 1, 0, times.size - 2)
-    j = np.clip(np.floor((t_event - times[k]) / h).astype(np.int64), 0, sps - 1)
-    for _ in range(2):  # the floor's rounding: at most one step either way, moved to the grid's own start times
-        start = np.where(j > 0, times[k] + j * h, times[k])
-        j = np.where((start >= t_event) & (j > 0), j - 1, j)
-        nxt = times[k] + (j + 1) * h
-        j = np.where((nxt < t_event) & (j + 1 < sps), j + 1, j)
-    return k * sps + j + 1
 
 
 def steady_omega(frame):

@@ -1,6 +1,6 @@
 """The engine's steady specialisations: DOP853 on a steady frame with uniform gravity, a string and one built-in
 crossing, compiled once; RK4 and the rotation splitting on a steady frame with uniform gravity, air drag, a string,
-the frame's terms and one built-in crossing, on the scenes' drivers.
+the frame's terms and one built-in crossing, on the scenes' drivers, and on the GPU on the scenes' GPU kernel.
 
 Most particle problems that run DOP853 in a rotating frame are *steady*: a constant rotation rate,
 uniform gravity (or none), the pendulum's string (or none), and no other term. Foucault's pendulum is
@@ -68,6 +68,18 @@ around them included, where the engine's inlined loop took 1.66 and 1.12 (``pyth
   (`rotframe.particles.forces.position_acceleration`);
 - there is at most one event, a built-in crossing (`rotframe.events.crossing`), not zero at any particle's start
   (the drivers take the sign after a zero start from derivatives, the engine from re-steps).
+
+On the GPU (``device="gpu"``) the same fixed-step problems qualify where the run keeps its end alone (``samples=1``)
+and its event, if any, is terminal, whatever the frame's omega (`omega_kept` asks for the bits the CPU's drivers
+share with the engine's loop, which the GPU does not promise), and so does altitude gravity (`rotframe.forces.altitude_gravity`, known by its
+``Force.scene``) in place of uniform gravity: the scenes' GPU kernel runs them (`rotframe.particles.gpu.GpuLaunch`,
+one thread a particle, its six numbers in registers, no samples between: since 2026-12-02), where the engine's own
+GPU loop (`rotframe.problem.gpu`) keeps a sample grid and reaches the terms through the problem's glue, at 0.08 to
+0.16 of the kernel's speed when last measured on an H200 (2026-11-30). It takes the steps of the CPU's run of the
+same problem (a step cut to divide the sample interval, counted from the start), so the samples, event times and
+states agree with the engine's loop to round-off (a GPU may fuse a multiply and an add; on numba's simulator to the
+bit, ``tests/test_simulate_gpu.py``), and the counts are the drivers'. The tower drop's sweeps on the GPU reach the
+kernel this way (`rotframe.scenes.tower_drop._on_gpu`), as one run of the engine a group of drops.
 
 A run that fails on the drivers (a state not finite, their guard on a speed that grows under no force) runs again
 on the engine's loop, which names the cause (`rotframe.problem.tiers.SteadyLoopFailed`). The counts reported are
@@ -152,7 +164,7 @@ def omega_kept(w):
 
 
 def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, frame_terms, r=None, v=None,
-                 event_names=(), fixed=True):
+                 event_names=(), fixed=True, samples=0):
     """The `SteadyProblem` of a run that a steady loop runs, or None where the run does not qualify (the module
     docstring): ``terms`` the run's forces and string as `set_up` reads them, ``frame_terms`` those of the frame's
     terms that act, ``r``, ``v`` (N, 3) the start states and ``event_names`` the events' names; ``fixed`` False
@@ -160,18 +172,21 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
     is the DOP853 loop's parameters (`rotframe.particles.dop853_steady.steady_parameters`: the frame's omega as
     given, so the engine's arithmetic to the bit), ``model`` the same problem as the scenes'
     `rotframe.particles.model.ParticleModel`, which the calls' driver (`rotframe.particles.chunked`) reads for its
-    work limits and the fixed-step drivers run."""
+    work limits and the fixed-step drivers run. On the GPU (``on_gpu``) a fixed-step run whose ``samples`` is 1 and
+    whose event, if any, is terminal qualifies too: the scenes' GPU kernel runs it (`rotframe.particles.gpu`, the
+    module docstring)."""
     fixed_step = fixed and method in FIXED_STEADY
-    if ((method != "dop853" and not fixed_step) or on_gpu or not jit or inline is not None
+    on_gpu_kernel = on_gpu and fixed_step and samples == 1
+    if ((method != "dop853" and not fixed_step) or (on_gpu and not on_gpu_kernel) or not jit or inline is not None
             or (events and not fixed) or frame.kind != "constant" or origin.kind != "zero"):
         return None
     omega = np.asarray(frame.data[0], dtype=float)
-    if fixed_step and np.any(omega) and not omega_kept(omega):  # the drivers take the engine's steps (docstring)
-        return None
+    if fixed_step and not on_gpu and np.any(omega) and not omega_kept(omega):  # the drivers take the engine's steps
+        return None  # to the bit (docstring); the GPU's kernel, to round-off whatever the omega
     rows = _event_rows(events, event_names, r, v)
-    if rows is None:
+    if rows is None or (on_gpu and not all(row.terminal for row in rows)):  # the GPU's thread ends at its first event
         return None
-    g = string = drag = None
+    g = string = drag = altitude = None
     for f in terms:
         if isinstance(f, StringConstraint) and string is None:
             string = f
@@ -180,7 +195,10 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
         if flow is not None:  # the drivers' drag is the engine's
             drag = flow
             continue
-        b = _constant_acceleration(f) if g is None else None
+        if on_gpu and g is None and altitude is None and isinstance(f, Force) and f.scene[:1] == ("altitude-gravity",):
+            altitude = f.scene[1:]  # the GPU's kernel computes the scenes' term, the engine's to round-off
+            continue
+        b = _constant_acceleration(f) if g is None and altitude is None else None
         if b is None:
             return None
         g = b
@@ -191,6 +209,9 @@ def steady_model(method, on_gpu, jit, inline, frame, origin, terms, events, fram
 
     names = (("gravity",) if g is not None else ()) + tuple(t for t in frame_terms if t != "euler")
     extra = {"g": g} if g is not None else {}
+    if altitude is not None:
+        names += ("altitude-gravity",)
+        extra.update(g0=float(altitude[0]), radius=float(altitude[1]))
     pivot, length = np.zeros(3), 0.0
     if string is not None:
         names += ("pendulum",)

@@ -61,6 +61,11 @@ class Force:
         energy diagnostic is then computed by numpy, with nothing compiled for it. Set by the built-in terms
         of `rotframe.forces` whose potential is arithmetic on ``r[0]``, ``r[1]``, ``r[2]``; False for a force
         of your own, whose potential is compiled.
+    scene : tuple, optional
+        The term as the scenes' model (`rotframe.particles.model.ParticleModel`) holds it, where nothing else of the
+        term says what it is: ``("altitude-gravity", g0, R)`` for `rotframe.forces.altitude_gravity`. The GPU's
+        steady specialisation reads it (`rotframe.problem.steady`). Set by the built-in terms; empty for a force of
+        your own.
     """
 
     accel: object
@@ -71,6 +76,7 @@ class Force:
     takes_params: bool = True
     linear: tuple = ()
     array_potential: bool = False
+    scene: tuple = ()
 
     def params_for(self, params) -> tuple:
         """The ``params`` this force's functions are called with: the run's, or none (`takes_params`)."""

@@ -194,14 +194,16 @@ def engine_remarks(res) -> dict:
             "warnings": list(getattr(res, "warnings", []))}
 
 
-def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=(), atol=None, energy=True):
+def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events=(), atol=None, energy=True,
+                  device=None):
     """Integrate a particle scene's model on the engine (`rotframe.problem.particles.simulate_particles`) with the
     run settings (``step``, ``rtol``, ``samples``): every particle scene's run.
 
     ``finish(result)`` builds the scene's result from the engine's run (a `ProblemRun`, or the trajectory up to an
     early stop: `guarded`); its ``notes`` and ``warnings`` are the engine's. ``atol`` (DOP853's absolute tolerance,
     as ``rotframe.simulate`` takes it) where the scene has its own scale; None for each particle's own. ``energy``
-    False skips the engine's energy diagnostic (an ensemble that reads its events alone).
+    False skips the engine's energy diagnostic (an ensemble that reads its events alone); ``device`` is
+    ``rotframe.simulate``'s (None: the CPU).
     """
     from rotframe.problem.particles import simulate_particles  # the engine's front door: imported by a run
 
@@ -209,7 +211,7 @@ def run_on_engine(model, r0, v0, duration, method, run, progress, finish, events
     return guarded(finish, simulate_particles, omega=omega, r0=r0, v0=v0, duration=duration, method=method,
                    forces=forces, frame_terms=frame_terms, events=list(events), rtol=run_setting(run, "rtol"),
                    atol=atol, step=run.get("step"), samples=int(run_setting(run, "samples")), progress=progress,
-                   energy=energy)
+                   energy=energy, device=device)
 
 
 def guarded(finish, func, *args, **kwargs):

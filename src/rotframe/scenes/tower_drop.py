@@ -73,7 +73,7 @@ def fall_duration(h, drag, g):
     return float(out) if np.ndim(out) == 0 else out
 
 
-#: the ground on the engine: the same crossing as `GROUND` (which the sweeps' ensembles run on the scenes' kernels)
+#: the ground on the engine: the same crossing as `GROUND`, the scenes' row that the engine's steady loops take it as
 GROUND_EVENT = crossing(2, 0.0, direction=-1, terminal=True, name="ground")
 
 
@@ -257,10 +257,10 @@ def _on_engine(model, r0, duration, method, run, keep):
     `rotframe.particles.ensemble.MAX_TRACK_SAMPLES`) whatever the number of drops, in calls of at most
     `rotframe.particles.ensemble.PATH_BUDGET` particle-samples: a drop's numbers never depend on the others.
     """
-    from rotframe.particles.ensemble import MAX_TRACK_SAMPLES, PATH_BUDGET
+    from rotframe.particles.ensemble import PATH_BUDGET
 
     n = len(r0)
-    samples = max(16, min(int(run.get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
+    samples = _path_samples(run)
     per_call = max(1, PATH_BUDGET // (samples + 1))
     t_event, state, paths = np.full(n, math.nan), np.empty((n, 6)), {}
     for lo in range(0, n, per_call):
@@ -276,12 +276,37 @@ def _on_engine(model, r0, duration, method, run, keep):
 
 
 def _on_gpu(model, r0, duration, method, run, keep):
-    """`_on_engine` on the GPU: the scenes' GPU kernels (`rotframe.particles.ensemble.integrate_ensemble`), where the
-    engine's GPU loop (``simulate(device="gpu")``) ran at 0.08 to 0.16 of their speed when last measured (2026-11)."""
-    from rotframe.particles.ensemble import integrate_ensemble
+    """`_on_engine` on the GPU: every drop a thread of one run of the engine that keeps each drop's end alone
+    (``samples=1``, the ground its terminal event), which the engine gives to the scenes' GPU kernel, chosen from the
+    terms (`rotframe.problem.steady`); the paths of the indices ``keep`` on the CPU (`_on_engine`). Its step is
+    `_on_engine`'s, which divides the intervals of a kept path's samples, so each drop takes the CPU's steps (to
+    round-off: the GPU counts them from the start). The drops are cut in calls that each fit the run limits in force
+    (`rotframe.limits`), as `_on_engine`'s calls fit its paths' memory."""
+    from rotframe import limits
+    from rotframe.problem.arguments import run_grid
 
-    ens = integrate_ensemble(model, r0, np.zeros_like(r0), duration, GROUND, method=method, run=run, keep=keep)
-    return ens.t_event, ens.state, ens.paths
+    n = len(r0)
+    step = run_grid(duration, _path_samples(run), None, run.get("step"), fixed=True, what=f"method {method}")[4]
+    lim = limits.current()
+    fit = min(lim.max_steps / math.ceil(duration / step), lim.max_samples / 2)  # drops a call within the limits
+    per_call = n if fit >= n else max(1, int(fit))
+    t_event, state = np.full(n, math.nan), np.empty((n, 6))
+    for lo in range(0, n, per_call):
+        hi = min(n, lo + per_call)
+        traj = run_on_engine(model, r0[lo:hi], np.zeros((hi - lo, 3)), duration, method,
+                             dict(run, samples=1, step=step), None, lambda res: getattr(res, "trajectory", res),
+                             events=[GROUND_EVENT], energy=False, device="gpu")
+        t_event[lo:hi], state[lo:hi] = traj.first_events("ground")
+    paths = _on_engine(model, r0[keep], duration, method, run, range(len(keep)))[2] if keep else {}
+    return t_event, state, {k: paths[j] for j, k in enumerate(keep)}
+
+
+def _path_samples(run):
+    """The samples of a kept path (the run's ``samples``, 16 to `rotframe.particles.ensemble.MAX_TRACK_SAMPLES`), on
+    whose intervals every drop of an ensemble steps, whether or not its path is kept."""
+    from rotframe.particles.ensemble import MAX_TRACK_SAMPLES
+
+    return max(16, min(int(run.get("samples") or MAX_TRACK_SAMPLES), MAX_TRACK_SAMPLES))
 
 
 def ensemble_duration(duration):

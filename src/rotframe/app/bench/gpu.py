@@ -40,7 +40,7 @@ import numpy as np
 
 from rotframe.app.bench.throughput import best_interleaved
 
-__all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL", "USER_ROW"]
+__all__ = ["gpu_rows", "CEILING_GOAL", "JAX_GOAL", "USER_ROW", "BUILTIN_ROW"]
 
 #: issue 26's goals: rotframe's GPU rate over the hand-written kernel's, and over JAX vmap's on the same GPU
 CEILING_GOAL = 0.5
@@ -122,7 +122,8 @@ def _case(method, rk4, event, n, steps, quick):
     cases = [("rotframe integrate_ensemble(device='gpu')", ours, ours_state),
              ("hand-written numba CUDA kernel", lambda: _host_to_host(numba_kernel, r0, v0, g, w, c, s, h, steps),
               hand_state),
-             (USER_ROW, _user_problem(method, event, r0, v0, g, w, h, duration), _user_state)]
+             (USER_ROW, _user_problem(method, event, r0, v0, g, w, h, duration), _user_state),
+             (BUILTIN_ROW, _user_problem(method, event, r0, v0, g, w, h, duration, builtin=True), _user_state)]
     # rotframe.simulate always models the frame's centrifugal term: its scene twin, for the user row's ratio and check
     spun = ParticleModel(("gravity", "coriolis", "centrifugal"), omega=model.omega, g=np.array(g))
     cases.append((SCENE_TWIN_ROW, lambda: integrate_ensemble(spun, r0, v0, duration, ground, method=method, run=run,
@@ -191,6 +192,11 @@ def _case(method, rk4, event, n, steps, quick):
                                                                                        twin_state)
     user["same_work_note"] = "against the scene twin (+ centrifugal): " + user["same_work_note"]
     user["of_scene_gpu"] = user["particle_steps_per_s"] / twin["particle_steps_per_s"]
+    builtin = next(r for r in rows if r["method"].startswith(BUILTIN_ROW))
+    builtin_state, builtin_landed = results[[name for name, _, _ in cases].index(BUILTIN_ROW)]
+    builtin["same_work"], builtin["same_work_max_rel"], note = same_state(builtin_state, builtin_landed, twin_state)
+    builtin["same_work_note"] = "against the scene twin (+ centrifugal): " + note
+    builtin["builtin_of_scene_gpu"] = builtin["particle_steps_per_s"] / twin["particle_steps_per_s"]
     mine["notes"] = "; ".join(notes)
     return rows
 
@@ -198,15 +204,20 @@ def _case(method, rk4, event, n, steps, quick):
 #: the row of a user's problem: the same work through ``rotframe.simulate(device="gpu")`` (the frame's centrifugal
 #: term included, as simulate always models it)
 USER_ROW = "rotframe.simulate(device='gpu'), user force and event"
+#: the same work through ``rotframe.simulate(device="gpu")`` with the built-in terms (`rotframe.forces.gravity`, the
+#: built-in crossing), one sample: the engine gives it to the scenes' GPU kernel (`rotframe.problem.steady`)
+BUILTIN_ROW = "rotframe.simulate(device='gpu', samples=1), built-in terms"
 #: the scenes' ensemble of the same terms as the user row (gravity, Coriolis, centrifugal): its reference
 SCENE_TWIN_ROW = "rotframe integrate_ensemble(device='gpu'), + centrifugal"
 
 
-def _user_problem(method, event, r0, v0, g, w, h, duration):
-    """The same work as a user's problem: gravity as a force of the user's, the ground as an event of the user's.
+def _user_problem(method, event, r0, v0, g, w, h, duration, builtin=False):
+    """The same work as a user's problem: gravity as a force of the user's, the ground as an event of the user's;
+    with ``builtin``, gravity and the ground as `rotframe.forces.gravity` and `rotframe.events.crossing`.
 
-    Through the public door, ``rotframe.simulate`` (`rotframe.problem.gpu`): the frame's Coriolis
-    term is rotframe's, from ``omega``; one sample at the end (the ensemble's calls keep no path).
+    Through the public door, ``rotframe.simulate`` (`rotframe.problem.gpu`; with ``builtin``, the steady
+    specialisation that `rotframe.problem.steady` chooses from the terms): the frame's Coriolis term is rotframe's,
+    from ``omega``; one sample at the end (the ensemble's calls keep no path).
     """
     import rotframe
     from rotframe import limits
@@ -221,12 +232,18 @@ def _user_problem(method, event, r0, v0, g, w, h, duration):
 
     ground.terminal = True
     ground.direction = -1
+    force = gravity
+    if builtin:
+        from rotframe.events import crossing
+        from rotframe.forces import gravity as builtin_gravity
+
+        force, ground = builtin_gravity(g), crossing(2, 0.0, direction=-1, terminal=True, name="ground")
     events = [ground] if event else []
     work = limits.current().with_overrides(max_steps=math.inf)
 
     def call():
         with limits.applied(work):
-            return rotframe.simulate(omega=list(w), r0=r0, v0=v0, duration=duration, forces=[gravity], events=events,
+            return rotframe.simulate(omega=list(w), r0=r0, v0=v0, duration=duration, forces=[force], events=events,
                                      method=method, step=h, samples=1, device="gpu", max_events=1)
 
     return call
