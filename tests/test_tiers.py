@@ -325,8 +325,11 @@ def spring(t, r, v):
     return -1.7 * r[0], -1.7 * r[1], -1.7 * r[2]
 
 def spring_run():
-    return simulate_particles(omega=[0.0, 0.0, 0.5], r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=float(sys.argv[1]),
-                              forces=[spring], samples=10)
+    T = float(sys.argv[1])
+    # a frame given as a table (argv[2] "table"; the same steady rate) has an evaluator of its own to compile
+    omega = ([0.0, T / 2, T], [[0.0, 0.0, 0.5]] * 3) if sys.argv[2:] == ["table"] else [0.0, 0.0, 0.5]
+    return simulate_particles(omega=omega, r0=[1.0, 0.0, 0.0], v0=[0.0, 1.0, 0.0], duration=T, forces=[spring],
+                              samples=10)
 
 
 run = spring_run()
@@ -356,15 +359,14 @@ print(json.dumps({"notes": run.notes, "r": run.trajectory.r[-1, 0].tolist(),
 def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     """In a new process with every cache empty, a short run is answered by the plain tier and compiles no loop; a long
     one switches and compiles DOP853's trajectory tier, not the whole loop, its trajectory and stages in forked
-    processes where there are two cores (`rotframe.numerics.compile_apart`), begun before the run's own functions
-    compiled (`rotframe.problem.tiers.begin_ahead`: the short run begins them too, and leaves them, stopped at its
-    process's exit); the next short one, in another process, finds the tier in the cache and runs there, compiling
-    nothing. The final states agree to the bit."""
+    processes where there are two cores (`rotframe.numerics.compile_apart`); the next short one, in another process,
+    finds the tier in the cache and runs there, compiling nothing. The final states agree to the bit. A steady frame
+    begins nothing ahead: the run's own compile is short, and a short run would pay for processes it never uses."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
 
-    def child(duration):
-        out = subprocess.run([sys.executable, "-c", _CHILD, repr(duration)], env=env, capture_output=True, text=True,
-                             timeout=600)
+    def child(duration, *frame):
+        out = subprocess.run([sys.executable, "-c", _CHILD, repr(duration), *frame], env=env, capture_output=True,
+                             text=True, timeout=600)
         assert out.returncode == 0, out.stderr[-2000:]
         return json.loads(out.stdout.strip().splitlines()[-1])
 
@@ -375,10 +377,9 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     assert any("then the loop compiled, its trajectories alone" in n for n in long["notes"]), long["notes"]
     assert long["trajectory"] and not long["compiled"]
     two = len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux")
-    assert long["apart"] == (["fork", "fork"] if two else [None, None]) and short["apart"] == []
-    ahead = ["compile_tier_trajectory", "compile_tier_stages"]
-    assert short["begun"] == long["begun"] == ahead and short["unused"] == (2 if two else 0)
-    assert long["unused"] == 0  # the long run adopted both
+    # the trajectory forked, the stages compiled here meanwhile (nothing begun ahead: the frame is steady)
+    assert long["apart"] == (["fork"] if two else [None]) and short["apart"] == []
+    assert short["begun"] == long["begun"] == [] and short["unused"] == long["unused"] == 0
     again = child(10.0)
     assert not any("plain-Python" in n for n in again["notes"]), again["notes"]
     assert again["trajectory"] and not again["compiled"] and again["apart"] == []
@@ -387,6 +388,27 @@ def test_a_first_run_in_a_fresh_install_begins_in_the_plain_tier(tmp_path):
     # the whole loop, once not found in numba's cache, is not looked for there again (`engine._NOT_CACHED`)
     assert long["reloaded"] == again["reloaded"] == [], (long["reloaded"], again["reloaded"])
     assert long["looked"] == again["looked"] == [], (long["looked"], again["looked"])
+
+
+def test_a_first_run_of_a_varying_frame_begins_the_tier_ahead_of_its_own_compile(tmp_path):
+    """A frame given as a table compiles its evaluator before the run's first plain call: the trajectory tier's two
+    parts are begun in second processes before it (`rotframe.problem.tiers.begin_ahead`), a long run adopts both and
+    compiles the tier, not the whole loop; a short one leaves them running, stopped at its process's exit."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), ROTFRAME_CACHE_DIR=str(tmp_path / "drivers"))
+    two = len(os.sched_getaffinity(0)) >= 2 and sys.platform.startswith("linux")
+    ahead = ["compile_tier_trajectory", "compile_tier_stages"]
+    runs = {}
+    for name, duration in (("short", 10.0), ("long", 400.0)):  # the long one in caches of its own: nothing made
+        own = dict(env, NUMBA_CACHE_DIR=str(tmp_path / name))
+        out = subprocess.run([sys.executable, "-c", _CHILD, repr(duration), "table"], env=own, capture_output=True,
+                             text=True, timeout=600)
+        assert out.returncode == 0, out.stderr[-2000:]
+        runs[name] = json.loads(out.stdout.strip().splitlines()[-1])
+    short, long = runs["short"], runs["long"]
+    assert any("short enough for its plain-Python remake" in n for n in short["notes"]), short["notes"]
+    assert short["begun"] == long["begun"] == ahead and short["unused"] == (2 if two else 0)
+    assert long["unused"] == 0 and long["trajectory"] and not long["compiled"]  # the long run adopted both
+    assert long["apart"] == (["fork", "fork"] if two else [None, None]) and short["apart"] == []
 
 
 def _blows_up(t, r, v):

@@ -199,8 +199,10 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     checked, its driver None (the flow is the caller's, `rotframe.problem.exact`). Nor for a run
     that a steady loop runs (``steady``, `rotframe.problem.steady`): its ``steady`` is that loop's problem
     (``fixed_steady`` False: DOP853's alone, not the scenes' fixed-step drivers). With ``ahead`` (the run may begin
-    in the plain tier), a loop the run will compile if it is long begins to compile in second processes before the
-    problem's functions compile (`rotframe.problem.tiers.begin_ahead`).
+    in the plain tier) and a varying frame or origin, whose evaluator compiles first, a loop the run will compile if
+    it is long begins to compile in second processes before the problem's functions compile
+    (`rotframe.problem.tiers.begin_ahead`): a steady frame's own compile is too short for the overlap to pay for the
+    processes a short run never uses (`tools/startup_side_by_side.py`, 2026-12-02).
     """
     import time
 
@@ -258,7 +260,8 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
-    if ahead and jit and not on_gpu and inline is not True:
+    # begun ahead where the run has much of its own to compile first: a varying frame's or origin's evaluator
+    if ahead and jit and not on_gpu and inline is not True and (frame.kind != "constant" or origin.kind != "zero"):
         from rotframe.problem.signatures import PARTICLE
         from rotframe.problem.tiers import begin_ahead
 

@@ -119,7 +119,8 @@ def begin_ahead(variant, particles) -> bool:
 
     A long first run then compiles them beside its functions' compile and its first plain call, on the second core; a
     run that ends plain leaves them to a later run of the process, stopped if still running at its exit
-    (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun.
+    (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun. The caller asks only where the run has
+    much of its own to compile first: a varying frame's or origin's evaluator (`rotframe.problem.particle_setup`).
     """
     from rotframe.problem.engine import TRAJECTORY_TIER
 
