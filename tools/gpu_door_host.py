@@ -1,4 +1,4 @@
-"""The host's share of the tower drop's GPU sweeps through the engine, beside the scenes' door, on a machine with no GPU.
+"""The host's share of the tower drop's GPU sweeps through the engine, beside the scenes' door, with no GPU.
 
     NUMBA_ENABLE_CUDASIM=1 PYTHONPATH=src python tools/gpu_door_host.py [N] [rounds]
 

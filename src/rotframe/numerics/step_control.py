@@ -37,8 +37,8 @@ import numpy as np
 
 from rotframe.numerics.compiled import jit_inline, jit_internal, jit_kernel
 
-__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "grid_time", "steps_to_event", "start_short_of",
-           "own_tolerances", "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
+__all__ = ["next_step", "first_step_trial", "first_step", "step_collapsed", "grid_time", "steps_to_event",
+           "start_short_of", "own_tolerances", "own_tolerance_rows", "ensemble_scale", "SAFE", "FACC1", "FACC2",
            "NONFINITE_SHRINK"]
 
 SAFE = 0.9  # dop853.f's safety factor

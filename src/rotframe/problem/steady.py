@@ -71,8 +71,9 @@ around them included, where the engine's inlined loop took 1.66 and 1.12 (``pyth
 
 On the GPU (``device="gpu"``) the same fixed-step problems qualify where the run keeps its end alone (``samples=1``)
 and its event, if any, is terminal, whatever the frame's omega (`omega_kept` asks for the bits the CPU's drivers
-share with the engine's loop, which the GPU does not promise), and so does altitude gravity (`rotframe.forces.altitude_gravity`, known by its
-``Force.scene``) in place of uniform gravity: the scenes' GPU kernel runs them (`rotframe.particles.gpu.GpuLaunch`,
+share with the engine's loop, which the GPU does not promise), and so does altitude gravity
+(`rotframe.forces.altitude_gravity`, known by its ``Force.scene``) in place of uniform gravity: the scenes' GPU
+kernel runs them (`rotframe.particles.gpu.GpuLaunch`,
 one thread a particle, its six numbers in registers, no samples between: since 2026-12-02), where the engine's own
 GPU loop (`rotframe.problem.gpu`) keeps a sample grid and reaches the terms through the problem's glue, at 0.08 to
 0.16 of the kernel's speed when last measured on an H200 (2026-11-30). It takes the steps of the CPU's run of the
