@@ -17,6 +17,7 @@ from rotframe.numerics.compiled import jit_inline, jit_uncounted
 from rotframe.numerics.dop853_loop import PAUSED, REACHED, dop853_stages, dop853_trajectory
 from rotframe.numerics.plain import plain
 from rotframe.numerics.stops import next_stop
+from rotframe.problem.dop853_variant import store_rows
 
 
 @jit_uncounted
@@ -24,12 +25,6 @@ def _forced(ctx, t, z, K, s):
     """x'' = -k x + a floor(t / T): a forcing that jumps at every multiple of T (``ctx = (k, a, T, ...)``)."""
     K[s, 0] = z[1]
     K[s, 1] = -ctx[0] * z[0] + ctx[1] * math.floor(t / ctx[2])
-
-
-@jit_inline
-def _store(out, k, p, y):
-    for j in range(y.shape[0]):
-        out[k, p, j] = y[j]
 
 
 @jit_inline
@@ -43,8 +38,8 @@ def _stops(ctx):
 
 
 _STAGES = dop853_stages("stops_test", _forced, 2)
-_LEG = plain(dop853_trajectory("stops_test_legs", _STAGES, _store, 2, enter=_constants))
-_THROUGH = plain(dop853_trajectory("stops_test_through", _STAGES, _store, 2, enter=_constants, stops=_stops))
+_LEG = plain(dop853_trajectory("stops_test_legs", _STAGES, store_rows, 2, enter=_constants))
+_THROUGH = plain(dop853_trajectory("stops_test_through", _STAGES, store_rows, 2, enter=_constants, stops=_stops))
 
 
 def _arrays(times):

@@ -260,12 +260,11 @@ def set_up(r0, v0, *, omega, duration, forces, params, origin_acceleration, even
     key, cache_note = uf.cache_key(roles, f"|{[f.axes for f in forces]}")
     cache_notes = [cache_note] if cache_note and jit else []
     t0 = time.perf_counter()
-    # begun ahead where the run has much of its own to compile first: a varying frame's or origin's evaluator
-    if ahead and jit and not on_gpu and inline is not True and (frame.kind != "constant" or origin.kind != "zero"):
+    if ahead and jit and not on_gpu and inline is not True:
         from rotframe.problem.signatures import PARTICLE
         from rotframe.problem.tiers import begin_ahead
 
-        begin_ahead((PARTICLE, method, bool(events), D), N)
+        begin_ahead((PARTICLE, method, bool(events), D), N, frame.kind != "constant" or origin.kind != "zero")
     try:
         driver = Driver(build_module("particle", key, lambda: _bind(frame, origin, forces, events, labels, jit), glue,
                                      compiled=jit, notes=cache_notes), compiled=jit)

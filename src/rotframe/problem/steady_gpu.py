@@ -36,8 +36,8 @@ def steady_gpu_trajectory(s, progress):
     traj = Trajectory(s.times.copy(), np.stack([s.r, end[:, :3]]), np.stack([s.v, end[:, 3:]]), s.method,
                       t_reached=float(s.times[-1]), extras={"step": launch.h})
     stopped = np.isfinite(t_stop)
+    counts = stopped.astype(np.int64)  # one record (its terminal event) where a particle stopped
     for row in rows:
-        counts = stopped.astype(np.int64)
         traj.event_times[row.name] = per_particle(t_stop[stopped], counts)
         traj.event_states[row.name] = per_particle(end[stopped], counts)
     traj.extras["status"] = np.where(stopped, 2, 1).astype(np.int64)

@@ -110,7 +110,7 @@ def trajectory_tier_fits(method, particles) -> bool:
     return method == "dop853" and particles <= TRAJECTORY_CALLS
 
 
-def begin_ahead(variant, particles) -> bool:
+def begin_ahead(variant, particles, varying) -> bool:
     """Begin compiling the loop that a first run of ``variant`` (`rotframe.problem.engine.variant`'s ``(model, method,
     events, D)``) and ``particles`` particles will compile if it is long, in second processes, before the run's own
     functions compile: DOP853's trajectory tier's trajectory and stages (`rotframe.problem.dop853_split.begin_tier`),
@@ -119,14 +119,18 @@ def begin_ahead(variant, particles) -> bool:
 
     A long first run then compiles them beside its functions' compile and its first plain call, on the second core; a
     run that ends plain leaves them to a later run of the process, stopped if still running at its exit
-    (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun. The caller asks only where the run has
-    much of its own to compile first: a varying frame's or origin's evaluator (`rotframe.problem.particle_setup`).
+    (`rotframe.numerics.compile_apart.stop_begun`). Whether any was begun.
+
+    Only where the run has much of its own to compile first: a varying frame's or origin's evaluator (``varying``).
+    A steady frame's own compile is too short for the overlap to pay for the processes a short run never uses
+    (`tools/startup_side_by_side.py`, 2026-12-02: a short first problem 0.82 to 1.00 of its time without them, a
+    long one 0.92 to 1.10).
     """
     from rotframe.problem.engine import TRAJECTORY_TIER
 
     model, method, events, D = variant
     # the tier first: once made in this process, it answers without a look in numba's cache (a warm run's case)
-    if particles > PLAIN_PARTICLES or not trajectory_tier_fits(method, particles) \
+    if not varying or particles > PLAIN_PARTICLES or not trajectory_tier_fits(method, particles) \
             or loop_is_compiled(tuple(variant) + (TRAJECTORY_TIER,)) or loop_is_compiled(variant):
         return False
     from rotframe.problem.dop853_split import begin_tier
