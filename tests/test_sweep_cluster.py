@@ -276,7 +276,9 @@ def wait_for_part(tmp_path, proc, name):
 def test_a_signal_during_a_dask_sweep_gives_its_code_and_the_hint(cluster, tmp_path, sig, code):
     module, toml = plugin(tmp_path, scene="slow-projectile", nap=0.3)
     env = dict(ENV, ROTFRAME_PLUGINS=str(module))
-    argv = [sys.executable, "-m", "rotframe", "sweep", str(toml), "--samples", "40", "--vary",
+    # 120 rows of 0.3 s: the sweep is still running when the signal comes, even where a loaded machine delays this
+    # process's view of the first part (with 40, CI once saw the sweep end, exit 0, before its signal landed)
+    argv = [sys.executable, "-m", "rotframe", "sweep", str(toml), "--samples", "120", "--vary",
             "speed=normal(1600,5)", "--scheduler", cluster.address, "--out", "s.parquet"]
     proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     wait_for_part(tmp_path, proc, "s.parquet")
